@@ -1,0 +1,9 @@
+// SPDX-License-Identifier: MIT
+// Placeholder until issue 3 lands: the verb(s) answer "not built yet" with exit 1.
+#include "commands.hpp"
+
+namespace tgraph::app {
+
+void add_capture(CLI::App& app) { (void)app; }
+
+}  // namespace tgraph::app

@@ -1,0 +1,9 @@
+// SPDX-License-Identifier: MIT
+// Placeholder until issue 2 lands: the verb(s) answer "not built yet" with exit 1.
+#include "commands.hpp"
+
+namespace tgraph::app {
+
+void add_demo(CLI::App& app) { (void)app; }
+
+}  // namespace tgraph::app

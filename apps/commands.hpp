@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+// The verbs of the `tgraph` command line. Each verb lives in its own cmd_<verb>.cpp and
+// only parses flags and calls the modules.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/graph/trace_io.hpp"
+
+namespace tgraph::app {
+
+/// The work itself failed (exit 1), as opposed to bad input (tgraph::Error, exit 2).
+class Failure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Prints a JSON object on stdout (one line, as `--json` promises).
+void print_json(const nlohmann::json& j);
+/// Reads a trace for a verb; malformed input throws InputError (exit 2).
+Trace load_trace(const std::string& path, bool recover = false);
+
+// Registration of each verb (one function per cmd_*.cpp).
+void add_info(CLI::App& app);
+void add_export(CLI::App& app);
+void add_capture(CLI::App& app);
+void add_demo(CLI::App& app);
+void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
+void add_replay_verbs(CLI::App& app);     // replay, run
+
+}  // namespace tgraph::app

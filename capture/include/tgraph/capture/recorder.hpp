@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+// The instrumentation API an engine's coordination code calls (paper section 3.1).
+#pragma once
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <initializer_list>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+#include "tgraph/graph/step_graph.hpp"
+
+namespace tgraph::capture {
+
+/// What a Recorder does with the tasks the coordination code issues.
+enum class Mode : std::uint8_t {
+  kOff = 0,       ///< run task bodies immediately, record nothing (uninstrumented baseline)
+  kCapture = 1,   ///< run task bodies immediately, time them, record the step graph
+  kDeferred = 2,  ///< record the graph and keep the bodies; nothing runs (live replay)
+};
+
+/// "off", "capture" or "deferred".
+std::string_view to_string(Mode mode);
+
+/// A step recorded in deferred mode: the graph plus the bodies to run.
+///
+/// bodies[t] runs task t; conditions[l] evaluates loop l's break condition after an
+/// iteration (true = leave the loop). An executor runs each loop body until its
+/// condition holds or `max_iterations` is reached, and sets `Loop::iterations`.
+struct StepProgram {
+  StepGraph graph;
+  std::vector<std::function<void()>> bodies;
+  std::vector<std::function<bool()>> conditions;
+};
+
+/// Records the tasks of each step. Cheap on the hot path: no allocation per task once
+/// the step's vectors have grown, two clock reads per task, never throws.
+///
+///   Recorder rec(Mode::kCapture);
+///   ObjectId bar = rec.object("bar0");
+///   DatumId x = rec.datum("bar0.x", bar, n * 24), f = rec.datum("bar0.f", bar, n * 24);
+///   KindId add_force = rec.kind("addForce");
+///   rec.begin_step();
+///   rec.task(add_force, bar, {{x, AccessMode::R}, {f, AccessMode::CW}}, [&] { ff.add_force(); });
+///   StepGraph g = rec.end_step();
+///
+/// Dynamic loops (do-while; the break is tested after each full iteration):
+///
+///   LoopId l = rec.begin_loop(cond, max_iter);
+///   do { rec.task(...); ... } while (!rec.conditional_break(l, [&] { return res < tol; }));
+///   rec.end_loop(l);
+///
+/// In capture mode the body is recorded on the first iteration and later iterations add
+/// their measured cost to the same tasks; in deferred mode conditional_break returns true
+/// after recording the body once, and the executor iterates.
+class Recorder {
+ public:
+  explicit Recorder(Mode mode = Mode::kCapture);
+
+  /// Current mode.
+  Mode mode() const { return mode_; }
+
+  /// Declares an object (or interaction) with a name that is stable across steps.
+  /// Declaring an existing name returns its id.
+  ObjectId object(std::string_view name);
+  /// Declares a datum; persistent across steps. `ptr` (optional) is its storage, used by
+  /// live replay for first touch and state comparison.
+  DatumId datum(std::string_view name, ObjectId owner, std::uint64_t bytes, void* ptr = nullptr);
+  /// Interns a task kind (method name).
+  KindId kind(std::string_view name);
+
+  /// Storage pointer given for datum `d` (nullptr if none).
+  void* datum_ptr(DatumId d) const { return ptrs_[d]; }
+
+  /// Starts recording a step.
+  void begin_step();
+  /// Sets the step's contact set (object pairs) and collision group per object.
+  void set_contacts(std::vector<Contact> contacts, std::vector<std::uint32_t> groups);
+  /// Ends the step and returns its graph with edges derived (empty graph in kOff mode).
+  StepGraph end_step();
+  /// Ends a deferred step: its graph (edges derived) and task bodies.
+  StepProgram end_step_program();
+
+  /// Issues one task: runs (and in capture mode times) `body` now, or keeps it (deferred).
+  template <class F>
+  void task(KindId kind, ObjectId obj, std::initializer_list<Access> acc, F&& body) {
+    switch (mode_) {
+      case Mode::kOff:
+        body();
+        return;
+      case Mode::kCapture: {
+        const auto t0 = std::chrono::steady_clock::now();
+        body();
+        const auto t1 = std::chrono::steady_clock::now();
+        record(kind, obj, acc.begin(), acc.size(),
+               static_cast<std::uint64_t>(
+                   std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
+        return;
+      }
+      case Mode::kDeferred:
+        if (record(kind, obj, acc.begin(), acc.size(), 0)) bodies_.emplace_back(std::forward<F>(body));
+        return;
+    }
+  }
+
+  /// RAII form: times the enclosing scope as one task (capture mode only; in deferred mode
+  /// a scope cannot be deferred, so use task()).
+  class Scope {
+   public:
+    /// At most kMaxAccesses accesses (more are counted as an error and dropped).
+    Scope(Recorder& rec, KindId kind, ObjectId obj, std::initializer_list<Access> acc)
+        : rec_(rec), kind_(kind), obj_(obj) {
+      for (const Access& a : acc) {
+        if (n_ == kMaxAccesses) {
+          ++rec_.errors_;
+          break;
+        }
+        acc_[n_++] = a;
+      }
+      t0_ = std::chrono::steady_clock::now();
+    }
+    ~Scope() {
+      if (rec_.mode_ == Mode::kOff) return;
+      const auto t1 = std::chrono::steady_clock::now();
+      rec_.record(kind_, obj_, acc_.data(), n_,
+                  static_cast<std::uint64_t>(
+                      std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0_).count()));
+    }
+    Scope(const Scope&) = delete;
+    Scope& operator=(const Scope&) = delete;
+
+   private:
+    static constexpr std::size_t kMaxAccesses = 16;
+    Recorder& rec_;
+    KindId kind_;
+    ObjectId obj_;
+    std::array<Access, kMaxAccesses> acc_{};
+    std::size_t n_ = 0;
+    std::chrono::steady_clock::time_point t0_;
+  };
+
+  /// Opens a dynamic loop whose break condition is the shared datum `condition`.
+  LoopId begin_loop(DatumId condition, std::uint32_t max_iterations);
+  /// Records the loop's break task (first iteration) and says whether to leave the loop:
+  /// capture/off: evaluates `pred` now (or max iterations reached); deferred: keeps `pred`
+  /// and returns true so that the body is recorded once.
+  template <class P>
+  bool conditional_break(LoopId loop, P&& pred) {
+    if (mode_ == Mode::kDeferred) {
+      record_break(loop, 0);
+      conditions_.emplace_back(std::forward<P>(pred));
+      return true;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const bool stop = pred();
+    const auto t1 = std::chrono::steady_clock::now();
+    return record_break(loop, static_cast<std::uint64_t>(
+                                  std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count())) ||
+           stop;
+  }
+  /// Closes the loop.
+  void end_loop(LoopId loop);
+
+  /// Number of API misuses seen (task count changing between iterations, unbalanced
+  /// loops...); the hot path never throws, it counts and end_step() reports.
+  std::uint64_t errors() const { return errors_; }
+
+ private:
+  // Returns true when a new task was appended (false for later loop iterations).
+  bool record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ns);
+  // Returns true when the loop has reached its maximum iteration count.
+  bool record_break(LoopId loop, std::uint64_t ns);
+  StepGraph finish_step();
+
+  Mode mode_;
+  StepGraph cur_;                        // step being recorded
+  std::vector<std::string> kinds_;
+  std::vector<ObjectInfo> objects_;
+  std::vector<Datum> data_;
+  std::vector<void*> ptrs_;
+  std::unordered_map<std::string, ObjectId> object_ids_;
+  std::vector<std::uint64_t> cost_sum_;  // per task, summed over iterations
+  std::vector<std::function<void()>> bodies_;
+  std::vector<std::function<bool()>> conditions_;
+  LoopId open_loop_ = kNoLoop;
+  std::uint32_t iteration_ = 0;          // current iteration of the open loop (0-based)
+  std::uint32_t replay_pos_ = 0;         // next body task to match in iterations > 0
+  bool in_step_ = false;
+  std::uint64_t errors_ = 0;
+};
+
+}  // namespace tgraph::capture

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: MIT
+// Recorder: builds the step graph from the coordination code's calls.
+#include "tgraph/capture/recorder.hpp"
+
+#include <unordered_map>
+
+namespace tgraph::capture {
+
+std::string_view to_string(Mode mode) {
+  switch (mode) {
+    case Mode::kOff: return "off";
+    case Mode::kCapture: return "capture";
+    case Mode::kDeferred: return "deferred";
+  }
+  return "?";
+}
+
+Recorder::Recorder(Mode mode) : mode_(mode) {}
+
+ObjectId Recorder::object(std::string_view name) {
+  const std::string key(name);
+  if (auto it = object_ids_.find(key); it != object_ids_.end()) return it->second;
+  const auto id = static_cast<ObjectId>(objects_.size());
+  objects_.push_back({key});
+  object_ids_.emplace(key, id);
+  return id;
+}
+
+DatumId Recorder::datum(std::string_view name, ObjectId owner, std::uint64_t bytes, void* ptr) {
+  data_.push_back({std::string(name), owner, bytes});
+  ptrs_.push_back(ptr);
+  return static_cast<DatumId>(data_.size() - 1);
+}
+
+KindId Recorder::kind(std::string_view name) {
+  for (std::size_t i = 0; i < kinds_.size(); ++i)
+    if (kinds_[i] == name) return static_cast<KindId>(i);
+  kinds_.emplace_back(name);
+  return static_cast<KindId>(kinds_.size() - 1);
+}
+
+void Recorder::begin_step() {
+  if (in_step_) ++errors_;
+  in_step_ = true;
+  cur_.tasks.clear();
+  cur_.accesses.clear();
+  cur_.loops.clear();
+  cur_.contacts.clear();
+  cur_.groups.clear();
+  cost_sum_.clear();
+  bodies_.clear();
+  conditions_.clear();
+  open_loop_ = kNoLoop;
+}
+
+void Recorder::set_contacts(std::vector<Contact> contacts, std::vector<std::uint32_t> groups) {
+  cur_.contacts = std::move(contacts);
+  cur_.groups = std::move(groups);
+}
+
+bool Recorder::record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ns) {
+  if (open_loop_ != kNoLoop && iteration_ > 0) {
+    // Later iteration: the body was recorded once; add the cost to the matching task.
+    const Loop& loop = cur_.loops[open_loop_];
+    const TaskId t = loop.first + replay_pos_;
+    if (t + 1 >= loop.last || cur_.tasks[t].kind != kind || cur_.tasks[t].object != obj) {
+      ++errors_;  // the body changed between iterations
+      return false;
+    }
+    cost_sum_[t] += ns;
+    ++replay_pos_;
+    return false;
+  }
+  Task t;
+  t.kind = kind;
+  t.object = obj;
+  t.access_begin = static_cast<std::uint32_t>(cur_.accesses.size());
+  t.access_count = static_cast<std::uint32_t>(n);
+  t.loop = open_loop_;
+  cur_.accesses.insert(cur_.accesses.end(), acc, acc + n);
+  cur_.tasks.push_back(t);
+  cost_sum_.push_back(ns);
+  return true;
+}
+
+LoopId Recorder::begin_loop(DatumId condition, std::uint32_t max_iterations) {
+  if (open_loop_ != kNoLoop) {
+    ++errors_;  // nested loops are not supported
+    return open_loop_;
+  }
+  Loop loop;
+  loop.condition = condition;
+  loop.first = static_cast<TaskId>(cur_.tasks.size());
+  loop.last = loop.first;
+  loop.iterations = 0;
+  loop.max_iterations = max_iterations;
+  cur_.loops.push_back(loop);
+  open_loop_ = static_cast<LoopId>(cur_.loops.size() - 1);
+  iteration_ = 0;
+  replay_pos_ = 0;
+  return open_loop_;
+}
+
+bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
+  if (loop_id != open_loop_ || loop_id == kNoLoop) {
+    ++errors_;
+    return true;
+  }
+  Loop& loop = cur_.loops[loop_id];
+  if (iteration_ == 0) {
+    const Access acc{loop.condition, AccessMode::R};
+    record(kind("loop.break"), kNoObject, &acc, 1, ns);
+    if (mode_ == Mode::kDeferred) bodies_.emplace_back();  // the executor runs conditions[loop]
+    loop.last = static_cast<TaskId>(cur_.tasks.size());
+  } else {
+    const TaskId t = loop.first + replay_pos_;
+    if (t + 1 != loop.last) ++errors_;  // fewer tasks than in the first iteration
+    cost_sum_[loop.last - 1] += ns;
+  }
+  ++iteration_;
+  replay_pos_ = 0;
+  loop.iterations = iteration_;
+  return loop.max_iterations != 0 && iteration_ >= loop.max_iterations;
+}
+
+void Recorder::end_loop(LoopId loop) {
+  if (loop != open_loop_ || loop == kNoLoop) {
+    ++errors_;
+    return;
+  }
+  if (cur_.loops[loop].iterations == 0) ++errors_;  // no conditional_break was recorded
+  open_loop_ = kNoLoop;
+}
+
+StepGraph Recorder::finish_step() {
+  if (!in_step_) ++errors_;
+  in_step_ = false;
+  if (open_loop_ != kNoLoop) {
+    ++errors_;
+    open_loop_ = kNoLoop;
+  }
+  if (mode_ == Mode::kOff) return {};
+  StepGraph g = cur_;
+  g.kinds = kinds_;
+  g.objects = objects_;
+  g.data = data_;
+  // Mean cost per execution; stable key = hash(object name, kind name, occurrence).
+  std::unordered_map<std::uint64_t, std::uint32_t> occurrence;
+  occurrence.reserve(g.tasks.size());
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    Task& task = g.tasks[t];
+    const std::uint64_t runs = g.runs(t);
+    task.cost_ns = runs == 0 ? cost_sum_[t] : cost_sum_[t] / runs;
+    const std::uint64_t slot = (static_cast<std::uint64_t>(task.object) << 32) | task.kind;
+    const std::uint32_t occ = occurrence[slot]++;
+    std::uint64_t h = 1469598103934665603ull;
+    auto mix = [&h](std::string_view s) {
+      for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+      h = (h ^ 0xff) * 1099511628211ull;
+    };
+    mix(task.object == kNoObject ? std::string_view("<none>") : std::string_view(g.objects[task.object].name));
+    mix(g.kinds[task.kind]);
+    h = (h ^ occ) * 1099511628211ull;
+    task.key = h;
+  }
+  g.derive_edges();
+  return g;
+}
+
+StepGraph Recorder::end_step() { return finish_step(); }
+
+StepProgram Recorder::end_step_program() {
+  StepProgram p;
+  p.graph = finish_step();
+  p.bodies = std::move(bodies_);
+  p.conditions = std::move(conditions_);
+  bodies_.clear();
+  conditions_.clear();
+  return p;
+}
+
+}  // namespace tgraph::capture

@@ -1,0 +1,18 @@
+// SPDX-License-Identifier: MIT
+// Whole-file reads and all-or-nothing writes.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tgraph {
+
+/// Reads a whole file; throws InputError("cannot open ...") naming it.
+std::vector<std::uint8_t> read_file_bytes(const std::string& path);
+/// Writes `content` to `path` through a temporary file in the same folder renamed into
+/// place, so that a failure never leaves a half-written output. Throws tgraph::Error.
+void write_file_atomic(const std::string& path, std::string_view content);
+
+}  // namespace tgraph

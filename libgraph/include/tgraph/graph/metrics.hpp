@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+// Work, span and parallelism of a step graph, loops taken into account.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/step_graph.hpp"
+
+namespace tgraph {
+
+/// Summary numbers of one step.
+struct Metrics {
+  std::uint64_t tasks = 0;
+  std::uint64_t edges = 0;          ///< intra-step + loop-carried edges
+  std::uint64_t data = 0;
+  std::uint64_t loops = 0;
+  std::uint64_t loop_iterations = 0;  ///< sum over loops
+  std::uint64_t work_ns = 0;        ///< sum of cost x runs
+  std::uint64_t span_ns = 0;        ///< critical path with loops unrolled
+  double parallelism = 0.0;         ///< work / span (0 for an empty step)
+  std::map<std::string, std::uint64_t> per_kind;  ///< task count per kind
+};
+
+/// Computes the metrics; `g.edges` must be derived.
+///
+/// The span is the longest path of the graph unrolled over its loops' iterations:
+/// iteration i+1 of a loop starts no earlier than the conditional break of
+/// iteration i (loop control is a synchronisation point), and loop-carried edges
+/// link a writer in iteration i to its reader in iteration i+1.
+Metrics compute_metrics(const StepGraph& g);
+
+/// Earliest finish time (ns) of every task in the last iteration it runs, under
+/// unlimited processors; the span is the maximum. Same rules as compute_metrics.
+std::vector<std::uint64_t> earliest_finish(const StepGraph& g);
+
+}  // namespace tgraph

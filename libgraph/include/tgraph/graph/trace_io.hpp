@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: MIT
+// Reading and writing .tgt trace files (format: docs/trace-format.md).
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/trace.hpp"
+
+namespace tgraph {
+
+/// Options of the trace reader.
+struct ReadOptions {
+  /// Accept a trace whose last frame is cut short (capture killed): return the complete
+  /// steps before it instead of failing.
+  bool recover = false;
+};
+
+/// Streams steps to a .tgt file, one self-delimiting frame per step, each written and
+/// flushed before append() returns, so a capture killed at any moment leaves a file whose
+/// complete steps read back (with ReadOptions::recover). Steps whose structure equals an
+/// earlier step's are stored as a reference plus costs, loop counts and contacts.
+///
+///   TraceWriter w("run.tgt", header);
+///   for (...) w.append(step);
+///   w.close();
+class TraceWriter {
+ public:
+  /// Opens (truncates) `path` and writes the header frame. Throws tgraph::Error.
+  TraceWriter(const std::string& path, const TraceHeader& header);
+  ~TraceWriter();
+  TraceWriter(const TraceWriter&) = delete;
+  TraceWriter& operator=(const TraceWriter&) = delete;
+  /// Appends one step (edges need not be derived; they are not stored).
+  void append(const StepGraph& step);
+  /// Writes the end frame and closes the file.
+  void close();
+  /// Bytes written so far.
+  std::uint64_t bytes_written() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Reads a whole trace; edges of every step are derived. Throws InputError naming the file
+/// and offset for any malformed input; never crashes, hangs or allocates without bound.
+Trace read_trace(const std::string& path, const ReadOptions& options = {});
+/// Same from bytes in memory; `name` is used in error messages.
+Trace read_trace_bytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                       const ReadOptions& options = {});
+/// Writes a whole trace (to a temporary file renamed into place).
+void write_trace(const std::string& path, const Trace& trace);
+/// Encodes a whole trace into bytes (what write_trace writes).
+std::vector<std::uint8_t> encode_trace(const Trace& trace);
+
+}  // namespace tgraph

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+// Work, span (loops unrolled) and parallelism.
+#include "tgraph/graph/metrics.hpp"
+
+#include <algorithm>
+
+namespace tgraph {
+namespace {
+
+// Predecessor lists in CSR form.
+struct Preds {
+  std::vector<std::uint32_t> begin;
+  std::vector<TaskId> from;
+};
+
+Preds build_preds(std::size_t n, const std::vector<Edge>& edges) {
+  Preds p;
+  p.begin.assign(n + 1, 0);
+  for (const Edge& e : edges) ++p.begin[e.to + 1];
+  for (std::size_t i = 0; i < n; ++i) p.begin[i + 1] += p.begin[i];
+  p.from.resize(edges.size());
+  std::vector<std::uint32_t> fill(p.begin.begin(), p.begin.end() - 1);
+  for (const Edge& e : edges) p.from[fill[e.to]++] = e.from;
+  return p;
+}
+
+}  // namespace
+
+std::vector<std::uint64_t> earliest_finish(const StepGraph& g) {
+  const std::size_t n = g.tasks.size();
+  const Preds intra = build_preds(n, g.edges);
+  const Preds carried = build_preds(n, g.carried_edges);
+  std::vector<std::uint64_t> finish(n, 0);
+  std::vector<std::uint64_t> prev;  // finish times of the previous iteration (loop body)
+
+  auto run = [&](TaskId t, std::uint64_t gate, bool use_carried) {
+    std::uint64_t start = gate;
+    for (auto i = intra.begin[t]; i < intra.begin[t + 1]; ++i) start = std::max(start, finish[intra.from[i]]);
+    if (use_carried)
+      for (auto i = carried.begin[t]; i < carried.begin[t + 1]; ++i)
+        start = std::max(start, prev[carried.from[i]]);
+    finish[t] = start + g.tasks[t].cost_ns;
+  };
+
+  std::size_t next_loop = 0;
+  for (TaskId t = 0; t < n;) {
+    if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
+      const Loop& loop = g.loops[next_loop++];
+      std::uint64_t gate = 0;
+      prev.assign(n, 0);
+      for (std::uint32_t it = 0; it < loop.iterations; ++it) {
+        if (it > 0) {
+          std::copy(finish.begin() + loop.first, finish.begin() + loop.last, prev.begin() + loop.first);
+          gate = finish[loop.last - 1];  // the conditional break of the previous iteration
+        }
+        for (TaskId u = loop.first; u < loop.last; ++u) run(u, gate, it > 0);
+      }
+      t = loop.last;
+      continue;
+    }
+    run(t, 0, false);
+    ++t;
+  }
+  return finish;
+}
+
+Metrics compute_metrics(const StepGraph& g) {
+  Metrics m;
+  m.tasks = g.tasks.size();
+  m.edges = g.edges.size() + g.carried_edges.size();
+  m.data = g.data.size();
+  m.loops = g.loops.size();
+  for (const Loop& l : g.loops) m.loop_iterations += l.iterations;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    m.work_ns += g.tasks[t].cost_ns * g.runs(t);
+    ++m.per_kind[g.kind_name(t)];
+  }
+  const auto finish = earliest_finish(g);
+  for (auto f : finish) m.span_ns = std::max(m.span_ns, f);
+  m.parallelism = m.span_ns == 0 ? 0.0 : static_cast<double>(m.work_ns) / static_cast<double>(m.span_ns);
+  return m;
+}
+
+}  // namespace tgraph

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: MIT
+// Trace and assignment helpers.
+#include "tgraph/graph/trace.hpp"
+
+#include <numeric>
+
+#include "tgraph/graph/assignment.hpp"
+
+namespace tgraph {
+
+bool contacts_changed(const Trace& trace, std::size_t i) {
+  if (i == 0 || i >= trace.steps.size()) return false;
+  const StepGraph& a = trace.steps[i - 1];
+  const StepGraph& b = trace.steps[i];
+  if (a.contacts.size() != b.contacts.size()) return true;
+  // Compare by object names: ids may differ between steps.
+  for (std::size_t c = 0; c < a.contacts.size(); ++c) {
+    const auto& ca = a.contacts[c];
+    const auto& cb = b.contacts[c];
+    if (a.objects[ca.a].name != b.objects[cb.a].name || a.objects[ca.b].name != b.objects[cb.b].name)
+      return true;
+  }
+  return false;
+}
+
+std::vector<TaskId> tasks_of(const Assignment& a, ProcId p) {
+  if (!a.order.empty()) return p < a.order.size() ? a.order[p] : std::vector<TaskId>{};
+  std::vector<TaskId> out;
+  for (TaskId t = 0; t < a.proc.size(); ++t)
+    if (a.proc[t] == p) out.push_back(t);
+  return out;
+}
+
+}  // namespace tgraph
