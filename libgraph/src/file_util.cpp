@@ -1,0 +1,105 @@
+// SPDX-License-Identifier: MIT
+// Whole-file reads and all-or-nothing writes (temporary file + rename in the same folder).
+#include "tgraph/graph/file_util.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph {
+namespace {
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+// Closes a descriptor on scope exit unless released.
+class FdGuard {
+ public:
+  explicit FdGuard(int fd) : fd_(fd) {}
+  ~FdGuard() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  FdGuard(const FdGuard&) = delete;
+  FdGuard& operator=(const FdGuard&) = delete;
+  int get() const { return fd_; }
+  int release() {
+    const int fd = fd_;
+    fd_ = -1;
+    return fd;
+  }
+
+ private:
+  int fd_;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw InputError(path, std::nullopt, "cannot open: " + errno_text(errno));
+  FdGuard guard(fd);
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw InputError(path, std::nullopt, "cannot stat: " + errno_text(errno));
+  if (S_ISDIR(st.st_mode)) throw InputError(path, std::nullopt, "cannot read: is a directory");
+  // Regular files: one allocation of the right size (+1 to see the end of file without
+  // growing). Pipes and devices: grow by doubling as read.
+  std::vector<std::uint8_t> bytes(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1
+                                                      : std::size_t{65536});
+  std::size_t size = 0;
+  for (;;) {
+    if (size == bytes.size()) bytes.resize(bytes.size() * 2);
+    const ::ssize_t n = ::read(fd, bytes.data() + size, bytes.size() - size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(path, size, "cannot read: " + errno_text(errno));
+    }
+    if (n == 0) break;
+    size += static_cast<std::size_t>(n);
+  }
+  bytes.resize(size);
+  return bytes;
+}
+
+void write_file_atomic(const std::string& path, std::string_view content) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::string tmp = (folder / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  const int fd = ::mkstemp(tmp.data());
+  if (fd < 0) throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));
+  FdGuard guard(fd);
+  const auto fail = [&](const std::string& what, int err) {
+    ::close(guard.release());
+    ::unlink(tmp.c_str());
+    throw Error(path + ": " + what + ": " + errno_text(err));
+  };
+  ::fchmod(fd, 0644);  // mkstemp creates 0600; outputs are ordinary readable files
+  std::size_t done = 0;
+  while (done < content.size()) {
+    const ::ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail("cannot write", errno);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  // Flush the data before the rename so that a crash never exposes an empty new file.
+  if (::fsync(fd) != 0 && errno != EINVAL) fail("cannot sync", errno);
+  if (::close(guard.release()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw Error(path + ": cannot close: " + errno_text(err));
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    throw Error(path + ": cannot rename the temporary file into place: " + errno_text(err));
+  }
+}
+
+}  // namespace tgraph
