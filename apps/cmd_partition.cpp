@@ -1,9 +1,396 @@
 // SPDX-License-Identifier: MIT
-// Placeholder until issue 4 lands: the verb(s) answer "not built yet" with exit 1.
+// `tgraph partition | evaluate | compare | import | calibrate`: thin wrappers over
+// tgraph::partition (strategies, .tga files, evaluation, STG import, calibration).
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
 #include "commands.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/partition/evaluate.hpp"
+#include "tgraph/partition/stg.hpp"
+#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
+namespace {
 
-void add_partition_verbs(CLI::App& app) { (void)app; }
+namespace tp = tgraph::partition;
+
+// Flags shared by `partition` and `compare`.
+struct StrategyFlags {
+  double imbalance = 1.03;
+  std::uint64_t seed = 1;
+  std::string objective = "cut";
+  std::uint32_t phases = 0;
+  std::string scotch = "quality";
+  std::string sticky_base = "metis";
+  double threshold = 1.10;
+  double migration_cost = 1.0;
+
+  void add(CLI::App* cmd) {
+    cmd->add_option("--imbalance", imbalance, "Tolerated max/mean load for METIS and Scotch (default 1.03)");
+    cmd->add_option("--seed", seed, "Seed of METIS, Scotch and random (default 1)");
+    cmd->add_option("--objective", objective, "METIS objective: cut or vol")
+        ->check(CLI::IsMember({"cut", "vol"}));
+    cmd->add_option("--phases", phases,
+                    "METIS multi-constraint mode: balance each of N graph phases (0 = off)");
+    cmd->add_option("--scotch-strategy", scotch, "Scotch flavour: default, quality, speed, balance")
+        ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
+    cmd->add_option("--sticky-base", sticky_base, "sticky: method for the first step (default metis)");
+    cmd->add_option("--threshold", threshold, "sticky: rebalance above this imbalance (default 1.10)");
+    cmd->add_option("--migration-cost", migration_cost,
+                    "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
+  }
+  tp::Options options(const tp::CostModel& model) const {
+    tp::Options o;
+    o.imbalance = imbalance;
+    o.seed = seed;
+    o.objective = tp::parse_objective(objective);
+    o.phases = phases;
+    o.scotch = tp::parse_scotch_flavour(scotch);
+    o.sticky_base = sticky_base;
+    o.sticky_threshold = threshold;
+    o.migration_cost = migration_cost;
+    o.model = model;
+    return o;
+  }
+};
+
+// --model / --calibration, shared by evaluate, compare and partition (list's estimate).
+struct ModelFlags {
+  std::string model = "calibrated";
+  std::string calibration;
+
+  void add(CLI::App* cmd) {
+    cmd->add_option("--model", model, "Cost model: calibrated (default) or ideal (no sync/transfer cost)")
+        ->check(CLI::IsMember({"ideal", "calibrated"}));
+    cmd->add_option("--calibration", calibration,
+                    "Calibration file (default: " + tp::default_calibration_path() + " if present)");
+  }
+  tp::CostModel load() const {
+    if (model == "ideal") return tp::CostModel::ideal();
+    if (!calibration.empty()) return tp::load_calibration(calibration);
+    const std::string def = tp::default_calibration_path();
+    std::error_code ec;
+    if (std::filesystem::exists(def, ec)) return tp::load_calibration(def);
+    return tp::CostModel::defaults();
+  }
+};
+
+std::vector<std::uint64_t> structure_hashes(const Trace& trace) {
+  std::vector<std::uint64_t> h;
+  for (const StepGraph& g : trace.steps) h.push_back(g.structural_hash());
+  return h;
+}
+
+// ---- partition ----------------------------------------------------------------------
+
+struct PartitionCmd {
+  std::string trace, method = "metis", out;
+  std::uint32_t k = 2;
+  bool json = false;
+  StrategyFlags flags;
+  ModelFlags model;
+};
+
+void run_partition(const PartitionCmd& c) {
+  const Trace trace = load_trace(c.trace);
+  if (c.k == 0) throw UsageError("-k: expected at least 1");
+  const tp::TracePartition tp = tp::partition_trace(trace, c.method, c.k, c.flags.options(c.model.load()));
+  if (!c.out.empty()) tp::write_assignment(c.out, tp.assignment, structure_hashes(trace));
+
+  double ms = 0;
+  std::uint64_t moved = 0, reused = 0, rebalanced = 0;
+  std::optional<std::int64_t> cut;
+  nlohmann::json per_step = nlohmann::json::array();
+  for (std::size_t s = 0; s < tp.stats.size(); ++s) {
+    const tp::Stats& st = tp.stats[s];
+    ms += st.partition_ms;
+    moved += st.moved_tasks;
+    reused += st.reused ? 1 : 0;
+    rebalanced += st.rebalanced ? 1 : 0;
+    if (st.edgecut) cut = cut.value_or(0) + *st.edgecut;
+    nlohmann::json j = {{"step", s},
+                        {"partition_ms", st.partition_ms},
+                        {"moved_tasks", st.moved_tasks},
+                        {"reused", st.reused},
+                        {"rebalanced", st.rebalanced}};
+    if (st.edgecut) j["edgecut"] = *st.edgecut;
+    per_step.push_back(j);
+  }
+  if (c.json) {
+    nlohmann::json j = {{"method", c.method},   {"k", c.k},           {"steps", trace.steps.size()},
+                        {"partition_ms", ms},   {"moved_tasks", moved}, {"reused_steps", reused},
+                        {"rebalanced_steps", rebalanced}, {"output", c.out}, {"per_step", per_step}};
+    if (cut) j["edgecut"] = *cut;
+    print_json(j);
+    return;
+  }
+  std::printf("method %s, k = %u, %zu steps: %.3f ms partitioning", c.method.c_str(), c.k,
+              trace.steps.size(), ms);
+  if (cut) std::printf(", edgecut %lld", static_cast<long long>(*cut));
+  std::printf(", %llu tasks moved", static_cast<unsigned long long>(moved));
+  if (c.method == "sticky")
+    std::printf(" (%llu steps reused, %llu rebalanced)", static_cast<unsigned long long>(reused),
+                static_cast<unsigned long long>(rebalanced));
+  std::printf("\n");
+  if (!c.out.empty()) std::printf("wrote %s\n", c.out.c_str());
+}
+
+// ---- evaluate -----------------------------------------------------------------------
+
+nlohmann::json step_json(const tp::StepReport& r) {
+  return {{"tasks", r.tasks},
+          {"cut_edges", r.cut_edges},
+          {"cut_bytes", r.cut_bytes},
+          {"signals", r.signals},
+          {"waits", r.waits},
+          {"reducers", r.reducers},
+          {"transfer_bytes", r.transfer_bytes},
+          {"imbalance", r.imbalance},
+          {"max_load_ns", r.max_load_ns},
+          {"work_ns", r.work_ns},
+          {"span_ns", r.span_ns},
+          {"lower_bound_ns", r.lower_bound_ns},
+          {"predicted_makespan_ns", r.makespan_ns},
+          {"predicted_speedup", r.speedup},
+          {"migrated_tasks", r.migrated_tasks},
+          {"migrated_bytes", r.migrated_bytes},
+          {"partition_ms", r.partition_ms},
+          {"quotient_acyclic", r.quotient_acyclic},
+          {"ping_pong_pairs", r.ping_pong_pairs}};
+}
+
+nlohmann::json report_json(const tp::Report& rep) {
+  nlohmann::json j = step_json(rep.total);
+  j["method"] = rep.method;
+  j["k"] = rep.k;
+  j["model"] = rep.model;
+  j["steps"] = rep.steps.size();
+  j["imbalance_max"] = rep.imbalance_max;
+  j["cyclic_steps"] = rep.cyclic_steps;
+  j["predicted_speedup_with_partitioning"] = rep.speedup_with_partitioning;
+  nlohmann::json per = nlohmann::json::array();
+  for (std::size_t s = 0; s < rep.steps.size(); ++s) {
+    nlohmann::json sj = step_json(rep.steps[s]);
+    sj["step"] = s;
+    per.push_back(sj);
+  }
+  j["per_step"] = per;
+  return j;
+}
+
+struct EvaluateCmd {
+  std::string trace, assignment;
+  bool json = false;
+  ModelFlags model;
+};
+
+void run_evaluate(const EvaluateCmd& c) {
+  const Trace trace = load_trace(c.trace);
+  std::vector<std::uint64_t> hashes;
+  const TraceAssignment a = tp::read_assignment(c.assignment, &hashes);
+  tp::check_fits(trace, a, c.assignment);
+  for (std::size_t s = 0; s < hashes.size() && s < trace.steps.size(); ++s)
+    if (hashes[s] != 0 && hashes[s] != trace.steps[s].structural_hash())
+      throw InputError(c.assignment, std::nullopt,
+                       "step " + std::to_string(s) + " was partitioned for a graph of another structure than " +
+                           c.trace + "'s");
+  const tp::Report rep = tp::evaluate(trace, a, c.model.load(), c.assignment);
+  if (c.json) {
+    print_json(report_json(rep));
+    return;
+  }
+  const tp::StepReport& t = rep.total;
+  std::printf("method %s, k = %u, %zu steps, cost model: %s\n", rep.method.c_str(), rep.k, rep.steps.size(),
+              rep.model.c_str());
+  std::printf("  cut: %llu edges, %llu bytes; %llu signals, %llu waits, %llu reducers, %llu bytes moved\n",
+              static_cast<unsigned long long>(t.cut_edges), static_cast<unsigned long long>(t.cut_bytes),
+              static_cast<unsigned long long>(t.signals), static_cast<unsigned long long>(t.waits),
+              static_cast<unsigned long long>(t.reducers), static_cast<unsigned long long>(t.transfer_bytes));
+  std::printf("  imbalance %.3f (worst step %.3f); migrations: %llu tasks, %llu bytes\n", t.imbalance,
+              rep.imbalance_max, static_cast<unsigned long long>(t.migrated_tasks),
+              static_cast<unsigned long long>(t.migrated_bytes));
+  std::printf("  predicted makespan %.3f ms, lower bound %.3f ms, work %.3f ms: speed-up %.2f "
+              "(%.2f with %.3f ms partitioning)\n",
+              static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
+              static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning, t.partition_ms);
+  std::printf("  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
+              t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),
+              static_cast<unsigned long long>(t.ping_pong_pairs));
+}
+
+// ---- compare ------------------------------------------------------------------------
+
+struct CompareCmd {
+  std::string trace, csv;
+  std::vector<std::string> methods = {"owner", "metis", "scotch", "sticky", "list", "roundrobin"};
+  std::vector<std::uint32_t> ks = {2, 4, 8, 16};
+  bool json = false;
+  StrategyFlags flags;
+  ModelFlags model;
+};
+
+void run_compare(const CompareCmd& c) {
+  const Trace trace = load_trace(c.trace);
+  const tp::CostModel model = c.model.load();
+  const tp::Options options = c.flags.options(model);
+  for (const std::string& m : c.methods) (void)tp::make_strategy(m);  // reject unknown names early
+  for (std::uint32_t k : c.ks)
+    if (k == 0) throw UsageError("-k: expected values >= 1");
+  nlohmann::json rows = nlohmann::json::array();
+  std::ostringstream csv;
+  csv << "method,k,partition_ms,cut_edges,cut_bytes,signals,reducers,imbalance,migrated_tasks,"
+         "predicted_makespan_ns,lower_bound_ns,predicted_speedup,quotient_acyclic\n";
+  if (!c.json)
+    std::printf("%-11s %4s %12s %10s %12s %9s %9s %9s %14s %8s %8s\n", "method", "k", "partition_ms", "cut_edges",
+                "cut_bytes", "signals", "imbalance", "migrated", "makespan_ms", "speedup", "bound");
+  for (const std::string& m : c.methods)
+    for (std::uint32_t k : c.ks) {
+      const tp::TracePartition tp = tp::partition_trace(trace, m, k, options);
+      const tp::Report rep = tp::evaluate(trace, tp.assignment, model);
+      const tp::StepReport& t = rep.total;
+      const double bound_speedup =
+          t.lower_bound_ns == 0 ? 1.0 : static_cast<double>(t.work_ns) / static_cast<double>(t.lower_bound_ns);
+      nlohmann::json row = report_json(rep);
+      row.erase("per_step");
+      rows.push_back(row);
+      csv << m << ',' << k << ',' << t.partition_ms << ',' << t.cut_edges << ',' << t.cut_bytes << ','
+          << t.signals << ',' << t.imbalance << ',' << t.migrated_tasks << ',' << t.makespan_ns << ','
+          << t.lower_bound_ns << ',' << t.speedup << ',' << (t.quotient_acyclic ? 1 : 0) << '\n';
+      if (!c.json)
+        std::printf("%-11s %4u %12.3f %10llu %12llu %9llu %9.3f %9llu %14.3f %8.2f %8.2f\n", m.c_str(), k,
+                    t.partition_ms, static_cast<unsigned long long>(t.cut_edges),
+                    static_cast<unsigned long long>(t.cut_bytes), static_cast<unsigned long long>(t.signals),
+                    t.imbalance, static_cast<unsigned long long>(t.migrated_tasks),
+                    static_cast<double>(t.makespan_ns) / 1e6, t.speedup, bound_speedup);
+    }
+  if (!c.csv.empty()) write_file_atomic(c.csv, csv.str());
+  if (c.json) print_json({{"trace", c.trace}, {"model", model.source}, {"rows", rows}});
+}
+
+// ---- import -------------------------------------------------------------------------
+
+struct ImportCmd {
+  std::string format = "stg", input, out;
+  std::uint64_t unit_ns = 1000, edge_bytes = 8;
+  bool json = false;
+};
+
+void run_import(const ImportCmd& c) {
+  const tp::StgGraph stg = tp::read_stg(c.input, c.unit_ns, c.edge_bytes);
+  write_trace(c.out, stg.trace);
+  const StepGraph& g = stg.trace.steps[0];
+  if (c.json) {
+    nlohmann::json j = {{"input", c.input},   {"output", c.out},           {"tasks", g.tasks.size()},
+                        {"edges", g.edges.size()}, {"unit_ns", c.unit_ns}};
+    j["cp_length"] = stg.cp_length ? nlohmann::json(*stg.cp_length) : nlohmann::json(nullptr);
+    print_json(j);
+    return;
+  }
+  std::printf("imported %s: %zu tasks, %zu edges", c.input.c_str(), g.tasks.size(), g.edges.size());
+  if (stg.cp_length)
+    std::printf(", stated critical path %llu units = %llu ns", static_cast<unsigned long long>(*stg.cp_length),
+                static_cast<unsigned long long>(*stg.cp_length * c.unit_ns));
+  std::printf("\nwrote %s\n", c.out.c_str());
+}
+
+// ---- calibrate ----------------------------------------------------------------------
+
+struct CalibrateCmd {
+  std::string out;
+  bool json = false;
+  int rounds = 20000;
+};
+
+void run_calibrate(const CalibrateCmd& c) {
+  tp::CalibrateOptions o;
+  o.rounds = c.rounds;
+  tp::Calibration cal;
+  try {
+    cal = tp::measure_calibration(o);
+  } catch (const Error& e) {
+    throw Failure(e.what());
+  }
+  const std::string path = c.out.empty() ? tp::default_calibration_path() : c.out;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  write_file_atomic(path, tp::calibration_json(cal));
+  if (c.json) {
+    print_json({{"sync_latency_ns", cal.sync_latency_ns}, {"per_byte_ns", cal.per_byte_ns},
+                {"cpus", {cal.cpu_a, cal.cpu_b}}, {"output", path}});
+    return;
+  }
+  std::printf("signal/wait latency %.1f ns, transfer %.4f ns/byte (CPUs %d and %d)\nwrote %s\n",
+              cal.sync_latency_ns, cal.per_byte_ns, cal.cpu_a, cal.cpu_b, path.c_str());
+}
+
+}  // namespace
+
+void add_partition_verbs(CLI::App& app) {
+  {
+    auto c = std::make_shared<PartitionCmd>();
+    auto* cmd = app.add_subcommand("partition", "Partition every step of a trace over K processors");
+    cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
+    cmd->add_option("--method,-m", c->method, "Strategy: " + [] {
+      std::string s;
+      for (const auto& n : tp::strategy_names()) s += (s.empty() ? "" : ", ") + n;
+      return s;
+    }());
+    cmd->add_option("-k", c->k, "Number of processors")->required();
+    cmd->add_option("-o,--output", c->out, "Assignment file to write (.tga)");
+    cmd->add_flag("--json", c->json, "Print one JSON object");
+    c->flags.add(cmd);
+    c->model.add(cmd);
+    cmd->callback([c] { run_partition(*c); });
+  }
+  {
+    auto c = std::make_shared<EvaluateCmd>();
+    auto* cmd = app.add_subcommand("evaluate", "Cut, imbalance, syncs, migrations and predicted makespan");
+    cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
+    cmd->add_option("assignment", c->assignment, "Assignment file (.tga)")->required();
+    cmd->add_flag("--json", c->json, "Print one JSON object");
+    c->model.add(cmd);
+    cmd->callback([c] { run_evaluate(*c); });
+  }
+  {
+    auto c = std::make_shared<CompareCmd>();
+    auto* cmd = app.add_subcommand("compare", "Evaluate the method x K grid in one table");
+    cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
+    cmd->add_option("--methods", c->methods, "Comma-separated methods")->delimiter(',');
+    cmd->add_option("-k", c->ks, "Comma-separated processor counts (default 2,4,8,16)")->delimiter(',');
+    cmd->add_option("--csv", c->csv, "Also write the table as CSV");
+    cmd->add_flag("--json", c->json, "Print one JSON object");
+    c->flags.add(cmd);
+    c->model.add(cmd);
+    cmd->callback([c] { run_compare(*c); });
+  }
+  {
+    auto c = std::make_shared<ImportCmd>();
+    auto* cmd = app.add_subcommand("import", "Turn a Standard Task Graph Set file into a one-step trace");
+    cmd->add_option("--format", c->format, "Input format (stg)")->check(CLI::IsMember({"stg"}));
+    cmd->add_option("input", c->input, "Input file")->required();
+    cmd->add_option("-o,--output", c->out, "Trace file to write (.tgt)")->required();
+    cmd->add_option("--unit-ns", c->unit_ns, "Nanoseconds per STG time unit (default 1000)")
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1000000000}));
+    cmd->add_option("--edge-bytes", c->edge_bytes, "Bytes of the datum each edge carries (default 8)");
+    cmd->add_flag("--json", c->json, "Print one JSON object");
+    cmd->callback([c] { run_import(*c); });
+  }
+  {
+    auto c = std::make_shared<CalibrateCmd>();
+    auto* cmd = app.add_subcommand("calibrate", "Measure signal/wait latency and transfer cost for the simulator");
+    cmd->add_option("--out,-o", c->out, "Output file (default " + tp::default_calibration_path() + ")");
+    cmd->add_option("--rounds", c->rounds, "Ping-pong round trips (default 20000)")
+        ->check(CLI::Range(500, 10000000));
+    cmd->add_flag("--json", c->json, "Print one JSON object");
+    cmd->callback([c] { run_calibrate(*c); });
+  }
+}
 
 }  // namespace tgraph::app

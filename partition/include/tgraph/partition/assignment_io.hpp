@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+// Reading and writing .tga assignment files (format: docs/assignment-format.md).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+
+namespace tgraph::partition {
+
+/// Current .tga format version.
+inline constexpr std::uint32_t kAssignmentVersion = 1;
+
+/// Encodes `a` (with per-step structural hashes, one per step or empty) as .tga bytes.
+std::vector<std::uint8_t> encode_assignment(const TraceAssignment& a,
+                                            const std::vector<std::uint64_t>& hashes = {});
+/// Decodes .tga bytes; throws InputError naming `name` and the offset for any malformed
+/// input (truncation, bad magic, version, checksum, k = 0, processor out of range, bad
+/// order). `hashes` receives the stored structural hashes (0 where none was stored).
+TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std::string& name,
+                                  std::vector<std::uint64_t>* hashes = nullptr);
+/// Writes a .tga file atomically.
+void write_assignment(const std::string& path, const TraceAssignment& a,
+                      const std::vector<std::uint64_t>& hashes = {});
+/// Reads a .tga file.
+TraceAssignment read_assignment(const std::string& path,
+                                std::vector<std::uint64_t>* hashes = nullptr);
+
+}  // namespace tgraph::partition

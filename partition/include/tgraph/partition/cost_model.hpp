@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// Costs of synchronisation and data transfer that the schedule simulator charges.
+#pragma once
+
+#include <string>
+
+namespace tgraph::partition {
+
+/// What a cross-processor dependency costs in a simulated schedule.
+///
+///   CostModel m = CostModel::defaults();           // or load_calibration("calib.json")
+///   Schedule s = simulate(graph, assignment, m);
+struct CostModel {
+  /// One-way signal -> wait latency between two cores (ns), added to every dependency
+  /// whose source runs on another processor.
+  double sync_latency_ns = 100.0;
+  /// Cost per byte (ns) of reading data last written on another processor, charged to the
+  /// reading processor once per datum version.
+  double per_byte_ns = 0.05;
+  /// Where the constants come from ("default", "ideal" or the calibration file's path).
+  std::string source = "default";
+
+  /// Zero synchronisation and transfer cost: pure precedence and load.
+  static CostModel ideal();
+  /// Constants used when no calibration file is given (see docs/partitioning.md).
+  static CostModel defaults();
+};
+
+/// Default calibration file: $XDG_CONFIG_HOME/tgraph/calibration.json, else
+/// ~/.config/tgraph/calibration.json.
+std::string default_calibration_path();
+/// Reads a calibration file written by `tgraph calibrate`; throws InputError naming the
+/// file for unreadable or malformed content.
+CostModel load_calibration(const std::string& path);
+
+/// What `tgraph calibrate` measured.
+struct Calibration {
+  double sync_latency_ns = 0;   ///< median one-way handoff by spinning on an atomic
+  double per_byte_ns = 0;       ///< extra cost per byte of reading data written on the other core
+  int cpu_a = 0, cpu_b = 1;     ///< the two CPUs the threads were pinned to
+  int rounds = 0;               ///< handoffs measured
+  std::size_t buffer_bytes = 0; ///< buffer size of the transfer measurement
+};
+
+/// Options of measure_calibration().
+struct CalibrateOptions {
+  int rounds = 20000;                 ///< ping-pong round trips
+  std::size_t buffer_bytes = 1 << 18; ///< transferred buffer (fits a private L2)
+  int repeats = 15;                   ///< transfer measurements (median taken)
+};
+
+/// Measures this machine with two threads pinned to two different CPUs; throws
+/// tgraph::Error when fewer than two CPUs are available.
+Calibration measure_calibration(const CalibrateOptions& options = {});
+/// The calibration file's JSON text.
+std::string calibration_json(const Calibration& c);
+
+}  // namespace tgraph::partition

@@ -1,0 +1,58 @@
+// SPDX-License-Identifier: MIT
+// Offline evaluation of the assignments of a trace.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::partition {
+
+/// Evaluation of one step's assignment.
+struct StepReport {
+  std::uint64_t tasks = 0;
+  std::uint64_t cut_edges = 0;        ///< dependencies (intra + loop-carried) between processors
+  std::uint64_t cut_bytes = 0;        ///< their datum bytes
+  std::uint64_t signals = 0;          ///< simulated signals (per execution)
+  std::uint64_t waits = 0;            ///< simulated waits (per execution)
+  std::uint64_t reducers = 0;         ///< CW groups whose writers span processors (per execution)
+  std::uint64_t transfer_bytes = 0;   ///< bytes read across processors (per execution)
+  double imbalance = 1.0;             ///< max load / mean load
+  std::uint64_t max_load_ns = 0;
+  std::uint64_t work_ns = 0;
+  std::uint64_t span_ns = 0;
+  std::uint64_t lower_bound_ns = 0;   ///< max(ceil(work / K), span)
+  std::uint64_t makespan_ns = 0;      ///< predicted by simulate()
+  double speedup = 1.0;               ///< work / makespan
+  std::uint64_t migrated_tasks = 0;   ///< tasks (by stable key) whose processor changed
+  std::uint64_t migrated_bytes = 0;   ///< bytes of the data those tasks access
+  double partition_ms = 0.0;
+  bool quotient_acyclic = true;       ///< processor graph of intra-step cross edges acyclic
+  std::uint64_t ping_pong_pairs = 0;  ///< processor pairs with cross edges both ways
+};
+
+/// Evaluation of a whole trace's assignment.
+struct Report {
+  std::string method;
+  std::uint32_t k = 1;
+  std::string model;                  ///< cost model source
+  std::vector<StepReport> steps;
+  StepReport total;  ///< sums; imbalance = sum max load / sum mean load; speedup = work / makespan
+  double imbalance_max = 1.0;         ///< worst step
+  std::uint64_t cyclic_steps = 0;     ///< steps whose quotient graph has a cycle
+  double speedup_with_partitioning = 1.0;  ///< work / (makespan + partition time)
+};
+
+/// Evaluates `a` on `trace`; throws InputError (naming `a_name`) when the assignment does
+/// not fit the trace (step count, task count, processor range, order).
+Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
+                const std::string& a_name = "<assignment>");
+
+/// Checks that `a` fits `trace`; throws InputError naming `a_name` otherwise.
+void check_fits(const Trace& trace, const TraceAssignment& a, const std::string& a_name);
+
+}  // namespace tgraph::partition

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: MIT
+// The weights METIS and Scotch see: libgraph's undirected task graph (the one that
+// `tgraph export --format metis|scotch` writes), in 32-bit form, optionally per phase.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/undirected.hpp"
+
+namespace tgraph::partition {
+
+/// Totals above which make_undirected scales weights down; the same bound as
+/// `tgraph export`, so that the METIS objective matches gpmetis on the exported file.
+inline constexpr std::int64_t kMaxLibraryWeight = std::int64_t{1} << 30;
+
+/// The undirected graph the partitioners see (make_undirected with kMaxLibraryWeight).
+UndirectedGraph library_graph(const StepGraph& g);
+
+/// 32-bit weights for the libraries.
+struct LibraryWeights {
+  std::uint32_t ncon = 1;               ///< vertex weights per vertex
+  std::vector<std::int32_t> vwgt;       ///< n * ncon, interleaved per vertex
+  std::vector<std::int32_t> adjwgt;     ///< one per arc
+};
+
+/// Single-constraint (`phase` empty) or multi-constraint weights: with `phase[v]` in
+/// [0, nphases), vertex v carries its weight in constraint phase[v] and 0 elsewhere.
+LibraryWeights library_weights(const UndirectedGraph& u,
+                               const std::vector<std::uint32_t>& phase = {},
+                               std::uint32_t nphases = 1);
+
+/// Level of every task: longest path, in edges, from a source of the step's DAG (intra-step
+/// edges only, loops not unrolled).
+std::vector<std::uint32_t> task_levels(const StepGraph& g);
+/// Buckets consecutive levels into at most `nphases` phases of about equal work; returns
+/// the phase of every task and sets `used` to the number of non-empty phases.
+std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
+                                       std::uint32_t& used);
+
+/// Edge cut of `part` in the graph's (scaled) weight units: what METIS's objval counts.
+std::int64_t edgecut(const UndirectedGraph& u, const std::vector<std::uint32_t>& part);
+
+}  // namespace tgraph::partition

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// Discrete-event simulation of a partitioned step: what its makespan would be.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::partition {
+
+/// A simulated schedule. Task instances are numbered task by task: instance
+/// `first_instance[t] + i` is iteration i of task t (i < g.runs(t)).
+struct Schedule {
+  std::uint64_t makespan_ns = 0;
+  std::vector<std::uint64_t> busy_ns;     ///< per processor: task cost + transfer time
+  std::vector<std::uint64_t> finish_ns;   ///< per processor: end of its last task
+  std::uint64_t signals = 0;     ///< datum versions (and loop decisions) sent to other processors
+  std::uint64_t waits = 0;       ///< (version, receiving processor) pairs
+  std::uint64_t transfer_bytes = 0;  ///< bytes read from another processor's writes
+  std::vector<std::uint64_t> first_instance;  ///< per task, plus the total at the end
+  std::vector<std::uint64_t> start_ns;        ///< per instance
+  std::vector<std::uint64_t> end_ns;          ///< per instance
+};
+
+/// Simulates step `g` (edges derived) under assignment `a`:
+///
+/// * every processor runs its tasks one after the other, in `a.order[p]` or program order;
+/// * a task starts when its processor is free and every dependency (intra-step edges;
+///   loop-carried edges from the previous iteration) has finished, plus
+///   `sync_latency_ns` when the source ran on another processor;
+/// * the first task on a processor that reads a datum version written elsewhere also pays
+///   `bytes x per_byte_ns`;
+/// * a loop body is run by every processor holding some of its tasks (loop control
+///   replicated, paper section 3.3): iteration i+1 starts, and the loop is left, only once
+///   the break task of iteration i is known (plus latency if it ran elsewhere);
+///   a processor's loop tasks form one block placed where its first loop task appears.
+///
+/// Throws tgraph::Error when `a` does not fit `g` or its order deadlocks.
+Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model);
+
+}  // namespace tgraph::partition

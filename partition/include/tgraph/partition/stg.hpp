@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+// Standard Task Graph Set (Kasahara lab) files as one-step traces.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "tgraph/graph/trace.hpp"
+
+namespace tgraph::partition {
+
+/// An STG file read into a trace.
+struct StgGraph {
+  Trace trace;                          ///< one step; edges derived
+  std::optional<std::uint64_t> cp_length;  ///< "CP Length" stated in the trailer (STG units)
+};
+
+/// Parses STG text: the first line holds n, then n + 2 task lines "id cost npred preds...";
+/// task 0 and n + 1 are the dummy entry and exit (cost 0). Each STG time unit becomes
+/// `unit_ns` ns; each precedence edge becomes a datum of `edge_bytes` bytes written by the
+/// predecessor and read by the successor. Throws InputError naming `name` and the offset.
+StgGraph parse_stg(std::string_view text, const std::string& name, std::uint64_t unit_ns = 1000,
+                   std::uint64_t edge_bytes = 8);
+/// Reads and parses an STG file.
+StgGraph read_stg(const std::string& path, std::uint64_t unit_ns = 1000,
+                  std::uint64_t edge_bytes = 8);
+
+}  // namespace tgraph::partition

@@ -1,0 +1,109 @@
+// SPDX-License-Identifier: MIT
+// Partitioning strategies behind one small interface, chosen by name.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::partition {
+
+/// What METIS minimises.
+enum class Objective : std::uint8_t { kCut = 0, kVolume = 1 };
+/// "cut" or "vol".
+std::string_view to_string(Objective o);
+/// Parses "cut" / "vol"; throws UsageError.
+Objective parse_objective(std::string_view s);
+
+/// Scotch's strategy flavour (SCOTCH_STRAT* flags).
+enum class ScotchFlavour : std::uint8_t { kDefault = 0, kQuality = 1, kSpeed = 2, kBalance = 3 };
+/// "default", "quality", "speed" or "balance".
+std::string_view to_string(ScotchFlavour f);
+/// Parses a flavour name; throws UsageError.
+ScotchFlavour parse_scotch_flavour(std::string_view s);
+
+/// Knobs of the strategies; each strategy reads the ones it understands.
+struct Options {
+  double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
+  std::uint64_t seed = 1;           ///< METIS / Scotch / random seed
+  Objective objective = Objective::kCut;  ///< METIS objective
+  std::uint32_t phases = 0;         ///< METIS multi-constraint: phases balanced separately (<2: off)
+  ScotchFlavour scotch = ScotchFlavour::kQuality;
+  std::string sticky_base = "metis";  ///< sticky: strategy for the first step
+  double sticky_threshold = 1.10;   ///< sticky: rebalance above this imbalance
+  double migration_cost = 1.0;      ///< sticky: Scotch emraval (quantised to 0.01 by Scotch)
+  CostModel model = CostModel::defaults();  ///< list: communication cost estimate
+};
+
+/// The previous step, for incremental strategies (both null for the first step).
+struct Previous {
+  const StepGraph* graph = nullptr;
+  const Assignment* assignment = nullptr;
+};
+
+/// What a call cost and what it changed.
+struct Stats {
+  double partition_ms = 0.0;            ///< wall time of the strategy itself
+  std::optional<std::int64_t> edgecut;  ///< library objective (METIS objval, Scotch cut), library units
+  std::uint64_t matched_tasks = 0;      ///< tasks found in the previous step by stable key
+  std::uint64_t moved_tasks = 0;        ///< matched tasks whose processor changed
+  bool reused = false;                  ///< sticky: previous assignment reused as is
+  bool rebalanced = false;              ///< sticky: repartitioned with a migration cost
+};
+
+/// An assignment and its statistics.
+struct Result {
+  Assignment assignment;
+  Stats stats;
+};
+
+/// A partitioning strategy. Adding one = one source file + one line in registry.cpp.
+///
+///   auto s = make_strategy("metis");
+///   Result r = s->partition(step, 8, {}, Options{});
+///   // r.assignment.proc[t] in [0, 8)
+class Strategy {
+ public:
+  virtual ~Strategy() = default;
+  /// Name under which the strategy is registered.
+  virtual std::string_view name() const = 0;
+  /// Partitions `g` (edges derived) over `k` processors. Validates the inputs (UsageError
+  /// for k = 0 or an inconsistent previous step), times the call and counts the tasks that
+  /// moved relative to `prev` (matched by stable key).
+  Result partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
+                   const Options& options);
+
+ private:
+  virtual Result do_partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
+                              const Options& options) = 0;
+};
+
+/// Creates a strategy by name; throws UsageError listing the known names.
+std::unique_ptr<Strategy> make_strategy(std::string_view name);
+/// Names of all registered strategies, sorted.
+std::vector<std::string> strategy_names();
+
+/// One assignment per step, plus each step's statistics.
+struct TracePartition {
+  TraceAssignment assignment;
+  std::vector<Stats> stats;
+};
+
+/// Runs strategy `method` on every step of `trace` in order, handing each step the previous
+/// step and its assignment (what `sticky` needs).
+TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
+                               const Options& options = {});
+
+/// Tasks of `g` matched in `prev` by stable key (the i-th task with a key matches the
+/// i-th task with the same key); match[t] = task in prev or kNoTask.
+std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev);
+
+}  // namespace tgraph::partition

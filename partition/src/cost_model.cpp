@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/partition/cost_model.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+
+namespace tgraph::partition {
+
+CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal"}; }
+
+// Defaults: the middle of the cross-core spin handoff measured on this machine kind
+// (../shared/notes/machine.md: 70-150 ns) and 0.05 ns/byte (20 GB/s cross-core).
+CostModel CostModel::defaults() { return CostModel{100.0, 0.05, "default"}; }
+
+std::string default_calibration_path() {
+  if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg != nullptr && *xdg != '\0')
+    return std::string(xdg) + "/tgraph/calibration.json";
+  if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
+    return std::string(home) + "/.config/tgraph/calibration.json";
+  return "calibration.json";
+}
+
+CostModel load_calibration(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(bytes.begin(), bytes.end());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
+                     "expected a JSON calibration object");
+  }
+  auto number = [&](const char* key) {
+    if (!j.is_object() || !j.contains(key) || !j[key].is_number())
+      throw InputError(path, std::nullopt, std::string("expected a number under \"") + key + "\"");
+    const double v = j[key].get<double>();
+    if (!std::isfinite(v) || v < 0 || v > 1e9)
+      throw InputError(path, std::nullopt, std::string("\"") + key + "\" out of range [0, 1e9]");
+    return v;
+  };
+  CostModel m;
+  m.sync_latency_ns = number("sync_latency_ns");
+  m.per_byte_ns = number("per_byte_ns");
+  m.source = path;
+  return m;
+}
+
+std::string calibration_json(const Calibration& c) {
+  nlohmann::json j;
+  j["sync_latency_ns"] = c.sync_latency_ns;
+  j["per_byte_ns"] = c.per_byte_ns;
+  j["cpus"] = {c.cpu_a, c.cpu_b};
+  j["rounds"] = c.rounds;
+  j["buffer_bytes"] = c.buffer_bytes;
+  j["tgraph_version"] = TGRAPH_VERSION;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace tgraph::partition

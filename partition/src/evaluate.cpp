@@ -1,0 +1,201 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/partition/evaluate.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/metrics.hpp"
+#include "tgraph/partition/simulator.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::partition {
+
+namespace {
+
+// CW groups (maximal runs of cumulative writes to one datum, within one loop level) whose
+// writers run on more than one processor: each needs a reducer, per execution.
+std::uint64_t count_reducers(const StepGraph& g, const Assignment& a) {
+  struct Group {
+    bool open = false;
+    LoopId loop = kNoLoop;
+    ProcId first = 0;
+    bool spans = false;
+  };
+  std::vector<Group> group(g.data.size());
+  std::uint64_t reducers = 0;
+  auto close = [&](Group& gr) {
+    if (gr.open && gr.spans) reducers += gr.loop == kNoLoop ? 1 : g.loops[gr.loop].iterations;
+    gr = Group{};
+  };
+  for (TaskId t = 0; t < g.tasks.size(); ++t)
+    for (const Access& acc : g.accesses_of(t)) {
+      Group& gr = group[acc.datum];
+      if (acc.mode != AccessMode::CW) {
+        close(gr);
+        continue;
+      }
+      if (gr.open && gr.loop != g.tasks[t].loop) close(gr);
+      if (!gr.open) {
+        gr.open = true;
+        gr.loop = g.tasks[t].loop;
+        gr.first = a.proc[t];
+      } else if (a.proc[t] != gr.first) {
+        gr.spans = true;
+      }
+    }
+  for (Group& gr : group) close(gr);
+  return reducers;
+}
+
+void quotient(const StepGraph& g, const Assignment& a, StepReport& r) {
+  const std::uint32_t k = a.k;
+  std::vector<std::uint8_t> adj(static_cast<std::size_t>(k) * k, 0);
+  for (const Edge& e : g.edges)
+    if (a.proc[e.from] != a.proc[e.to]) adj[static_cast<std::size_t>(a.proc[e.from]) * k + a.proc[e.to]] = 1;
+  r.ping_pong_pairs = 0;
+  for (ProcId p = 0; p < k; ++p)
+    for (ProcId q = p + 1; q < k; ++q)
+      if (adj[static_cast<std::size_t>(p) * k + q] && adj[static_cast<std::size_t>(q) * k + p]) ++r.ping_pong_pairs;
+  std::vector<std::uint32_t> indeg(k, 0);
+  for (ProcId p = 0; p < k; ++p)
+    for (ProcId q = 0; q < k; ++q) indeg[q] += adj[static_cast<std::size_t>(p) * k + q];
+  std::vector<ProcId> stack;
+  for (ProcId p = 0; p < k; ++p)
+    if (indeg[p] == 0) stack.push_back(p);
+  std::uint32_t removed = 0;
+  while (!stack.empty()) {
+    const ProcId p = stack.back();
+    stack.pop_back();
+    ++removed;
+    for (ProcId q = 0; q < k; ++q)
+      if (adj[static_cast<std::size_t>(p) * k + q] && --indeg[q] == 0) stack.push_back(q);
+  }
+  r.quotient_acyclic = removed == k;
+}
+
+void migrations(const StepGraph& g, const Assignment& a, const StepGraph& prev,
+                const Assignment& prev_a, StepReport& r) {
+  const std::vector<TaskId> match = match_by_key(g, prev);
+  std::vector<DatumId> seen;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    if (match[t] == kNoTask || prev_a.proc[match[t]] == a.proc[t]) continue;
+    ++r.migrated_tasks;
+    seen.clear();
+    for (const Access& acc : g.accesses_of(t))
+      if (std::find(seen.begin(), seen.end(), acc.datum) == seen.end()) {
+        seen.push_back(acc.datum);
+        r.migrated_bytes += g.data[acc.datum].bytes;
+      }
+  }
+}
+
+StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostModel& model) {
+  StepReport r;
+  r.tasks = g.tasks.size();
+  std::vector<std::uint64_t> load(a.k, 0);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) load[a.proc[t]] += g.tasks[t].cost_ns * g.runs(t);
+  for (std::uint64_t l : load) {
+    r.work_ns += l;
+    r.max_load_ns = std::max(r.max_load_ns, l);
+  }
+  r.imbalance = r.work_ns == 0 ? 1.0
+                               : static_cast<double>(r.max_load_ns) * a.k / static_cast<double>(r.work_ns);
+  auto cut = [&](const Edge& e) {
+    if (a.proc[e.from] == a.proc[e.to]) return;
+    ++r.cut_edges;
+    r.cut_bytes += g.data[e.datum].bytes;
+  };
+  for (const Edge& e : g.edges) cut(e);
+  for (const Edge& e : g.carried_edges) cut(e);
+  r.reducers = count_reducers(g, a);
+  quotient(g, a, r);
+
+  const Schedule s = simulate(g, a, model);
+  r.makespan_ns = s.makespan_ns;
+  r.signals = s.signals;
+  r.waits = s.waits;
+  r.transfer_bytes = s.transfer_bytes;
+  const Metrics m = compute_metrics(g);
+  r.span_ns = m.span_ns;
+  r.lower_bound_ns = std::max<std::uint64_t>((r.work_ns + a.k - 1) / a.k, m.span_ns);
+  r.speedup = r.makespan_ns == 0 ? 1.0 : static_cast<double>(r.work_ns) / static_cast<double>(r.makespan_ns);
+  return r;
+}
+
+}  // namespace
+
+void check_fits(const Trace& trace, const TraceAssignment& a, const std::string& a_name) {
+  if (a.steps.size() != trace.steps.size())
+    throw InputError(a_name, std::nullopt,
+                     "has " + std::to_string(a.steps.size()) + " steps, the trace has " +
+                         std::to_string(trace.steps.size()));
+  for (std::size_t s = 0; s < a.steps.size(); ++s) {
+    const Assignment& as = a.steps[s];
+    const std::string where = "step " + std::to_string(s) + ": ";
+    if (as.k == 0 || as.k != a.k)
+      throw InputError(a_name, std::nullopt, where + "k = " + std::to_string(as.k) + ", expected " +
+                                                 std::to_string(a.k));
+    if (as.proc.size() != trace.steps[s].tasks.size())
+      throw InputError(a_name, std::nullopt,
+                       where + "assigns " + std::to_string(as.proc.size()) + " tasks, the trace has " +
+                           std::to_string(trace.steps[s].tasks.size()));
+    for (ProcId p : as.proc)
+      if (p >= as.k)
+        throw InputError(a_name, std::nullopt, where + "processor " + std::to_string(p) + " >= k");
+  }
+}
+
+Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
+                const std::string& a_name) {
+  check_fits(trace, a, a_name);
+  Report rep;
+  rep.method = a.method;
+  rep.k = a.k;
+  rep.model = model.source;
+  StepReport& tot = rep.total;
+  double sum_mean_load = 0.0, sum_partition_ms = 0.0;
+  tot.quotient_acyclic = true;
+  for (std::size_t s = 0; s < trace.steps.size(); ++s) {
+    StepReport r;
+    try {
+      r = evaluate_step(trace.steps[s], a.steps[s], model);
+    } catch (const InputError&) {
+      throw;
+    } catch (const Error& e) {
+      throw InputError(a_name, std::nullopt, "step " + std::to_string(s) + ": " + e.what());
+    }
+    if (s > 0) migrations(trace.steps[s], a.steps[s], trace.steps[s - 1], a.steps[s - 1], r);
+    if (s < a.partition_ms.size()) r.partition_ms = a.partition_ms[s];
+    tot.tasks += r.tasks;
+    tot.cut_edges += r.cut_edges;
+    tot.cut_bytes += r.cut_bytes;
+    tot.signals += r.signals;
+    tot.waits += r.waits;
+    tot.reducers += r.reducers;
+    tot.transfer_bytes += r.transfer_bytes;
+    tot.max_load_ns += r.max_load_ns;
+    tot.work_ns += r.work_ns;
+    tot.span_ns += r.span_ns;
+    tot.lower_bound_ns += r.lower_bound_ns;
+    tot.makespan_ns += r.makespan_ns;
+    tot.migrated_tasks += r.migrated_tasks;
+    tot.migrated_bytes += r.migrated_bytes;
+    tot.partition_ms += r.partition_ms;
+    tot.ping_pong_pairs += r.ping_pong_pairs;
+    tot.quotient_acyclic = tot.quotient_acyclic && r.quotient_acyclic;
+    if (!r.quotient_acyclic) ++rep.cyclic_steps;
+    rep.imbalance_max = std::max(rep.imbalance_max, r.imbalance);
+    sum_mean_load += static_cast<double>(r.work_ns) / a.k;
+    sum_partition_ms += r.partition_ms;
+    rep.steps.push_back(r);
+  }
+  tot.imbalance = sum_mean_load > 0 ? static_cast<double>(tot.max_load_ns) / sum_mean_load : 1.0;
+  tot.speedup = tot.makespan_ns == 0 ? 1.0 : static_cast<double>(tot.work_ns) / static_cast<double>(tot.makespan_ns);
+  const double with_partitioning = static_cast<double>(tot.makespan_ns) + sum_partition_ms * 1e6;
+  rep.speedup_with_partitioning =
+      with_partitioning <= 0 ? 1.0 : static_cast<double>(tot.work_ns) / with_partitioning;
+  return rep;
+}
+
+}  // namespace tgraph::partition

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+// `metis`: METIS 5.1 k-way partitioning of the undirected task graph.
+#include <metis.h>
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+#include "strategies.hpp"
+
+static_assert(sizeof(idx_t) == 4, "tgraph expects METIS built with 32-bit idx_t");
+static_assert(sizeof(real_t) == sizeof(float), "tgraph expects METIS built with float real_t");
+
+namespace tgraph::partition::detail {
+
+namespace {
+
+// METIS reseeds rand() and installs signal handlers on every call: one caller at a time.
+std::mutex& metis_mutex() {
+  static std::mutex m;
+  return m;
+}
+
+}  // namespace
+
+std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std::uint32_t k,
+                        const Options& options, std::vector<std::uint32_t>& part) {
+  idx_t nvtxs = static_cast<idx_t>(pg.vertices());
+  idx_t ncon = static_cast<idx_t>(w.ncon);
+  idx_t nparts = static_cast<idx_t>(k);
+  std::vector<idx_t> xadj(pg.xadj.begin(), pg.xadj.end());
+  std::vector<idx_t> adjncy(pg.adjncy.begin(), pg.adjncy.end());
+  std::vector<idx_t> vwgt(w.vwgt.begin(), w.vwgt.end());
+  std::vector<idx_t> adjwgt(w.adjwgt.begin(), w.adjwgt.end());
+  std::vector<real_t> ubvec(w.ncon, static_cast<real_t>(options.imbalance));
+  std::vector<idx_t> out(pg.vertices(), 0);
+  idx_t opts[METIS_NOPTIONS];
+  METIS_SetDefaultOptions(opts);
+  opts[METIS_OPTION_NUMBERING] = 0;
+  opts[METIS_OPTION_SEED] = static_cast<idx_t>(options.seed % 0x7fffffff);
+  opts[METIS_OPTION_OBJTYPE] = options.objective == Objective::kVolume ? METIS_OBJTYPE_VOL : METIS_OBJTYPE_CUT;
+  opts[METIS_OPTION_UFACTOR] =
+      static_cast<idx_t>(std::lround(std::max(0.0, options.imbalance - 1.0) * 1000.0));
+  idx_t objval = 0;
+  int status;
+  {
+    std::lock_guard<std::mutex> lock(metis_mutex());
+    status = METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.empty() ? nullptr : adjncy.data(),
+                                 vwgt.data(), nullptr, adjwgt.empty() ? nullptr : adjwgt.data(),
+                                 &nparts, nullptr, ubvec.data(), opts, &objval, out.data());
+  }
+  if (status != METIS_OK)
+    throw std::runtime_error("METIS_PartGraphKway failed with status " + std::to_string(status));
+  part.resize(pg.vertices());
+  for (std::uint32_t v = 0; v < pg.vertices(); ++v) {
+    if (out[v] < 0 || out[v] >= nparts)
+      throw std::runtime_error("METIS returned part " + std::to_string(out[v]) + " for vertex " +
+                               std::to_string(v));
+    part[v] = static_cast<std::uint32_t>(out[v]);
+  }
+  return objval;
+}
+
+namespace {
+
+/// METIS k-way on the task graph; optional multi-constraint mode balancing each phase.
+class Metis final : public Strategy {
+ public:
+  std::string_view name() const override { return "metis"; }
+
+ private:
+  Result do_partition(const StepGraph& g, std::uint32_t k, const Previous&,
+                      const Options& options) override {
+    const auto n = static_cast<std::uint32_t>(g.tasks.size());
+    Result r;
+    r.assignment.k = k;
+    // METIS divides by log2(1) for K = 1 and returns incomplete partitions for K >= n.
+    if (k == 1 || n == 0) {
+      r.assignment.proc.assign(n, 0);
+      r.stats.edgecut = 0;
+      return r;
+    }
+    if (k >= n) {
+      r.assignment = one_task_per_processor(g, k);
+      const UndirectedGraph pg = library_graph(g);
+      r.stats.edgecut = edgecut(pg, r.assignment.proc);
+      return r;
+    }
+    const UndirectedGraph pg = library_graph(g);
+    std::vector<std::uint32_t> phase;
+    std::uint32_t used = 1;
+    if (options.phases > 1) phase = task_phases(g, options.phases, used);
+    const LibraryWeights w = library_weights(pg, phase, used);
+    std::vector<std::uint32_t> part;
+    r.stats.edgecut = metis_kway(pg, w, k, options, part);
+    r.assignment.proc.assign(part.begin(), part.end());
+    return r;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Strategy> make_metis() { return std::make_unique<Metis>(); }
+
+}  // namespace tgraph::partition::detail

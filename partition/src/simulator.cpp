@@ -1,0 +1,256 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/partition/simulator.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <unordered_set>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::partition {
+
+namespace {
+
+constexpr std::uint64_t kUnknown = std::numeric_limits<std::uint64_t>::max();
+
+struct Dep {
+  TaskId from;
+  DatumId datum;
+  bool raw;
+  bool carried;
+};
+
+// One thing a processor runs: a task outside loops, or its share of one loop's body.
+struct Item {
+  TaskId task = kNoTask;
+  LoopId loop = kNoLoop;
+  std::vector<TaskId> body;
+};
+
+struct SyncKey {
+  std::uint64_t instance;
+  std::uint32_t datum;
+  std::uint32_t proc;
+  friend bool operator==(const SyncKey&, const SyncKey&) = default;
+};
+struct SyncKeyHash {
+  std::size_t operator()(const SyncKey& k) const {
+    std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
+    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+void check_assignment(const StepGraph& g, const Assignment& a) {
+  if (a.k == 0) throw Error("assignment: k must be at least 1");
+  if (a.proc.size() != g.tasks.size())
+    throw Error("assignment has " + std::to_string(a.proc.size()) + " tasks, step has " +
+                std::to_string(g.tasks.size()));
+  for (TaskId t = 0; t < a.proc.size(); ++t)
+    if (a.proc[t] >= a.k)
+      throw Error("assignment: task " + std::to_string(t) + " on processor " +
+                  std::to_string(a.proc[t]) + " >= k = " + std::to_string(a.k));
+  if (a.order.empty()) return;
+  if (a.order.size() != a.k)
+    throw Error("assignment: order has " + std::to_string(a.order.size()) + " processors, k = " +
+                std::to_string(a.k));
+  std::vector<bool> seen(g.tasks.size(), false);
+  std::size_t count = 0;
+  for (ProcId p = 0; p < a.k; ++p)
+    for (TaskId t : a.order[p]) {
+      if (t >= g.tasks.size() || a.proc[t] != p || seen[t])
+        throw Error("assignment: order of processor " + std::to_string(p) + " lists task " +
+                    std::to_string(t) + " that is not its own or listed twice");
+      seen[t] = true;
+      ++count;
+    }
+  if (count != g.tasks.size()) throw Error("assignment: order misses some tasks");
+}
+
+class Simulator {
+ public:
+  Simulator(const StepGraph& g, const Assignment& a, const CostModel& m)
+      : g_(g), a_(a), k_(a.k), latency_(static_cast<std::uint64_t>(std::llround(m.sync_latency_ns))),
+        per_byte_(m.per_byte_ns) {
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    s_.first_instance.resize(n + 1);
+    std::uint64_t total = 0;
+    for (TaskId t = 0; t < n; ++t) {
+      s_.first_instance[t] = total;
+      total += g.runs(t);
+    }
+    s_.first_instance[n] = total;
+    s_.start_ns.assign(total, 0);
+    s_.end_ns.assign(total, kUnknown);
+    deps_.resize(n);
+    for (const Edge& e : g.edges)
+      if (e.from != e.to) deps_[e.to].push_back({e.from, e.datum, e.kind == EdgeKind::RAW, false});
+    for (const Edge& e : g.carried_edges)
+      deps_[e.to].push_back({e.from, e.datum, e.kind == EdgeKind::RAW, true});
+
+    items_.resize(k_);
+    std::vector<std::vector<std::size_t>> block(k_, std::vector<std::size_t>(g.loops.size(), SIZE_MAX));
+    auto place = [&](ProcId p, TaskId t) {
+      const LoopId l = g.tasks[t].loop;
+      if (l == kNoLoop) {
+        items_[p].push_back({t, kNoLoop, {}});
+        return;
+      }
+      if (block[p][l] == SIZE_MAX) {
+        block[p][l] = items_[p].size();
+        items_[p].push_back({kNoTask, l, {}});
+      }
+      items_[p][block[p][l]].body.push_back(t);
+    };
+    if (a.order.empty()) {
+      for (TaskId t = 0; t < n; ++t) place(a.proc[t], t);
+    } else {
+      for (ProcId p = 0; p < k_; ++p)
+        for (TaskId t : a.order[p]) place(p, t);
+    }
+    state_.resize(k_);
+    s_.busy_ns.assign(k_, 0);
+    s_.finish_ns.assign(k_, 0);
+  }
+
+  Schedule run() {
+    bool progress = true;
+    while (progress) {
+      progress = false;
+      for (ProcId p = 0; p < k_; ++p) progress = advance(p) || progress;
+    }
+    for (ProcId p = 0; p < k_; ++p)
+      if (state_[p].item < items_[p].size()) {
+        const Item& it = items_[p][state_[p].item];
+        const TaskId t = it.task != kNoTask ? it.task
+                         : state_[p].pos < it.body.size() ? it.body[state_[p].pos]
+                                                          : g_.loops[it.loop].last - 1;
+        throw Error("assignment order deadlocks: processor " + std::to_string(p) +
+                    " waits forever before task " + std::to_string(t));
+      }
+    for (ProcId p = 0; p < k_; ++p) {
+      s_.finish_ns[p] = state_[p].time;
+      s_.makespan_ns = std::max(s_.makespan_ns, state_[p].time);
+    }
+    return std::move(s_);
+  }
+
+ private:
+  struct State {
+    std::size_t item = 0;
+    std::uint32_t iter = 0;
+    std::size_t pos = 0;
+    std::uint64_t time = 0;
+  };
+
+  // Instance that dependency `d` of iteration `i` of a task refers to; kUnknown for none.
+  std::uint64_t source(const Dep& d, TaskId t, std::uint32_t i) const {
+    const LoopId lu = g_.tasks[d.from].loop;
+    if (d.carried) return i == 0 ? kUnknown : s_.first_instance[d.from] + i - 1;
+    if (lu != kNoLoop && lu == g_.tasks[t].loop) return s_.first_instance[d.from] + i;
+    const std::uint64_t runs = g_.runs(d.from);
+    return runs == 0 ? kUnknown : s_.first_instance[d.from] + runs - 1;
+  }
+
+  // Records that processor p receives (instance, datum) from another processor; returns
+  // true the first time (a wait, and a signal if nobody received it before).
+  bool receive(std::uint64_t instance, DatumId datum, ProcId p) {
+    if (!waits_.insert({instance, datum, p}).second) return false;
+    ++s_.waits;
+    if (signals_.insert({instance, datum, 0}).second) ++s_.signals;
+    return true;
+  }
+
+  bool try_run(ProcId p, TaskId t, std::uint32_t i) {
+    for (const Dep& d : deps_[t]) {
+      const std::uint64_t src = source(d, t, i);
+      if (src != kUnknown && s_.end_ns[src] == kUnknown) return false;
+    }
+    State& st = state_[p];
+    std::uint64_t ready = st.time, bytes = 0;
+    for (const Dep& d : deps_[t]) {
+      const std::uint64_t src = source(d, t, i);
+      if (src == kUnknown) continue;
+      std::uint64_t arrival = s_.end_ns[src];
+      if (a_.proc[d.from] != p) {
+        arrival += latency_;
+        if (receive(src, d.datum, p) && d.raw) bytes += g_.data[d.datum].bytes;
+      }
+      ready = std::max(ready, arrival);
+    }
+    const std::uint64_t duration =
+        g_.tasks[t].cost_ns + static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
+    const std::uint64_t inst = s_.first_instance[t] + i;
+    s_.start_ns[inst] = ready;
+    s_.end_ns[inst] = ready + duration;
+    st.time = ready + duration;
+    s_.busy_ns[p] += duration;
+    s_.transfer_bytes += bytes;
+    return true;
+  }
+
+  // Runs processor p as far as it can; returns whether it moved.
+  bool advance(ProcId p) {
+    State& st = state_[p];
+    bool moved = false;
+    while (st.item < items_[p].size()) {
+      const Item& it = items_[p][st.item];
+      if (it.task != kNoTask) {
+        if (!try_run(p, it.task, 0)) return moved;
+        ++st.item;
+        moved = true;
+        continue;
+      }
+      const Loop& loop = g_.loops[it.loop];
+      if (loop.iterations == 0) {
+        ++st.item;
+        moved = true;
+        continue;
+      }
+      if (st.pos < it.body.size()) {
+        if (!try_run(p, it.body[st.pos], st.iter)) return moved;
+        ++st.pos;
+        moved = true;
+        continue;
+      }
+      // End of iteration: loop control needs the break task's decision.
+      const TaskId brk = loop.last - 1;
+      const std::uint64_t inst = s_.first_instance[brk] + st.iter;
+      if (s_.end_ns[inst] == kUnknown) return moved;
+      std::uint64_t known = s_.end_ns[inst];
+      if (a_.proc[brk] != p) {
+        known += latency_;
+        receive(inst, loop.condition, p);
+      }
+      st.time = std::max(st.time, known);
+      st.pos = 0;
+      if (++st.iter == loop.iterations) {
+        st.iter = 0;
+        ++st.item;
+      }
+      moved = true;
+    }
+    return moved;
+  }
+
+  const StepGraph& g_;
+  const Assignment& a_;
+  const std::uint32_t k_;
+  const std::uint64_t latency_;
+  const double per_byte_;
+  Schedule s_;
+  std::vector<std::vector<Dep>> deps_;
+  std::vector<std::vector<Item>> items_;
+  std::vector<State> state_;
+  std::unordered_set<SyncKey, SyncKeyHash> waits_, signals_;
+};
+
+}  // namespace
+
+Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model) {
+  check_assignment(g, a);
+  return Simulator(g, a, model).run();
+}
+
+}  // namespace tgraph::partition

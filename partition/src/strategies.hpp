@@ -1,0 +1,48 @@
+// SPDX-License-Identifier: MIT
+// Factories of the built-in strategies (one per source file) and shared helpers.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "tgraph/partition/partition_graph.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::partition::detail {
+
+std::unique_ptr<Strategy> make_single();
+std::unique_ptr<Strategy> make_roundrobin();
+std::unique_ptr<Strategy> make_random();
+std::unique_ptr<Strategy> make_owner();
+std::unique_ptr<Strategy> make_metis();
+std::unique_ptr<Strategy> make_scotch();
+std::unique_ptr<Strategy> make_sticky();
+std::unique_ptr<Strategy> make_list();
+
+/// Work of every task (cost x runs).
+std::vector<std::uint64_t> task_work(const StepGraph& g);
+/// Per-processor load of `proc`.
+std::vector<std::uint64_t> loads(const std::vector<std::uint64_t>& work,
+                                 const std::vector<ProcId>& proc, std::uint32_t k);
+/// max load / mean load (1 for zero work).
+double imbalance(const std::vector<std::uint64_t>& load);
+
+/// Assignment for K >= n: task i on processor i. Empty graph: empty assignment.
+Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k);
+
+/// METIS k-way (serialised behind a process-wide mutex). `part` gets n entries; returns
+/// METIS's objval. Requires 2 <= k < n.
+std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std::uint32_t k,
+                        const Options& options, std::vector<std::uint32_t>& part);
+
+/// Scotch graph partitioning (serialised). Requires 2 <= k < n.
+void scotch_part(const UndirectedGraph& pg, const LibraryWeights& w, std::uint32_t k,
+                 const Options& options, std::vector<std::uint32_t>& part);
+/// Scotch repartitioning: old[v] = previous part or -1, migration cost per vertex.
+void scotch_repart(const UndirectedGraph& pg, const LibraryWeights& w, std::uint32_t k,
+                   const Options& options, const std::vector<std::int32_t>& old,
+                   const std::vector<std::int32_t>& migration_cost,
+                   std::vector<std::uint32_t>& part);
+
+}  // namespace tgraph::partition::detail

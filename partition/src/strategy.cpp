@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/partition/strategy.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "strategies.hpp"
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::partition {
+
+std::string_view to_string(Objective o) {
+  switch (o) {
+    case Objective::kCut:
+      return "cut";
+    case Objective::kVolume:
+      return "vol";
+  }
+  return "?";
+}
+
+Objective parse_objective(std::string_view s) {
+  if (s == "cut") return Objective::kCut;
+  if (s == "vol") return Objective::kVolume;
+  throw UsageError("--objective: expected cut or vol, got '" + std::string(s) + "'");
+}
+
+std::string_view to_string(ScotchFlavour f) {
+  switch (f) {
+    case ScotchFlavour::kDefault:
+      return "default";
+    case ScotchFlavour::kQuality:
+      return "quality";
+    case ScotchFlavour::kSpeed:
+      return "speed";
+    case ScotchFlavour::kBalance:
+      return "balance";
+  }
+  return "?";
+}
+
+ScotchFlavour parse_scotch_flavour(std::string_view s) {
+  if (s == "default") return ScotchFlavour::kDefault;
+  if (s == "quality") return ScotchFlavour::kQuality;
+  if (s == "speed") return ScotchFlavour::kSpeed;
+  if (s == "balance") return ScotchFlavour::kBalance;
+  throw UsageError("--scotch-strategy: expected default, quality, speed or balance, got '" +
+                   std::string(s) + "'");
+}
+
+std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
+  std::unordered_map<StableKey, std::vector<TaskId>> by_key;
+  by_key.reserve(prev.tasks.size());
+  for (TaskId t = 0; t < prev.tasks.size(); ++t) by_key[prev.tasks[t].key].push_back(t);
+  std::unordered_map<StableKey, std::size_t> seen;
+  std::vector<TaskId> match(g.tasks.size(), kNoTask);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    auto it = by_key.find(g.tasks[t].key);
+    if (it == by_key.end()) continue;
+    std::size_t& i = seen[g.tasks[t].key];
+    if (i < it->second.size()) match[t] = it->second[i];
+    ++i;
+  }
+  return match;
+}
+
+Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
+                           const Options& options) {
+  if (k == 0) throw UsageError("k must be at least 1");
+  if ((prev.graph == nullptr) != (prev.assignment == nullptr))
+    throw UsageError("previous step: graph and assignment must be given together");
+  if (prev.graph != nullptr && prev.assignment->proc.size() != prev.graph->tasks.size())
+    throw UsageError("previous step: assignment has " + std::to_string(prev.assignment->proc.size()) +
+                     " tasks, graph has " + std::to_string(prev.graph->tasks.size()));
+  if (!(options.imbalance >= 1.0)) throw UsageError("imbalance tolerance must be >= 1");
+  if (const std::string why = g.validate(); !why.empty())
+    throw UsageError("invalid step graph: " + why);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  Result r = do_partition(g, k, prev, options);
+  const auto t1 = std::chrono::steady_clock::now();
+  r.stats.partition_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+
+  Assignment& a = r.assignment;
+  a.k = k;
+  if (a.proc.size() != g.tasks.size())
+    throw std::logic_error("strategy " + std::string(name()) + " assigned " +
+                           std::to_string(a.proc.size()) + " of " + std::to_string(g.tasks.size()) +
+                           " tasks");
+  for (ProcId p : a.proc)
+    if (p >= k) throw std::logic_error("strategy " + std::string(name()) + " used processor " +
+                                       std::to_string(p) + " >= k");
+
+  if (prev.graph != nullptr) {
+    const std::vector<TaskId> match = match_by_key(g, *prev.graph);
+    r.stats.matched_tasks = 0;
+    r.stats.moved_tasks = 0;
+    for (TaskId t = 0; t < match.size(); ++t) {
+      if (match[t] == kNoTask) continue;
+      ++r.stats.matched_tasks;
+      if (prev.assignment->proc[match[t]] != a.proc[t]) ++r.stats.moved_tasks;
+    }
+  }
+  return r;
+}
+
+TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
+                               const Options& options) {
+  std::unique_ptr<Strategy> s = make_strategy(method);
+  TracePartition out;
+  out.assignment.method = std::string(method);
+  out.assignment.k = k;
+  out.assignment.steps.reserve(trace.steps.size());
+  for (std::size_t i = 0; i < trace.steps.size(); ++i) {
+    Previous prev;
+    if (i > 0) prev = {&trace.steps[i - 1], &out.assignment.steps[i - 1]};
+    Result r = s->partition(trace.steps[i], k, prev, options);
+    out.assignment.partition_ms.push_back(r.stats.partition_ms);
+    out.assignment.steps.push_back(std::move(r.assignment));
+    out.stats.push_back(r.stats);
+  }
+  return out;
+}
+
+namespace detail {
+
+std::vector<std::uint64_t> task_work(const StepGraph& g) {
+  std::vector<std::uint64_t> w(g.tasks.size());
+  for (TaskId t = 0; t < g.tasks.size(); ++t) w[t] = g.tasks[t].cost_ns * g.runs(t);
+  return w;
+}
+
+std::vector<std::uint64_t> loads(const std::vector<std::uint64_t>& work,
+                                 const std::vector<ProcId>& proc, std::uint32_t k) {
+  std::vector<std::uint64_t> l(k, 0);
+  for (std::size_t t = 0; t < proc.size(); ++t) l[proc[t]] += work[t];
+  return l;
+}
+
+double imbalance(const std::vector<std::uint64_t>& load) {
+  std::uint64_t total = 0, max = 0;
+  for (std::uint64_t l : load) {
+    total += l;
+    max = std::max(max, l);
+  }
+  if (total == 0 || load.empty()) return 1.0;
+  return static_cast<double>(max) * static_cast<double>(load.size()) / static_cast<double>(total);
+}
+
+Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k) {
+  Assignment a;
+  a.k = k;
+  a.proc.resize(g.tasks.size());
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc[t] = t % k;
+  return a;
+}
+
+}  // namespace detail
+}  // namespace tgraph::partition
