@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Shared set-up of scripts/demo and scripts/test: Debian packages, configure, build.
+# Sourced, not run. Idempotent: quick when nothing changed.
+set -euo pipefail
+
+TGRAPH_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+TGRAPH_PACKAGES=(cmake g++ ninja-build pkg-config python3
+  libeigen3-dev libmetis-dev metis libscotch-dev scotch libgraphviz-dev graphviz
+  libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libhwloc-dev libcli11-dev nlohmann-json3-dev)
+
+tgraph_install_packages() {
+  local missing=()
+  for p in "${TGRAPH_PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  if [ "$(id -u)" -eq 0 ]; then
+    echo "tgraph: installing ${missing[*]}" >&2
+    DEBIAN_FRONTEND=noninteractive apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  else
+    echo "tgraph: missing Debian packages; run as root:" >&2
+    echo "  apt-get install -y ${missing[*]}" >&2
+    exit 2
+  fi
+}
+
+# tgraph_build PRESET [TARGET...]: configure once, then build incrementally.
+tgraph_build() {
+  local preset="$1"; shift
+  cd "$TGRAPH_ROOT"
+  if [ ! -f "build/$preset/build.ninja" ]; then
+    cmake --preset "$preset" >/dev/null
+  fi
+  local jobs
+  jobs="$(nproc 2>/dev/null || echo 2)"
+  if [ $# -gt 0 ]; then
+    cmake --build "build/$preset" -j "$jobs" --target "$@"
+  else
+    cmake --build "build/$preset" -j "$jobs"
+  fi
+}
