@@ -44,7 +44,8 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
   if (fd < 0) throw InputError(path, std::nullopt, "cannot open: " + errno_text(errno));
   FdGuard guard(fd);
   struct stat st {};
-  if (::fstat(fd, &st) != 0) throw InputError(path, std::nullopt, "cannot stat: " + errno_text(errno));
+  if (::fstat(fd, &st) != 0)
+    throw InputError(path, std::nullopt, "cannot stat: " + errno_text(errno));
   if (S_ISDIR(st.st_mode)) throw InputError(path, std::nullopt, "cannot read: is a directory");
   // Regular files: one allocation of the right size (+1 to see the end of file without
   // growing). Pipes and devices: grow by doubling as read.
@@ -71,7 +72,8 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
   std::string tmp = (folder / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
   const int fd = ::mkstemp(tmp.data());
-  if (fd < 0) throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));
+  if (fd < 0)
+    throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));
   FdGuard guard(fd);
   const auto fail = [&](const std::string& what, int err) {
     ::close(guard.release());

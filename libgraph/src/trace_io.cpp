@@ -54,10 +54,10 @@ enum class FrameType : std::uint32_t { Header = 1, FullStep = 2, ReferenceStep =
 // Smallest encoded size of one element of each counted list: what `count * size <= bytes
 // left` checks before anything is allocated.
 constexpr std::uint64_t kStringMin = 4;
-constexpr std::uint64_t kDatumSize = 4 + 4 + 8;           // name length, object, bytes
-constexpr std::uint64_t kAccessSize = 4 + 1;              // datum, mode
-constexpr std::uint64_t kTaskSize = 4 + 4 + 4 + 4 + 8;    // kind, object, access count, loop, key
-constexpr std::uint64_t kLoopSize = 4 + 4 + 4 + 4;        // condition, first, last, max
+constexpr std::uint64_t kDatumSize = 4 + 4 + 8;         // name length, object, bytes
+constexpr std::uint64_t kAccessSize = 4 + 1;            // datum, mode
+constexpr std::uint64_t kTaskSize = 4 + 4 + 4 + 4 + 8;  // kind, object, access count, loop, key
+constexpr std::uint64_t kLoopSize = 4 + 4 + 4 + 4;      // condition, first, last, max
 constexpr std::uint64_t kCostSize = 8;
 constexpr std::uint64_t kIterationSize = 4;
 constexpr std::uint64_t kContactSize = 8;
@@ -96,7 +96,8 @@ class ByteWriter {
 };
 
 void put_u32_at(std::vector<std::uint8_t>& out, std::size_t at, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i) out[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
+  for (int i = 0; i < 4; ++i)
+    out[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
 // Reserves a frame header at the end of `out`; finish_frame() fills it once the payload
@@ -301,14 +302,16 @@ class Payload {
   std::uint32_t u32(const char* what) {
     need(4, what);
     std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= std::uint32_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
+    for (int i = 0; i < 4; ++i)
+      v |= std::uint32_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
     pos_ += 4;
     return v;
   }
   std::uint64_t u64(const char* what) {
     need(8, what);
     std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= std::uint64_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
+    for (int i = 0; i < 8; ++i)
+      v |= std::uint64_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
     pos_ += 8;
     return v;
   }
@@ -330,7 +333,8 @@ class Payload {
 
 class TraceDecoder {
  public:
-  TraceDecoder(std::span<const std::uint8_t> bytes, const std::string& name, const ReadOptions& options)
+  TraceDecoder(std::span<const std::uint8_t> bytes, const std::string& name,
+               const ReadOptions& options)
       : bytes_(bytes), name_(name), options_(options) {
     const std::uint64_t size = bytes.size();
     budget_ = size > (std::numeric_limits<std::uint64_t>::max() - kDecodedBase) / kDecodedPerByte
@@ -348,12 +352,14 @@ class TraceDecoder {
     for (;;) {
       const std::size_t left = bytes_.size() - pos;
       if (left == 0) {
-        if (!have_header_) fail(pos, "expected a header frame after the file header, found the end of the file");
+        if (!have_header_)
+          fail(pos, "expected a header frame after the file header, found the end of the file");
         return unclosed(pos, "trace not closed");
       }
       if (left < kFrameHeaderSize) {
-        return unclosed(pos, "truncated frame header: expected " + std::to_string(kFrameHeaderSize) +
-                                 " bytes, found " + std::to_string(left));
+        return unclosed(pos, "truncated frame header: expected " +
+                                 std::to_string(kFrameHeaderSize) + " bytes, found " +
+                                 std::to_string(left));
       }
       const std::uint32_t type = get_u32(pos);
       const std::uint32_t length = get_u32(pos + 4);
@@ -365,20 +371,22 @@ class TraceDecoder {
       }
       if (length > left - kFrameHeaderSize) {
         return unclosed(pos, "truncated frame: expected " + std::to_string(length) +
-                                 " payload bytes, found " + std::to_string(left - kFrameHeaderSize));
+                                 " payload bytes, found " +
+                                 std::to_string(left - kFrameHeaderSize));
       }
       const std::size_t begin = pos + kFrameHeaderSize;
       const std::size_t end = begin + length;
       std::uint32_t crc = detail::crc32(bytes_.data() + pos, 8);
       crc = detail::crc32(bytes_.data() + begin, length, crc);
       if (crc != stored_crc) {
-        fail(pos, "checksum mismatch: expected CRC-32 " + hex32(stored_crc) + " (stored in the frame), computed " +
-                      hex32(crc));
+        fail(pos, "checksum mismatch: expected CRC-32 " + hex32(stored_crc) +
+                      " (stored in the frame), computed " + hex32(crc));
       }
       Payload p(*this, bytes_.data(), begin, end);
       const auto frame_type = static_cast<FrameType>(type);
       if (!have_header_ && frame_type != FrameType::Header)
-        fail(pos, "expected the header frame (type 1) first, found frame type " + std::to_string(type));
+        fail(pos,
+             "expected the header frame (type 1) first, found frame type " + std::to_string(type));
       switch (frame_type) {
         case FrameType::Header:
           if (have_header_) fail(pos, "expected a step or end frame, found a second header frame");
@@ -410,20 +418,20 @@ class TraceDecoder {
  private:
   std::uint32_t get_u32(std::size_t at) const {
     std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= std::uint32_t{bytes_[at + static_cast<std::size_t>(i)]} << (8 * i);
+    for (int i = 0; i < 4; ++i)
+      v |= std::uint32_t{bytes_[at + static_cast<std::size_t>(i)]} << (8 * i);
     return v;
   }
 
   void read_file_header() {
     if (bytes_.size() < kFileHeaderSize) {
       fail(0, "truncated file header: expected " + std::to_string(kFileHeaderSize) +
-                  " bytes (magic \"TGTR\", u32 format version), found " + std::to_string(bytes_.size()) +
-                  (bytes_.empty() ? " (empty file)" : ""));
+                  " bytes (magic \"TGTR\", u32 format version), found " +
+                  std::to_string(bytes_.size()) + (bytes_.empty() ? " (empty file)" : ""));
     }
     if (!std::equal(kMagic.begin(), kMagic.end(), bytes_.begin()))
       fail(0, "bad magic: expected \"TGTR\" (" + hex_bytes(kMagic.data(), 4) + "), found " +
-                  hex_bytes(bytes_.data(), 4) +
-                  " (not a .tgt trace)");
+                  hex_bytes(bytes_.data(), 4) + " (not a .tgt trace)");
     const std::uint32_t version = get_u32(4);
     if (version != kFormatVersion)
       fail(4, "unsupported format version " + std::to_string(version) + ": expected " +
@@ -434,7 +442,8 @@ class TraceDecoder {
   Trace unclosed(std::size_t pos, const std::string& what) {
     if (!have_header_) fail(pos, "truncated header frame: " + what);
     if (options_.recover) return std::move(trace_);
-    fail(pos, what + " (" + steps_text(trace_.steps.size()) + "; capture interrupted?) — read with --recover");
+    fail(pos, what + " (" + steps_text(trace_.steps.size()) +
+                  "; capture interrupted?) — read with --recover");
   }
 
   void read_header(Payload& p) {
@@ -493,7 +502,8 @@ class TraceDecoder {
 
   void check_valid(const StepGraph& g, std::size_t frame) const {
     const std::string reason = g.validate();
-    if (!reason.empty()) fail(frame, "invalid step " + std::to_string(trace_.steps.size()) + ": " + reason);
+    if (!reason.empty())
+      fail(frame, "invalid step " + std::to_string(trace_.steps.size()) + ": " + reason);
   }
 
   static std::uint64_t values_memory(const StepGraph& g) {
@@ -505,20 +515,21 @@ class TraceDecoder {
     if (decoded_ > budget_)
       fail(frame, "decoded trace too large: expected at most " + std::to_string(budget_) +
                       " bytes of memory (64 MiB + 128 x file size), step " +
-                      std::to_string(trace_.steps.size()) + " brings it to " + std::to_string(decoded_));
+                      std::to_string(trace_.steps.size()) + " brings it to " +
+                      std::to_string(decoded_));
   }
 
   // Object ids may also be kNoObject.
   void check_object(std::size_t at, std::uint32_t id, std::size_t n, const char* what) const {
     if (id != kNoObject && id >= n)
-      fail(at, std::string("id out of range: expected ") + what + " object id < " + std::to_string(n) +
-                   " or 4294967295 (none), found " + std::to_string(id));
+      fail(at, std::string("id out of range: expected ") + what + " object id < " +
+                   std::to_string(n) + " or 4294967295 (none), found " + std::to_string(id));
   }
 
   void check_id(std::size_t at, std::uint32_t id, std::size_t n, const char* what) const {
     if (id >= n)
-      fail(at, std::string("id out of range: expected ") + what + " < " + std::to_string(n) + ", found " +
-                   std::to_string(id));
+      fail(at, std::string("id out of range: expected ") + what + " < " + std::to_string(n) +
+                   ", found " + std::to_string(id));
   }
 
   void read_structure(Payload& p, StepGraph& g) {
@@ -570,8 +581,8 @@ class TraceDecoder {
       t.access_count = p.u32("u32 task access count");
       if (t.access_count > n_accesses - next_access)
         fail(at, "id out of range: expected task " + std::to_string(i) + " to own at most the " +
-                     std::to_string(n_accesses - next_access) + " accesses left, found access count " +
-                     std::to_string(t.access_count));
+                     std::to_string(n_accesses - next_access) +
+                     " accesses left, found access count " + std::to_string(t.access_count));
       t.access_begin = static_cast<std::uint32_t>(next_access);
       next_access += t.access_count;
       loop_field_at[i] = p.pos();
@@ -579,8 +590,9 @@ class TraceDecoder {
       t.key = p.u64("u64 task stable key");
     }
     if (next_access != n_accesses)
-      fail(p.pos(), "expected the tasks' access counts to add up to the " + std::to_string(n_accesses) +
-                        " accesses, they add up to " + std::to_string(next_access));
+      fail(p.pos(), "expected the tasks' access counts to add up to the " +
+                        std::to_string(n_accesses) + " accesses, they add up to " +
+                        std::to_string(next_access));
 
     const std::uint32_t n_loops = p.count("loops", kLoopSize);
     g.loops.resize(n_loops);
@@ -608,15 +620,17 @@ class TraceDecoder {
       if (l == kNoLoop) continue;
       check_id(loop_field_at[i], l, n_loops, "task loop id (or 4294967295 for none)");
       if (i < g.loops[l].first || i >= g.loops[l].last)
-        fail(loop_field_at[i], "malformed loop " + std::to_string(l) + ": expected task " + std::to_string(i) +
-                                   " marked with it to lie in its body [" + std::to_string(g.loops[l].first) +
-                                   ", " + std::to_string(g.loops[l].last) + ")");
+        fail(loop_field_at[i], "malformed loop " + std::to_string(l) + ": expected task " +
+                                   std::to_string(i) + " marked with it to lie in its body [" +
+                                   std::to_string(g.loops[l].first) + ", " +
+                                   std::to_string(g.loops[l].last) + ")");
     }
     for (std::uint32_t l = 0; l < n_loops; ++l)
       for (TaskId t = g.loops[l].first; t < g.loops[l].last; ++t)
         if (g.tasks[t].loop != l)
-          fail(loop_field_at[t], "malformed loop " + std::to_string(l) + ": expected task " + std::to_string(t) +
-                                     " in its body to be marked with loop " + std::to_string(l));
+          fail(loop_field_at[t], "malformed loop " + std::to_string(l) + ": expected task " +
+                                     std::to_string(t) + " in its body to be marked with loop " +
+                                     std::to_string(l));
   }
 
   void read_step_values(Payload& p, StepGraph& g) {
@@ -630,8 +644,8 @@ class TraceDecoder {
     at = p.pos();
     const std::uint32_t n_iterations = p.count("loop iteration counts", kIterationSize);
     if (n_iterations != g.loops.size())
-      fail(at, "expected " + std::to_string(g.loops.size()) + " loop iteration counts (one per loop), found " +
-                   std::to_string(n_iterations));
+      fail(at, "expected " + std::to_string(g.loops.size()) +
+                   " loop iteration counts (one per loop), found " + std::to_string(n_iterations));
     for (auto& l : g.loops) l.iterations = p.u32("u32 loop iterations");
 
     const std::uint32_t n_contacts = p.count("contacts", kContactSize);
@@ -648,8 +662,8 @@ class TraceDecoder {
     at = p.pos();
     const std::uint32_t n_groups = p.count("groups", kGroupSize);
     if (n_groups != 0 && n_groups != g.objects.size())
-      fail(at, "expected 0 or " + std::to_string(g.objects.size()) + " collision groups (one per object), found " +
-                   std::to_string(n_groups));
+      fail(at, "expected 0 or " + std::to_string(g.objects.size()) +
+                   " collision groups (one per object), found " + std::to_string(n_groups));
     g.groups.resize(n_groups);
     for (auto& group : g.groups) group = p.u32("u32 collision group");
   }
@@ -675,8 +689,9 @@ std::uint32_t Payload::count(const char* what, std::uint64_t min_size) {
   const std::uint32_t n = u32("u32 count");
   const std::uint64_t fits = left() / min_size;
   if (n > fits)
-    dec_.fail(at, std::string("absurd count: expected at most ") + std::to_string(fits) + " " + what +
-                      " in the " + std::to_string(left()) + " bytes left in the frame, found " + std::to_string(n));
+    dec_.fail(at, std::string("absurd count: expected at most ") + std::to_string(fits) + " " +
+                      what + " in the " + std::to_string(left()) +
+                      " bytes left in the frame, found " + std::to_string(n));
   return n;
 }
 
@@ -684,8 +699,9 @@ std::string Payload::str(const char* what) {
   const std::size_t at = pos_;
   const std::uint32_t n = u32("u32 string length");
   if (n > left())
-    dec_.fail(at, std::string("absurd count: expected a ") + what + " of at most " + std::to_string(left()) +
-                      " bytes (left in the frame), found length " + std::to_string(n));
+    dec_.fail(at, std::string("absurd count: expected a ") + what + " of at most " +
+                      std::to_string(left()) + " bytes (left in the frame), found length " +
+                      std::to_string(n));
   std::string s(reinterpret_cast<const char*>(file_ + pos_), n);
   pos_ += n;
   return s;
@@ -729,7 +745,8 @@ struct TraceWriter::Impl {
   }
 };
 
-TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header) : impl_(std::make_unique<Impl>()) {
+TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header)
+    : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
   impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (impl_->fd < 0) throw Error(path + ": cannot create: " + std::strerror(errno));
@@ -786,10 +803,12 @@ std::vector<std::uint8_t> encode_trace(const Trace& trace) {
 
 void write_trace(const std::string& path, const Trace& trace) {
   const std::vector<std::uint8_t> bytes = encode_trace(trace);
-  write_file_atomic(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  write_file_atomic(path,
+                    std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
-Trace read_trace_bytes(std::span<const std::uint8_t> bytes, const std::string& name, const ReadOptions& options) {
+Trace read_trace_bytes(std::span<const std::uint8_t> bytes, const std::string& name,
+                       const ReadOptions& options) {
   return TraceDecoder(bytes, name, options).decode();
 }
 

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The .tgt format: round trips, structure dedupe, streaming, and every class of corruption.
+#include "tgraph/graph/trace_io.hpp"
+
 #include <gtest/gtest.h>
 #include <sys/resource.h>
 
@@ -13,7 +15,6 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/graph/trace_io.hpp"
 
 namespace tgraph {
 namespace {
@@ -34,7 +35,8 @@ StepGraph make_step(int variant, int salt) {
   const int n_objects = 3 + variant;
   for (int o = 0; o < n_objects; ++o) g.objects.push_back({"body" + std::to_string(o)});
   for (int o = 0; o < n_objects; ++o)
-    g.data.push_back({"x" + std::to_string(o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
+    g.data.push_back(
+        {"x" + std::to_string(o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
   const auto r = static_cast<DatumId>(g.data.size());
   g.data.push_back({"cg.r", kNoObject, 8});
   const auto done = static_cast<DatumId>(g.data.size());
@@ -49,7 +51,8 @@ StepGraph make_step(int variant, int salt) {
   loop.first = static_cast<TaskId>(g.tasks.size());
   for (int o = 0; o < n_objects; ++o) {
     std::vector<Access> acc{{static_cast<DatumId>(o), M::R}, {r, M::CW}};
-    const TaskId t = g.add_task(dot, static_cast<ObjectId>(o), acc, cost(10 + o), 2000u + static_cast<unsigned>(o));
+    const TaskId t = g.add_task(dot, static_cast<ObjectId>(o), acc, cost(10 + o),
+                                2000u + static_cast<unsigned>(o));
     g.tasks[t].loop = 0;
   }
   std::vector<Access> acc{{r, M::R}, {done, M::W}, {done, M::R}};
@@ -63,7 +66,8 @@ StepGraph make_step(int variant, int salt) {
   if (salt % 2 == 0) g.contacts.push_back({0, 1});
   if (salt % 3 == 0) g.contacts.push_back({1, 2});
   if (salt % 4 != 1)
-    for (int o = 0; o < n_objects; ++o) g.groups.push_back(static_cast<std::uint32_t>((o + salt) % 2));
+    for (int o = 0; o < n_objects; ++o)
+      g.groups.push_back(static_cast<std::uint32_t>((o + salt) % 2));
   return g;
 }
 
@@ -144,9 +148,13 @@ Bytes frame(std::uint32_t type, const Bytes& payload) {
   return head.raw(payload).b;
 }
 
-Bytes file_header(std::uint32_t version = 1) { return Buf().u8('T').u8('G').u8('T').u8('R').u32(version).b; }
+Bytes file_header(std::uint32_t version = 1) {
+  return Buf().u8('T').u8('G').u8('T').u8('R').u32(version).b;
+}
 
-Bytes header_frame() { return frame(1, Buf().str("scene").str("engine").str("machine").str("0.1.0").b); }
+Bytes header_frame() {
+  return frame(1, Buf().str("scene").str("engine").str("machine").str("0.1.0").b);
+}
 
 Bytes end_frame(std::uint32_t steps) { return frame(4, Buf().u32(steps).b); }
 
@@ -192,7 +200,8 @@ struct RawStep {
     w.u32(static_cast<std::uint32_t>(accesses.size()));
     for (const auto& a : accesses) w.u32(a.datum).u8(a.mode);
     w.u32(static_cast<std::uint32_t>(tasks.size()));
-    for (const auto& t : tasks) w.u32(t.kind).u32(t.object).u32(t.access_count).u32(t.loop).u64(t.key);
+    for (const auto& t : tasks)
+      w.u32(t.kind).u32(t.object).u32(t.access_count).u32(t.loop).u64(t.key);
     w.u32(static_cast<std::uint32_t>(loops.size()));
     for (const auto& l : loops) w.u32(l.condition).u32(l.first).u32(l.last).u32(l.max_iterations);
     return w.b;
@@ -210,7 +219,9 @@ struct RawStep {
     return w.b;
   }
   Bytes full_frame() const { return frame(2, Buf().raw(structure()).raw(values()).b); }
-  Bytes reference_frame(std::uint32_t ref) const { return frame(3, Buf().u32(ref).raw(values()).b); }
+  Bytes reference_frame(std::uint32_t ref) const {
+    return frame(3, Buf().u32(ref).raw(values()).b);
+  }
 };
 
 // A complete trace of the given step frames.
@@ -226,7 +237,8 @@ Bytes trace_of(const RawStep& s) { return trace_of({s.full_frame()}, 1); }
 // Frame types of an encoded trace, walking the 12-byte frame headers.
 std::vector<std::uint32_t> frame_types(const Bytes& b) {
   std::vector<std::uint32_t> types;
-  for (std::size_t pos = 8; pos + 12 <= b.size(); pos += 12 + get_u32(b, pos + 4)) types.push_back(get_u32(b, pos));
+  for (std::size_t pos = 8; pos + 12 <= b.size(); pos += 12 + get_u32(b, pos + 4))
+    types.push_back(get_u32(b, pos));
   return types;
 }
 
@@ -262,11 +274,11 @@ constexpr bool kSanitized = false;
   std::_Exit(1);
 }
 
-#define EXPECT_READ_ERROR(bytes, substring)                                 \
-  do {                                                                      \
-    const std::string msg_ = read_error(bytes);                             \
+#define EXPECT_READ_ERROR(bytes, substring)                                    \
+  do {                                                                         \
+    const std::string msg_ = read_error(bytes);                                \
     EXPECT_NE(msg_.find(substring), std::string::npos) << "message: " << msg_; \
-    EXPECT_EQ(msg_.find('\n'), std::string::npos) << msg_;                  \
+    EXPECT_EQ(msg_.find('\n'), std::string::npos) << msg_;                     \
   } while (0)
 
 // ---- round trips ------------------------------------------------------------------------
@@ -279,7 +291,8 @@ TEST(TraceIo, RoundTripKeepsCostsLoopsContactsGroupsAndEdges) {
   write_trace(p.string(), trace);
   const Trace back = read_trace(p.string());
   ASSERT_EQ(back.steps.size(), trace.steps.size());
-  for (std::size_t i = 0; i < trace.steps.size(); ++i) EXPECT_EQ(back.steps[i], trace.steps[i]) << "step " << i;
+  for (std::size_t i = 0; i < trace.steps.size(); ++i)
+    EXPECT_EQ(back.steps[i], trace.steps[i]) << "step " << i;
   EXPECT_EQ(back.header, trace.header);
   EXPECT_EQ(back, trace);
   EXPECT_EQ(back.steps[3].loops[0].iterations, 4u);
@@ -348,7 +361,9 @@ TEST(TraceWriter, CompleteFramesReadBackBeforeClose) {
   for (const auto& s : trace.steps) w.append(s);
   const Bytes open_bytes = slurp(p);
   EXPECT_EQ(open_bytes.size(), w.bytes_written());
-  EXPECT_READ_ERROR(open_bytes, "trace not closed (3 complete steps; capture interrupted?) — read with --recover");
+  EXPECT_READ_ERROR(
+      open_bytes,
+      "trace not closed (3 complete steps; capture interrupted?) — read with --recover");
   ReadOptions recover;
   recover.recover = true;
   EXPECT_EQ(read_trace(p.string(), recover), trace);
@@ -436,7 +451,8 @@ TEST(TraceReader, RejectsATruncatedFrame) {
   const Bytes cut(whole.begin(), whole.begin() + static_cast<std::ptrdiff_t>(step_frame + 20));
   EXPECT_READ_ERROR(cut, "offset " + std::to_string(step_frame) + ": truncated frame: expected ");
   EXPECT_READ_ERROR(cut, "(0 complete steps; capture interrupted?) — read with --recover");
-  const Bytes cut_header(whole.begin(), whole.begin() + static_cast<std::ptrdiff_t>(step_frame + 5));
+  const Bytes cut_header(whole.begin(),
+                         whole.begin() + static_cast<std::ptrdiff_t>(step_frame + 5));
   EXPECT_READ_ERROR(cut_header, "truncated frame header: expected 12 bytes, found 5");
   const Bytes in_header_frame(whole.begin(), whole.begin() + 15);
   EXPECT_READ_ERROR(in_header_frame, "offset 8: truncated header frame");
@@ -447,7 +463,8 @@ TEST(TraceReader, RejectsAChecksumMismatch) {
   Bytes b = trace_of(RawStep{});
   const std::size_t step_frame = 8 + header_frame().size();
   b[step_frame + 12 + 5] ^= 0x40;  // a byte inside the payload
-  EXPECT_READ_ERROR(b, "offset " + std::to_string(step_frame) + ": checksum mismatch: expected CRC-32 0x");
+  EXPECT_READ_ERROR(
+      b, "offset " + std::to_string(step_frame) + ": checksum mismatch: expected CRC-32 0x");
   EXPECT_NE(read_error(b, true).find("checksum mismatch"), std::string::npos);  // not recoverable
   Bytes c = trace_of(RawStep{});
   c[step_frame + 8] ^= 1;  // the stored checksum itself
@@ -456,8 +473,9 @@ TEST(TraceReader, RejectsAChecksumMismatch) {
 
 TEST(TraceReader, RejectsAnUnknownFrameType) {
   RawStep s;
-  EXPECT_READ_ERROR(trace_of({frame(9, Bytes{1, 2, 3})}, 0),
-                    "unknown frame type 9: expected 1 (header), 2 (full step), 3 (reference step) or 4 (end)");
+  EXPECT_READ_ERROR(
+      trace_of({frame(9, Bytes{1, 2, 3})}, 0),
+      "unknown frame type 9: expected 1 (header), 2 (full step), 3 (reference step) or 4 (end)");
   EXPECT_READ_ERROR(trace_of({frame(0, Bytes{})}, 0), "unknown frame type 0");
 }
 
@@ -500,15 +518,18 @@ TEST(TraceReader, RejectsAbsurdCountsWithoutAllocatingForThem) {
     EXPECT_NE(msg.find("found 4294967295"), std::string::npos) << msg;
     // Reserving first would ask for 4294967295 elements (>= 20 GiB): fatal under the cap.
     if (!kSanitized) {
-      EXPECT_EXIT(read_with_memory_cap(b, "absurd count"), ::testing::ExitedWithCode(0), "") << what;
+      EXPECT_EXIT(read_with_memory_cap(b, "absurd count"), ::testing::ExitedWithCode(0), "")
+          << what;
     }
   }
   // A string length larger than the frame.
   Bytes payload = Buf().raw(structure).raw(values).b;
   for (int i = 4; i < 8; ++i) payload[static_cast<std::size_t>(i)] = 0xFF;
-  EXPECT_READ_ERROR(trace_of({frame(2, payload)}, 1), "absurd count: expected a kind name of at most");
+  EXPECT_READ_ERROR(trace_of({frame(2, payload)}, 1),
+                    "absurd count: expected a kind name of at most");
   // The same in the header frame.
-  Bytes header = Buf().raw(file_header()).raw(frame(1, Buf().u32(0xFFFFFFFFu).b)).raw(end_frame(0)).b;
+  Bytes header =
+      Buf().raw(file_header()).raw(frame(1, Buf().u32(0xFFFFFFFFu).b)).raw(end_frame(0)).b;
   EXPECT_READ_ERROR(header, "offset 20: absurd count: expected a scene string of at most 0 bytes");
 }
 
@@ -521,7 +542,8 @@ TEST(TraceReader, RejectsKindIdOutOfRange) {
 TEST(TraceReader, RejectsObjectIdOutOfRange) {
   RawStep s;
   s.tasks[1].object = 7;
-  EXPECT_READ_ERROR(trace_of(s), "id out of range: expected task object id < 2 or 4294967295 (none), found 7");
+  EXPECT_READ_ERROR(trace_of(s),
+                    "id out of range: expected task object id < 2 or 4294967295 (none), found 7");
   RawStep d;
   d.data[0].object = 2;
   EXPECT_READ_ERROR(trace_of(d), "expected datum object id < 2");
@@ -542,13 +564,15 @@ TEST(TraceReader, RejectsDatumIdOutOfRange) {
 TEST(TraceReader, RejectsLoopIdOutOfRange) {
   RawStep s;
   s.tasks[1].loop = 1;
-  EXPECT_READ_ERROR(trace_of(s), "id out of range: expected task loop id (or 4294967295 for none) < 1, found 1");
+  EXPECT_READ_ERROR(trace_of(s),
+                    "id out of range: expected task loop id (or 4294967295 for none) < 1, found 1");
 }
 
 TEST(TraceReader, RejectsTaskIdsOfALoopOutOfRange) {
   RawStep s;
   s.loops[0].last = 3;
-  EXPECT_READ_ERROR(trace_of(s), "malformed loop 0: expected first < last <= 2 tasks, found [1, 3)");
+  EXPECT_READ_ERROR(trace_of(s),
+                    "malformed loop 0: expected first < last <= 2 tasks, found [1, 3)");
 }
 
 TEST(TraceReader, RejectsMalformedLoops) {
@@ -558,17 +582,21 @@ TEST(TraceReader, RejectsMalformedLoops) {
   RawStep overlap;
   overlap.loops.push_back({1, 1, 2, 0});
   overlap.iterations.push_back(1);
-  EXPECT_READ_ERROR(trace_of(overlap), "malformed loop 1: expected its body to start at or after task 2");
+  EXPECT_READ_ERROR(trace_of(overlap),
+                    "malformed loop 1: expected its body to start at or after task 2");
   RawStep unmarked;
   unmarked.tasks[1].loop = kNone;
-  EXPECT_READ_ERROR(trace_of(unmarked), "malformed loop 0: expected task 1 in its body to be marked with loop 0");
+  EXPECT_READ_ERROR(trace_of(unmarked),
+                    "malformed loop 0: expected task 1 in its body to be marked with loop 0");
   RawStep outside;
   outside.tasks[0].loop = 0;
-  EXPECT_READ_ERROR(trace_of(outside), "malformed loop 0: expected task 0 marked with it to lie in its body [1, 2)");
+  EXPECT_READ_ERROR(trace_of(outside),
+                    "malformed loop 0: expected task 0 marked with it to lie in its body [1, 2)");
   // Deeper rules come from StepGraph::validate().
   RawStep no_read;
   no_read.accesses[3].mode = 1;  // the break task writes but no longer reads the condition
-  EXPECT_READ_ERROR(trace_of(no_read), "invalid step 0: loop 0: last body task does not read the condition");
+  EXPECT_READ_ERROR(trace_of(no_read),
+                    "invalid step 0: loop 0: last body task does not read the condition");
   RawStep zero;
   zero.iterations[0] = 0;
   EXPECT_READ_ERROR(trace_of(zero), "invalid step 0: loop 0: zero iterations");
@@ -576,16 +604,20 @@ TEST(TraceReader, RejectsMalformedLoops) {
 
 TEST(TraceReader, RejectsAReferenceToANonExistentStep) {
   RawStep s;
-  EXPECT_READ_ERROR(trace_of({s.full_frame(), s.reference_frame(1)}, 2),
-                    "reference to a non-existent step: expected an earlier step index < 1, found 1");
-  EXPECT_READ_ERROR(trace_of({s.full_frame(), s.reference_frame(0xFFFFFFFFu)}, 2), "found 4294967295");
+  EXPECT_READ_ERROR(
+      trace_of({s.full_frame(), s.reference_frame(1)}, 2),
+      "reference to a non-existent step: expected an earlier step index < 1, found 1");
+  EXPECT_READ_ERROR(trace_of({s.full_frame(), s.reference_frame(0xFFFFFFFFu)}, 2),
+                    "found 4294967295");
 }
 
 TEST(TraceReader, RejectsAMissingEndFrameUnlessRecovering) {
   RawStep s;
-  Bytes b = Buf().raw(file_header()).raw(header_frame()).raw(s.full_frame()).raw(s.reference_frame(0)).b;
-  EXPECT_READ_ERROR(b, "offset " + std::to_string(b.size()) +
-                           ": trace not closed (2 complete steps; capture interrupted?) — read with --recover");
+  Bytes b =
+      Buf().raw(file_header()).raw(header_frame()).raw(s.full_frame()).raw(s.reference_frame(0)).b;
+  EXPECT_READ_ERROR(
+      b, "offset " + std::to_string(b.size()) +
+             ": trace not closed (2 complete steps; capture interrupted?) — read with --recover");
   ReadOptions recover;
   recover.recover = true;
   EXPECT_EQ(read_trace_bytes(b, "t", recover).steps.size(), 2u);
@@ -600,14 +632,18 @@ TEST(TraceReader, RejectsFramesOutOfPlace) {
   EXPECT_READ_ERROR(trace_of({s.full_frame()}, 2), "end frame count mismatch: expected 1 steps");
   Bytes trailing = trace_of(s);
   trailing.push_back(0);
-  EXPECT_READ_ERROR(trailing, "expected the end of the file after the end frame, found 1 more bytes");
+  EXPECT_READ_ERROR(trailing,
+                    "expected the end of the file after the end frame, found 1 more bytes");
   EXPECT_READ_ERROR(trace_of({header_frame()}, 0), "found a second header frame");
   const Bytes step_first = Buf().raw(file_header()).raw(s.full_frame()).raw(end_frame(1)).b;
-  EXPECT_READ_ERROR(step_first, "offset 8: expected the header frame (type 1) first, found frame type 2");
-  const Bytes extra_payload = trace_of({frame(2, Buf().raw(s.structure()).raw(s.values()).u8(0).b)}, 1);
+  EXPECT_READ_ERROR(step_first,
+                    "offset 8: expected the header frame (type 1) first, found frame type 2");
+  const Bytes extra_payload =
+      trace_of({frame(2, Buf().raw(s.structure()).raw(s.values()).u8(0).b)}, 1);
   EXPECT_READ_ERROR(extra_payload, "expected the frame payload to end here, found 1 unread bytes");
   const Bytes short_payload = trace_of({frame(2, s.structure())}, 1);
-  EXPECT_READ_ERROR(short_payload, "truncated payload: expected u32 count (4 bytes), the frame has 0 left");
+  EXPECT_READ_ERROR(short_payload,
+                    "truncated payload: expected u32 count (4 bytes), the frame has 0 left");
 }
 
 TEST(TraceReader, RejectsInconsistentLists) {
@@ -616,16 +652,20 @@ TEST(TraceReader, RejectsInconsistentLists) {
   EXPECT_READ_ERROR(trace_of(mode), "expected access mode 0..3 (R, W, RW, CW), found 7");
   RawStep sum;
   sum.tasks[1].access_count = 2;
-  EXPECT_READ_ERROR(trace_of(sum), "expected the tasks' access counts to add up to the 4 accesses, they add up to 3");
+  EXPECT_READ_ERROR(
+      trace_of(sum),
+      "expected the tasks' access counts to add up to the 4 accesses, they add up to 3");
   RawStep over;
   over.tasks[0].access_count = 5;
-  EXPECT_READ_ERROR(trace_of(over), "expected task 0 to own at most the 4 accesses left, found access count 5");
+  EXPECT_READ_ERROR(trace_of(over),
+                    "expected task 0 to own at most the 4 accesses left, found access count 5");
   RawStep costs;
   costs.costs.pop_back();
   EXPECT_READ_ERROR(trace_of(costs), "expected 2 task costs (one per task), found 1");
   RawStep iterations;
   iterations.iterations.push_back(1);
-  EXPECT_READ_ERROR(trace_of(iterations), "expected 1 loop iteration counts (one per loop), found 2");
+  EXPECT_READ_ERROR(trace_of(iterations),
+                    "expected 1 loop iteration counts (one per loop), found 2");
   RawStep groups;
   groups.groups.push_back(0);
   EXPECT_READ_ERROR(trace_of(groups), "expected 0 or 2 collision groups (one per object), found 3");
@@ -722,7 +762,8 @@ TEST(TraceReader, RejectsEachCommittedBrokenTrace) {
       {"bad_loop.tgt", "malformed loop 0"},
       {"bad_reference.tgt", "reference to a non-existent step"},
       {"truncated.tgt", "truncated frame"},
-      {"interrupted.tgt", "trace not closed (2 complete steps; capture interrupted?) — read with --recover"},
+      {"interrupted.tgt",
+       "trace not closed (2 complete steps; capture interrupted?) — read with --recover"},
   };
   for (const auto& [file, substring] : cases) {
     const fs::path p = data_dir() / file;
@@ -754,7 +795,8 @@ TEST(FileUtil, ReadFileBytesNamesAMissingFile) {
     read_file_bytes("/nonexistent-folder/none.bin");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/none.bin: cannot open"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("/nonexistent-folder/none.bin: cannot open"),
+              std::string::npos);
   }
   EXPECT_THROW(read_file_bytes(::testing::TempDir()), InputError);  // a directory
 }
