@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: MIT
+// Executors: run the tasks of a step graph on threads under one Policy.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/lowering.hpp"
+#include "tgraph/replay/observer.hpp"
+#include "tgraph/replay/policy.hpp"
+#include "tgraph/replay/workload.hpp"
+
+namespace tgraph::replay {
+
+/// Default spin time before a waiting thread parks in the kernel (see docs/replay.md and
+/// bench/replay: a futex hand-off costs 9-36 µs on this machine, a spinning one 0.1 µs).
+inline constexpr std::int64_t kDefaultSpinNs = 50'000;
+
+/// How an executor runs.
+struct ExecOptions {
+  std::uint32_t threads = 1;          ///< threads (processors); partition: must equal Assignment::k
+  bool pin = true;                    ///< bind thread p to a core with hwloc (partition, barrier)
+  std::int64_t spin_ns = kDefaultSpinNs;  ///< spin this long before parking (0: park at once)
+  std::optional<CwMode> cw;           ///< default: kReduce for partition, kSerialize otherwise
+  /// Partition only: run the per-processor programs interleaved on the calling thread
+  /// (deterministic, same plans and waits; the serial twin of the threaded executor).
+  bool serial = false;
+};
+
+/// Counters of one thread in one step, kept by the executor itself.
+struct ThreadCounters {
+  std::uint64_t tasks = 0;          ///< task instances run
+  std::uint64_t signals = 0;        ///< completion counters published for other threads
+  std::uint64_t waits = 0;          ///< cross-thread wait points passed
+  std::uint64_t blocked_waits = 0;  ///< waits whose condition did not hold at once
+  std::uint64_t parks = 0;          ///< blocked waits that slept in the kernel
+  std::int64_t wait_ns = 0;         ///< time in blocked waits
+};
+
+/// What one step cost.
+struct StepStats {
+  std::int64_t wall_ns = 0;        ///< whole step, structure build included
+  std::int64_t build_ns = 0;       ///< lowering + plan build (0 when the plan was reused)
+  bool rebuilt = false;            ///< a new plan was built for this step
+  std::vector<ThreadCounters> threads;
+  std::vector<std::uint32_t> loop_iterations;  ///< iterations each loop ran
+  /// Sums over threads.
+  std::uint64_t signals() const;
+  std::uint64_t waits() const;
+  std::uint64_t blocked_waits() const;
+  std::uint64_t parks() const;
+  std::int64_t wait_ns() const;
+};
+
+/// Runs steps. The structure of a step (lowering, per-thread task lists, signal and wait
+/// points, phases) is built once per distinct (structure, assignment) and reused while it
+/// repeats, as in the paper (section 3.2); its build time is part of the step's wall time.
+///
+///   auto ex = make_executor(Policy::kPartition, {.threads = 2});
+///   SyntheticWorkload w;
+///   w.set_step(g);
+///   StepStats s = ex->run_step(g, &assignment, w);
+///
+/// An exception thrown by a task (or a loop condition) stops the step; every thread is
+/// joined and the first exception is rethrown by run_step.
+class Executor {
+ public:
+  virtual ~Executor();
+  Executor(const Executor&) = delete;
+  Executor& operator=(const Executor&) = delete;
+
+  /// The policy this executor implements.
+  Policy policy() const { return policy_; }
+  /// Number of threads.
+  std::uint32_t threads() const { return options_.threads; }
+  /// Options in force.
+  const ExecOptions& options() const { return options_; }
+  /// Adds an observer (not owned; must outlive the executor's use).
+  void add_observer(Observer& observer) { observers_.push_back(&observer); }
+  /// Removes every observer.
+  void clear_observers() { observers_.clear(); }
+
+  /// Runs one step of `g` (edges derived). `a` is required by Policy::kPartition
+  /// (a->k == threads()) and ignored by the others. Throws UsageError on a bad assignment.
+  StepStats run_step(const StepGraph& g, const Assignment* a, Workload& w);
+
+  /// Number of plans built so far.
+  std::uint64_t plans_built() const { return plans_built_; }
+  /// The exec graph of the last step.
+  const ExecGraph* last_exec() const { return last_exec_; }
+
+ protected:
+  Executor(Policy policy, ExecOptions options);
+  /// Builds the policy's plan for `x` (called on a cache miss). Returns an opaque plan.
+  virtual std::shared_ptr<void> build(const ExecGraph& x) = 0;
+  /// Runs one step with a plan. Fills `stats.threads` and `stats.loop_iterations`.
+  virtual void execute(void* plan, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) = 0;
+  /// The CW mode this executor uses.
+  CwMode cw_mode() const;
+
+  std::vector<Observer*> observers_;
+  ExecOptions options_;
+
+ private:
+  struct CacheEntry;
+  Policy policy_;
+  std::vector<std::shared_ptr<CacheEntry>> cache_;
+  std::uint64_t plans_built_ = 0;
+  const ExecGraph* last_exec_ = nullptr;
+};
+
+/// Creates an executor; throws UsageError for threads == 0 (or != 1 for sequential).
+std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options);
+
+/// Thread p's processing unit under pinning (hwloc, one PU per core first), for reports.
+int pinned_pu(std::uint32_t p);
+
+}  // namespace tgraph::replay

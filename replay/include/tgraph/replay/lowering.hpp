@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+// The graph an executor actually runs: cumulative writes made safe for threads.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/policy.hpp"
+
+namespace tgraph::replay {
+
+inline constexpr std::uint32_t kNoReduction = std::numeric_limits<std::uint32_t>::max();
+
+/// A reducer task: target += temps[0] + temps[1] + ... (in this fixed order), then each
+/// temporary is reset to zero for its next use.
+struct Reduction {
+  DatumId target = 0;               ///< exec datum id (same as the original)
+  std::vector<DatumId> temps;       ///< exec datum ids, in increasing processor order
+};
+
+/// A step graph after lowering, with the maps back to the original step.
+///
+/// Paper section 3.2: "cumulative writes by tasks on different processors go to temporary
+/// copies, and a reduction task is added". Lowering with CwMode::kReduce does exactly that
+/// for every group of consecutive CW writers of one datum that spans several processors:
+/// writers off the group's home processor (the first writer's) write a per-processor
+/// temporary, and a `reduce` task on the home processor adds them in processor order.
+/// CwMode::kSerialize turns every CW into RW instead (writers in program order).
+struct ExecGraph {
+  StepGraph graph;                       ///< edges derived
+  std::vector<TaskId> origin;            ///< exec task -> original task (kNoTask: reducer)
+  std::vector<std::uint32_t> reduction;  ///< exec task -> index in reductions, or kNoReduction
+  std::vector<Reduction> reductions;
+  std::vector<DatumId> datum_origin;     ///< exec datum -> original datum (a temp: its target)
+  std::vector<TaskId> exec_of;           ///< original task -> exec task
+  Assignment assignment;                 ///< the assignment on exec tasks (k = 1 when none)
+};
+
+/// Lowers `g` (edges derived) for assignment `a` (nullptr: everything on processor 0).
+/// With kReduce, reducers are only needed where a CW group spans processors.
+ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode);
+
+}  // namespace tgraph::replay

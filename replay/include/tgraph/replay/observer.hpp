@@ -1,0 +1,161 @@
+// SPDX-License-Identifier: MIT
+// Observers of an executor: timelines, per-thread counters and locality are computed here,
+// from read-only callbacks, never by code inside the executors' hot loops.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/lowering.hpp"
+
+namespace tgraph::replay {
+
+/// Nanoseconds on the steady clock (the time base of every callback).
+std::int64_t now_ns();
+
+/// Receives the events of an executor. Callbacks for different `thread` values may come
+/// concurrently; callbacks for one thread come in order from that thread. Instances of one
+/// task (its loop iterations) never overlap.
+///
+///   TimelineObserver timeline;
+///   executor->add_observer(timeline);
+///   executor->run_step(g, &a, workload);
+///   write_file_atomic("r.json", timeline.to_json());
+class Observer {
+ public:
+  virtual ~Observer() = default;
+  /// Before the first task of a step (calling thread). `exec` stays valid until on_step_end.
+  virtual void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) {
+    (void)exec, (void)threads, (void)t_ns;
+  }
+  /// A task instance starts on `thread`.
+  virtual void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+    (void)thread, (void)task, (void)iteration, (void)t_ns;
+  }
+  /// A task instance ends on `thread`.
+  virtual void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+    (void)thread, (void)task, (void)iteration, (void)t_ns;
+  }
+  /// `thread` waited from t0 to t1 before running `task` (only waits that did not succeed at
+  /// once are reported; `parked` = it slept in the kernel).
+  virtual void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) {
+    (void)thread, (void)task, (void)t0, (void)t1, (void)parked;
+  }
+  /// After the last task of the step, once every thread is done (calling thread).
+  virtual void on_step_end(std::int64_t t_ns) { (void)t_ns; }
+};
+
+/// Per-thread busy / waiting / idle time of each step.
+class StatsObserver : public Observer {
+ public:
+  /// Per-thread totals of one step.
+  struct Thread {
+    std::int64_t busy_ns = 0;
+    std::int64_t wait_ns = 0;
+    std::int64_t idle_ns = 0;  ///< step wall time minus busy and waiting
+    std::uint64_t tasks = 0;
+  };
+  void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
+  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) override;
+  void on_step_end(std::int64_t t_ns) override;
+  /// The last step's per-thread figures.
+  const std::vector<Thread>& threads() const { return last_; }
+
+ private:
+  struct alignas(64) Slot {
+    std::int64_t begin = 0;
+    Thread t;
+  };
+  std::vector<Slot> slots_;
+  std::vector<Thread> last_;
+  std::int64_t step_begin_ = 0;
+};
+
+/// Data locality of each step, from which thread ran each task instance:
+/// remote bytes = bytes a task reads (RAW edge) that a different thread wrote in this step;
+/// migrated bytes = bytes of data whose owner thread (the thread of its first writer in the
+/// step) differs from the previous step's.
+class LocalityObserver : public Observer {
+ public:
+  void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_step_end(std::int64_t t_ns) override;
+  /// Remote bytes of the last step.
+  std::uint64_t remote_bytes() const { return remote_; }
+  /// Migrated bytes of the last step (0 for the first step).
+  std::uint64_t migrated_bytes() const { return migrated_; }
+
+ private:
+  const ExecGraph* exec_ = nullptr;
+  std::vector<std::vector<std::uint16_t>> where_;  // exec task -> thread per iteration
+  std::vector<std::uint32_t> prev_owner_;          // original datum -> owner thread, last step
+  std::uint64_t remote_ = 0;
+  std::uint64_t migrated_ = 0;
+};
+
+/// One task instance in a timeline.
+struct TimelineEvent {
+  std::uint32_t step = 0;
+  std::uint32_t thread = 0;
+  TaskId task = 0;           ///< exec task
+  TaskId origin = kNoTask;   ///< original task (kNoTask: reducer)
+  std::uint32_t iteration = 0;
+  std::int64_t start_ns = 0;  ///< from the start of the step
+  std::int64_t end_ns = 0;
+};
+
+/// One blocking wait in a timeline.
+struct TimelineWait {
+  std::uint32_t step = 0;
+  std::uint32_t thread = 0;
+  TaskId task = 0;
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  bool parked = false;
+};
+
+/// Records every task instance (thread, start, end) and every blocking wait.
+class TimelineObserver : public Observer {
+ public:
+  void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
+  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) override;
+  void on_step_end(std::int64_t t_ns) override;
+
+  /// Every event recorded so far, step by step, sorted by start time within a step.
+  const std::vector<TimelineEvent>& events() const { return events_; }
+  const std::vector<TimelineWait>& waits() const { return waits_; }
+  /// Kind names by exec task of the last step (for labels).
+  const std::vector<std::string>& labels() const { return labels_; }
+  /// Number of threads seen.
+  std::uint32_t threads() const { return threads_; }
+  /// Keeps at most this many steps (older steps are not recorded); default unlimited.
+  void set_max_steps(std::uint32_t n) { max_steps_ = n; }
+  /// The timeline as JSON: {"threads", "steps", "tasks": [{step, thread, task, origin,
+  /// kind, iteration, start_ns, end_ns}], "waits": [...]}.
+  std::string to_json() const;
+  /// Chrome / Perfetto trace-event JSON (one complete event "X" per task, times in µs).
+  std::string to_chrome_json() const;
+
+ private:
+  std::vector<std::vector<TimelineEvent>> per_thread_;
+  std::vector<std::vector<TimelineWait>> waits_per_thread_;
+  std::vector<TimelineEvent> events_;
+  std::vector<TimelineWait> waits_;
+  std::vector<std::int64_t> open_;  // start of the running task, per thread (8 apart)
+  std::vector<std::string> labels_;
+  const ExecGraph* exec_ = nullptr;
+  std::int64_t step_begin_ = 0;
+  std::uint32_t step_ = 0;
+  std::uint32_t threads_ = 0;
+  std::uint32_t max_steps_ = 0xffffffffu;
+  bool recording_ = false;
+};
+
+}  // namespace tgraph::replay

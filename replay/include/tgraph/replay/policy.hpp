@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+// Execution policies of the replay executors and how cumulative writes are handled.
+#pragma once
+
+#include <optional>
+#include <string_view>
+
+namespace tgraph::replay {
+
+/// How the tasks of a step are put on threads.
+enum class Policy : unsigned char {
+  kSequential = 0,  ///< one thread, program order
+  kPartition = 1,   ///< one pinned thread per processor of an Assignment, signal/wait
+  kWorksteal = 2,   ///< oneTBB, dependency counting over the dataflow graph, no affinity
+  kBarrier = 3,     ///< a parallel loop per operation, barrier after each (OpenMP)
+};
+
+/// "sequential", "partition", "worksteal" or "barrier".
+std::string_view to_string(Policy policy);
+/// Inverse of to_string; nullopt for an unknown name.
+std::optional<Policy> parse_policy(std::string_view name);
+
+/// How cumulative (CW) writes by tasks on different threads are made safe.
+enum class CwMode : unsigned char {
+  kReduce = 0,     ///< per-processor temporaries summed by a reducer task in processor order
+  kSerialize = 1,  ///< CW treated as RW: writers run in program order (bit-identical to sequential)
+};
+
+/// "reduce" or "serialize".
+std::string_view to_string(CwMode mode);
+
+}  // namespace tgraph::replay

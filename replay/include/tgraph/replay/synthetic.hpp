@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+// Synthetic task bodies for replaying traces: each task spins for its recorded cost while
+// reading and writing buffers of its data's recorded sizes.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "tgraph/replay/lowering.hpp"
+#include "tgraph/replay/workload.hpp"
+
+namespace tgraph::replay {
+
+/// Speed of this machine for the synthetic bodies, measured once per process.
+struct Calibration {
+  double spin_iterations_per_ns = 0;  ///< iterations of the busy loop per nanosecond
+  double touch_ns_per_byte = 0;       ///< reading + writing data already in cache
+};
+
+/// Options of the synthetic bodies.
+struct SyntheticOptions {
+  double cost_scale = 1.0;                       ///< multiplies every recorded cost
+  bool touch = true;                             ///< read/write the data buffers
+  std::uint64_t max_datum_bytes = 64ull << 20;   ///< larger data are touched only this far
+};
+
+/// Bodies that cost what the trace recorded and move the memory the data would.
+///
+/// A task reads every word of its R/RW data, then writes its W/RW/CW data (W: overwrite,
+/// RW: combine, CW: add), with values derived from what it read, so that the final buffer
+/// contents depend on the order the dataflow graph prescribes (and CW sums are exact
+/// integers: any reduction order gives the same bits). It then spins for its recorded cost
+/// minus the calibrated time the memory pass takes in cache: running away from its data
+/// costs the real cache misses on top. Buffers are allocated and first touched by the
+/// thread that first uses them in the plan (Workload::first_touch).
+///
+///   SyntheticWorkload w;
+///   w.set_step(trace.steps[s]);       // costs and loop iterations of that step
+///   executor->run_step(trace.steps[s], &assignment, w);
+class SyntheticWorkload : public Workload {
+ public:
+  explicit SyntheticWorkload(SyntheticOptions options = {});
+  ~SyntheticWorkload() override;
+
+  /// The original step whose costs and iteration counts the next run uses (kept by pointer).
+  void set_step(const StepGraph& step) { step_ = &step; }
+
+  void bind(const ExecGraph& exec) override;
+  bool needs_touch(DatumId d) const override;
+  void first_touch(DatumId d) override;
+  void run(const TaskRun& r) override;
+  bool stop_after(LoopId loop, std::uint32_t iteration) override;
+
+  /// Words of exec datum `d` (empty before first touch).
+  std::span<const std::uint64_t> words(DatumId d) const;
+  /// Bytes currently allocated for data.
+  std::uint64_t allocated_bytes() const;
+
+  /// The calibration in use (measured on first call, about 20 ms).
+  static const Calibration& calibration();
+
+ private:
+  struct Buffer;
+  SyntheticOptions options_;
+  const StepGraph* step_ = nullptr;
+  std::vector<std::unique_ptr<Buffer>> buffers_;  // by exec datum
+  std::vector<std::uint64_t> want_words_;         // by exec datum
+  std::vector<bool> is_temp_;                     // by exec datum
+};
+
+/// Busy loop of `iterations` dependent multiply-adds; returns a value to keep it alive.
+std::uint64_t spin_iterations(std::uint64_t iterations, std::uint64_t seed);
+
+}  // namespace tgraph::replay

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// What an executor runs: the body of each task and the break condition of each loop.
+#pragma once
+
+#include <cstdint>
+
+#include "tgraph/graph/step_graph.hpp"
+
+namespace tgraph::replay {
+
+struct ExecGraph;
+
+/// One execution of one task, as handed to Workload::run.
+struct TaskRun {
+  const ExecGraph* exec = nullptr;  ///< the graph being executed (lowered, see lowering.hpp)
+  TaskId task = 0;                  ///< task id in exec->graph
+  TaskId origin = kNoTask;          ///< task id in the original step, kNoTask for a reducer
+  std::uint32_t iteration = 0;      ///< loop iteration (0 outside loops)
+  std::uint32_t thread = 0;         ///< executor thread running it
+};
+
+/// Task bodies and loop conditions. run() may be called concurrently for tasks the
+/// dataflow graph leaves independent; stop_after() is called once per loop iteration, by
+/// the thread that ran the loop's break task, after that task.
+class Workload {
+ public:
+  virtual ~Workload() = default;
+  /// Called on the executor's calling thread when a new structure (plan) is installed.
+  virtual void bind(const ExecGraph& exec) { (void)exec; }
+  /// Called on the thread that owns datum `d` (exec id) before the first step of a plan,
+  /// for every datum whose storage the workload allocates (first touch).
+  virtual void first_touch(DatumId d) { (void)d; }
+  /// True when first_touch(d) would allocate or touch something.
+  virtual bool needs_touch(DatumId d) const {
+    (void)d;
+    return false;
+  }
+  /// Runs one task.
+  virtual void run(const TaskRun& r) = 0;
+  /// After iteration `iteration` (0-based) of loop `loop`: true = leave the loop.
+  virtual bool stop_after(LoopId loop, std::uint32_t iteration) = 0;
+};
+
+}  // namespace tgraph::replay

@@ -1,0 +1,183 @@
+// SPDX-License-Identifier: MIT
+// Barrier baseline (the paper's first attempt): one parallel loop per operation, i.e. per
+// run of consecutive tasks of the same kind in program order, with a barrier after each
+// (OpenMP `omp for`). A run is also cut where a task depends on a task of the same run, so
+// that the barrier is always what orders dependent tasks.
+#include <omp.h>
+
+#include <array>
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "common.hpp"
+#include "sync.hpp"
+#include "tgraph/replay/executor.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+struct Phase {
+  std::vector<TaskId> tasks;
+  LoopId loop_end = kNoLoop;  // the phase ending a loop body: decide after it
+  std::uint32_t jump = 0;     // first phase of that body
+};
+
+struct BarrierPlan {
+  std::vector<Phase> phases;
+};
+
+class BarrierExecutor final : public Executor {
+ public:
+  explicit BarrierExecutor(const ExecOptions& o) : Executor(Policy::kBarrier, o) {
+    counters_ = std::make_unique<Slot[]>(o.threads);
+  }
+  ~BarrierExecutor() override {
+    if (pinned_main_) detail::restore_binding(main_binding_);
+  }
+
+ private:
+  struct alignas(64) Slot {
+    ThreadCounters c;
+  };
+
+  std::shared_ptr<void> build(const ExecGraph& x) override {
+    const StepGraph& g = x.graph;
+    auto plan = std::make_shared<BarrierPlan>();
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    const detail::Csr pred = detail::build_csr(n, g.edges, true);
+    std::vector<std::uint32_t> phase_of(n, 0);
+    auto& phases = plan->phases;
+    LoopId region = kNoLoop;
+    std::uint32_t body_first_phase = 0;
+    bool open = false;
+    for (TaskId t = 0; t < n; ++t) {
+      const Task& task = g.tasks[t];
+      const bool region_change = task.loop != region || (task.loop != kNoLoop && g.loops[task.loop].first == t);
+      if (region_change) {
+        open = false;
+        region = task.loop;
+        if (region != kNoLoop) body_first_phase = static_cast<std::uint32_t>(phases.size());
+      }
+      bool cut = !open || g.tasks[phases.back().tasks.front()].kind != task.kind;
+      if (!cut) {
+        const auto current = static_cast<std::uint32_t>(phases.size() - 1);
+        for (auto i = pred.begin[t]; i < pred.begin[t + 1] && !cut; ++i)
+          cut = phase_of[pred.ids[i]] == current;
+      }
+      if (cut) {
+        phases.emplace_back();
+        open = true;
+      }
+      phases.back().tasks.push_back(t);
+      phase_of[t] = static_cast<std::uint32_t>(phases.size() - 1);
+      if (task.loop != kNoLoop && t + 1 == g.loops[task.loop].last) {
+        phases.back().loop_end = task.loop;
+        phases.back().jump = body_first_phase;
+        open = false;
+      }
+    }
+    return plan;
+  }
+
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+    const BarrierPlan& plan = *static_cast<BarrierPlan*>(plan_ptr);
+    const StepGraph& g = x.graph;
+    const auto k = static_cast<int>(options_.threads);
+    if (options_.pin && !saved_) {
+      saved_ = true;
+      detail::save_binding(main_binding_);
+      pinned_main_ = true;
+    }
+    for (int p = 0; p < k; ++p) counters_[p].c = {};
+    std::vector<std::uint32_t> iterations(g.loops.size(), 0);
+    // Decision of iteration i of a loop lives in slot i % 2: a fast thread may write the
+    // next iteration's decision while a slow one still reads this one's.
+    std::vector<std::array<int, 2>> decision(g.loops.size(), {0, 0});
+    std::atomic<bool> abort{false};
+    std::exception_ptr error;
+    std::mutex error_mutex;
+    const bool observe = !observers_.empty();
+    const bool pin = options_.pin;
+    std::vector<std::uint8_t> is_break(g.tasks.size(), 0);
+    for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
+
+#pragma omp parallel num_threads(k)
+    {
+      const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
+      if (pin) detail::pin_current_thread(thread);
+      ThreadCounters& tc = counters_[thread].c;
+      if (fresh) {
+#pragma omp for schedule(static)
+        for (DatumId d = 0; d < g.data.size(); ++d)
+          if (w.needs_touch(d)) w.first_touch(d);
+      }
+      std::size_t ph = 0;
+      std::uint32_t iter = 0;
+      while (ph < plan.phases.size()) {
+        const Phase& phase = plan.phases[ph];
+        const auto size = static_cast<std::int64_t>(phase.tasks.size());
+#pragma omp for schedule(static)
+        for (std::int64_t i = 0; i < size; ++i) {
+          const TaskId t = phase.tasks[static_cast<std::size_t>(i)];
+          // relaxed: a hint to skip work once a task failed; the barriers order the rest.
+          const bool aborted = abort.load(std::memory_order_relaxed);
+          if (!aborted) {
+            try {
+              if (observe) detail::notify_begin(observers_, thread, t, iter);
+              w.run(TaskRun{&x, t, x.origin[t], iter, thread});
+              if (observe) detail::notify_end(observers_, thread, t, iter);
+              ++tc.tasks;
+            } catch (...) {
+              std::lock_guard<std::mutex> lock(error_mutex);
+              if (!error) error = std::current_exception();
+              abort.store(true, std::memory_order_relaxed);  // relaxed: see above
+            }
+          }
+          if (is_break[t]) {
+            const LoopId l = g.tasks[t].loop;
+            bool stop = true;
+            if (!abort.load(std::memory_order_relaxed)) {  // relaxed: see above
+              try {
+                stop = detail::leave_loop(x, l, iter, w);
+              } catch (...) {
+                std::lock_guard<std::mutex> lock(error_mutex);
+                if (!error) error = std::current_exception();
+                abort.store(true, std::memory_order_relaxed);  // relaxed: see above
+              }
+            }
+            decision[l][iter % 2] = stop ? 1 : 0;
+            if (stop) iterations[l] = iter + 1;
+          }
+        }  // implicit barrier: the phase's writes (and the decision) are visible to all
+        ++tc.waits;
+        if (phase.loop_end != kNoLoop && decision[phase.loop_end][iter % 2] == 0) {
+          ++iter;
+          ph = phase.jump;
+        } else {
+          if (phase.loop_end != kNoLoop) iter = 0;
+          ++ph;
+        }
+      }
+    }
+    stats.threads.resize(options_.threads);
+    for (int p = 0; p < k; ++p) stats.threads[static_cast<std::size_t>(p)] = counters_[p].c;
+    stats.loop_iterations = iterations;
+    if (error) std::rethrow_exception(error);
+  }
+
+  std::unique_ptr<Slot[]> counters_;
+  bool saved_ = false;
+  bool pinned_main_ = false;
+  detail::SavedBinding main_binding_;
+};
+
+}  // namespace
+
+std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o) {
+  return std::make_unique<BarrierExecutor>(o);
+}
+
+}  // namespace tgraph::replay

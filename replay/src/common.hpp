@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// Internal helpers shared by the executors.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "tgraph/replay/executor.hpp"
+
+namespace tgraph::replay::detail {
+
+/// Hard cap on the iterations of one loop (a live condition that never holds).
+inline constexpr std::uint32_t kIterationCap = 1u << 16;
+
+/// After iteration `i` of loop `l`: leave it? (the workload's condition, or the loop's
+/// maximum, or the hard cap).
+inline bool leave_loop(const ExecGraph& x, LoopId l, std::uint32_t i, Workload& w) {
+  const bool stop = w.stop_after(l, i);
+  const Loop& loop = x.graph.loops[l];
+  return stop || (loop.max_iterations != 0 && i + 1 >= loop.max_iterations) || i + 1 >= kIterationCap;
+}
+
+/// Calls every observer's on_begin.
+inline void notify_begin(const std::vector<Observer*>& obs, std::uint32_t thread, TaskId t,
+                         std::uint32_t it) {
+  const std::int64_t now = now_ns();
+  for (Observer* o : obs) o->on_begin(thread, t, it, now);
+}
+/// Calls every observer's on_end.
+inline void notify_end(const std::vector<Observer*>& obs, std::uint32_t thread, TaskId t,
+                       std::uint32_t it) {
+  const std::int64_t now = now_ns();
+  for (Observer* o : obs) o->on_end(thread, t, it, now);
+}
+
+/// Predecessor lists in CSR form.
+struct Csr {
+  std::vector<std::uint32_t> begin;
+  std::vector<TaskId> ids;
+  std::uint32_t size(TaskId t) const { return begin[t + 1] - begin[t]; }
+};
+/// Predecessors (by_to = true) or successors of every task along `edges`, deduplicated.
+Csr build_csr(std::size_t n, const std::vector<Edge>& edges, bool by_to);
+
+/// First-touch owner of each datum: the processor of the first task (program order)
+/// accessing it; 0 for data no task touches.
+std::vector<std::uint32_t> first_accessor_owner(const ExecGraph& x);
+
+}  // namespace tgraph::replay::detail

@@ -1,0 +1,269 @@
+// SPDX-License-Identifier: MIT
+// Executor base (plan cache, timing, validation), the sequential executor and the factory.
+#include "tgraph/replay/executor.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <string>
+
+#include "common.hpp"
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::replay {
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+namespace detail {
+
+Csr build_csr(std::size_t n, const std::vector<Edge>& edges, bool by_to) {
+  Csr c;
+  c.begin.assign(n + 1, 0);
+  for (const Edge& e : edges) ++c.begin[(by_to ? e.to : e.from) + 1];
+  for (std::size_t i = 0; i < n; ++i) c.begin[i + 1] += c.begin[i];
+  c.ids.resize(edges.size());
+  std::vector<std::uint32_t> fill(c.begin.begin(), c.begin.end() - 1);
+  for (const Edge& e : edges) c.ids[fill[by_to ? e.to : e.from]++] = by_to ? e.from : e.to;
+  // Deduplicate each list (several data can link the same pair).
+  std::vector<std::uint32_t> nb(n + 1, 0);
+  std::vector<TaskId> out;
+  out.reserve(c.ids.size());
+  for (std::size_t t = 0; t < n; ++t) {
+    auto b = c.ids.begin() + c.begin[t], e = c.ids.begin() + c.begin[t + 1];
+    std::sort(b, e);
+    auto u = std::unique(b, e);
+    out.insert(out.end(), b, u);
+    nb[t + 1] = static_cast<std::uint32_t>(out.size());
+  }
+  c.begin = std::move(nb);
+  c.ids = std::move(out);
+  return c;
+}
+
+std::vector<std::uint32_t> first_accessor_owner(const ExecGraph& x) {
+  std::vector<std::uint32_t> owner(x.graph.data.size(), 0);
+  std::vector<bool> seen(x.graph.data.size(), false);
+  for (TaskId t = 0; t < x.graph.tasks.size(); ++t)
+    for (const Access& a : x.graph.accesses_of(t))
+      if (!seen[a.datum]) {
+        seen[a.datum] = true;
+        owner[a.datum] = x.assignment.proc.empty() ? 0 : x.assignment.proc[t];
+      }
+  return owner;
+}
+
+}  // namespace detail
+
+std::uint64_t StepStats::signals() const {
+  std::uint64_t s = 0;
+  for (const auto& t : threads) s += t.signals;
+  return s;
+}
+std::uint64_t StepStats::waits() const {
+  std::uint64_t s = 0;
+  for (const auto& t : threads) s += t.waits;
+  return s;
+}
+std::uint64_t StepStats::blocked_waits() const {
+  std::uint64_t s = 0;
+  for (const auto& t : threads) s += t.blocked_waits;
+  return s;
+}
+std::uint64_t StepStats::parks() const {
+  std::uint64_t s = 0;
+  for (const auto& t : threads) s += t.parks;
+  return s;
+}
+std::int64_t StepStats::wait_ns() const {
+  std::int64_t s = 0;
+  for (const auto& t : threads) s += t.wait_ns;
+  return s;
+}
+
+struct Executor::CacheEntry {
+  std::uint64_t key = 0;
+  StepGraph shape;
+  Assignment assignment;
+  bool has_assignment = false;
+  ExecGraph exec;
+  std::shared_ptr<void> plan;
+  const Workload* bound = nullptr;
+};
+
+Executor::Executor(Policy policy, ExecOptions options) : options_(options), policy_(policy) {}
+Executor::~Executor() = default;
+
+CwMode Executor::cw_mode() const {
+  if (options_.cw) return *options_.cw;
+  return policy_ == Policy::kPartition ? CwMode::kReduce : CwMode::kSerialize;
+}
+
+namespace {
+
+std::uint64_t hash_assignment(const Assignment& a) {
+  std::uint64_t h = 1469598103934665603ull ^ a.k;
+  auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
+  for (ProcId p : a.proc) mix(p);
+  for (const auto& o : a.order) {
+    mix(0xabcdefull);
+    for (TaskId t : o) mix(t);
+  }
+  return h;
+}
+
+void validate_assignment(const StepGraph& g, const Assignment& a, std::uint32_t threads) {
+  if (a.k != threads)
+    throw UsageError("assignment has k = " + std::to_string(a.k) + " processors but " +
+                     std::to_string(threads) + " threads were asked for");
+  if (a.proc.size() != g.tasks.size())
+    throw UsageError("assignment covers " + std::to_string(a.proc.size()) + " tasks, the step has " +
+                     std::to_string(g.tasks.size()));
+  for (std::size_t t = 0; t < a.proc.size(); ++t)
+    if (a.proc[t] >= a.k)
+      throw UsageError("assignment puts task " + std::to_string(t) + " on processor " +
+                       std::to_string(a.proc[t]) + " >= k");
+  if (a.order.empty()) return;
+  if (a.order.size() != a.k) throw UsageError("assignment order has the wrong number of processors");
+  std::vector<bool> seen(g.tasks.size(), false);
+  for (ProcId p = 0; p < a.k; ++p)
+    for (TaskId t : a.order[p]) {
+      if (t >= g.tasks.size() || a.proc[t] != p || seen[t])
+        throw UsageError("assignment order of processor " + std::to_string(p) +
+                         " lists task " + std::to_string(t) + " wrongly");
+      seen[t] = true;
+    }
+  if (std::find(seen.begin(), seen.end(), false) != seen.end())
+    throw UsageError("assignment order misses tasks");
+}
+
+}  // namespace
+
+StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& w) {
+  StepStats stats;
+  const std::int64_t t0 = now_ns();
+  const bool use_assignment = policy_ == Policy::kPartition;
+  if (use_assignment && a == nullptr) throw UsageError("the partition policy needs an assignment");
+  std::uint64_t key = g.structural_hash() * 31 + static_cast<std::uint64_t>(cw_mode());
+  if (use_assignment) key ^= hash_assignment(*a) * 0x9e3779b97f4a7c15ull;
+
+  std::shared_ptr<CacheEntry> entry;
+  for (auto& e : cache_) {
+    if (e->key == key && e->shape.same_structure(g) &&
+        (!use_assignment || (e->has_assignment && e->assignment == *a))) {
+      entry = e;
+      break;
+    }
+  }
+  if (!entry) {
+    if (use_assignment) validate_assignment(g, *a, options_.threads);
+    entry = std::make_shared<CacheEntry>();
+    entry->key = key;
+    entry->shape = g;
+    entry->shape.edges.clear();
+    entry->shape.carried_edges.clear();
+    if (use_assignment) {
+      entry->assignment = *a;
+      entry->has_assignment = true;
+    }
+    entry->exec = lower(g, use_assignment ? a : nullptr, cw_mode());
+    entry->plan = build(entry->exec);
+    ++plans_built_;
+    stats.rebuilt = true;
+    if (cache_.size() >= 16) cache_.erase(cache_.begin());
+    cache_.push_back(entry);
+  }
+  const bool fresh = entry->bound != &w;
+  if (fresh) {
+    for (auto& e : cache_) e->bound = nullptr;  // the workload now holds this plan's buffers
+    w.bind(entry->exec);
+    entry->bound = &w;
+  }
+  const std::int64_t t_built = now_ns();
+  if (stats.rebuilt) stats.build_ns = t_built - t0;
+  last_exec_ = &entry->exec;
+  for (Observer* o : observers_) o->on_step_begin(entry->exec, options_.threads, t_built);
+  try {
+    execute(entry->plan.get(), entry->exec, w, fresh, stats);
+  } catch (...) {
+    const std::int64_t t_end = now_ns();
+    for (Observer* o : observers_) o->on_step_end(t_end);
+    throw;
+  }
+  const std::int64_t t1 = now_ns();
+  stats.wall_ns = t1 - t0;
+  for (Observer* o : observers_) o->on_step_end(t1);
+  return stats;
+}
+
+namespace {
+
+/// One thread, program order: the reference every other policy is compared with.
+class SequentialExecutor final : public Executor {
+ public:
+  explicit SequentialExecutor(ExecOptions o) : Executor(Policy::kSequential, o) {}
+
+ private:
+  std::shared_ptr<void> build(const ExecGraph&) override { return std::make_shared<int>(0); }
+
+  void execute(void*, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+    const StepGraph& g = x.graph;
+    if (fresh)
+      for (DatumId d = 0; d < g.data.size(); ++d)
+        if (w.needs_touch(d)) w.first_touch(d);
+    stats.threads.assign(1, {});
+    stats.loop_iterations.assign(g.loops.size(), 0);
+    ThreadCounters& c = stats.threads[0];
+    const bool observe = !observers_.empty();
+    auto run = [&](TaskId t, std::uint32_t it) {
+      if (observe) detail::notify_begin(observers_, 0, t, it);
+      w.run(TaskRun{&x, t, x.origin[t], it, 0});
+      if (observe) detail::notify_end(observers_, 0, t, it);
+      ++c.tasks;
+    };
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    std::size_t next_loop = 0;
+    for (TaskId t = 0; t < n;) {
+      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
+        const auto l = static_cast<LoopId>(next_loop++);
+        const Loop& loop = g.loops[l];
+        std::uint32_t it = 0;
+        for (;; ++it) {
+          for (TaskId u = loop.first; u < loop.last; ++u) run(u, it);
+          if (detail::leave_loop(x, l, it, w)) break;
+        }
+        stats.loop_iterations[l] = it + 1;
+        t = loop.last;
+        continue;
+      }
+      run(t, 0);
+      ++t;
+    }
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
+
+std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
+  if (options.threads == 0) throw UsageError("--threads must be at least 1");
+  if (options.threads > 1024) throw UsageError("--threads must be at most 1024");
+  switch (policy) {
+    case Policy::kSequential: {
+      ExecOptions o = options;
+      o.threads = 1;
+      return std::make_unique<SequentialExecutor>(o);
+    }
+    case Policy::kPartition: return make_partition_executor(options);
+    case Policy::kWorksteal: return make_worksteal_executor(options);
+    case Policy::kBarrier: return make_barrier_executor(options);
+  }
+  throw UsageError("unknown policy");
+}
+
+}  // namespace tgraph::replay

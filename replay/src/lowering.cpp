@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: MIT
+// CW lowering (paper section 3.2): temporaries + reducer, or serialisation.
+#include "tgraph/replay/lowering.hpp"
+
+#include <algorithm>
+#include <string>
+#include <unordered_map>
+
+namespace tgraph::replay {
+namespace {
+
+struct Segment {
+  std::vector<TaskId> members;
+};
+
+struct PendingReducer {
+  DatumId target = 0;
+  ProcId home = 0;
+  std::vector<ProcId> procs;  // other processors, increasing
+};
+
+std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
+  return (static_cast<std::uint64_t>(a) << 32) | b;
+}
+
+}  // namespace
+
+ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  auto proc = [&](TaskId t) -> ProcId { return a ? a->proc[t] : 0; };
+
+  // 1. Find the CW groups that span processors (split at loop-region boundaries).
+  std::unordered_map<std::uint64_t, ProcId> redirect;     // (task, datum) -> processor temp
+  std::unordered_map<std::uint64_t, bool> serialize_acc;  // (task, datum) -> CW becomes RW
+  std::vector<std::vector<PendingReducer>> after(n);      // reducers emitted after task t
+  if (mode == CwMode::kReduce && a != nullptr && a->k > 1) {
+    std::vector<Segment> open(g.data.size());
+    std::vector<DatumId> open_list;
+    auto close = [&](DatumId d) {
+      Segment& s = open[d];
+      if (s.members.empty()) return;
+      std::vector<ProcId> procs;
+      for (TaskId m : s.members) procs.push_back(proc(m));
+      std::sort(procs.begin(), procs.end());
+      procs.erase(std::unique(procs.begin(), procs.end()), procs.end());
+      if (procs.size() > 1) {
+        const TaskId last = s.members.back();
+        const LoopId l = g.tasks[last].loop;
+        const bool ends_body = l != kNoLoop && last + 1 == g.loops[l].last;
+        if (ends_body) {
+          // A break task with a CW access: no room for a reducer after it; serialise.
+          for (TaskId m : s.members) serialize_acc[pair_key(m, d)] = true;
+        } else {
+          PendingReducer r;
+          r.target = d;
+          r.home = proc(s.members.front());
+          for (ProcId p : procs)
+            if (p != r.home) r.procs.push_back(p);
+          for (TaskId m : s.members)
+            if (proc(m) != r.home) redirect[pair_key(m, d)] = proc(m);
+          after[last].push_back(std::move(r));
+        }
+      }
+      s.members.clear();
+    };
+    auto close_all = [&] {
+      for (DatumId d : open_list) close(d);
+      open_list.clear();
+    };
+    LoopId region = kNoLoop;
+    for (TaskId t = 0; t < n; ++t) {
+      const LoopId l = g.tasks[t].loop;
+      const bool body_start = l != kNoLoop && g.loops[l].first == t;
+      if (l != region || body_start) close_all();
+      region = l;
+      for (const Access& acc : g.accesses_of(t)) {
+        Segment& s = open[acc.datum];
+        if (acc.mode == AccessMode::CW) {
+          if (s.members.empty()) open_list.push_back(acc.datum);
+          if (s.members.empty() || s.members.back() != t) s.members.push_back(t);
+        } else {
+          close(acc.datum);
+        }
+      }
+    }
+    close_all();
+  }
+
+  // 2. Emit the exec graph.
+  ExecGraph x;
+  StepGraph& out = x.graph;
+  out.kinds = g.kinds;
+  out.objects = g.objects;
+  out.data = g.data;
+  out.contacts = g.contacts;
+  out.groups = g.groups;
+  x.datum_origin.resize(g.data.size());
+  for (DatumId d = 0; d < g.data.size(); ++d) x.datum_origin[d] = d;
+  std::unordered_map<std::uint64_t, DatumId> temp_of;  // (datum, proc) -> exec datum
+  auto temp = [&](DatumId d, ProcId p) {
+    const auto key = pair_key(d, p);
+    if (auto it = temp_of.find(key); it != temp_of.end()) return it->second;
+    Datum t = g.data[d];
+    t.name.push_back('@');
+    t.name.append(std::to_string(p));
+    out.data.push_back(std::move(t));
+    x.datum_origin.push_back(d);
+    const auto id = static_cast<DatumId>(out.data.size() - 1);
+    temp_of.emplace(key, id);
+    return id;
+  };
+  KindId reduce_kind = 0;
+  bool have_reduce_kind = false;
+  x.exec_of.resize(n);
+  std::vector<ProcId> exec_proc;
+  std::vector<Access> acc_buf;
+  for (TaskId t = 0; t < n; ++t) {
+    const Task& task = g.tasks[t];
+    acc_buf.clear();
+    for (Access acc : g.accesses_of(t)) {
+      if (acc.mode == AccessMode::CW) {
+        if (mode == CwMode::kSerialize || serialize_acc.count(pair_key(t, acc.datum)) != 0) {
+          acc.mode = AccessMode::RW;
+        } else if (auto it = redirect.find(pair_key(t, acc.datum)); it != redirect.end()) {
+          acc.datum = temp(acc.datum, it->second);
+        }
+      }
+      acc_buf.push_back(acc);
+    }
+    const TaskId id = out.add_task(task.kind, task.object, acc_buf, task.cost_ns, task.key);
+    out.tasks[id].loop = task.loop;
+    x.exec_of[t] = id;
+    x.origin.push_back(t);
+    x.reduction.push_back(kNoReduction);
+    exec_proc.push_back(proc(t));
+    for (PendingReducer& r : after[t]) {
+      if (!have_reduce_kind) {
+        reduce_kind = out.intern_kind("reduce");
+        have_reduce_kind = true;
+      }
+      Reduction red;
+      red.target = r.target;
+      acc_buf.clear();
+      for (ProcId p : r.procs) {
+        const DatumId tmp = temp(r.target, p);
+        red.temps.push_back(tmp);
+        acc_buf.push_back({tmp, AccessMode::RW});
+      }
+      acc_buf.push_back({r.target, AccessMode::CW});
+      const TaskId rid = out.add_task(reduce_kind, g.data[r.target].object, acc_buf, 0,
+                                      task.key * 1099511628211ull + r.target + 1);
+      out.tasks[rid].loop = task.loop;
+      x.origin.push_back(kNoTask);
+      x.reduction.push_back(static_cast<std::uint32_t>(x.reductions.size()));
+      x.reductions.push_back(std::move(red));
+      exec_proc.push_back(r.home);
+    }
+  }
+  out.loops = g.loops;
+  for (Loop& l : out.loops) {
+    l.first = x.exec_of[l.first];
+    l.last = x.exec_of[l.last - 1] + 1;
+  }
+  out.derive_edges();
+
+  // 3. The assignment on exec tasks.
+  Assignment& ax = x.assignment;
+  ax.k = a ? a->k : 1;
+  ax.proc = std::move(exec_proc);
+  if (a != nullptr && !a->order.empty()) {
+    ax.order.assign(ax.k, {});
+    for (ProcId p = 0; p < ax.k && p < a->order.size(); ++p)
+      for (TaskId t : a->order[p]) ax.order[p].push_back(x.exec_of[t]);
+    for (TaskId r = 0; r < x.origin.size(); ++r) {
+      if (x.origin[r] != kNoTask) continue;
+      auto& ord = ax.order[ax.proc[r]];
+      std::size_t pos = 0;
+      for (std::size_t i = 0; i < ord.size(); ++i)
+        if (ord[i] < r) pos = i + 1;
+      ord.insert(ord.begin() + static_cast<std::ptrdiff_t>(pos), r);
+    }
+  }
+  return x;
+}
+
+}  // namespace tgraph::replay

@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: MIT
+// Built-in observers: per-thread stats, locality, timeline (+ Chrome trace-event export).
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "tgraph/replay/observer.hpp"
+
+namespace tgraph::replay {
+
+void StatsObserver::on_step_begin(const ExecGraph&, std::uint32_t threads, std::int64_t t_ns) {
+  slots_.assign(threads, Slot{});
+  step_begin_ = t_ns;
+}
+void StatsObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t_ns) {
+  slots_[thread].begin = t_ns;
+}
+void StatsObserver::on_end(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t_ns) {
+  Slot& s = slots_[thread];
+  s.t.busy_ns += t_ns - s.begin;
+  ++s.t.tasks;
+}
+void StatsObserver::on_wait(std::uint32_t thread, TaskId, std::int64_t t0, std::int64_t t1, bool) {
+  slots_[thread].t.wait_ns += t1 - t0;
+}
+void StatsObserver::on_step_end(std::int64_t t_ns) {
+  last_.clear();
+  const std::int64_t wall = t_ns - step_begin_;
+  for (const Slot& s : slots_) {
+    Thread t = s.t;
+    t.idle_ns = std::max<std::int64_t>(0, wall - t.busy_ns - t.wait_ns);
+    last_.push_back(t);
+  }
+}
+
+void LocalityObserver::on_step_begin(const ExecGraph& exec, std::uint32_t, std::int64_t) {
+  exec_ = &exec;
+  where_.resize(exec.graph.tasks.size());
+  for (auto& w : where_) w.clear();
+}
+
+void LocalityObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t) {
+  // Instances of one task never overlap, so only this thread touches where_[task] now.
+  auto& w = where_[task];
+  if (w.size() <= iteration) w.resize(iteration + 1, 0xffff);
+  w[iteration] = static_cast<std::uint16_t>(thread);
+}
+
+void LocalityObserver::on_step_end(std::int64_t) {
+  remote_ = 0;
+  migrated_ = 0;
+  if (!exec_) return;
+  const StepGraph& g = exec_->graph;
+  auto thread_of = [&](TaskId t, std::uint32_t it) -> std::uint32_t {
+    const auto& w = where_[t];
+    return it < w.size() ? w[it] : 0xffffu;
+  };
+  auto iterations = [&](TaskId t) -> std::uint32_t { return static_cast<std::uint32_t>(where_[t].size()); };
+  auto add = [&](const Edge& e, TaskId from, std::uint32_t it_from, TaskId to, std::uint32_t it_to) {
+    const std::uint32_t a = thread_of(from, it_from), b = thread_of(to, it_to);
+    if (a != 0xffffu && b != 0xffffu && a != b) remote_ += g.data[e.datum].bytes;
+  };
+  for (const Edge& e : g.edges) {
+    if (e.kind != EdgeKind::RAW) continue;
+    const LoopId lf = g.tasks[e.from].loop, lt = g.tasks[e.to].loop;
+    const std::uint32_t nt = iterations(e.to);
+    for (std::uint32_t it = 0; it < nt; ++it) {
+      if (lf != kNoLoop && lf == lt) {
+        add(e, e.from, it, e.to, it);
+      } else if (it == 0) {
+        const std::uint32_t nf = iterations(e.from);
+        if (nf > 0) add(e, e.from, nf - 1, e.to, 0);
+      }
+    }
+  }
+  for (const Edge& e : g.carried_edges) {
+    if (e.kind != EdgeKind::RAW) continue;
+    const std::uint32_t nt = iterations(e.to);
+    for (std::uint32_t it = 1; it < nt; ++it) add(e, e.from, it - 1, e.to, it);
+  }
+  // Owner of each original datum: thread of its first writer in program order (else of its
+  // first reader); temporaries count for their target.
+  const std::size_t n_orig = exec_->datum_origin.empty()
+                                 ? g.data.size()
+                                 : *std::max_element(exec_->datum_origin.begin(), exec_->datum_origin.end()) + 1;
+  std::vector<std::uint32_t> owner(n_orig, 0xffffffffu), reader(n_orig, 0xffffffffu);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    if (exec_->origin[t] == kNoTask || where_[t].empty()) continue;
+    for (const Access& a : g.accesses_of(t)) {
+      const DatumId d = exec_->datum_origin[a.datum];
+      if (writes(a.mode)) {
+        if (owner[d] == 0xffffffffu) owner[d] = where_[t][0];
+      } else if (reader[d] == 0xffffffffu) {
+        reader[d] = where_[t][0];
+      }
+    }
+  }
+  for (DatumId d = 0; d < n_orig; ++d)
+    if (owner[d] == 0xffffffffu) owner[d] = reader[d];
+  if (prev_owner_.size() == n_orig) {
+    for (DatumId d = 0; d < n_orig; ++d)
+      if (owner[d] != 0xffffffffu && prev_owner_[d] != 0xffffffffu && owner[d] != prev_owner_[d])
+        migrated_ += g.data[d].bytes;
+  }
+  prev_owner_ = std::move(owner);
+}
+
+void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) {
+  exec_ = &exec;
+  recording_ = step_ < max_steps_;
+  threads_ = std::max(threads_, threads);
+  per_thread_.resize(threads);
+  waits_per_thread_.resize(threads);
+  open_.assign(threads * 8, 0);  // one slot per 64 bytes
+  step_begin_ = t_ns;
+  labels_.clear();
+  for (TaskId t = 0; t < exec.graph.tasks.size(); ++t) labels_.push_back(exec.graph.kind_name(t));
+}
+
+void TimelineObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t_ns) {
+  open_[thread * 8] = t_ns;
+}
+
+void TimelineObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+  if (!recording_) return;
+  per_thread_[thread].push_back({step_, thread, task, exec_->origin[task], iteration,
+                                 open_[thread * 8] - step_begin_, t_ns - step_begin_});
+}
+
+void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) {
+  if (!recording_) return;
+  waits_per_thread_[thread].push_back({step_, thread, task, t0 - step_begin_, t1 - step_begin_, parked});
+}
+
+void TimelineObserver::on_step_end(std::int64_t) {
+  if (recording_) {
+    const std::size_t first = events_.size();
+    for (auto& v : per_thread_) {
+      events_.insert(events_.end(), v.begin(), v.end());
+      v.clear();
+    }
+    std::sort(events_.begin() + static_cast<std::ptrdiff_t>(first), events_.end(),
+              [](const TimelineEvent& a, const TimelineEvent& b) { return a.start_ns < b.start_ns; });
+    for (auto& v : waits_per_thread_) {
+      waits_.insert(waits_.end(), v.begin(), v.end());
+      v.clear();
+    }
+  }
+  ++step_;
+}
+
+std::string TimelineObserver::to_json() const {
+  nlohmann::json tasks = nlohmann::json::array(), waits = nlohmann::json::array();
+  for (const TimelineEvent& e : events_)
+    tasks.push_back({{"step", e.step},
+                     {"thread", e.thread},
+                     {"task", e.task},
+                     {"origin", e.origin == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(e.origin)},
+                     {"kind", e.task < labels_.size() ? labels_[e.task] : std::string()},
+                     {"iteration", e.iteration},
+                     {"start_ns", e.start_ns},
+                     {"end_ns", e.end_ns}});
+  for (const TimelineWait& w : waits_)
+    waits.push_back({{"step", w.step},
+                     {"thread", w.thread},
+                     {"task", w.task == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(w.task)},
+                     {"start_ns", w.start_ns},
+                     {"end_ns", w.end_ns},
+                     {"parked", w.parked}});
+  nlohmann::json j = {{"threads", threads_}, {"steps", step_}, {"tasks", tasks}, {"waits", waits}};
+  return j.dump();
+}
+
+std::string TimelineObserver::to_chrome_json() const {
+  nlohmann::json ev = nlohmann::json::array();
+  // Steps are laid end to end: each step starts after the previous one's last event.
+  std::int64_t offset = 0, step_end = 0;
+  std::uint32_t cur = 0;
+  for (const TimelineEvent& e : events_) {
+    if (e.step != cur) {
+      offset += step_end;
+      step_end = 0;
+      cur = e.step;
+    }
+    step_end = std::max(step_end, e.end_ns);
+    ev.push_back({{"name", e.task < labels_.size() ? labels_[e.task] : std::string("task")},
+                  {"ph", "X"},
+                  {"pid", 0},
+                  {"tid", e.thread},
+                  {"ts", static_cast<double>(offset + e.start_ns) / 1000.0},
+                  {"dur", static_cast<double>(e.end_ns - e.start_ns) / 1000.0},
+                  {"args", {{"step", e.step}, {"task", e.task}, {"iteration", e.iteration}}}});
+  }
+  for (std::uint32_t t = 0; t < threads_; ++t)
+    ev.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 0}, {"tid", t},
+                  {"args", {{"name", "thread " + std::to_string(t)}}}});
+  nlohmann::json j = {{"traceEvents", ev}, {"displayTimeUnit", "ns"}};
+  return j.dump();
+}
+
+}  // namespace tgraph::replay

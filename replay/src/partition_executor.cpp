@@ -1,0 +1,525 @@
+// SPDX-License-Identifier: MIT
+// The partitioned executor (paper section 3.2): one pinned thread per processor runs its
+// own tasks in order; a task needed by another processor publishes its completion count
+// (signal) and the reader waits for it (spin, then park).
+//
+// Synchronisation: every task that another processor depends on owns a completion counter
+// done[t] = (epoch << 32) | executions-this-step, so counters never need resetting between
+// steps (the epoch grows). A datum's version is the completion count of its writer: the
+// edges of the dataflow graph name, for each reader, exactly which writer (and for a CW
+// group, which writers) produced the version it needs; WAR edges make a writer wait for the
+// readers of the previous version the same way. Loops: every processor holding body tasks
+// runs the loop control itself; the processor of the break task publishes, per iteration,
+// loop[l] = (epoch << 32) | (iterations << 1) | stop, and the others read it before starting
+// the next iteration. Calling thread = processor 0.
+#include <atomic>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common.hpp"
+#include "sync.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/replay/executor.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+using detail::PaddedCounter;
+
+enum class WaitKind : std::uint8_t {
+  kOnce,       ///< producer outside loops: its single execution
+  kSameIter,   ///< producer in the same loop: the same iteration
+  kPrevIter,   ///< loop-carried: the previous iteration (nothing in iteration 0)
+  kAfterLoop,  ///< producer in an earlier loop: its last iteration
+};
+
+struct WaitPoint {
+  TaskId producer = 0;
+  LoopId loop = kNoLoop;  // kAfterLoop: the producer's loop
+  WaitKind kind = WaitKind::kOnce;
+};
+
+enum class OpKind : std::uint8_t { kTask, kLoopBegin, kLoopEnd };
+
+struct Op {
+  OpKind kind = OpKind::kTask;
+  bool signal = false;    // publish done[task] after running
+  bool is_break = false;  // evaluate and publish the loop decision after running
+  TaskId task = 0;
+  LoopId loop = kNoLoop;
+  std::uint32_t wait_begin = 0, wait_end = 0;
+  std::uint32_t jump = 0;  // kLoopEnd: first op of the body
+};
+
+struct ProcPlan {
+  std::vector<Op> ops;
+  std::vector<WaitPoint> waits;
+  std::vector<DatumId> owned;
+};
+
+struct Plan {
+  std::vector<ProcPlan> procs;
+  std::size_t tasks = 0;
+  std::size_t loops = 0;
+};
+
+/// Builds the per-processor programs.
+Plan build_plan(const ExecGraph& x, std::uint32_t k) {
+  const StepGraph& g = x.graph;
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  const Assignment& a = x.assignment;
+  Plan plan;
+  plan.tasks = n;
+  plan.loops = g.loops.size();
+  plan.procs.resize(k);
+  std::vector<std::uint32_t> pos(n, 0);
+  std::vector<bool> signal(n, false);
+
+  // 1. Ops per processor: its tasks in order, each loop's body tasks gathered in one block.
+  for (ProcId p = 0; p < k; ++p) {
+    std::vector<TaskId> seq = tasks_of(a, p);
+    std::vector<std::vector<TaskId>> in_loop(g.loops.size());
+    for (TaskId t : seq)
+      if (g.tasks[t].loop != kNoLoop) in_loop[g.tasks[t].loop].push_back(t);
+    std::vector<bool> opened(g.loops.size(), false);
+    auto& ops = plan.procs[p].ops;
+    for (TaskId t : seq) {
+      const LoopId l = g.tasks[t].loop;
+      if (l == kNoLoop) {
+        pos[t] = static_cast<std::uint32_t>(ops.size());
+        ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0});
+        continue;
+      }
+      if (opened[l]) continue;
+      opened[l] = true;
+      ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0});
+      const auto body = static_cast<std::uint32_t>(ops.size());
+      for (TaskId u : in_loop[l]) {
+        pos[u] = static_cast<std::uint32_t>(ops.size());
+        ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0});
+      }
+      ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body});
+    }
+  }
+
+  // 2. Wait points, deduplicated along each processor's program.
+  const detail::Csr intra = detail::build_csr(n, g.edges, true);
+  const detail::Csr carried = detail::build_csr(n, g.carried_edges, true);
+  for (ProcId p = 0; p < k; ++p) {
+    ProcPlan& pp = plan.procs[p];
+    std::vector<std::uint8_t> seen_once(n, 0), seen_iter(n, 0), seen_prev(n, 0);
+    std::vector<TaskId> iter_marks, prev_marks;
+    for (Op& op : pp.ops) {
+      if (op.kind == OpKind::kLoopBegin) {
+        for (TaskId u : iter_marks) seen_iter[u] = 0;
+        for (TaskId u : prev_marks) seen_prev[u] = 0;
+        iter_marks.clear();
+        prev_marks.clear();
+      }
+      if (op.kind != OpKind::kTask) continue;
+      const TaskId v = op.task;
+      op.wait_begin = static_cast<std::uint32_t>(pp.waits.size());
+      for (auto i = intra.begin[v]; i < intra.begin[v + 1]; ++i) {
+        const TaskId u = intra.ids[i];
+        if (a.proc[u] == p && pos[u] < pos[v]) continue;  // program order on p guarantees it
+        const LoopId lu = g.tasks[u].loop;
+        WaitPoint w{u, lu, WaitKind::kOnce};
+        if (lu == kNoLoop) {
+          w.kind = WaitKind::kOnce;
+        } else if (lu == g.tasks[v].loop) {
+          w.kind = WaitKind::kSameIter;
+        } else {
+          w.kind = WaitKind::kAfterLoop;
+        }
+        if (w.kind == WaitKind::kSameIter) {
+          if (seen_iter[u]) continue;
+          seen_iter[u] = 1;
+          iter_marks.push_back(u);
+        } else {
+          if (seen_once[u]) continue;
+          seen_once[u] = 1;
+        }
+        signal[u] = true;
+        pp.waits.push_back(w);
+      }
+      for (auto i = carried.begin[v]; i < carried.begin[v + 1]; ++i) {
+        const TaskId u = carried.ids[i];
+        if (a.proc[u] == p) continue;  // p finishes iteration i before starting i + 1
+        if (seen_prev[u]) continue;
+        seen_prev[u] = 1;
+        prev_marks.push_back(u);
+        signal[u] = true;
+        pp.waits.push_back({u, g.tasks[u].loop, WaitKind::kPrevIter});
+      }
+      op.wait_end = static_cast<std::uint32_t>(pp.waits.size());
+    }
+  }
+  for (ProcPlan& pp : plan.procs)
+    for (Op& op : pp.ops)
+      if (op.kind == OpKind::kTask) op.signal = signal[op.task];
+
+  // 3. First-touch owners.
+  const auto owner = detail::first_accessor_owner(x);
+  for (DatumId d = 0; d < owner.size(); ++d) plan.procs[owner[d] % k].owned.push_back(d);
+  return plan;
+}
+
+/// Runs the per-processor programs interleaved on one thread (round robin, each processor
+/// advancing while its waits hold). With a workload: the serial executor (deterministic);
+/// without: the deadlock check of a plan (every loop runs two iterations).
+/// Throws UsageError naming the first blocked processor when no processor can advance.
+void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
+                     const std::vector<Observer*>* observers, StepStats* stats) {
+  const std::size_t k = plan.procs.size();
+  const StepGraph& g = x.graph;
+  std::vector<std::uint32_t> done(plan.tasks, 0);
+  std::vector<std::uint32_t> loop_iters(plan.loops, 0);  // iterations decided so far
+  std::vector<bool> loop_stop(plan.loops, false);
+  struct Cursor {
+    std::size_t pc = 0;
+    std::uint32_t iter = 0;
+  };
+  std::vector<Cursor> cur(k);
+  if (stats) {
+    stats->threads.assign(k, {});
+    stats->loop_iterations.assign(plan.loops, 0);
+  }
+  auto ready = [&](const WaitPoint& wp, std::uint32_t iter) {
+    switch (wp.kind) {
+      case WaitKind::kOnce: return done[wp.producer] >= 1;
+      case WaitKind::kSameIter: return done[wp.producer] >= iter + 1;
+      case WaitKind::kPrevIter: return iter == 0 || done[wp.producer] >= iter;
+      case WaitKind::kAfterLoop:
+        return loop_stop[wp.loop] && done[wp.producer] >= loop_iters[wp.loop];
+    }
+    return false;
+  };
+  for (;;) {
+    bool all_done = true, progress = false;
+    for (std::size_t p = 0; p < k; ++p) {
+      const ProcPlan& pp = plan.procs[p];
+      Cursor& c = cur[p];
+      while (c.pc < pp.ops.size()) {
+        const Op& op = pp.ops[c.pc];
+        if (op.kind == OpKind::kLoopBegin) {
+          c.iter = 0;
+          ++c.pc;
+        } else if (op.kind == OpKind::kLoopEnd) {
+          if (loop_iters[op.loop] < c.iter + 1) break;  // decision not known yet
+          if (loop_iters[op.loop] > c.iter + 1 || !loop_stop[op.loop]) {
+            ++c.iter;
+            c.pc = op.jump;
+          } else {
+            c.iter = 0;
+            ++c.pc;
+          }
+        } else {
+          bool ok = true;
+          for (auto i = op.wait_begin; i < op.wait_end && ok; ++i) ok = ready(pp.waits[i], c.iter);
+          if (!ok) break;
+          const auto thread = static_cast<std::uint32_t>(p);
+          if (w) {
+            if (observers && !observers->empty()) detail::notify_begin(*observers, thread, op.task, c.iter);
+            w->run(TaskRun{&x, op.task, x.origin[op.task], c.iter, thread});
+            if (observers && !observers->empty()) detail::notify_end(*observers, thread, op.task, c.iter);
+          }
+          if (stats) {
+            auto& tc = stats->threads[p];
+            ++tc.tasks;
+            tc.waits += op.wait_end - op.wait_begin;
+            if (op.signal) ++tc.signals;
+          }
+          done[op.task] = c.iter + 1;
+          if (op.is_break) {
+            const bool stop = w ? detail::leave_loop(x, op.loop, c.iter, *w) : c.iter + 1 >= 2;
+            loop_iters[op.loop] = c.iter + 1;
+            loop_stop[op.loop] = stop;
+            if (stats) stats->loop_iterations[op.loop] = c.iter + 1;
+          }
+          ++c.pc;
+        }
+        progress = true;
+      }
+      if (c.pc < pp.ops.size()) all_done = false;
+    }
+    if (all_done) return;
+    if (!progress) {
+      for (std::size_t p = 0; p < k; ++p)
+        if (cur[p].pc < plan.procs[p].ops.size()) {
+          const Op& op = plan.procs[p].ops[cur[p].pc];
+          throw UsageError("the assignment's task order deadlocks: processor " + std::to_string(p) +
+                           " cannot run " +
+                           (op.kind == OpKind::kTask ? "task " + std::to_string(x.origin[op.task])
+                                                     : std::string("its loop control")) +
+                           " (" + g.kind_name(op.kind == OpKind::kTask ? op.task : 0) + ")");
+        }
+    }
+  }
+}
+
+class PartitionExecutor final : public Executor {
+ public:
+  explicit PartitionExecutor(const ExecOptions& o)
+      : Executor(Policy::kPartition, o),
+        parking_(o.spin_ns, o.threads > detail::hardware_pus()) {
+    counters_ = std::make_unique<Slot[]>(o.threads);
+  }
+
+  ~PartitionExecutor() override {
+    if (!workers_.empty()) {
+      // release: the workers that see the new step value also see shutdown_.
+      shutdown_.store(true, std::memory_order_relaxed);
+      parking_.signal(step_seq_, step_seq_.load(std::memory_order_relaxed) + 1);
+      parking_.wake(step_seq_);
+      for (auto& t : workers_) t.join();
+    }
+    if (pinned_main_) detail::restore_binding(main_binding_);
+  }
+
+ private:
+  struct alignas(64) Slot {
+    ThreadCounters c;
+  };
+
+  std::shared_ptr<void> build(const ExecGraph& x) override {
+    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads));
+    run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
+    return plan;
+  }
+
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+    Plan& plan = *static_cast<Plan*>(plan_ptr);
+    const std::uint32_t k = options_.threads;
+    if (options_.serial) {
+      if (fresh)
+        for (const ProcPlan& pp : plan.procs)
+          for (DatumId d : pp.owned)
+            if (w.needs_touch(d)) w.first_touch(d);
+      run_interleaved(plan, x, &w, &observers_, &stats);
+      return;
+    }
+    start_workers();
+    if (plan.tasks > done_cap_) {
+      done_ = std::make_unique<PaddedCounter[]>(plan.tasks);
+      done_cap_ = plan.tasks;
+    }
+    if (plan.loops > loop_cap_) {
+      loop_ = std::make_unique<PaddedCounter[]>(plan.loops);
+      loop_cap_ = plan.loops;
+    }
+    plan_ = &plan;
+    exec_ = &x;
+    workload_ = &w;
+    fresh_ = fresh;
+    error_ = nullptr;
+    // relaxed: published to the workers by the release in signal(step_seq_) below.
+    abort_.store(false, std::memory_order_relaxed);
+    const std::uint64_t seq = ++steps_;
+    epoch_ = seq << 32;
+    parking_.signal(step_seq_, seq);  // seq_cst store (a release): step context visible
+    run_proc(0);
+    if (k > 1) {
+      bool parked = false;
+      std::int64_t waited = 0;
+      const std::uint64_t target = seq * (k - 1);
+      // acquire (inside wait): every worker's counters and writes are visible afterwards.
+      parking_.wait(finished_, [target](std::uint64_t v) { return v >= target; }, never_abort_,
+                    parked, waited);
+    }
+    stats.threads.resize(k);
+    for (std::uint32_t p = 0; p < k; ++p) stats.threads[p] = counters_[p].c;
+    stats.loop_iterations.resize(plan.loops);
+    for (std::size_t l = 0; l < plan.loops; ++l) {
+      // relaxed: all writers finished (acquire on finished_ above).
+      const std::uint64_t v = loop_[l].v.load(std::memory_order_relaxed);
+      stats.loop_iterations[l] = (v >> 32) == seq ? static_cast<std::uint32_t>((v & 0xffffffffu) >> 1) : 0;
+    }
+    if (error_) std::rethrow_exception(error_);
+  }
+
+  void start_workers() {
+    if (started_) return;
+    started_ = true;
+    if (options_.pin) {
+      detail::save_binding(main_binding_);
+      pinned_main_ = detail::pin_current_thread(0);
+    }
+    for (std::uint32_t p = 1; p < options_.threads; ++p)
+      workers_.emplace_back([this, p] { worker(p); });
+  }
+
+  void worker(std::uint32_t p) {
+    if (options_.pin) detail::pin_current_thread(p);
+    std::uint64_t seen = 0;
+    for (;;) {
+      bool parked = false;
+      std::int64_t waited = 0;
+      // acquire (inside wait): the step context written before the store is visible.
+      seen = parking_.wait(step_seq_, [seen](std::uint64_t v) { return v > seen; }, never_abort_,
+                           parked, waited);
+      // relaxed: ordered by the acquire of step_seq_ above.
+      if (shutdown_.load(std::memory_order_relaxed)) return;
+      run_proc(p);
+      // seq_cst RMW (a release): the counters and the task's writes reach the main thread.
+      finished_.fetch_add(1, std::memory_order_seq_cst);
+      if (parking_.parked() != 0) parking_.wake(finished_);
+    }
+  }
+
+  void fail(std::exception_ptr e) {
+    {
+      std::lock_guard<std::mutex> lock(error_mutex_);
+      if (!error_) error_ = e;
+    }
+    // seq_cst: Dekker with the waiters' abort check before they sleep (sync.hpp).
+    if (abort_.exchange(true, std::memory_order_seq_cst)) return;
+    for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.wake(done_[t].v);
+    for (std::size_t l = 0; l < plan_->loops; ++l) parking_.wake(loop_[l].v);
+  }
+
+  // Waits until ok(c); false when the step is aborting.
+  template <class Ok>
+  bool wait(std::atomic<std::uint64_t>& c, Ok ok, std::uint32_t thread, TaskId task,
+            ThreadCounters& tc, std::uint64_t& value) {
+    ++tc.waits;
+    // acquire: pairs with the signaller's store; its writes are visible to our task.
+    value = c.load(std::memory_order_acquire);
+    if (!ok(value)) {
+      bool parked = false;
+      std::int64_t waited = 0;
+      const std::int64_t t0 = observers_.empty() ? 0 : now_ns();
+      value = parking_.wait(c, ok, abort_, parked, waited);
+      ++tc.blocked_waits;
+      tc.parks += parked ? 1 : 0;
+      tc.wait_ns += waited;
+      if (!observers_.empty())
+        for (Observer* o : observers_) o->on_wait(thread, task, t0, t0 + waited, parked);
+    }
+    // relaxed: a hint; when set, no task runs after this point, so nothing depends on it.
+    return !abort_.load(std::memory_order_relaxed);
+  }
+
+  void run_proc(std::uint32_t p) {
+    ThreadCounters tc{};
+    const Plan& plan = *plan_;
+    const ExecGraph& x = *exec_;
+    Workload& w = *workload_;
+    const ProcPlan& pp = plan.procs[p];
+    const std::uint64_t E = epoch_;
+    const bool observe = !observers_.empty();
+    try {
+      if (fresh_)
+        for (DatumId d : pp.owned)
+          if (w.needs_touch(d)) w.first_touch(d);
+      std::uint32_t iter = 0;
+      std::uint64_t v = 0;
+      for (std::size_t pc = 0; pc < pp.ops.size();) {
+        const Op& op = pp.ops[pc];
+        switch (op.kind) {
+          case OpKind::kLoopBegin:
+            iter = 0;
+            ++pc;
+            break;
+          case OpKind::kLoopEnd: {
+            const std::uint64_t need = E | (static_cast<std::uint64_t>(iter + 1) << 1);
+            if (!wait(loop_[op.loop].v, [need](std::uint64_t s) { return s >= need; }, p, kNoTask, tc, v))
+              goto out;
+            const std::uint64_t decided = (v & 0xffffffffu) >> 1;
+            if (decided > iter + 1 || (v & 1u) == 0) {
+              ++iter;
+              pc = op.jump;
+            } else {
+              iter = 0;
+              ++pc;
+            }
+            break;
+          }
+          case OpKind::kTask: {
+            for (auto i = op.wait_begin; i < op.wait_end; ++i) {
+              const WaitPoint& wp = pp.waits[i];
+              std::uint64_t target = E + 1;
+              switch (wp.kind) {
+                case WaitKind::kOnce: target = E + 1; break;
+                case WaitKind::kSameIter: target = E + iter + 1; break;
+                case WaitKind::kPrevIter:
+                  if (iter == 0) continue;
+                  target = E + iter;
+                  break;
+                case WaitKind::kAfterLoop: {
+                  const std::uint64_t epoch = E;
+                  if (!wait(loop_[wp.loop].v,
+                            [epoch](std::uint64_t s) { return (s >> 32) == (epoch >> 32) && (s & 1u); },
+                            p, op.task, tc, v))
+                    goto out;
+                  target = E + ((v & 0xffffffffu) >> 1);
+                  break;
+                }
+              }
+              if (!wait(done_[wp.producer].v, [target](std::uint64_t s) { return s >= target; }, p,
+                        op.task, tc, v))
+                goto out;
+            }
+            if (observe) detail::notify_begin(observers_, p, op.task, iter);
+            w.run(TaskRun{&x, op.task, x.origin[op.task], iter, p});
+            if (observe) detail::notify_end(observers_, p, op.task, iter);
+            ++tc.tasks;
+            if (op.signal) {
+              parking_.signal(done_[op.task].v, E + iter + 1);
+              ++tc.signals;
+            }
+            if (op.is_break) {
+              const bool stop = detail::leave_loop(x, op.loop, iter, w);
+              parking_.signal(loop_[op.loop].v,
+                              E | (static_cast<std::uint64_t>(iter + 1) << 1) | (stop ? 1u : 0u));
+              ++tc.signals;
+            }
+            ++pc;
+            break;
+          }
+        }
+      }
+    } catch (...) {
+      fail(std::current_exception());
+    }
+  out:
+    counters_[p].c = tc;
+  }
+
+  detail::Parking parking_;
+  std::vector<std::thread> workers_;
+  bool started_ = false;
+  bool pinned_main_ = false;
+  detail::SavedBinding main_binding_;
+  std::unique_ptr<Slot[]> counters_;
+  std::unique_ptr<PaddedCounter[]> done_;
+  std::size_t done_cap_ = 0;
+  std::unique_ptr<PaddedCounter[]> loop_;
+  std::size_t loop_cap_ = 0;
+  // Step context: written by the main thread before the step_seq_ store, read by workers
+  // after acquiring it.
+  const Plan* plan_ = nullptr;
+  const ExecGraph* exec_ = nullptr;
+  Workload* workload_ = nullptr;
+  bool fresh_ = false;
+  std::uint64_t epoch_ = 0;
+  std::uint64_t steps_ = 0;
+  alignas(64) std::atomic<std::uint64_t> step_seq_{0};
+  alignas(64) std::atomic<std::uint64_t> finished_{0};
+  alignas(64) std::atomic<bool> abort_{false};
+  std::atomic<bool> shutdown_{false};
+  const std::atomic<bool> never_abort_{false};
+  std::mutex error_mutex_;
+  std::exception_ptr error_;
+};
+
+}  // namespace
+
+std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o) {
+  return std::make_unique<PartitionExecutor>(o);
+}
+
+}  // namespace tgraph::replay

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: MIT
+// Thread pinning with hwloc: thread p -> p-th PU in "one PU per core first" order.
+#include <hwloc.h>
+
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "sync.hpp"
+#include "tgraph/replay/executor.hpp"
+
+namespace tgraph::replay {
+namespace detail {
+namespace {
+
+struct Topology {
+  hwloc_topology_t topo = nullptr;
+  std::vector<hwloc_obj_t> order;  // PUs: first PU of each core, then the others
+  Topology() {
+    if (hwloc_topology_init(&topo) != 0) return;
+    if (hwloc_topology_load(topo) != 0) {
+      hwloc_topology_destroy(topo);
+      topo = nullptr;
+      return;
+    }
+    const int cores = hwloc_get_nbobjs_by_type(topo, HWLOC_OBJ_CORE);
+    int depth = 0;
+    for (;; ++depth) {
+      bool any = false;
+      for (int c = 0; c < cores; ++c) {
+        hwloc_obj_t core = hwloc_get_obj_by_type(topo, HWLOC_OBJ_CORE, static_cast<unsigned>(c));
+        hwloc_obj_t pu = hwloc_get_obj_inside_cpuset_by_type(topo, core->cpuset, HWLOC_OBJ_PU,
+                                                             static_cast<unsigned>(depth));
+        if (pu) {
+          order.push_back(pu);
+          any = true;
+        }
+      }
+      if (!any) break;
+    }
+    if (order.empty()) {
+      const int pus = hwloc_get_nbobjs_by_type(topo, HWLOC_OBJ_PU);
+      for (int i = 0; i < pus; ++i)
+        order.push_back(hwloc_get_obj_by_type(topo, HWLOC_OBJ_PU, static_cast<unsigned>(i)));
+    }
+  }
+  ~Topology() {
+    if (topo) hwloc_topology_destroy(topo);
+  }
+};
+
+Topology& topology() {
+  static Topology t;
+  return t;
+}
+
+}  // namespace
+
+bool pin_current_thread(std::uint32_t p) {
+  Topology& t = topology();
+  if (!t.topo || t.order.empty()) return false;
+  hwloc_obj_t pu = t.order[p % t.order.size()];
+  return hwloc_set_cpubind(t.topo, pu->cpuset, HWLOC_CPUBIND_THREAD) == 0;
+}
+
+void save_binding(SavedBinding& s) {
+  Topology& t = topology();
+  if (!t.topo) return;
+  hwloc_bitmap_t set = hwloc_bitmap_alloc();
+  if (hwloc_get_cpubind(t.topo, set, HWLOC_CPUBIND_THREAD) == 0) {
+    s.set = set;
+  } else {
+    hwloc_bitmap_free(set);
+  }
+}
+
+void restore_binding(SavedBinding& s) {
+  Topology& t = topology();
+  if (!t.topo || !s.set) return;
+  hwloc_set_cpubind(t.topo, static_cast<hwloc_bitmap_t>(s.set), HWLOC_CPUBIND_THREAD);
+}
+
+SavedBinding::~SavedBinding() {
+  if (set) hwloc_bitmap_free(static_cast<hwloc_bitmap_t>(set));
+}
+
+unsigned hardware_pus() {
+  Topology& t = topology();
+  if (!t.topo || t.order.empty()) return std::max(1u, std::thread::hardware_concurrency());
+  return static_cast<unsigned>(t.order.size());
+}
+
+}  // namespace detail
+
+int pinned_pu(std::uint32_t p) {
+  detail::Topology& t = detail::topology();
+  if (!t.topo || t.order.empty()) return -1;
+  return static_cast<int>(t.order[p % t.order.size()]->os_index);
+}
+
+}  // namespace tgraph::replay

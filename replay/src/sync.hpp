@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+// Internal: spin-then-park waiting on 64-bit counters, thread pinning.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <thread>
+
+#include "tgraph/replay/observer.hpp"
+
+namespace tgraph::replay::detail {
+
+/// One CPU relaxation hint.
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
+/// A 64-bit counter alone on its cache line.
+struct alignas(64) PaddedCounter {
+  std::atomic<std::uint64_t> v{0};
+};
+
+/// Spin-then-park waiting shared by the threads of one executor.
+///
+/// Protocol (Dekker): a waiter that is about to sleep increments `parked` (seq_cst) and then
+/// re-reads the counter (seq_cst); a signaller stores the counter (seq_cst) and then reads
+/// `parked` (seq_cst). In the single total order of seq_cst operations, either the
+/// signaller sees the waiter registered (and notifies) or the waiter sees the new value
+/// (and does not sleep); std::atomic::wait itself never misses a notify that follows its
+/// value check.
+class Parking {
+ public:
+  explicit Parking(std::int64_t spin_ns, bool oversubscribed)
+      : spin_ns_(spin_ns), oversubscribed_(oversubscribed) {}
+
+  /// Publishes `value` into `c` and wakes sleepers if any.
+  void signal(std::atomic<std::uint64_t>& c, std::uint64_t value) {
+    // seq_cst: orders this store before the load of parked_ below (see class comment);
+    // it is also a release, so the writer's data is visible to whoever acquires `value`.
+    c.store(value, std::memory_order_seq_cst);
+    // seq_cst: the other half of the Dekker pair.
+    if (parked_.load(std::memory_order_seq_cst) != 0) c.notify_all();
+  }
+
+  /// Wakes every sleeper of `c` (abort, shutdown) without changing it.
+  void wake(std::atomic<std::uint64_t>& c) { c.notify_all(); }
+
+  /// Waits until ok(c) or `abort` is set; returns the last value read and whether it slept.
+  /// `spun_ns` receives the time spent (0 when ok at once).
+  template <class Ok>
+  std::uint64_t wait(std::atomic<std::uint64_t>& c, Ok ok, const std::atomic<bool>& abort,
+                     bool& parked, std::int64_t& waited_ns) {
+    parked = false;
+    waited_ns = 0;
+    // acquire: pairs with the signaller's store so its data writes are visible after.
+    std::uint64_t v = c.load(std::memory_order_acquire);
+    if (ok(v)) return v;
+    const std::int64_t t0 = now_ns();
+    std::int64_t t = t0;
+    while (t - t0 < spin_ns_) {
+      for (int i = 0; i < 64; ++i) {
+        if (oversubscribed_) {
+          std::this_thread::yield();
+        } else {
+          cpu_relax();
+        }
+        v = c.load(std::memory_order_acquire);  // acquire: as above
+        // relaxed: abort is only a hint to stop; no data is read because of it.
+        if (ok(v) || abort.load(std::memory_order_relaxed)) {
+          waited_ns = now_ns() - t0;
+          return v;
+        }
+      }
+      t = now_ns();
+    }
+    parked = true;
+    // seq_cst: Dekker with signal() (class comment).
+    parked_.fetch_add(1, std::memory_order_seq_cst);
+    for (;;) {
+      v = c.load(std::memory_order_seq_cst);  // seq_cst: Dekker with signal()
+      if (ok(v) || abort.load(std::memory_order_seq_cst)) break;  // seq_cst: Dekker with abort
+      c.wait(v, std::memory_order_acquire);  // acquire: as the loads above
+    }
+    // relaxed: only signallers read it, and a stale non-zero value costs one notify.
+    parked_.fetch_sub(1, std::memory_order_relaxed);
+    waited_ns = now_ns() - t0;
+    return v;
+  }
+
+  /// Number of sleeping waiters (for abort).
+  std::uint32_t parked() const { return parked_.load(std::memory_order_seq_cst); }
+
+ private:
+  std::int64_t spin_ns_;
+  bool oversubscribed_;
+  alignas(64) std::atomic<std::uint32_t> parked_{0};
+};
+
+/// Binds the calling thread to thread slot p's processing unit; returns false if hwloc
+/// cannot (never fails the run).
+bool pin_current_thread(std::uint32_t p);
+/// Restores the calling thread's binding saved by save_binding().
+struct SavedBinding {
+  void* set = nullptr;
+  ~SavedBinding();
+};
+/// Saves the calling thread's current binding.
+void save_binding(SavedBinding& s);
+void restore_binding(SavedBinding& s);
+
+/// Number of processing units.
+unsigned hardware_pus();
+
+}  // namespace tgraph::replay::detail

@@ -1,0 +1,182 @@
+// SPDX-License-Identifier: MIT
+// Synthetic bodies: calibrated busy loop + passes over the data buffers.
+#include "tgraph/replay/synthetic.hpp"
+
+#include <algorithm>
+#include <cstring>
+
+#include "tgraph/replay/observer.hpp"
+
+namespace tgraph::replay {
+
+struct SyntheticWorkload::Buffer {
+  std::unique_ptr<std::uint64_t[]> w;
+  std::uint64_t words = 0;
+  bool temp = false;
+};
+
+std::uint64_t spin_iterations(std::uint64_t iterations, std::uint64_t seed) {
+  std::uint64_t x = seed | 1;
+  for (std::uint64_t i = 0; i < iterations; ++i) {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;
+    asm volatile("" : "+r"(x));  // one dependent step per iteration, never folded
+  }
+  return x;
+}
+
+namespace {
+
+std::uint64_t read_pass(const std::uint64_t* w, std::uint64_t n) {
+  std::uint64_t s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  std::uint64_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    s0 += w[i];
+    s1 += w[i + 1];
+    s2 += w[i + 2];
+    s3 += w[i + 3];
+  }
+  for (; i < n; ++i) s0 += w[i];
+  return (s0 + s1) ^ (s2 + s3);
+}
+
+void write_pass(AccessMode mode, std::uint64_t* w, std::uint64_t n, std::uint64_t v) {
+  switch (mode) {
+    case AccessMode::R: return;
+    case AccessMode::W:
+      for (std::uint64_t i = 0; i < n; ++i) w[i] = v + i * 0x9e3779b97f4a7c15ull;
+      return;
+    case AccessMode::RW:
+      for (std::uint64_t i = 0; i < n; ++i) w[i] = w[i] * 3 + v + i;
+      return;
+    case AccessMode::CW:
+      for (std::uint64_t i = 0; i < n; ++i) w[i] += v + i;
+      return;
+  }
+}
+
+Calibration measure() {
+  Calibration c;
+  double best = 1e30;
+  const std::uint64_t iters = 200000;
+  for (int r = 0; r < 7; ++r) {
+    const std::int64_t t0 = now_ns();
+    volatile std::uint64_t sink = spin_iterations(iters, static_cast<std::uint64_t>(r));
+    (void)sink;
+    best = std::min(best, static_cast<double>(now_ns() - t0));
+  }
+  c.spin_iterations_per_ns = static_cast<double>(iters) / std::max(best, 1.0);
+  const std::uint64_t words = 2048;  // 16 KiB read + 16 KiB read-modify-write, in L1/L2
+  std::vector<std::uint64_t> a(words, 1), b(words, 2);
+  best = 1e30;
+  for (int r = 0; r < 21; ++r) {
+    const std::int64_t t0 = now_ns();
+    const std::uint64_t s = read_pass(a.data(), words);
+    write_pass(AccessMode::RW, b.data(), words, s);
+    asm volatile("" : : "r"(b.data()) : "memory");
+    best = std::min(best, static_cast<double>(now_ns() - t0));
+  }
+  c.touch_ns_per_byte = best / static_cast<double>(2 * words * 8);
+  return c;
+}
+
+}  // namespace
+
+const Calibration& SyntheticWorkload::calibration() {
+  static const Calibration c = measure();
+  return c;
+}
+
+SyntheticWorkload::SyntheticWorkload(SyntheticOptions options) : options_(options) { (void)calibration(); }
+SyntheticWorkload::~SyntheticWorkload() = default;
+
+void SyntheticWorkload::bind(const ExecGraph& exec) {
+  const std::size_t n = exec.graph.data.size();
+  buffers_.resize(n);
+  want_words_.assign(n, 0);
+  is_temp_.assign(n, false);
+  for (DatumId d = 0; d < n; ++d) {
+    const bool temp = exec.datum_origin[d] != d;
+    const std::uint64_t bytes = options_.touch ? std::min(exec.graph.data[d].bytes, options_.max_datum_bytes) : 0;
+    want_words_[d] = (bytes + 7) / 8;
+    is_temp_[d] = temp;
+    if (buffers_[d] && (temp || buffers_[d]->temp)) buffers_[d].reset();  // temps are per plan
+  }
+}
+
+bool SyntheticWorkload::needs_touch(DatumId d) const {
+  return d < want_words_.size() && want_words_[d] != 0 &&
+         (!buffers_[d] || buffers_[d]->words != want_words_[d]);
+}
+
+void SyntheticWorkload::first_touch(DatumId d) {
+  auto b = std::make_unique<Buffer>();
+  b->words = want_words_[d];
+  b->w = std::make_unique<std::uint64_t[]>(b->words);  // zeroed here: first touch
+  b->temp = is_temp_[d];
+  // Temporaries start at zero; original data with a deterministic pattern.
+  if (!b->temp)
+    for (std::uint64_t i = 0; i < b->words; ++i) b->w[i] = (static_cast<std::uint64_t>(d) << 32) + i;
+  buffers_[d] = std::move(b);
+}
+
+void SyntheticWorkload::run(const TaskRun& r) {
+  const ExecGraph& x = *r.exec;
+  if (r.origin == kNoTask) {
+    const Reduction& red = x.reductions[x.reduction[r.task]];
+    Buffer* target = buffers_[red.target].get();
+    if (!target) return;
+    for (DatumId t : red.temps) {
+      Buffer* tmp = buffers_[t].get();
+      if (!tmp) continue;
+      const std::uint64_t n = std::min(tmp->words, target->words);
+      for (std::uint64_t i = 0; i < n; ++i) {
+        target->w[i] += tmp->w[i];
+        tmp->w[i] = 0;
+      }
+    }
+    return;
+  }
+  std::uint64_t acc = (static_cast<std::uint64_t>(r.origin) << 20) ^ r.iteration;
+  std::uint64_t bytes = 0;
+  const auto acc_list = x.graph.accesses_of(r.task);
+  for (const Access& a : acc_list) {
+    if (!reads(a.mode)) continue;
+    const Buffer* b = buffers_[a.datum].get();
+    if (!b) continue;
+    acc = acc * 31 + read_pass(b->w.get(), b->words);
+    bytes += b->words * 8;
+  }
+  for (const Access& a : acc_list) {
+    if (!writes(a.mode)) continue;
+    Buffer* b = buffers_[a.datum].get();
+    if (!b) continue;
+    write_pass(a.mode, b->w.get(), b->words, acc);
+    bytes += b->words * 8;
+  }
+  const Calibration& c = calibration();
+  const double cost = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0) * options_.cost_scale;
+  const double rest = cost - static_cast<double>(bytes) * c.touch_ns_per_byte;
+  if (rest > 0) {
+    const auto n = static_cast<std::uint64_t>(rest * c.spin_iterations_per_ns);
+    volatile std::uint64_t sink = spin_iterations(n, acc);
+    (void)sink;
+  }
+}
+
+bool SyntheticWorkload::stop_after(LoopId loop, std::uint32_t iteration) {
+  return step_ == nullptr || iteration + 1 >= step_->loops[loop].iterations;
+}
+
+std::span<const std::uint64_t> SyntheticWorkload::words(DatumId d) const {
+  if (d >= buffers_.size() || !buffers_[d]) return {};
+  return {buffers_[d]->w.get(), buffers_[d]->words};
+}
+
+std::uint64_t SyntheticWorkload::allocated_bytes() const {
+  std::uint64_t s = 0;
+  for (const auto& b : buffers_)
+    if (b) s += b->words * 8;
+  return s;
+}
+
+}  // namespace tgraph::replay

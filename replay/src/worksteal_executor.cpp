@@ -1,0 +1,250 @@
+// SPDX-License-Identifier: MIT
+// Work-stealing baseline (oneTBB): the same dataflow graph executed by dependency counting,
+// loops unrolled on the fly, no affinity from step to step (the paper's Cilk-like baseline).
+//
+// Instance (v, i) = task v in loop iteration i. Its count is the number of instances it
+// waits for: iteration 0 (or outside loops): intra-step predecessors (a predecessor in
+// another loop counts once, for that loop's end); iteration i > 0: same-iteration
+// predecessors + loop-carried predecessors + the break of iteration i - 1 (the gate) +
+// (v, i - 1) itself. A completed instance decrements its successors and spawns those that
+// reach zero.
+#include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/task_arena.h>
+#include <oneapi/tbb/task_group.h>
+
+#include <algorithm>
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "common.hpp"
+#include "tgraph/replay/executor.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+struct Block {
+  std::atomic<std::uint32_t> remaining{0};  // body instances of this iteration not finished
+  std::atomic<int> decision{-1};            // -1 unknown, 0 continue, 1 stop
+  std::unique_ptr<std::atomic<std::uint32_t>[]> count;
+};
+
+struct LoopState {
+  TaskId first = 0, last = 0;
+  std::vector<std::atomic<Block*>> table;  // iteration -> block
+  std::vector<std::uint32_t> init_next;    // counts of iterations > 0, by body index
+  std::vector<TaskId> after;               // tasks outside the loop depending on its body
+};
+
+struct WsPlan {
+  std::size_t n = 0;
+  detail::Csr succ, succ_carried;
+  std::vector<std::uint32_t> init0;  // non-loop tasks and iteration 0 of loop tasks
+  std::vector<LoopState> loops;
+  std::unique_ptr<std::atomic<std::uint32_t>[]> count0;  // non-loop tasks
+};
+
+class WorkstealExecutor final : public Executor {
+ public:
+  explicit WorkstealExecutor(const ExecOptions& o)
+      : Executor(Policy::kWorksteal, o),
+        control_(tbb::global_control::max_allowed_parallelism, o.threads),
+        arena_(static_cast<int>(o.threads)),
+        counters_(std::make_unique<Slot[]>(o.threads)) {}
+
+ private:
+  struct alignas(64) Slot {
+    ThreadCounters c;
+  };
+
+  std::shared_ptr<void> build(const ExecGraph& x) override {
+    const StepGraph& g = x.graph;
+    auto plan = std::make_shared<WsPlan>();
+    const auto n = g.tasks.size();
+    plan->n = n;
+    plan->succ = detail::build_csr(n, g.edges, false);
+    plan->succ_carried = detail::build_csr(n, g.carried_edges, false);
+    const detail::Csr pred = detail::build_csr(n, g.edges, true);
+    const detail::Csr pred_carried = detail::build_csr(n, g.carried_edges, true);
+    plan->init0.assign(n, 0);
+    plan->loops = std::vector<LoopState>(g.loops.size());
+    for (LoopId l = 0; l < g.loops.size(); ++l) {
+      LoopState& ls = plan->loops[l];
+      ls.first = g.loops[l].first;
+      ls.last = g.loops[l].last;
+      const std::uint32_t cap = g.loops[l].max_iterations != 0
+                                    ? std::min(g.loops[l].max_iterations, detail::kIterationCap)
+                                    : detail::kIterationCap;
+      ls.table = std::vector<std::atomic<Block*>>(cap + 2);
+      ls.init_next.assign(ls.last - ls.first, 0);
+    }
+    std::vector<std::vector<bool>> after_seen(g.loops.size());
+    for (TaskId v = 0; v < n; ++v) {
+      const LoopId lv = g.tasks[v].loop;
+      std::vector<LoopId> counted_loops;
+      std::uint32_t c0 = 0, cn = 0;
+      for (auto i = pred.begin[v]; i < pred.begin[v + 1]; ++i) {
+        const TaskId u = pred.ids[i];
+        const LoopId lu = g.tasks[u].loop;
+        if (lu == kNoLoop) {
+          ++c0;
+        } else if (lu == lv) {
+          ++c0;
+          ++cn;
+        } else if (std::find(counted_loops.begin(), counted_loops.end(), lu) == counted_loops.end()) {
+          counted_loops.push_back(lu);
+          ++c0;
+          plan->loops[lu].after.push_back(v);
+        }
+      }
+      plan->init0[v] = c0;
+      if (lv != kNoLoop) {
+        cn += pred_carried.size(v) + 2;  // carried + gate + previous instance of itself
+        plan->loops[lv].init_next[v - plan->loops[lv].first] = cn;
+      }
+    }
+    plan->count0 = std::make_unique<std::atomic<std::uint32_t>[]>(n);
+    return plan;
+  }
+
+  Block* new_block(LoopState& ls, bool first) {
+    auto* b = new Block;
+    const std::size_t size = ls.last - ls.first;
+    b->count = std::make_unique<std::atomic<std::uint32_t>[]>(size);
+    for (std::size_t j = 0; j < size; ++j)
+      b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j], std::memory_order_relaxed);
+    b->remaining.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
+    return b;
+  }
+
+  void spawn(TaskId t, std::uint32_t it) {
+    tg_->run([this, t, it] { run_instance(t, it); });
+  }
+
+  // acq_rel: the last decrement acquires every earlier decrementer's writes (their tasks'
+  // data) and the spawned task runs after it.
+  void dec(std::atomic<std::uint32_t>& c, TaskId t, std::uint32_t it, ThreadCounters& tc) {
+    ++tc.signals;
+    if (c.fetch_sub(1, std::memory_order_acq_rel) == 1) spawn(t, it);
+  }
+
+  // A dependency of task s on an instance outside its loop (or s outside loops) is met.
+  void release_first(TaskId s, ThreadCounters& tc) {
+    const LoopId ls = exec_->graph.tasks[s].loop;
+    if (ls == kNoLoop) {
+      dec(plan_->count0[s], s, 0, tc);
+    } else {
+      LoopState& st = plan_->loops[ls];
+      // acquire: the block was published with release before any instance could see it.
+      Block* b = st.table[0].load(std::memory_order_acquire);
+      dec(b->count[s - st.first], s, 0, tc);
+    }
+  }
+
+  void run_instance(TaskId t, std::uint32_t it) {
+    const int idx = tbb::this_task_arena::current_thread_index();
+    const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options_.threads;
+    ThreadCounters& tc = counters_[thread].c;
+    const ExecGraph& x = *exec_;
+    if (!observers_.empty()) detail::notify_begin(observers_, thread, t, it);
+    workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
+    if (!observers_.empty()) detail::notify_end(observers_, thread, t, it);
+    ++tc.tasks;
+    const LoopId l = x.graph.tasks[t].loop;
+    const WsPlan& p = *plan_;
+    if (l == kNoLoop) {
+      for (auto i = p.succ.begin[t]; i < p.succ.begin[t + 1]; ++i) release_first(p.succ.ids[i], tc);
+      return;
+    }
+    LoopState& ls = plan_->loops[l];
+    // acquire: blocks are published with release before the instances that use them run.
+    Block* cur = ls.table[it].load(std::memory_order_acquire);
+    Block* next = ls.table[it + 1].load(std::memory_order_acquire);
+    for (auto i = p.succ.begin[t]; i < p.succ.begin[t + 1]; ++i) {
+      const TaskId s = p.succ.ids[i];
+      if (x.graph.tasks[s].loop == l) dec(cur->count[s - ls.first], s, it, tc);
+    }
+    for (auto i = p.succ_carried.begin[t]; i < p.succ_carried.begin[t + 1]; ++i) {
+      const TaskId s = p.succ_carried.ids[i];
+      dec(next->count[s - ls.first], s, it + 1, tc);
+    }
+    dec(next->count[t - ls.first], t, it + 1, tc);
+    if (t + 1 == ls.last) {
+      const bool stop = detail::leave_loop(x, l, it, *workload_);
+      // relaxed: published by the release of the remaining-count decrement below.
+      cur->decision.store(stop ? 1 : 0, std::memory_order_relaxed);
+      if (stop) {
+        // relaxed: read by the main thread after task_group::wait().
+        iterations_[l] = it + 1;
+      } else {
+        // release: instances of iteration it + 1 acquire the table entry.
+        ls.table[it + 2].store(new_block(ls, false), std::memory_order_release);
+        for (TaskId v = ls.first; v < ls.last; ++v) dec(next->count[v - ls.first], v, it + 1, tc);
+      }
+    }
+    // acq_rel: the last finisher of the iteration sees the decision and every instance's data.
+    if (cur->remaining.fetch_sub(1, std::memory_order_acq_rel) == 1 &&
+        cur->decision.load(std::memory_order_relaxed) == 1) {
+      for (TaskId s : ls.after) release_first(s, tc);
+    }
+  }
+
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+    WsPlan& plan = *static_cast<WsPlan*>(plan_ptr);
+    const StepGraph& g = x.graph;
+    if (fresh)
+      for (DatumId d = 0; d < g.data.size(); ++d)
+        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
+    plan_ = &plan;
+    exec_ = &x;
+    workload_ = &w;
+    iterations_.assign(g.loops.size(), 0);
+    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    for (TaskId t = 0; t < plan.n; ++t)
+      plan.count0[t].store(plan.init0[t], std::memory_order_relaxed);  // relaxed: before any spawn
+    for (LoopState& ls : plan.loops) {
+      ls.table[0].store(new_block(ls, true), std::memory_order_relaxed);   // relaxed: before spawns
+      ls.table[1].store(new_block(ls, false), std::memory_order_relaxed);  // (task_group::run releases)
+    }
+    std::exception_ptr error;
+    arena_.execute([&] {
+      tbb::task_group tg;
+      tg_ = &tg;
+      for (TaskId t = 0; t < plan.n; ++t)
+        if (plan.init0[t] == 0) spawn(t, 0);
+      try {
+        tg.wait();
+      } catch (...) {
+        error = std::current_exception();
+      }
+    });
+    for (LoopState& ls : plan.loops)
+      for (auto& e : ls.table) {
+        Block* b = e.load(std::memory_order_relaxed);  // relaxed: all tasks finished
+        if (!b) break;
+        delete b;
+        e.store(nullptr, std::memory_order_relaxed);
+      }
+    stats.threads.resize(options_.threads);
+    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    stats.loop_iterations = iterations_;
+    if (error) std::rethrow_exception(error);
+  }
+
+  tbb::global_control control_;
+  tbb::task_arena arena_;
+  std::unique_ptr<Slot[]> counters_;
+  WsPlan* plan_ = nullptr;
+  const ExecGraph* exec_ = nullptr;
+  Workload* workload_ = nullptr;
+  tbb::task_group* tg_ = nullptr;
+  std::vector<std::uint32_t> iterations_;
+};
+
+}  // namespace
+
+std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o) {
+  return std::make_unique<WorkstealExecutor>(o);
+}
+
+}  // namespace tgraph::replay

@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include "tgraph/replay/policy.hpp"
+
+namespace tgraph::replay {
+
+TEST(Policy, NamesRoundTrip) {
+  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+    EXPECT_EQ(parse_policy(to_string(p)), p);
+  EXPECT_FALSE(parse_policy("magic").has_value());
+  EXPECT_EQ(to_string(CwMode::kReduce), "reduce");
+}
+
+}  // namespace tgraph::replay
