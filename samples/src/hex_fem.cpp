@@ -1,0 +1,202 @@
+// SPDX-License-Identifier: MIT
+// Corotational hexahedral FEM (linear elasticity in each element's rotated frame).
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <array>
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "tgraph/samples/force_field.hpp"
+
+namespace tgraph::samples {
+namespace {
+
+using Mat38 = Eigen::Matrix<double, 3, 8>;
+using Vec24 = Eigen::Matrix<double, 24, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+// Reference corner coordinates, in the documented node order.
+constexpr std::array<std::array<double, 3>, 8> kCorner = {{{-1, -1, -1},
+                                                           {1, -1, -1},
+                                                           {1, 1, -1},
+                                                           {-1, 1, -1},
+                                                           {-1, -1, 1},
+                                                           {1, -1, 1},
+                                                           {1, 1, 1},
+                                                           {-1, 1, 1}}};
+
+// Derivatives of the 8 trilinear shape functions w.r.t. the reference coordinates (3 x 8).
+Mat38 shape_derivatives(double xi, double eta, double zeta) {
+  Mat38 d;
+  for (int i = 0; i < 8; ++i) {
+    const double a = kCorner[i][0], b = kCorner[i][1], c = kCorner[i][2];
+    d(0, i) = 0.125 * a * (1 + eta * b) * (1 + zeta * c);
+    d(1, i) = 0.125 * b * (1 + xi * a) * (1 + zeta * c);
+    d(2, i) = 0.125 * c * (1 + xi * a) * (1 + eta * b);
+  }
+  return d;
+}
+
+Mat6 elasticity(const FemMaterial& m) {
+  const double lambda = m.young * m.poisson / ((1 + m.poisson) * (1 - 2 * m.poisson));
+  const double mu = m.young / (2 * (1 + m.poisson));
+  Mat6 d = Mat6::Zero();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) d(i, j) = lambda;
+    d(i, i) = lambda + 2 * mu;
+    d(3 + i, 3 + i) = mu;
+  }
+  return d;
+}
+
+// Strain-displacement rows for one gradient vector g (Voigt: xx yy zz xy yz zx).
+void fill_b(Eigen::Ref<Eigen::Matrix<double, 6, 3>> b, const Vec3& g) {
+  b.setZero();
+  b(0, 0) = g.x();
+  b(1, 1) = g.y();
+  b(2, 2) = g.z();
+  b(3, 0) = g.y();
+  b(3, 1) = g.x();
+  b(4, 1) = g.z();
+  b(4, 2) = g.y();
+  b(5, 0) = g.z();
+  b(5, 2) = g.x();
+}
+
+// Rotation of the polar decomposition F = R S (Higham's scaled Newton iteration; SVD when
+// the element is inverted or degenerate).
+Mat3 polar_rotation(const Mat3& f) {
+  const double det = f.determinant();
+  if (!(det > 1e-12 * std::pow(f.norm() + 1e-300, 3))) {
+    Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Mat3 u = svd.matrixU();
+    const Mat3& v = svd.matrixV();
+    if ((u * v.transpose()).determinant() < 0) u.col(2) = -u.col(2);
+    return u * v.transpose();
+  }
+  Mat3 r = f;
+  for (int it = 0; it < 30; ++it) {
+    const Mat3 inv_t = r.inverse().transpose();
+    const double g = std::sqrt(std::sqrt(inv_t.squaredNorm() / r.squaredNorm()));
+    const Mat3 next = 0.5 * (g * r + inv_t / g);
+    const double change = (next - r).squaredNorm();
+    r = next;
+    if (change < 1e-24) break;
+  }
+  return r;
+}
+
+}  // namespace
+
+HexFemForceField::Mat24 HexFemForceField::element_stiffness(const Mat38& rest, const FemMaterial& material) {
+  const Mat6 d = elasticity(material);
+  const double gp = 1.0 / std::sqrt(3.0);
+  Mat24 kuu = Mat24::Zero();
+  Eigen::Matrix<double, 24, 9> kua = Eigen::Matrix<double, 24, 9>::Zero();
+  Eigen::Matrix<double, 9, 9> kaa = Eigen::Matrix<double, 9, 9>::Zero();
+  // Jacobian at the centre, for the incompatible modes (Taylor's patch-test correction).
+  const Mat3 j0 = rest * shape_derivatives(0, 0, 0).transpose();
+  const double det0 = j0.determinant();
+  const Mat3 j0_inv_t = j0.inverse().transpose();
+  for (int gi = 0; gi < 8; ++gi) {
+    const double xi = kCorner[gi][0] * gp, eta = kCorner[gi][1] * gp, zeta = kCorner[gi][2] * gp;
+    const Mat38 dref = shape_derivatives(xi, eta, zeta);
+    const Mat3 j = rest * dref.transpose();  // J_ab = sum_i X_i[a] dN_i/dxi_b
+    const double det = j.determinant();
+    const Mat38 grad = j.inverse().transpose() * dref;  // gradients w.r.t. X
+    Eigen::Matrix<double, 6, 24> b;
+    for (int i = 0; i < 8; ++i) fill_b(b.block<6, 3>(0, 3 * i), grad.col(i));
+    kuu.noalias() += b.transpose() * d * b * det;
+    if (material.incompatible_modes) {
+      // Modes 1 - xi^2, 1 - eta^2, 1 - zeta^2 for each displacement component.
+      const Vec3 dref_modes[3] = {Vec3(-2 * xi, 0, 0), Vec3(0, -2 * eta, 0), Vec3(0, 0, -2 * zeta)};
+      Eigen::Matrix<double, 6, 9> g;
+      for (int m = 0; m < 3; ++m)
+        fill_b(g.block<6, 3>(0, 3 * m), (det0 / det) * (j0_inv_t * dref_modes[m]));
+      kua.noalias() += b.transpose() * d * g * det;
+      kaa.noalias() += g.transpose() * d * g * det;
+    }
+  }
+  if (material.incompatible_modes) kuu.noalias() -= kua * kaa.ldlt().solve(kua.transpose());
+  return 0.5 * (kuu + kuu.transpose());
+}
+
+HexFemForceField::HexFemForceField(std::string name, ParticleBody* body,
+                                   std::vector<std::array<Index, 8>> elements, const FemMaterial& material)
+    : ForceField(std::move(name), body), body_(body), elements_(std::move(elements)) {
+  const StateVec& x0 = body->rest();
+  const std::size_t ne = elements_.size();
+  rest_.resize(ne);
+  grad_.resize(ne);
+  ke_index_.resize(ne);
+  rotations_.assign(ne, Mat3::Identity());
+  // Elements of identical rest shape (up to translation) share one stiffness matrix.
+  std::map<std::array<long long, 24>, std::uint32_t> shapes;
+  for (std::size_t e = 0; e < ne; ++e) {
+    Mat38& r = rest_[e];
+    for (int i = 0; i < 8; ++i) r.col(i) = x0.col(elements_[e][static_cast<std::size_t>(i)]);
+    const Mat3 j = r * shape_derivatives(0, 0, 0).transpose();
+    grad_[e] = j.inverse().transpose() * shape_derivatives(0, 0, 0);
+    std::array<long long, 24> key{};
+    const double scale = 1e-9 * std::max(1e-12, (r.col(6) - r.col(0)).norm());
+    for (int i = 0; i < 8; ++i)
+      for (int c = 0; c < 3; ++c)
+        key[static_cast<std::size_t>(3 * i + c)] = std::llround((r(c, i) - r(c, 0)) / scale);
+    auto [it, inserted] = shapes.emplace(key, static_cast<std::uint32_t>(ke_.size()));
+    if (inserted) ke_.push_back(element_stiffness(r, material));
+    ke_index_[e] = it->second;
+  }
+}
+
+std::uint64_t HexFemForceField::state_bytes() const { return rotations_.size() * sizeof(Mat3); }
+
+void HexFemForceField::add_force() {
+  const StateVec& x = body_->vec(VecId::kX);
+  StateVec& f = body_->vec(VecId::kF);
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    const auto& nodes = elements_[e];
+    Mat38 xe;
+    for (int i = 0; i < 8; ++i) xe.col(i) = x.col(nodes[static_cast<std::size_t>(i)]);
+    // Polar decomposition relative to the previous rotation converges in a few iterations.
+    const Mat3 f_grad = xe * grad_[e].transpose();
+    Mat3& rot = rotations_[e];
+    rot = rot * polar_rotation(rot.transpose() * f_grad);
+    Mat38 u = rot.transpose() * xe - rest_[e];
+    Vec24 fe = -(ke_[ke_index_[e]] * Eigen::Map<const Vec24>(u.data()));
+    const Mat38 fw = rot * Eigen::Map<const Mat38>(fe.data());
+    for (int i = 0; i < 8; ++i) f.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+  }
+}
+
+void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor) {
+  const StateVec& in = body_->vec(dx);
+  StateVec& out = body_->vec(df);
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    const auto& nodes = elements_[e];
+    const Mat3& rot = rotations_[e];
+    Mat38 de;
+    for (int i = 0; i < 8; ++i) de.col(i) = in.col(nodes[static_cast<std::size_t>(i)]);
+    const Mat38 local = rot.transpose() * de;
+    const Vec24 fe = ke_[ke_index_[e]] * Eigen::Map<const Vec24>(local.data());
+    const Mat38 fw = (-k_factor) * (rot * Eigen::Map<const Mat38>(fe.data()));
+    for (int i = 0; i < 8; ++i) out.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+  }
+}
+
+double HexFemForceField::potential_energy() const {
+  const StateVec& x = body_->vec(VecId::kX);
+  double energy = 0.0;
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    Mat38 xe;
+    for (int i = 0; i < 8; ++i) xe.col(i) = x.col(elements_[e][static_cast<std::size_t>(i)]);
+    const Mat3 rot = polar_rotation(xe * grad_[e].transpose());
+    Mat38 u = rot.transpose() * xe - rest_[e];
+    const auto uv = Eigen::Map<const Vec24>(u.data());
+    energy += 0.5 * uv.dot(ke_[ke_index_[e]] * uv);
+  }
+  return energy;
+}
+
+}  // namespace tgraph::samples

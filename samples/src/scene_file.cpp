@@ -1,0 +1,727 @@
+// SPDX-License-Identifier: MIT
+// Scene files (format: samples/scenes/README.md) and the built-in scenes.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "builders.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/samples/scene.hpp"
+
+namespace tgraph::samples {
+
+namespace detail {
+/// Built-in scene files: {name, text}, generated from samples/scenes/*.scene.
+struct BuiltinScene {
+  const char* name;
+  const char* text;
+};
+extern const BuiltinScene kBuiltinScenes[];
+extern const std::size_t kBuiltinSceneCount;
+}  // namespace detail
+
+namespace {
+
+using detail::HexMesh;
+using detail::Shape;
+
+// Deterministic uniform numbers in [-1, 1) from the scene seed (independent of the
+// standard library's distribution implementations).
+class Jitter {
+ public:
+  explicit Jitter(std::uint64_t seed) : gen_(seed) {}
+  double uniform() { return static_cast<double>(gen_() >> 11) * (2.0 / 9007199254740992.0) - 1.0; }
+  Vec3 vec() {
+    const double x = uniform(), y = uniform(), z = uniform();
+    return {x, y, z};
+  }
+
+ private:
+  std::mt19937_64 gen_;
+};
+
+// One line of a scene file: a keyword and key=value attributes.
+class Directive {
+ public:
+  Directive(std::string file, int line, std::string keyword, std::map<std::string, std::string> attrs)
+      : file_(std::move(file)), line_(line), keyword_(std::move(keyword)), attrs_(std::move(attrs)) {}
+
+  const std::string& keyword() const { return keyword_; }
+
+  [[noreturn]] void fail(const std::string& what) const {
+    throw InputError(file_ + ":" + std::to_string(line_), std::nullopt, what);
+  }
+
+  bool has(const std::string& key) const { return attrs_.count(key) != 0; }
+
+  std::string text(const std::string& key, std::optional<std::string> def = std::nullopt) {
+    auto it = attrs_.find(key);
+    if (it == attrs_.end()) {
+      if (!def) fail("'" + keyword_ + "' needs " + key + "=...");
+      return *def;
+    }
+    used_.insert(key);
+    return it->second;
+  }
+
+  double number(const std::string& key, std::optional<double> def = std::nullopt) {
+    if (!has(key)) {
+      if (!def) fail("'" + keyword_ + "' needs " + key + "=<number>");
+      return *def;
+    }
+    return parse_number(key, text(key));
+  }
+
+  double positive(const std::string& key, std::optional<double> def = std::nullopt) {
+    const double v = number(key, def);
+    if (!(v > 0.0)) fail(key + " must be > 0 (got " + text(key, std::to_string(v)) + ")");
+    return v;
+  }
+
+  double non_negative(const std::string& key, std::optional<double> def = std::nullopt) {
+    const double v = number(key, def);
+    if (!(v >= 0.0)) fail(key + " must be >= 0");
+    return v;
+  }
+
+  int integer(const std::string& key, std::optional<int> def, int lo, int hi) {
+    if (!has(key)) {
+      if (!def) fail("'" + keyword_ + "' needs " + key + "=<integer>");
+      return *def;
+    }
+    const std::string s = text(key);
+    int v = 0;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size()) fail(key + ": '" + s + "' is not an integer");
+    if (v < lo || v > hi) fail(key + " must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return v;
+  }
+
+  std::vector<double> numbers(const std::string& key, std::size_t count, const std::string& s) {
+    std::vector<double> out;
+    std::size_t start = 0;
+    while (start <= s.size()) {
+      const std::size_t comma = s.find(',', start);
+      const std::string part = s.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      out.push_back(parse_number(key, part));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    if (count != 0 && out.size() != count)
+      fail(key + ": expected " + std::to_string(count) + " comma-separated numbers, got " + std::to_string(out.size()));
+    return out;
+  }
+
+  Vec3 vec3(const std::string& key, std::optional<Vec3> def = std::nullopt) {
+    if (!has(key)) {
+      if (!def) fail("'" + keyword_ + "' needs " + key + "=x,y,z");
+      return *def;
+    }
+    const auto v = numbers(key, 3, text(key));
+    return {v[0], v[1], v[2]};
+  }
+
+  std::array<int, 3> int3(const std::string& key, std::optional<std::array<int, 3>> def, int lo, int hi) {
+    if (!has(key)) {
+      if (!def) fail("'" + keyword_ + "' needs " + key + "=a,b,c");
+      return *def;
+    }
+    const auto v = numbers(key, 3, text(key));
+    std::array<int, 3> out{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      if (v[i] != std::floor(v[i]) || v[i] < lo || v[i] > hi)
+        fail(key + ": each value must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      out[i] = static_cast<int>(v[i]);
+    }
+    return out;
+  }
+
+  std::string choice(const std::string& key, const std::string& def, std::initializer_list<const char*> allowed) {
+    const std::string v = text(key, def);
+    for (const char* a : allowed)
+      if (v == a) return v;
+    std::string list;
+    for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+    fail(key + ": '" + v + "' is not one of " + list);
+  }
+
+  // Every attribute must have been consumed.
+  void finish() const {
+    for (const auto& [k, v] : attrs_)
+      if (used_.count(k) == 0) fail("unknown attribute '" + k + "' for '" + keyword_ + "'");
+  }
+
+ private:
+  double parse_number(const std::string& key, const std::string& s) const {
+    double v = 0.0;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (ec != std::errc() || p != s.data() + s.size() || s.empty() || !std::isfinite(v))
+      fail(key + ": '" + s + "' is not a number");
+    return v;
+  }
+
+  std::string file_;
+  int line_;
+  std::string keyword_;
+  std::map<std::string, std::string> attrs_;
+  std::set<std::string> used_;
+};
+
+class SceneBuilder {
+ public:
+  SceneBuilder(std::string file, const SceneOptions& options)
+      : file_(std::move(file)), options_(options), jitter_(options.seed) {}
+
+  std::unique_ptr<Scene> build(std::string_view text) {
+    std::istringstream in{std::string(text)};
+    std::string line;
+    int number = 0;
+    bool header = false;
+    while (std::getline(in, line)) {
+      ++number;
+      if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+      std::istringstream words(line);
+      std::string keyword;
+      if (!(words >> keyword)) continue;
+      std::map<std::string, std::string> attrs;
+      std::vector<std::string> positional;
+      std::string word;
+      while (words >> word) {
+        const auto eq = word.find('=');
+        if (eq == std::string::npos) {
+          positional.push_back(word);
+          continue;
+        }
+        const std::string key = word.substr(0, eq);
+        if (key.empty()) Directive(file_, number, keyword, {}).fail("attribute with an empty name");
+        if (!attrs.emplace(key, word.substr(eq + 1)).second)
+          Directive(file_, number, keyword, {}).fail("attribute '" + key + "' given twice");
+      }
+      Directive d(file_, number, keyword, std::move(attrs));
+      if (!header) {
+        if (keyword != "tgraph-scene" || positional.size() != 1 || positional[0] != "1")
+          d.fail("the first line must be 'tgraph-scene 1'");
+        header = true;
+        continue;
+      }
+      if (!positional.empty()) d.fail("'" + positional[0] + "' is not a key=value attribute");
+      directive(d);
+      d.finish();
+    }
+    if (!header) Directive(file_, number, "", {}).fail("empty scene file (the first line must be 'tgraph-scene 1')");
+    if (!scene_) Directive(file_, number, "", {}).fail("no 'scene name=...' line");
+    if (scene_->bodies().empty()) Directive(file_, number, "", {}).fail("the scene has no objects");
+    if (options_.dt) {
+      if (!(*options_.dt > 0.0) || !std::isfinite(*options_.dt)) throw UsageError("--dt must be > 0");
+      scene_->solver().dt = *options_.dt;
+    }
+    if (options_.coupling) scene_->solver().coupling = *options_.coupling;
+    return std::move(scene_);
+  }
+
+ private:
+  void directive(Directive& d) {
+    const std::string& k = d.keyword();
+    if (k == "scene") {
+      if (scene_) d.fail("'scene' given twice");
+      scene_ = std::make_unique<Scene>(d.text("name"));
+      scene_->set_default_steps(d.integer("steps", 100, 1, 1000000));
+      return;
+    }
+    if (!scene_) d.fail("'" + k + "' before the 'scene name=...' line");
+    if (k == "solver") return solver(d);
+    if (k == "gravity") {
+      scene_->set_gravity(d.vec3("value"));
+      return;
+    }
+    if (k == "collision") return collision(d);
+    if (k == "particles") return particles(d);
+    if (k == "springs") return springs(d);
+    if (k == "fem" || k == "springgrid") return grid_object(d);
+    if (k == "rigid") return rigid(d);
+    if (k == "chain") return chain(d);
+    if (k == "cloth") return cloth(d);
+    d.fail("unknown directive '" + k + "'");
+  }
+
+  void solver(Directive& d) {
+    SolverSettings& s = scene_->solver();
+    s.integrator = d.choice("integrator", "implicit", {"implicit", "explicit"}) == "explicit"
+                       ? Integrator::kExplicitEuler
+                       : Integrator::kImplicitEuler;
+    s.coupling = d.choice("coupling", "groups", {"groups", "shared"}) == "shared" ? Coupling::kShared
+                                                                                   : Coupling::kGroups;
+    s.dt = d.positive("dt", 0.01);
+    s.tolerance = d.positive("tolerance", 1e-5);
+    s.max_iterations = static_cast<std::uint32_t>(d.integer("max_iterations", 100, 1, 100000));
+  }
+
+  void collision(Directive& d) {
+    CollisionSettings& c = scene_->collision();
+    c.enabled = true;
+    c.stiffness = d.positive("stiffness", 1e4);
+    c.alarm_distance = d.non_negative("alarm", 0.01);
+    if (d.has("floor")) {
+      c.floor = true;
+      c.floor_height = d.number("floor");
+    }
+    c.floor_stiffness = d.positive("floor_stiffness", c.stiffness);
+    c.floor_friction = d.non_negative("floor_friction", 0.0);
+  }
+
+  Body* body_by_name(Directive& d, const std::string& key) {
+    const std::string name = d.text(key);
+    Body* b = scene_->find_body(name);
+    if (b == nullptr) d.fail(key + ": no object named '" + name + "' (objects must be declared first)");
+    return b;
+  }
+
+  void check_new_name(Directive& d, const std::string& name) {
+    if (!names_.insert(name).second) d.fail("an object named '" + name + "' already exists");
+  }
+
+  // Attributes every body takes: damping, velocity, collision participation.
+  void common(Directive& d, Body& b, double spacing) {
+    b.mass_damping = d.non_negative("damping", 0.0);
+    const Vec3 v = d.vec3("velocity", Vec3::Zero());
+    if (dynamic_cast<RigidBody*>(&b) != nullptr)
+      b.vec(VecId::kV).col(0) = v;
+    else
+      b.vec(VecId::kV).colwise() = v;
+    const bool collide = d.integer("collide", 1, 0, 1) == 1 && scene_->collision().enabled;
+    b.contact_radius = d.positive("radius", 0.5 * spacing);
+    b.collision_layer = d.integer("layer", 0, 0, 1000000);
+    if (!collide) b.surface.clear();
+  }
+
+  std::vector<Index> fixed_nodes(Directive& d, const StateVec& x, const std::string& spec) {
+    std::vector<Index> out;
+    if (spec.empty() || spec == "none") return out;
+    if (spec == "all") {
+      for (Index i = 0; i < x.cols(); ++i) out.push_back(i);
+      return out;
+    }
+    if (spec.rfind("nodes:", 0) == 0) {
+      for (double v : d.numbers("fix", 0, spec.substr(6))) {
+        if (v != std::floor(v) || v < 0 || v >= static_cast<double>(x.cols()))
+          d.fail("fix: node " + std::to_string(v) + " out of range [0, " + std::to_string(x.cols() - 1) + "]");
+        out.push_back(static_cast<Index>(v));
+      }
+      return out;
+    }
+    static const std::map<std::string, std::pair<int, int>> kFaces = {
+        {"xmin", {0, -1}}, {"xmax", {0, 1}}, {"ymin", {1, -1}}, {"ymax", {1, 1}}, {"zmin", {2, -1}}, {"zmax", {2, 1}}};
+    auto it = kFaces.find(spec);
+    if (it == kFaces.end()) d.fail("fix: '" + spec + "' is not none, all, nodes:i,j,..., xmin, xmax, ymin, ymax, zmin or zmax");
+    const auto [axis, side] = it->second;
+    const double target = side < 0 ? x.row(axis).minCoeff() : x.row(axis).maxCoeff();
+    const double tol = 1e-9 * (1.0 + (x.row(axis).maxCoeff() - x.row(axis).minCoeff()));
+    for (Index i = 0; i < x.cols(); ++i)
+      if (std::abs(x(axis, i) - target) <= tol) out.push_back(i);
+    return out;
+  }
+
+  void add_gravity(Body& b) {
+    if (scene_->gravity().squaredNorm() > 0.0)
+      scene_->add_force_field(std::make_unique<GravityForceField>(b.name() + ".gravity", &b, scene_->gravity()));
+  }
+
+  void add_fix(Body& b, std::vector<Index> cols) {
+    if (!cols.empty()) scene_->add_constraint(std::make_unique<FixedConstraint>(b.name() + ".fixed", &b, std::move(cols)));
+  }
+
+  // Instances of an object: array=ax,ay,az spacing=dx,dy,dz, each jittered by jitter=a.
+  std::vector<std::pair<std::string, Vec3>> instances(Directive& d, const std::string& name, const Vec3& center) {
+    const auto arr = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+    const Vec3 step = d.vec3("spacing", Vec3::Zero());
+    const double jitter = d.non_negative("jitter", 0.0);
+    std::vector<std::pair<std::string, Vec3>> out;
+    const int count = arr[0] * arr[1] * arr[2];
+    if (count > 4096) d.fail("array: at most 4096 instances");
+    for (int k = 0; k < arr[2]; ++k)
+      for (int j = 0; j < arr[1]; ++j)
+        for (int i = 0; i < arr[0]; ++i) {
+          Vec3 c = center + Vec3(i * step.x(), j * step.y(), k * step.z());
+          if (jitter > 0.0) c += jitter * jitter_.vec();
+          const int idx = i + arr[0] * (j + arr[1] * k);
+          out.emplace_back(count == 1 ? name : name + std::to_string(idx), c);
+        }
+    return out;
+  }
+
+  void particles(Directive& d) {
+    const std::string name = d.text("name");
+    check_new_name(d, name);
+    const std::string spec = d.text("points");
+    std::vector<Vec3> pts;
+    std::size_t start = 0;
+    while (start <= spec.size()) {
+      const std::size_t semi = spec.find(';', start);
+      const auto v = d.numbers("points", 3, spec.substr(start, semi == std::string::npos ? std::string::npos : semi - start));
+      pts.emplace_back(v[0], v[1], v[2]);
+      if (semi == std::string::npos) break;
+      start = semi + 1;
+    }
+    StateVec x(3, static_cast<Index>(pts.size()));
+    for (std::size_t i = 0; i < pts.size(); ++i) x.col(static_cast<Index>(i)) = pts[i];
+    const double mass = d.positive("mass");
+    auto body = std::make_unique<ParticleBody>(name, x, std::vector<double>(pts.size(), mass));
+    for (Index i = 0; i < x.cols(); ++i) body->surface.push_back(i);
+    Body& b = scene_->add_body(std::move(body));
+    double spacing = 0.1;
+    if (x.cols() > 1) {
+      spacing = 1e300;
+      for (Index i = 0; i < x.cols(); ++i)
+        for (Index j = i + 1; j < x.cols(); ++j) spacing = std::min(spacing, (x.col(i) - x.col(j)).norm());
+    }
+    common(d, b, spacing);
+    add_gravity(b);
+    add_fix(b, fixed_nodes(d, x, d.text("fix", "none")));
+  }
+
+  void springs(Directive& d) {
+    Body* a = body_by_name(d, "a");
+    Body* b = d.has("b") ? body_by_name(d, "b") : nullptr;
+    if (b == a) b = nullptr;
+    const std::string name = d.text("name", b ? "springs[" + a->name() + "|" + b->name() + "]" : a->name() + ".springs");
+    check_new_name(d, name);
+    const double k = d.positive("stiffness");
+    const std::optional<double> rest = d.has("rest") ? std::optional<double>(d.non_negative("rest")) : std::nullopt;
+    std::vector<Spring> springs;
+    const std::string spec = d.text("pairs");
+    std::size_t start = 0;
+    Body* other = b ? b : a;
+    while (start <= spec.size()) {
+      const std::size_t comma = spec.find(',', start);
+      const std::string pair = spec.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      const auto dash = pair.find('-');
+      if (dash == std::string::npos) d.fail("pairs: '" + pair + "' is not i-j");
+      Index i = 0, j = 0;
+      auto r1 = std::from_chars(pair.data(), pair.data() + dash, i);
+      auto r2 = std::from_chars(pair.data() + dash + 1, pair.data() + pair.size(), j);
+      if (r1.ec != std::errc() || r1.ptr != pair.data() + dash || r2.ec != std::errc() ||
+          r2.ptr != pair.data() + pair.size())
+        d.fail("pairs: '" + pair + "' is not i-j");
+      if (i < 0 || i >= a->num_points() || j < 0 || j >= other->num_points())
+        d.fail("pairs: '" + pair + "' names a point out of range");
+      springs.push_back({i, j, rest ? *rest : (a->point(i) - other->point(j)).norm(), k});
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    scene_->add_force_field(std::make_unique<SpringForceField>(name, a, b, std::move(springs)));
+  }
+
+  // fem and springgrid: a hexahedral grid (box or ellipsoid).
+  void grid_object(Directive& d) {
+    const bool fem = d.keyword() == "fem";
+    const std::string name = d.text("name");
+    const auto nodes = d.int3("nodes", std::nullopt, 2, 512);
+    const Vec3 size = d.vec3("size");
+    if ((size.array() <= 0.0).any()) d.fail("size: every extent must be > 0");
+    const Vec3 center = d.vec3("center", Vec3::Zero());
+    const Shape shape = d.choice("shape", "box", {"box", "ellipsoid"}) == "ellipsoid" ? Shape::kEllipsoid : Shape::kBox;
+    const double density = d.positive("density", 1000.0);
+    FemMaterial mat;
+    double k = 0.0;
+    if (fem) {
+      mat.young = d.positive("young", 1e6);
+      mat.poisson = d.number("poisson", 0.3);
+      if (!(mat.poisson >= 0.0 && mat.poisson < 0.5)) d.fail("poisson must be in [0, 0.5)");
+      mat.incompatible_modes = d.choice("element", "incompatible", {"incompatible", "trilinear"}) == "incompatible";
+    } else {
+      k = d.positive("stiffness");
+    }
+    const std::string fix = d.text("fix", "none");
+    const HexMesh proto = detail::make_hex_grid(nodes, size, Vec3::Zero(), shape);
+    if (proto.elements.empty()) d.fail("the shape contains no element (use more nodes)");
+    const std::vector<Spring> springs = fem ? std::vector<Spring>{} : detail::grid_springs(proto, k);
+    bool first = true;
+    for (const auto& [inst, c] : instances(d, name, center)) {
+      check_new_name(d, inst);
+      StateVec x = proto.nodes;
+      x.colwise() += c;
+      std::vector<double> masses(proto.node_volume.size());
+      for (std::size_t i = 0; i < masses.size(); ++i) masses[i] = density * proto.node_volume[i];
+      auto body = std::make_unique<ParticleBody>(inst, x, std::move(masses));
+      ParticleBody* pb = body.get();
+      pb->surface = proto.surface;
+      pb->triangles = proto.triangles;
+      scene_->add_body(std::move(body));
+      if (first) {
+        common(d, *pb, proto.spacing.minCoeff());
+        damping_ = pb->mass_damping;
+        velocity_ = pb->vec(VecId::kV).cols() > 0 ? Vec3(pb->vec(VecId::kV).col(0)) : Vec3::Zero();
+        radius_ = pb->contact_radius;
+        layer_ = pb->collision_layer;
+        collide_ = !pb->surface.empty();
+        first = false;
+      } else {
+        pb->mass_damping = damping_;
+        pb->vec(VecId::kV).colwise() = velocity_;
+        pb->contact_radius = radius_;
+        pb->collision_layer = layer_;
+        if (!collide_) pb->surface.clear();
+      }
+      add_gravity(*pb);
+      if (fem)
+        scene_->add_force_field(std::make_unique<HexFemForceField>(inst + ".fem", pb, proto.elements, mat));
+      else
+        scene_->add_force_field(std::make_unique<SpringForceField>(inst + ".springs", pb, nullptr, springs));
+      add_fix(*pb, fixed_nodes(d, x, fix));
+    }
+  }
+
+  void rigid(Directive& d) {
+    const std::string name = d.text("name");
+    const std::string shape = d.choice("shape", "box", {"box", "sphere"});
+    const int res = d.integer("res", 8, 2, 256);
+    const double density = d.positive("density", 1000.0);
+    const Vec3 center = d.vec3("center", Vec3::Zero());
+    detail::RigidSurface surf;
+    double mass = 0.0;
+    Mat3 inertia = Mat3::Zero();
+    if (shape == "box") {
+      const Vec3 size = d.vec3("size");
+      if ((size.array() <= 0.0).any()) d.fail("size: every extent must be > 0");
+      surf = detail::box_surface(size, res);
+      mass = density * size.prod();
+      inertia.diagonal() << mass / 12.0 * (size.y() * size.y() + size.z() * size.z()),
+          mass / 12.0 * (size.x() * size.x() + size.z() * size.z()),
+          mass / 12.0 * (size.x() * size.x() + size.y() * size.y());
+    } else {
+      const double r = d.positive("size");
+      surf = detail::sphere_surface(r, res);
+      mass = density * 4.0 / 3.0 * M_PI * r * r * r;
+      inertia = Mat3::Identity() * (0.4 * mass * r * r);
+    }
+    Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
+    if (d.has("rotation")) {
+      const auto v = d.numbers("rotation", 4, d.text("rotation"));
+      const Vec3 axis(v[0], v[1], v[2]);
+      if (axis.norm() == 0.0) d.fail("rotation: the axis must not be zero");
+      q = Eigen::AngleAxisd(v[3] * M_PI / 180.0, axis.normalized());
+    }
+    const double spin = d.non_negative("spin", 0.0);
+    const bool fixed = d.choice("fix", "none", {"none", "all"}) == "all";
+    bool first = true;
+    for (const auto& [inst, c] : instances(d, name, center)) {
+      check_new_name(d, inst);
+      Eigen::Quaterniond qi = q;
+      if (spin > 0.0) {
+        Vec3 axis = jitter_.vec();
+        if (axis.norm() < 1e-6) axis = Vec3::UnitY();
+        qi = Eigen::AngleAxisd(spin * jitter_.uniform() * M_PI / 180.0, axis.normalized()) * q;
+      }
+      auto body = std::make_unique<RigidBody>(inst, mass, inertia, c, qi, surf.points);
+      RigidBody* rb = body.get();
+      for (Index i = 0; i < surf.points.cols(); ++i) rb->surface.push_back(i);
+      rb->triangles = surf.triangles;
+      scene_->add_body(std::move(body));
+      if (first) {
+        common(d, *rb, surf.spacing);
+        damping_ = rb->mass_damping;
+        velocity_ = rb->vec(VecId::kV).col(0);
+        radius_ = rb->contact_radius;
+        layer_ = rb->collision_layer;
+        collide_ = !rb->surface.empty();
+        first = false;
+      } else {
+        rb->mass_damping = damping_;
+        rb->vec(VecId::kV).col(0) = velocity_;
+        rb->contact_radius = radius_;
+        rb->collision_layer = layer_;
+        if (!collide_) rb->surface.clear();
+      }
+      if (fixed)
+        add_fix(*rb, {0, 1});
+      else
+        add_gravity(*rb);
+    }
+  }
+
+  // A serpentine chain of particles (the torso's intestine): stretch and bending springs.
+  void chain(Directive& d) {
+    const std::string name = d.text("name");
+    check_new_name(d, name);
+    const int n = d.integer("nodes", std::nullopt, 3, 1000000);
+    const int rows = d.integer("rows", 1, 1, n);
+    const double seg = d.positive("segment");
+    const Vec3 center = d.vec3("center", Vec3::Zero());
+    const double k = d.positive("stiffness");
+    const double kb = d.non_negative("bend", 0.0);
+    const double mass = d.positive("mass");
+    const int per_row = (n + rows - 1) / rows;
+    StateVec x(3, n);
+    const double width = seg * (per_row - 1);
+    const double row_gap = d.positive("row_gap", 2.0 * seg);
+    for (int i = 0; i < n; ++i) {
+      const int row = i / per_row;
+      int col = i % per_row;
+      if (row % 2 == 1) col = per_row - 1 - col;
+      x.col(i) = center + Vec3(col * seg - 0.5 * width, 0.0, row * row_gap - 0.5 * row_gap * (rows - 1));
+    }
+    auto body = std::make_unique<ParticleBody>(name, x, std::vector<double>(static_cast<std::size_t>(n), mass / n));
+    for (Index i = 0; i < n; ++i) body->surface.push_back(i);
+    Body& b = scene_->add_body(std::move(body));
+    common(d, b, seg);
+    std::vector<Spring> springs;
+    for (Index i = 0; i + 1 < n; ++i) springs.push_back({i, i + 1, (x.col(i + 1) - x.col(i)).norm(), k});
+    if (kb > 0.0)
+      for (Index i = 0; i + 2 < n; ++i) springs.push_back({i, i + 2, (x.col(i + 2) - x.col(i)).norm(), kb});
+    add_gravity(b);
+    scene_->add_force_field(std::make_unique<SpringForceField>(name + ".springs", &b, nullptr, std::move(springs)));
+    add_fix(b, fixed_nodes(d, x, d.text("fix", "none")));
+  }
+
+  // An N x N mass-spring sheet cut into split x split sub-objects joined by interaction
+  // springs (the paper's domain decomposition, section 4.3).
+  void cloth(Directive& d) {
+    const std::string name = d.text("name");
+    const int n = d.integer("nodes", std::nullopt, 2, 8192);
+    int split = d.integer("split", 4, 1, 1024);
+    if (options_.subobjects) {
+      const int s = static_cast<int>(std::lround(std::sqrt(static_cast<double>(*options_.subobjects))));
+      if (*options_.subobjects < 1 || s * s != *options_.subobjects)
+        throw UsageError("--subobjects must be a perfect square (1, 4, 9, 16, ...)");
+      split = s;
+    }
+    if (split > n) d.fail("split must not exceed nodes");
+    const double size = d.positive("size");
+    const Vec3 center = d.vec3("center", Vec3::Zero());
+    const double k = d.positive("stiffness");
+    const double ks = d.non_negative("shear", 0.5 * k);
+    const double kb = d.non_negative("bend", 0.0);
+    const double total_mass = d.positive("mass");
+    const double damping = d.non_negative("damping", 0.0);
+    const std::string fix = d.choice("fix", "corners", {"none", "corners", "edge"});
+    const double h = size / (n - 1);
+    auto block_of = [&](int i) { return static_cast<int>(static_cast<long long>(i) * split / n); };
+    // Local numbering inside each block.
+    std::vector<int> block(static_cast<std::size_t>(n) * static_cast<std::size_t>(n));
+    std::vector<Index> local(block.size());
+    std::vector<std::vector<Vec3>> pos(static_cast<std::size_t>(split * split));
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        const int bidx = block_of(i) + split * block_of(j);
+        const std::size_t node = static_cast<std::size_t>(i) + static_cast<std::size_t>(n) * static_cast<std::size_t>(j);
+        block[node] = bidx;
+        auto& p = pos[static_cast<std::size_t>(bidx)];
+        local[node] = static_cast<Index>(p.size());
+        p.push_back(center + Vec3(i * h - 0.5 * size, 0.0, j * h - 0.5 * size));
+      }
+    std::vector<ParticleBody*> bodies;
+    const double node_mass = total_mass / (static_cast<double>(n) * n);
+    for (int bj = 0; bj < split; ++bj)
+      for (int bi = 0; bi < split; ++bi) {
+        const std::string bname = split == 1 ? name : name + "_" + std::to_string(bi) + "_" + std::to_string(bj);
+        check_new_name(d, bname);
+        const auto& p = pos[static_cast<std::size_t>(bi + split * bj)];
+        StateVec x(3, static_cast<Index>(p.size()));
+        for (std::size_t v = 0; v < p.size(); ++v) x.col(static_cast<Index>(v)) = p[v];
+        auto body = std::make_unique<ParticleBody>(bname, x, std::vector<double>(p.size(), node_mass));
+        body->mass_damping = damping;
+        bodies.push_back(body.get());
+        scene_->add_body(std::move(body));
+      }
+    for (ParticleBody* b : bodies) add_gravity(*b);
+    // Springs, sorted into internal fields and interaction fields by the blocks they join.
+    std::vector<std::vector<Spring>> internal(bodies.size());
+    std::map<std::pair<int, int>, std::vector<Spring>> ties;
+    auto add = [&](int i0, int j0, int i1, int j1, double stiffness) {
+      if (stiffness <= 0.0 || i1 < 0 || i1 >= n || j1 >= n) return;
+      const std::size_t a = static_cast<std::size_t>(i0) + static_cast<std::size_t>(n) * static_cast<std::size_t>(j0);
+      const std::size_t b = static_cast<std::size_t>(i1) + static_cast<std::size_t>(n) * static_cast<std::size_t>(j1);
+      const double rest = h * std::hypot(i1 - i0, j1 - j0);
+      if (block[a] == block[b]) {
+        internal[static_cast<std::size_t>(block[a])].push_back({local[a], local[b], rest, stiffness});
+      } else if (block[a] < block[b]) {
+        ties[{block[a], block[b]}].push_back({local[a], local[b], rest, stiffness});
+      } else {
+        ties[{block[b], block[a]}].push_back({local[b], local[a], rest, stiffness});
+      }
+    };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        add(i, j, i + 1, j, k);
+        add(i, j, i, j + 1, k);
+        add(i, j, i + 1, j + 1, ks);
+        add(i + 1, j, i, j + 1, ks);
+        add(i, j, i + 2, j, kb);
+        add(i, j, i, j + 2, kb);
+      }
+    for (std::size_t b = 0; b < bodies.size(); ++b)
+      scene_->add_force_field(
+          std::make_unique<SpringForceField>(bodies[b]->name() + ".springs", bodies[b], nullptr, std::move(internal[b])));
+    for (auto& [key, springs] : ties) {
+      ParticleBody* a = bodies[static_cast<std::size_t>(key.first)];
+      ParticleBody* b = bodies[static_cast<std::size_t>(key.second)];
+      scene_->add_force_field(std::make_unique<SpringForceField>("ties[" + a->name() + "|" + b->name() + "]", a, b,
+                                                                 std::move(springs)));
+    }
+    // Fixed nodes: the two corners of the first row, or the whole first row.
+    std::map<int, std::vector<Index>> fixed;
+    if (fix == "corners") {
+      for (int i : {0, n - 1}) fixed[block[static_cast<std::size_t>(i)]].push_back(local[static_cast<std::size_t>(i)]);
+    } else if (fix == "edge") {
+      for (int i = 0; i < n; ++i) fixed[block[static_cast<std::size_t>(i)]].push_back(local[static_cast<std::size_t>(i)]);
+    }
+    for (auto& [bidx, cols] : fixed) add_fix(*bodies[static_cast<std::size_t>(bidx)], std::move(cols));
+  }
+
+  std::string file_;
+  SceneOptions options_;
+  Jitter jitter_;
+  std::unique_ptr<Scene> scene_;
+  std::set<std::string> names_;
+  // Attributes shared by the instances of an array (parsed on the first one).
+  double damping_ = 0.0;
+  Vec3 velocity_ = Vec3::Zero();
+  double radius_ = 0.0;
+  int layer_ = 0;
+  bool collide_ = true;
+};
+
+}  // namespace
+
+std::vector<std::string> builtin_scene_names() {
+  std::vector<std::string> out;
+  for (std::size_t i = 0; i < detail::kBuiltinSceneCount; ++i) out.emplace_back(detail::kBuiltinScenes[i].name);
+  return out;
+}
+
+std::optional<std::string_view> builtin_scene_text(std::string_view name) {
+  for (std::size_t i = 0; i < detail::kBuiltinSceneCount; ++i)
+    if (name == detail::kBuiltinScenes[i].name) return std::string_view(detail::kBuiltinScenes[i].text);
+  return std::nullopt;
+}
+
+std::unique_ptr<Scene> parse_scene(std::string_view text, std::string_view file, const SceneOptions& options) {
+  return SceneBuilder(std::string(file), options).build(text);
+}
+
+std::unique_ptr<Scene> make_scene(std::string_view name_or_path, const SceneOptions& options) {
+  if (auto text = builtin_scene_text(name_or_path)) return parse_scene(*text, std::string(name_or_path), options);
+  const std::string path(name_or_path);
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    std::string names;
+    for (const auto& n : builtin_scene_names()) names += (names.empty() ? "" : ", ") + n;
+    throw InputError(path, std::nullopt, "no such scene file, and not a built-in scene (" + names + ")");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::nullopt, "cannot open the scene file");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  if (text.size() > (64u << 20)) throw InputError(path, std::nullopt, "scene file larger than 64 MiB");
+  return parse_scene(text, path, options);
+}
+
+}  // namespace tgraph::samples

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+// Private state of a Scene: recorder bindings, collision pipeline, solver instances.
+#pragma once
+
+#include <array>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "tgraph/samples/scene.hpp"
+
+namespace tgraph::samples::detail {
+
+inline constexpr DatumId kNoDatum = std::numeric_limits<DatumId>::max();
+
+/// Scalars and ids of one CG solver instance (one per collision group, or one shared).
+/// Task bodies reference these fields, so an instance lives as long as the scene.
+struct GroupSolver {
+  std::string name;
+  int first_body = 0;  // body whose group this solver serves
+  // CG scalars (each a shared datum of the graph).
+  double rho = 0.0;      // r.r of the previous iteration
+  double rho_new = 0.0;  // r.r of this iteration (partial sums CW)
+  double den = 0.0;      // p.q (partial sums CW)
+  double beta = 0.0;     // rho_new / rho
+  double b2 = 0.0;       // |b|^2 (tolerance reference)
+  bool converged = false;  // the loop's condition datum
+  std::uint32_t iterations = 0;
+  double residual = 0.0;  // |r| / |b| reached
+  // Recorder ids (valid for Binding::generation == generation).
+  std::uint64_t generation = 0;
+  ObjectId object = kNoObject;
+  DatumId d_rho = kNoDatum, d_rho_new = kNoDatum, d_den = kNoDatum, d_beta = kNoDatum,
+          d_b2 = kNoDatum, d_cond = kNoDatum;
+};
+
+/// Ids declared in one recorder.
+struct Binding {
+  const capture::Recorder* rec = nullptr;
+  std::uint64_t generation = 0;
+  KindId reset_force = 0, add_force = 0, add_dforce = 0, project = 0, update_velocity = 0,
+         update_position = 0, compute_rhs = 0, dot = 0, cg_init = 0, cg_start = 0,
+         cg_direction = 0, add_mdx = 0, cg_update = 0, cg_scalars = 0;
+  std::vector<ObjectId> body_object;                        // per body index
+  std::vector<std::array<DatumId, kVecCount>> body_vec;     // per body index
+  std::unordered_map<std::string, ObjectId> field_object;   // interaction fields
+  std::unordered_map<std::string, DatumId> field_state;     // fields with cached state
+  std::unordered_map<ObjectId, int> object_body;            // object -> a body (for groups)
+};
+
+/// One solver instance's share of the scene this step.
+struct Group {
+  std::vector<int> bodies;
+  std::vector<ForceField*> fields;
+  std::vector<FixedConstraint*> constraints;
+  GroupSolver* solver = nullptr;
+};
+
+}  // namespace tgraph::samples::detail
+
+namespace tgraph::samples {
+
+struct Scene::Impl {
+  bool finalized = false;
+  std::unordered_map<const Body*, int> body_index;
+  std::vector<std::vector<ForceField*>> body_fields;  // internal fields per body, floor included
+  std::vector<std::vector<FixedConstraint*>> body_constraints;
+  std::vector<ForceField*> interactions;  // permanent interaction fields
+  std::vector<std::unique_ptr<FloorContactForceField>> floors;
+  std::map<std::pair<int, int>, std::unique_ptr<ContactForceField>> contacts;
+  std::map<std::string, std::unique_ptr<detail::GroupSolver>> solvers;
+  std::vector<detail::Group> groups;
+  std::vector<int> body_group;
+  detail::Binding bind;
+  std::uint64_t next_generation = 1;
+};
+
+namespace detail {
+/// Collision detection: updates the floor points and creates/removes contact fields.
+void detect_collisions(Scene& scene, Scene::Impl& impl);
+}  // namespace detail
+
+}  // namespace tgraph::samples
