@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// The `tgraph` command line: exit codes, one-line errors, capture -> info -> export.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "tgraph/graph/trace_io.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("tgraph_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result run(const std::string& args) {
+    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
+    const std::string cmd = std::string("cd '") + dir_.string() + "' && '" + TGRAPH_BIN + "' " + args + " >'" +
+                            out.string() + "' 2>'" + err.string() + "'";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+  static bool one_line(const std::string& s) {
+    return !s.empty() && s.back() == '\n' && std::count(s.begin(), s.end(), '\n') == 1;
+  }
+  fs::path dir_;
+};
+
+TEST_F(Cli, UnknownVerbExits2WithOneLine) {
+  const Result r = run("frobnicate");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+}
+
+TEST_F(Cli, InfoOnMissingFileExits2NamingIt) {
+  const Result r = run("info nowhere.tgt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("nowhere.tgt"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, InfoOnGarbageExits2WithOffset) {
+  std::ofstream(dir_ / "garbage.tgt") << "this is not a trace at all, just text\n";
+  const Result r = run("info garbage.tgt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_NE(r.err.find("garbage.tgt: offset"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UnknownSceneExits2) {
+  const Result r = run("capture --scene no_such_scene --steps 2 -o x.tgt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.tgt"));
+}
+
+TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
+  Result r = run("export f.tgt --step 3 --format json");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--step"), std::string::npos) << r.err;
+  r = run("export f.tgt --format dot");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_TRUE(one_line(r.err)) << r.err;
+}
+
+// Figure 2 of the paper: two objects A and B joined by an interaction force, explicit Euler.
+// Per step: resetForce x2, addForce x2 (own forces), addForce on the interaction (reads both
+// x, CW into both f), updateVelocity x2, updatePosition x2 = 9 tasks over 6 data (x, v, f of
+// each object). Edges: reset -> own addForce and reset -> interaction (WAW, 4), both force
+// writers -> updateVelocity (RAW, 4), interaction -> updatePosition (WAR on x, 2),
+// updateVelocity -> updatePosition (RAW on v, 2): 12 edges, no loops.
+TEST_F(Cli, Fig2CaptureInfoReportsTheFigure2Graph) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 10 -o f.tgt").code, 0);
+  const Result r = run("info f.tgt --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["steps"], 10);
+  EXPECT_EQ(j["tasks"], 90);
+  EXPECT_EQ(j["edges"], 120);
+  EXPECT_EQ(j["data"], 6);
+  EXPECT_EQ(j["loops"], 0);
+  EXPECT_EQ(j["distinct_structures"], 1);
+  EXPECT_EQ(j["contact_changes"], 0);
+  ASSERT_EQ(j["per_step"].size(), 10u);
+
+  // Work and span from the recorded costs, computed by hand on the Figure 2 structure.
+  const tgraph::Trace trace = tgraph::read_trace((dir_ / "f.tgt").string());
+  std::uint64_t work_total = 0, span_total = 0;
+  for (std::size_t s = 0; s < trace.steps.size(); ++s) {
+    const auto& g = trace.steps[s];
+    ASSERT_EQ(g.tasks.size(), 9u);
+    auto c = [&](int t) { return g.tasks[static_cast<std::size_t>(t)].cost_ns; };
+    auto kind = [&](int t) { return g.kind_name(static_cast<tgraph::TaskId>(t)); };
+    ASSERT_EQ(kind(4), "addForce");
+    ASSERT_EQ(g.tasks[4].access_count, 4u);  // the interaction
+    // Finish times along the figure's dependencies.
+    const auto e0 = c(0), e1 = c(1), e2 = e0 + c(2), e3 = e1 + c(3), e4 = std::max(e0, e1) + c(4);
+    const auto e5 = std::max(e2, e4) + c(5), e6 = std::max(e3, e4) + c(6);
+    const auto e7 = std::max(e4, e5) + c(7), e8 = std::max(e4, e6) + c(8);
+    const auto span = std::max({e0, e1, e2, e3, e4, e5, e6, e7, e8});
+    std::uint64_t work = 0;
+    for (int t = 0; t < 9; ++t) work += c(t);
+    EXPECT_EQ(j["per_step"][s]["span_ns"], span) << "step " << s;
+    EXPECT_EQ(j["per_step"][s]["work_ns"], work) << "step " << s;
+    EXPECT_EQ(j["per_step"][s]["edges"], 12);
+    work_total += work;
+    span_total += span;
+  }
+  EXPECT_EQ(j["work_ns"], work_total);
+  EXPECT_EQ(j["span_ns"], span_total);
+  EXPECT_DOUBLE_EQ(j["parallelism"].get<double>(),
+                   static_cast<double>(work_total) / static_cast<double>(span_total));
+}
+
+TEST_F(Cli, ExportedGraphsAreAcceptedByGpmetisAndScotchGpart) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  ASSERT_EQ(run("export f.tgt --step 1 --format metis -o g.metis").code, 0);
+  ASSERT_EQ(run("export f.tgt --step 1 --format scotch -o g.grf").code, 0);
+  const std::string d = dir_.string();
+  ASSERT_EQ(std::system(("gpmetis '" + d + "/g.metis' 2 >'" + d + "/gpmetis.out' 2>&1").c_str()), 0)
+      << slurp(dir_ / "gpmetis.out");
+  EXPECT_NE(slurp(dir_ / "gpmetis.out").find("Edgecut:"), std::string::npos);
+  EXPECT_TRUE(fs::exists(dir_ / "g.metis.part.2"));
+  ASSERT_EQ(std::system(("scotch_gpart 2 '" + d + "/g.grf' '" + d + "/g.map' >'" + d + "/gpart.out' 2>&1").c_str()), 0)
+      << slurp(dir_ / "gpart.out");
+  // The mapping file: vertex count, then one "vertex part" line per vertex.
+  std::ifstream map(dir_ / "g.map");
+  int n = 0;
+  map >> n;
+  EXPECT_EQ(n, 9);
+}
+
+TEST_F(Cli, ExportWritesNothingOnBadInput) {
+  std::ofstream(dir_ / "bad.tgt") << "TGT";
+  const Result r = run("export bad.tgt --format metis -o out.metis");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "out.metis"));
+}
+
+}  // namespace
