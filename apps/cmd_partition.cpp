@@ -30,6 +30,7 @@ struct StrategyFlags {
   std::string sticky_base = "metis";
   double threshold = 1.10;
   double migration_cost = 1.0;
+  std::string rebalance = "greedy";
 
   void add(CLI::App* cmd) {
     cmd->add_option("--imbalance", imbalance, "Tolerated max/mean load for METIS and Scotch (default 1.03)");
@@ -42,6 +43,8 @@ struct StrategyFlags {
         ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
     cmd->add_option("--sticky-base", sticky_base, "sticky: method for the first step (default metis)");
     cmd->add_option("--threshold", threshold, "sticky: rebalance above this imbalance (default 1.10)");
+    cmd->add_option("--rebalance", rebalance, "sticky: greedy (move whole objects) or scotch (graphRepart)")
+        ->check(CLI::IsMember({"greedy", "scotch"}));
     cmd->add_option("--migration-cost", migration_cost,
                     "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
   }
@@ -55,6 +58,7 @@ struct StrategyFlags {
     o.sticky_base = sticky_base;
     o.sticky_threshold = threshold;
     o.migration_cost = migration_cost;
+    o.rebalance = tp::parse_rebalance(rebalance);
     o.model = model;
     return o;
   }

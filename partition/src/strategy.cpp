@@ -50,6 +50,22 @@ ScotchFlavour parse_scotch_flavour(std::string_view s) {
                    std::string(s) + "'");
 }
 
+std::string_view to_string(Rebalance r) {
+  switch (r) {
+    case Rebalance::kGreedy:
+      return "greedy";
+    case Rebalance::kScotch:
+      return "scotch";
+  }
+  return "?";
+}
+
+Rebalance parse_rebalance(std::string_view s) {
+  if (s == "greedy") return Rebalance::kGreedy;
+  if (s == "scotch") return Rebalance::kScotch;
+  throw UsageError("--rebalance: expected greedy or scotch, got '" + std::string(s) + "'");
+}
+
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
   std::unordered_map<StableKey, std::vector<TaskId>> by_key;
   by_key.reserve(prev.tasks.size());

@@ -30,6 +30,16 @@ std::string_view to_string(ScotchFlavour f);
 /// Parses a flavour name; throws UsageError.
 ScotchFlavour parse_scotch_flavour(std::string_view s);
 
+/// How `sticky` rebalances when imbalance exceeds its threshold.
+enum class Rebalance : std::uint8_t {
+  kGreedy = 0,  ///< move whole objects from the most to the least loaded processor
+  kScotch = 1,  ///< SCOTCH_graphRepart from the current assignment with a migration cost
+};
+/// "greedy" or "scotch".
+std::string_view to_string(Rebalance r);
+/// Parses a rebalance name; throws UsageError.
+Rebalance parse_rebalance(std::string_view s);
+
 /// Knobs of the strategies; each strategy reads the ones it understands.
 struct Options {
   double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
@@ -39,7 +49,8 @@ struct Options {
   ScotchFlavour scotch = ScotchFlavour::kQuality;
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.10;   ///< sticky: rebalance above this imbalance
-  double migration_cost = 1.0;      ///< sticky: Scotch emraval (quantised to 0.01 by Scotch)
+  Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
+  double migration_cost = 1.0;      ///< sticky + scotch rebalance: emraval (quantised to 0.01)
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
 };
 

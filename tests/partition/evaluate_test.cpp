@@ -1,0 +1,135 @@
+// SPDX-License-Identifier: MIT
+// Evaluation numbers on hand-made traces.
+#include <gtest/gtest.h>
+
+#include "test_graphs.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/partition/evaluate.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::partition {
+namespace {
+
+using testing::Builder;
+using testing::M;
+
+TraceAssignment one_step(std::uint32_t k, std::vector<ProcId> proc) {
+  TraceAssignment a;
+  a.method = "hand";
+  a.k = k;
+  Assignment s;
+  s.k = k;
+  s.proc = std::move(proc);
+  a.steps = {s};
+  a.partition_ms = {2.5};
+  return a;
+}
+
+TEST(Evaluate, CountsCutSignalsReducersAndImbalance) {
+  Builder b;
+  const DatumId x = b.datum("x", 100), f = b.datum("f", 40);
+  b.task({{x, M::W}}, 10);             // 0 p0
+  b.task({{x, M::R}, {f, M::CW}}, 10); // 1 p0
+  b.task({{x, M::R}, {f, M::CW}}, 10); // 2 p1
+  b.task({{f, M::R}}, 10);             // 3 p0
+  Trace tr;
+  tr.steps = {b.done()};
+  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), CostModel::ideal());
+  const StepReport& s = r.steps[0];
+  // Cross edges: 0->2 (x, 100 bytes) and 2->3 (f, 40 bytes).
+  EXPECT_EQ(s.cut_edges, 2u);
+  EXPECT_EQ(s.cut_bytes, 140u);
+  EXPECT_EQ(s.signals, 2u);
+  EXPECT_EQ(s.waits, 2u);
+  EXPECT_EQ(s.reducers, 1u);
+  EXPECT_DOUBLE_EQ(s.imbalance, 1.5);  // loads 30 and 10
+  EXPECT_EQ(s.work_ns, 40u);
+  EXPECT_EQ(s.span_ns, 30u);
+  EXPECT_EQ(s.lower_bound_ns, 30u);
+  EXPECT_EQ(s.makespan_ns, 30u);
+  EXPECT_DOUBLE_EQ(s.speedup, 40.0 / 30.0);
+  EXPECT_DOUBLE_EQ(s.partition_ms, 2.5);
+  // p0 -> p1 (x) and p1 -> p0 (f): the two processors wait on each other within the step.
+  EXPECT_FALSE(s.quotient_acyclic);
+  EXPECT_EQ(s.ping_pong_pairs, 1u);
+  EXPECT_EQ(r.total.cut_bytes, 140u);
+  EXPECT_EQ(r.model, "ideal");
+}
+
+TEST(Evaluate, ReportsPingPongBetweenProcessorsAsACycle) {
+  Builder b;
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
+  b.task({{x, M::W}}, 1);                // p0
+  b.task({{x, M::R}, {y, M::W}}, 1);     // p1
+  b.task({{y, M::R}}, 1);                // p0
+  Trace tr;
+  tr.steps = {b.done()};
+  const Report r = evaluate(tr, one_step(2, {0, 1, 0}), CostModel::defaults());
+  EXPECT_FALSE(r.steps[0].quotient_acyclic);
+  EXPECT_EQ(r.steps[0].ping_pong_pairs, 1u);
+  EXPECT_EQ(r.cyclic_steps, 1u);
+}
+
+TEST(Evaluate, CountsMigrationsByStableKey) {
+  Builder b;
+  const DatumId x = b.datum("x", 100), y = b.datum("y", 30);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{x, M::RW}}, 5, 1);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{y, M::RW}, {x, M::R}}, 5, 2);
+  const StepGraph g0 = b.done();
+  // Next step: a new task first, then the two old ones (matched by key, not by index).
+  Builder c;
+  c.datum("x", 100);
+  c.datum("y", 30);
+  c.g.add_task(0, kNoObject, std::vector<Access>{{y, M::R}}, 5, 3);
+  c.g.add_task(0, kNoObject, std::vector<Access>{{x, M::RW}}, 5, 1);
+  c.g.add_task(0, kNoObject, std::vector<Access>{{y, M::RW}, {x, M::R}}, 5, 2);
+  Trace tr;
+  tr.steps = {g0, c.done()};
+  TraceAssignment a = one_step(2, {0, 1});
+  Assignment s1;
+  s1.k = 2;
+  s1.proc = {1, 0, 0};  // key 2 moved from p1 to p0; key 1 stayed on p0
+  a.steps.push_back(s1);
+  a.partition_ms.push_back(0.5);
+  const Report r = evaluate(tr, a, CostModel::ideal());
+  EXPECT_EQ(r.steps[0].migrated_tasks, 0u);
+  EXPECT_EQ(r.steps[1].migrated_tasks, 1u);
+  EXPECT_EQ(r.steps[1].migrated_bytes, 130u);
+  EXPECT_EQ(r.total.migrated_tasks, 1u);
+  EXPECT_DOUBLE_EQ(r.total.partition_ms, 3.0);
+}
+
+TEST(Evaluate, RejectsAnAssignmentThatDoesNotFitTheTrace) {
+  Trace tr;
+  tr.steps = {testing::two_halves(3)};
+  EXPECT_THROW(evaluate(tr, one_step(2, {0, 1, 0}), CostModel::ideal(), "a.tga"), InputError);
+  try {
+    evaluate(tr, one_step(2, {0, 1, 0, 1, 0}), CostModel::ideal(), "a.tga");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assigns 5 tasks, the trace has 6"), std::string::npos)
+        << e.what();
+  }
+  TraceAssignment two = one_step(2, {0, 1, 0, 1, 0, 1});
+  two.steps.push_back(two.steps[0]);
+  EXPECT_THROW(evaluate(tr, two, CostModel::ideal(), "a.tga"), InputError);
+  TraceAssignment deadlock = one_step(1, {0, 0, 0, 0, 0, 0});
+  deadlock.steps[0].order = {{1, 0, 2, 3, 4, 5}};
+  EXPECT_THROW(evaluate(tr, deadlock, CostModel::ideal(), "a.tga"), InputError);
+}
+
+TEST(Evaluate, EvaluatesATracePartitionedByEveryMethod) {
+  Trace tr;
+  for (std::uint64_t s = 0; s < 4; ++s) tr.steps.push_back(testing::random_graph(40 + s, 60, 8, true));
+  for (const std::string& m : strategy_names()) {
+    const TracePartition tp = partition_trace(tr, m, 4);
+    ASSERT_EQ(tp.assignment.steps.size(), 4u);
+    const Report ideal = evaluate(tr, tp.assignment, CostModel::ideal());
+    EXPECT_GE(ideal.total.makespan_ns, ideal.total.lower_bound_ns) << m;
+    EXPECT_GE(ideal.total.imbalance, 1.0) << m;
+    EXPECT_GT(ideal.total.speedup, 0.0) << m;
+  }
+}
+
+}  // namespace
+}  // namespace tgraph::partition

@@ -1,0 +1,386 @@
+// SPDX-License-Identifier: MIT
+// Each strategy on hand-made graphs whose right answer is known.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <future>
+#include <set>
+#include <thread>
+
+#include "test_graphs.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/partition/partition_graph.hpp"
+#include "tgraph/partition/simulator.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::partition {
+namespace {
+
+using testing::Builder;
+using testing::M;
+
+std::vector<std::uint64_t> loads_of(const StepGraph& g, const Assignment& a) {
+  std::vector<std::uint64_t> l(a.k, 0);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) l[a.proc[t]] += g.tasks[t].cost_ns * g.runs(t);
+  return l;
+}
+
+TEST(Registry, KnowsEveryStrategyAndRejectsUnknownNames) {
+  const std::vector<std::string> names = strategy_names();
+  for (const char* n : {"single", "roundrobin", "random", "owner", "metis", "scotch", "sticky", "list"})
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+  EXPECT_THROW(make_strategy("nope"), UsageError);
+  for (const std::string& n : names) EXPECT_EQ(make_strategy(n)->name(), n);
+}
+
+class EveryStrategy : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryStrategy, PutsEverythingOnProcessorZeroWhenKIsOne) {
+  const StepGraph g = testing::random_graph(7, 40, 6, true);
+  const Result r = make_strategy(GetParam())->partition(g, 1, {}, {});
+  EXPECT_EQ(r.assignment.k, 1u);
+  ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
+  for (ProcId p : r.assignment.proc) EXPECT_EQ(p, 0u);
+}
+
+TEST_P(EveryStrategy, HandlesTheEmptyGraph) {
+  StepGraph g;
+  g.derive_edges();
+  const Result r = make_strategy(GetParam())->partition(g, 4, {}, {});
+  EXPECT_TRUE(r.assignment.proc.empty());
+  EXPECT_EQ(r.assignment.k, 4u);
+}
+
+TEST_P(EveryStrategy, GivesValidAssignmentsWhenKIsAtLeastTheTaskCount) {
+  const StepGraph g = testing::random_graph(11, 6, 3, false);
+  for (std::uint32_t k : {6u, 7u, 64u}) {
+    const Result r = make_strategy(GetParam())->partition(g, k, {}, {});
+    ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
+    for (ProcId p : r.assignment.proc) EXPECT_LT(p, k);
+    EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults()));
+  }
+}
+
+TEST_P(EveryStrategy, RejectsZeroProcessors) {
+  const StepGraph g = testing::random_graph(3, 10, 3, false);
+  EXPECT_THROW(make_strategy(GetParam())->partition(g, 0, {}, {}), UsageError);
+}
+
+TEST_P(EveryStrategy, GivesValidAssignmentsOnRandomGraphs) {
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const StepGraph g = testing::random_graph(seed, 50, 8, seed % 2 == 0);
+    for (std::uint32_t k : {2u, 3u, 8u}) {
+      const Result r = make_strategy(GetParam())->partition(g, k, {}, {});
+      ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
+      for (ProcId p : r.assignment.proc) ASSERT_LT(p, k);
+      EXPECT_GE(r.stats.partition_ms, 0.0);
+      EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults())) << GetParam() << " seed " << seed;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Strategies, EveryStrategy,
+                         ::testing::Values("single", "roundrobin", "random", "owner", "metis", "scotch",
+                                           "sticky", "list"));
+
+class GraphPartitioner : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(GraphPartitioner, CutsNothingBetweenTwoDisconnectedHalves) {
+  const StepGraph g = testing::two_halves(20);
+  const Result r = make_strategy(GetParam())->partition(g, 2, {}, {});
+  const std::vector<std::uint32_t> part(r.assignment.proc.begin(), r.assignment.proc.end());
+  EXPECT_EQ(edgecut(library_graph(g), part), 0);
+  for (TaskId t = 1; t < 20; ++t) EXPECT_EQ(r.assignment.proc[t], r.assignment.proc[0]);
+  for (TaskId t = 21; t < 40; ++t) EXPECT_EQ(r.assignment.proc[t], r.assignment.proc[20]);
+  EXPECT_NE(r.assignment.proc[0], r.assignment.proc[20]);
+  if (GetParam() == "metis" || GetParam() == "scotch") {
+    ASSERT_TRUE(r.stats.edgecut.has_value());
+    EXPECT_EQ(*r.stats.edgecut, 0);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Partitioners, GraphPartitioner, ::testing::Values("owner", "metis", "scotch", "sticky"));
+
+TEST(Owner, KeepsEachObjectsTasksTogetherAndInteractionsWithTheWrittenObject) {
+  Builder b;
+  const ObjectId a = b.object("a"), o = b.object("b"), c = b.object("c");
+  const DatumId ax = b.datum("a.x", 800, a), af = b.datum("a.f", 800, a);
+  const DatumId bx = b.datum("b.x", 80, o), bf = b.datum("b.f", 80, o);
+  const DatumId cx = b.datum("c.x", 80, c);
+  b.task({{af, M::CW}, {ax, M::R}}, 50, a);              // 0
+  b.task({{bf, M::CW}, {bx, M::R}}, 30, o);              // 1
+  b.task({{af, M::CW}, {bf, M::CW}, {ax, M::R}, {bx, M::R}}, 5, kNoObject);  // 2: interaction
+  b.task({{ax, M::RW}, {af, M::R}}, 50, a);              // 3
+  b.task({{bx, M::RW}, {bf, M::R}}, 30, o);              // 4
+  b.task({{cx, M::RW}}, 40, c);                          // 5
+  const StepGraph g = b.done();
+  const Result r = make_strategy("owner")->partition(g, 2, {}, {});
+  const auto& p = r.assignment.proc;
+  EXPECT_EQ(p[0], p[3]);
+  EXPECT_EQ(p[1], p[4]);
+  EXPECT_EQ(p[2], p[0]) << "the interaction writes more bytes of a than of b";
+  // Object costs: a = 105, b = 60, c = 40: a alone, b and c together.
+  EXPECT_NE(p[0], p[1]);
+  EXPECT_EQ(p[1], p[5]);
+  const auto l = loads_of(g, r.assignment);
+  EXPECT_EQ(std::max(l[0], l[1]), 105u);
+}
+
+TEST(Owner, BalancesObjectsByMeasuredCostNotByCount) {
+  Builder b;
+  std::vector<DatumId> x;
+  // One heavy object (cost 90) and nine light ones (10 each): K = 2 gives 90 | 90.
+  for (int i = 0; i < 10; ++i) {
+    const ObjectId o = b.object(testing::name("o", i));
+    x.push_back(b.datum(testing::name("x", i), 8, o));
+    b.task({{x.back(), M::RW}}, i == 0 ? 90 : 10, o);
+  }
+  const StepGraph g = b.done();
+  const Result r = make_strategy("owner")->partition(g, 2, {}, {});
+  const auto l = loads_of(g, r.assignment);
+  EXPECT_EQ(l[0], 90u);
+  EXPECT_EQ(l[1], 90u);
+}
+
+TEST(Metis, BalancesEachPhaseInMultiConstraintMode) {
+  // Phase 1: 16 producers; phase 2: 16 consumers each reading two producers' data.
+  Builder b;
+  std::vector<DatumId> x;
+  for (int i = 0; i < 16; ++i) x.push_back(b.datum(testing::name("x", i), 64));
+  std::vector<DatumId> y;
+  for (int i = 0; i < 16; ++i) y.push_back(b.datum(testing::name("y", i), 64));
+  for (int i = 0; i < 16; ++i) b.task({{x[static_cast<std::size_t>(i)], M::W}}, 100);
+  for (int i = 0; i < 16; ++i)
+    b.task({{x[static_cast<std::size_t>(i)], M::R}, {x[static_cast<std::size_t>((i + 1) % 16)], M::R},
+            {y[static_cast<std::size_t>(i)], M::W}},
+           100);
+  const StepGraph g = b.done();
+  std::uint32_t used = 0;
+  const std::vector<std::uint32_t> phase = task_phases(g, 2, used);
+  ASSERT_EQ(used, 2u);
+  for (TaskId t = 0; t < 32; ++t) EXPECT_EQ(phase[t], t < 16 ? 0u : 1u);
+  Options o;
+  o.phases = 2;
+  const Result r = make_strategy("metis")->partition(g, 2, {}, o);
+  for (std::uint32_t ph = 0; ph < 2; ++ph) {
+    std::uint64_t on0 = 0;
+    for (TaskId t = ph * 16; t < ph * 16 + 16; ++t) on0 += r.assignment.proc[t] == 0 ? 1 : 0;
+    EXPECT_GE(on0, 7u) << "phase " << ph;
+    EXPECT_LE(on0, 9u) << "phase " << ph;
+  }
+}
+
+TEST(Metis, IsReproducibleAndSafeFromSeveralThreads) {
+  const StepGraph g = testing::random_graph(99, 300, 40, true);
+  const Result serial = make_strategy("metis")->partition(g, 4, {}, {});
+  std::vector<std::future<Result>> futures;
+  for (int i = 0; i < 4; ++i)
+    futures.push_back(std::async(std::launch::async, [&g] {
+      Result last;
+      for (int j = 0; j < 10; ++j) last = make_strategy("metis")->partition(g, 4, {}, {});
+      return last;
+    }));
+  for (auto& f : futures) EXPECT_EQ(f.get().assignment.proc, serial.assignment.proc);
+}
+
+TEST(Scotch, IsReproducibleAndSafeFromSeveralThreads) {
+  const StepGraph g = testing::random_graph(98, 300, 40, true);
+  const Result serial = make_strategy("scotch")->partition(g, 4, {}, {});
+  std::vector<std::future<Result>> futures;
+  for (int i = 0; i < 4; ++i)
+    futures.push_back(std::async(std::launch::async, [&g] {
+      Result last;
+      for (int j = 0; j < 10; ++j) last = make_strategy("scotch")->partition(g, 4, {}, {});
+      return last;
+    }));
+  for (auto& f : futures) EXPECT_EQ(f.get().assignment.proc, serial.assignment.proc);
+}
+
+TEST(Scotch, AcceptsEveryStrategyFlavour) {
+  const StepGraph g = testing::two_halves(30);
+  for (const char* f : {"default", "quality", "speed", "balance"}) {
+    Options o;
+    o.scotch = parse_scotch_flavour(f);
+    const Result r = make_strategy("scotch")->partition(g, 2, {}, o);
+    EXPECT_EQ(*r.stats.edgecut, 0) << f;
+  }
+  EXPECT_THROW(parse_scotch_flavour("fastest"), UsageError);
+}
+
+TEST(Random, IsReproducibleForOneSeed) {
+  const StepGraph g = testing::random_graph(5, 100, 10, false);
+  Options a, b;
+  a.seed = b.seed = 42;
+  EXPECT_EQ(make_strategy("random")->partition(g, 8, {}, a).assignment.proc,
+            make_strategy("random")->partition(g, 8, {}, b).assignment.proc);
+}
+
+// A scene of objects each with a few tasks; contacts add interaction tasks.
+StepGraph objects_scene(int objects, const std::vector<std::pair<int, int>>& contacts,
+                        int heavy_on_zero = 0) {
+  Builder b;
+  std::vector<DatumId> x, f;
+  for (int i = 0; i < objects; ++i) {
+    const ObjectId o = b.object(testing::name("obj", i));
+    x.push_back(b.datum(testing::name("x", i), 1024, o));
+    f.push_back(b.datum(testing::name("f", i), 1024, o));
+  }
+  for (int i = 0; i < objects; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{f[u], M::W}, {x[u], M::R}}, 100,
+                 static_cast<StableKey>(10 * i + 1));
+  }
+  for (const auto& [a, c] : contacts) {
+    const auto ua = static_cast<std::size_t>(a), uc = static_cast<std::size_t>(c);
+    b.g.add_task(0, kNoObject,
+                 std::vector<Access>{{f[ua], M::CW}, {f[uc], M::CW}, {x[ua], M::R}, {x[uc], M::R}}, 20,
+                 static_cast<StableKey>(100000 + 1000 * a + c));
+    b.g.contacts.push_back({static_cast<ObjectId>(a), static_cast<ObjectId>(c)});
+  }
+  for (int j = 0; j < heavy_on_zero; ++j)
+    b.g.add_task(0, kNoObject, std::vector<Access>{{f[0], M::CW}, {x[0], M::R}}, 400,
+                 static_cast<StableKey>(200000 + j));
+  for (int i = 0; i < objects; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{x[u], M::RW}, {f[u], M::R}}, 100,
+                 static_cast<StableKey>(10 * i + 2));
+  }
+  return b.done();
+}
+
+TEST(Sticky, ReusesThePreviousAssignmentWhileTheStructureIsUnchanged) {
+  const StepGraph g0 = objects_scene(8, {{0, 1}});
+  StepGraph g1 = g0;
+  for (Task& t : g1.tasks) t.cost_ns += 7;  // costs change, structure does not
+  auto s = make_strategy("sticky");
+  const Result r0 = s->partition(g0, 4, {}, {});
+  const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, {});
+  EXPECT_TRUE(r1.stats.reused);
+  EXPECT_EQ(r1.assignment.proc, r0.assignment.proc);
+  EXPECT_EQ(r1.stats.moved_tasks, 0u);
+  EXPECT_EQ(r1.stats.matched_tasks, g1.tasks.size());
+}
+
+TEST(Sticky, KeepsExistingTasksAndPlacesNewOnesByAffinity) {
+  const StepGraph g0 = objects_scene(8, {});
+  const StepGraph g1 = objects_scene(8, {{2, 5}});
+  Options o;
+  o.sticky_threshold = 10.0;  // no rebalancing
+  auto s = make_strategy("sticky");
+  const Result r0 = s->partition(g0, 4, {}, o);
+  const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, o);
+  EXPECT_FALSE(r1.stats.reused);
+  EXPECT_FALSE(r1.stats.rebalanced);
+  EXPECT_EQ(r1.stats.moved_tasks, 0u);
+  EXPECT_EQ(r1.stats.matched_tasks, g0.tasks.size());
+  // The new interaction task (index 8) touches objects 2 and 5: it joins one of them.
+  const ProcId p = r1.assignment.proc[8];
+  const ProcId p2 = r0.assignment.proc[2], p5 = r0.assignment.proc[5];
+  EXPECT_TRUE(p == p2 || p == p5);
+}
+
+TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
+  const StepGraph g0 = objects_scene(16, {});
+  // New heavy tasks on object 0's data only: affinity placement overloads its processor.
+  const StepGraph g1 = objects_scene(16, {}, 8);
+  Options o;
+  o.sticky_threshold = 1.2;
+  auto s = make_strategy("sticky");
+  const Result r0 = s->partition(g0, 4, {}, o);
+  const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, o);
+  EXPECT_TRUE(r1.stats.rebalanced);
+  const auto l = loads_of(g1, r1.assignment);
+  const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
+  EXPECT_LE(static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total), 1.2);
+  // Greedy rebalancing moves the heavy new tasks first: few of the 32 existing tasks move.
+  EXPECT_LE(r1.stats.moved_tasks, 4u);
+}
+
+TEST(Sticky, RebalancesWithScotchRepartitioningWithoutCrashing) {
+  const StepGraph g0 = objects_scene(16, {});
+  const StepGraph g1 = objects_scene(16, {}, 8);
+  Options o;
+  o.sticky_threshold = 1.2;
+  o.rebalance = Rebalance::kScotch;
+  auto s = make_strategy("sticky");
+  const Result r0 = s->partition(g0, 4, {}, o);
+  // Scotch quantises the migration cost ratio to 0.01; with new vertices marked -1 in the
+  // old partition, Scotch 7.0.3 read uninitialised memory and crashed at 0.01.
+  for (double emraval : {0.001, 0.01, 1.0, 10.0}) {
+    o.migration_cost = emraval;
+    const Result r = s->partition(g1, 4, {&g0, &r0.assignment}, o);
+    EXPECT_TRUE(r.stats.rebalanced);
+    for (ProcId p : r.assignment.proc) EXPECT_LT(p, 4u);
+  }
+  EXPECT_EQ(parse_rebalance("scotch"), Rebalance::kScotch);
+  EXPECT_THROW(parse_rebalance("magic"), UsageError);
+}
+
+TEST(Sticky, StartsFromItsBaseMethodAndWhenKChanges) {
+  const StepGraph g = testing::two_halves(10);
+  Options o;
+  o.sticky_base = "owner";
+  const Result r0 = make_strategy("sticky")->partition(g, 2, {}, o);
+  EXPECT_EQ(r0.assignment.proc, make_strategy("owner")->partition(g, 2, {}, o).assignment.proc);
+  const Result r1 = make_strategy("sticky")->partition(g, 3, {&g, &r0.assignment}, o);
+  EXPECT_FALSE(r1.stats.reused);
+  EXPECT_EQ(r1.assignment.k, 3u);
+}
+
+TEST(List, SchedulesForkJoinOnTwoProcessorsOptimally) {
+  Builder b;
+  const DatumId s = b.datum("s", 8), u = b.datum("u", 8), v = b.datum("v", 8), w = b.datum("w", 8);
+  b.task({{s, M::W}}, 1);                        // 0
+  b.task({{s, M::R}, {u, M::W}}, 10);            // 1
+  b.task({{s, M::R}, {v, M::W}}, 10);            // 2
+  b.task({{u, M::R}, {v, M::R}, {w, M::W}}, 1);  // 3
+  const StepGraph g = b.done();
+  Options o;
+  o.model = CostModel::ideal();
+  const Result r = make_strategy("list")->partition(g, 2, {}, o);
+  EXPECT_NE(r.assignment.proc[1], r.assignment.proc[2]);
+  EXPECT_EQ(simulate(g, r.assignment, CostModel::ideal()).makespan_ns, 12u);
+  ASSERT_EQ(r.assignment.order.size(), 2u);
+  EXPECT_EQ(r.assignment.order[0].size() + r.assignment.order[1].size(), 4u);
+}
+
+TEST(List, OrdersEachProcessorByStartTimeKeepingLoopsTogether) {
+  const StepGraph g = testing::random_graph(21, 60, 6, true);
+  const Result r = make_strategy("list")->partition(g, 3, {}, {});
+  ASSERT_EQ(r.assignment.order.size(), 3u);
+  for (ProcId p = 0; p < 3; ++p) {
+    // Loop tasks of one processor are contiguous in its order.
+    int runs = 0;
+    bool in = false;
+    for (TaskId t : r.assignment.order[p]) {
+      const bool l = g.tasks[t].loop != kNoLoop;
+      if (l && !in) ++runs;
+      in = l;
+    }
+    EXPECT_LE(runs, 1);
+  }
+  EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults()));
+}
+
+TEST(Strategy, CountsMovedTasksByStableKey) {
+  const StepGraph g = objects_scene(4, {});
+  Assignment prev;
+  prev.k = 2;
+  prev.proc.assign(g.tasks.size(), 0);
+  const Result r = make_strategy("roundrobin")->partition(g, 2, {&g, &prev}, {});
+  std::uint64_t moved = 0;
+  for (ProcId p : r.assignment.proc) moved += p != 0 ? 1 : 0;
+  EXPECT_EQ(r.stats.moved_tasks, moved);
+  EXPECT_EQ(r.stats.matched_tasks, g.tasks.size());
+}
+
+TEST(Strategy, RejectsAPreviousAssignmentOfTheWrongSize) {
+  const StepGraph g = objects_scene(4, {});
+  Assignment prev;
+  prev.k = 2;
+  prev.proc.assign(3, 0);
+  EXPECT_THROW(make_strategy("sticky")->partition(g, 2, {&g, &prev}, {}), UsageError);
+}
+
+}  // namespace
+}  // namespace tgraph::partition
