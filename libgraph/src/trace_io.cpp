@@ -354,12 +354,12 @@ class TraceDecoder {
       if (left == 0) {
         if (!have_header_)
           fail(pos, "expected a header frame after the file header, found the end of the file");
-        return unclosed(pos, "trace not closed");
+        return unclosed(pos, "trace not closed", "");
       }
       if (left < kFrameHeaderSize) {
-        return unclosed(pos, "truncated frame header: expected " +
-                                 std::to_string(kFrameHeaderSize) + " bytes, found " +
-                                 std::to_string(left));
+        return unclosed(pos, "truncated frame header",
+                        "expected " + std::to_string(kFrameHeaderSize) + " bytes, found " +
+                            std::to_string(left));
       }
       const std::uint32_t type = get_u32(pos);
       const std::uint32_t length = get_u32(pos + 4);
@@ -370,9 +370,9 @@ class TraceDecoder {
                       ": expected 1 (header), 2 (full step), 3 (reference step) or 4 (end)");
       }
       if (length > left - kFrameHeaderSize) {
-        return unclosed(pos, "truncated frame: expected " + std::to_string(length) +
-                                 " payload bytes, found " +
-                                 std::to_string(left - kFrameHeaderSize));
+        return unclosed(pos, "truncated frame",
+                        "expected " + std::to_string(length) + " payload bytes, found " +
+                            std::to_string(left - kFrameHeaderSize));
       }
       const std::size_t begin = pos + kFrameHeaderSize;
       const std::size_t end = begin + length;
@@ -439,10 +439,12 @@ class TraceDecoder {
   }
 
   // The data end cleanly or in a partial frame, without an end frame.
-  Trace unclosed(std::size_t pos, const std::string& what) {
-    if (!have_header_) fail(pos, "truncated header frame: " + what);
+  // `kind` names the problem, `detail` says what was expected (may be empty).
+  Trace unclosed(std::size_t pos, const std::string& kind, const std::string& detail) {
+    if (!have_header_) fail(pos, "truncated header frame: " + detail);
     if (options_.recover) return std::move(trace_);
-    fail(pos, what + " (" + steps_text(trace_.steps.size()) +
+    fail(pos, kind + (detail.empty() ? "" : ": " + detail) + " (" +
+                  steps_text(trace_.steps.size()) +
                   "; capture interrupted?) — read with --recover");
   }
 
@@ -738,8 +740,19 @@ struct TraceWriter::Impl {
   std::vector<std::uint8_t> buffer;  // reused frame buffer
   std::uint64_t written = 0;
 
+  std::string closed_because;  // why appends are refused once fd is closed
+
+  // Writes the buffered frame. After a failed write the file may end in a partial frame:
+  // the writer closes it and refuses further frames, so the partial frame stays the last.
   void flush_buffer() {
-    write_all(fd, buffer, path);
+    try {
+      write_all(fd, buffer, path);
+    } catch (...) {
+      ::close(fd);
+      fd = -1;
+      closed_because = "a failed write";
+      throw;
+    }
     written += buffer.size();
     buffer.clear();
   }
@@ -751,12 +764,7 @@ TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header)
   impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (impl_->fd < 0) throw Error(path + ": cannot create: " + std::strerror(errno));
   encode_file_header(impl_->buffer, header);
-  try {
-    impl_->flush_buffer();
-  } catch (...) {
-    ::close(impl_->fd);
-    throw;
-  }
+  impl_->flush_buffer();
 }
 
 // Without close() no end frame is written: the trace then reads as interrupted.
@@ -765,7 +773,7 @@ TraceWriter::~TraceWriter() {
 }
 
 void TraceWriter::append(const StepGraph& step) {
-  if (impl_->fd < 0) throw UsageError(impl_->path + ": append() after close()");
+  if (impl_->fd < 0) throw UsageError(impl_->path + ": append() after " + impl_->closed_because);
   impl_->buffer.clear();
   impl_->encoder.encode(step, impl_->buffer);
   impl_->flush_buffer();
@@ -775,15 +783,10 @@ void TraceWriter::close() {
   if (impl_->fd < 0) return;
   impl_->buffer.clear();
   encode_end(impl_->buffer, impl_->encoder.steps());
-  try {
-    impl_->flush_buffer();
-  } catch (...) {
-    ::close(impl_->fd);
-    impl_->fd = -1;
-    throw;
-  }
+  impl_->flush_buffer();
   const int fd = impl_->fd;
   impl_->fd = -1;
+  impl_->closed_because = "close()";
   if (::close(fd) != 0) throw Error(impl_->path + ": cannot close: " + std::strerror(errno));
 }
 

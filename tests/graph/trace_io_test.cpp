@@ -25,6 +25,13 @@ using Bytes = std::vector<std::uint8_t>;
 
 // ---- building blocks -------------------------------------------------------------------
 
+// "prefix<i>" (appended, not `+`: GCC 12 -O3 misreports -Wrestrict on the latter).
+std::string numbered(const char* prefix, int i) {
+  std::string s(prefix);
+  s.append(std::to_string(i));
+  return s;
+}
+
 // A step with a dynamic loop, shared and owned data, contacts and groups. `variant`
 // changes the structure; `salt` changes only costs, iterations, contacts and groups.
 StepGraph make_step(int variant, int salt) {
@@ -33,10 +40,10 @@ StepGraph make_step(int variant, int salt) {
   const KindId dot = g.intern_kind("dot");
   const KindId brk = g.intern_kind("loop.break");
   const int n_objects = 3 + variant;
-  for (int o = 0; o < n_objects; ++o) g.objects.push_back({"body" + std::to_string(o)});
+  for (int o = 0; o < n_objects; ++o) g.objects.push_back({numbered("body", o)});
   for (int o = 0; o < n_objects; ++o)
     g.data.push_back(
-        {"x" + std::to_string(o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
+        {numbered("x", o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
   const auto r = static_cast<DatumId>(g.data.size());
   g.data.push_back({"cg.r", kNoObject, 8});
   const auto done = static_cast<DatumId>(g.data.size());
@@ -396,6 +403,15 @@ TEST(TraceWriter, RejectsAnInvalidStep) {
 TEST(TraceWriter, ReportsAnUnwritablePath) {
   EXPECT_THROW(TraceWriter("/nonexistent-folder/x.tgt", {}), Error);
   EXPECT_THROW(write_trace("/nonexistent-folder/x.tgt", Trace{}), Error);
+  if (fs::exists("/dev/full")) {  // every write fails with ENOSPC
+    try {
+      TraceWriter w("/dev/full", {});
+      ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("/dev/full: cannot write"), std::string::npos)
+          << e.what();
+    }
+  }
 }
 
 // ---- hand-made files and the reference encoder in the test agree ------------------------
