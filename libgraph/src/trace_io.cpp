@@ -18,9 +18,10 @@
 #include "tgraph/graph/file_util.hpp"
 
 namespace tgraph {
-namespace detail {
 
-/// CRC-32 as in zlib, PNG and Ethernet (reflected polynomial 0xEDB88320), table-driven.
+namespace {
+
+// CRC-32 as in zlib, PNG and Ethernet (reflected polynomial 0xEDB88320), table-driven.
 constexpr std::array<std::uint32_t, 256> make_crc32_table() {
   std::array<std::uint32_t, 256> table{};
   for (std::uint32_t i = 0; i < 256; ++i) {
@@ -31,18 +32,14 @@ constexpr std::array<std::uint32_t, 256> make_crc32_table() {
   return table;
 }
 
-inline constexpr std::array<std::uint32_t, 256> kCrc32Table = make_crc32_table();
+constexpr std::array<std::uint32_t, 256> kCrc32Table = make_crc32_table();
 
-/// Continues a CRC-32 over `bytes` (start with crc = 0).
+// Continues a CRC-32 over `bytes` (start with crc = 0).
 std::uint32_t crc32(const std::uint8_t* bytes, std::size_t n, std::uint32_t crc = 0) {
   crc = ~crc;
   for (std::size_t i = 0; i < n; ++i) crc = kCrc32Table[(crc ^ bytes[i]) & 0xFFu] ^ (crc >> 8);
   return ~crc;
 }
-
-}  // namespace detail
-
-namespace {
 
 constexpr std::array<std::uint8_t, 4> kMagic = {'T', 'G', 'T', 'R'};
 constexpr std::uint32_t kFormatVersion = 1;
@@ -115,8 +112,8 @@ void finish_frame(std::vector<std::uint8_t>& out, std::size_t at, FrameType type
   put_u32_at(out, at, static_cast<std::uint32_t>(type));
   put_u32_at(out, at + 4, static_cast<std::uint32_t>(length));
   // The checksum covers type, length and payload.
-  std::uint32_t crc = detail::crc32(out.data() + at, 8);
-  crc = detail::crc32(out.data() + at + kFrameHeaderSize, length, crc);
+  std::uint32_t crc = crc32(out.data() + at, 8);
+  crc = crc32(out.data() + at + kFrameHeaderSize, length, crc);
   put_u32_at(out, at + 8, crc);
 }
 
@@ -376,8 +373,8 @@ class TraceDecoder {
       }
       const std::size_t begin = pos + kFrameHeaderSize;
       const std::size_t end = begin + length;
-      std::uint32_t crc = detail::crc32(bytes_.data() + pos, 8);
-      crc = detail::crc32(bytes_.data() + begin, length, crc);
+      std::uint32_t crc = crc32(bytes_.data() + pos, 8);
+      crc = crc32(bytes_.data() + begin, length, crc);
       if (crc != stored_crc) {
         fail(pos, "checksum mismatch: expected CRC-32 " + hex32(stored_crc) +
                       " (stored in the frame), computed " + hex32(crc));

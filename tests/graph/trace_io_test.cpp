@@ -3,14 +3,19 @@
 #include "tgraph/graph/trace_io.hpp"
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <new>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
@@ -377,6 +382,40 @@ TEST(TraceWriter, CompleteFramesReadBackBeforeClose) {
   w.close();
   EXPECT_EQ(read_trace(p.string()), trace);
   EXPECT_THROW(w.append(trace.steps[0]), UsageError);
+}
+
+TEST(TraceWriter, CaptureKilledBySigkillLeavesItsCompleteStepsReadable) {
+  const fs::path p = temp_path("killed.tgt");
+  fs::remove(p);
+  const TraceHeader header{"killed", "test", "here", "0.1.0"};
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {  // the "capture": appends steps until killed
+    TraceWriter w(p.string(), header);
+    for (int i = 0; i < 1000000; ++i) w.append(make_step(i % 3, i));
+    std::_Exit(0);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  std::error_code ec;
+  while ((!fs::exists(p, ec) || fs::file_size(p, ec) < 200000) &&
+         std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  kill(child, SIGKILL);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status));
+  const Bytes bytes = slurp(p);
+  EXPECT_READ_ERROR(bytes, "capture interrupted?) — read with --recover");
+  ReadOptions recover;
+  recover.recover = true;
+  const Trace back = read_trace_bytes(bytes, p.string(), recover);
+  EXPECT_EQ(back.header, header);
+  ASSERT_GT(back.steps.size(), 10u);
+  for (std::size_t i = 0; i < back.steps.size(); ++i) {
+    StepGraph expected = make_step(static_cast<int>(i % 3), static_cast<int>(i));
+    expected.derive_edges();
+    ASSERT_EQ(back.steps[i], expected) << "step " << i;
+  }
 }
 
 TEST(TraceWriter, DestroyedWithoutCloseLeavesAnUnclosedTrace) {
