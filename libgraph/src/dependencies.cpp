@@ -17,6 +17,7 @@
 // state at the end of the body: edges from a first-pass task to a second-pass task are the
 // loop-carried edges (iteration i -> i + 1).
 #include <algorithm>
+#include <limits>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -32,9 +33,12 @@ struct DatumState {
   bool cw_group = false;
 };
 
+struct TooManyEdges {};
+
 class Extractor {
  public:
-  Extractor(const StepGraph& g, std::vector<Edge>& out) : g_(g), out_(out), state_(g.data.size()) {}
+  Extractor(const StepGraph& g, std::vector<Edge>& out, std::size_t max_edges)
+      : g_(g), out_(out), state_(g.data.size()), max_edges_(max_edges) {}
 
   // Second-pass mode: ids >= offset_ are second-pass copies; only edges from a first-pass
   // body task to a second-pass task are emitted (as carried edges).
@@ -51,8 +55,8 @@ class Extractor {
       switch (a.mode) {
         case AccessMode::R:
           for (TaskId w : s.writers) emit(w, id, a.datum, EdgeKind::RAW);
-          if (std::find(s.readers.begin(), s.readers.end(), id) == s.readers.end())
-            s.readers.push_back(id);
+          // A task's accesses are processed together: a repeated reader is the last one.
+          if (s.readers.empty() || s.readers.back() != id) s.readers.push_back(id);
           break;
         case AccessMode::W:
         case AccessMode::RW:
@@ -82,8 +86,7 @@ class Extractor {
             s.cw_group = true;
           }
           for (TaskId p : s.group_preds) emit(p, id, a.datum, s.group_kind);
-          if (std::find(s.writers.begin(), s.writers.end(), id) == s.writers.end())
-            s.writers.push_back(id);
+          if (s.writers.empty() || s.writers.back() != id) s.writers.push_back(id);
           break;
       }
     }
@@ -94,6 +97,7 @@ class Extractor {
  private:
   void emit(TaskId from, TaskId to, DatumId d, EdgeKind kind) {
     if (from == to) return;
+    if (out_.size() >= max_edges_) throw TooManyEdges{};
     if (offset_ == 0) {
       out_.push_back({from, to, d, kind});
       return;
@@ -108,6 +112,7 @@ class Extractor {
   const StepGraph& g_;
   std::vector<Edge>& out_;
   std::vector<DatumState> state_;
+  std::size_t max_edges_;
   TaskId offset_ = 0;
   TaskId body_first_ = 0;
   TaskId body_last_ = 0;
@@ -128,10 +133,25 @@ void sort_unique(std::vector<Edge>& edges) {
 
 }  // namespace
 
-void StepGraph::derive_edges() {
+void StepGraph::derive_edges() { derive_edges(std::numeric_limits<std::size_t>::max()); }
+
+bool StepGraph::derive_edges(std::size_t max_edges) {
   edges.clear();
   carried_edges.clear();
-  Extractor main(*this, edges);
+  try {
+    derive_edges_unchecked(max_edges);
+  } catch (const TooManyEdges&) {
+    edges.clear();
+    carried_edges.clear();
+    edges.shrink_to_fit();
+    carried_edges.shrink_to_fit();
+    return false;
+  }
+  return true;
+}
+
+void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
+  Extractor main(*this, edges, max_edges);
   std::size_t next_loop = 0;
   const auto n = static_cast<TaskId>(tasks.size());
   for (TaskId t = 0; t < n;) {
@@ -139,7 +159,7 @@ void StepGraph::derive_edges() {
       const Loop& loop = loops[next_loop++];
       for (TaskId u = loop.first; u < loop.last; ++u) main.process(u);
       // Second pass over the body from the end-of-body state, on a copy.
-      Extractor second(*this, carried_edges);
+      Extractor second(*this, carried_edges, max_edges);
       second.state() = main.state();
       second.set_pass(n, loop.first, loop.last);
       for (TaskId u = loop.first; u < loop.last; ++u) second.process(u);

@@ -55,15 +55,15 @@ std::string StepGraph::validate() const {
   std::uint64_t expected_begin = 0;
   for (std::size_t t = 0; t < n_tasks; ++t) {
     const Task& task = tasks[t];
-    const std::string where = "task " + std::to_string(t);
-    if (task.kind >= kinds.size()) return where + ": kind " + std::to_string(task.kind) + " out of range";
+    auto where = [t] { return "task " + std::to_string(t); };
+    if (task.kind >= kinds.size()) return where() + ": kind " + std::to_string(task.kind) + " out of range";
     if (task.object != kNoObject && task.object >= objects.size())
-      return where + ": object " + std::to_string(task.object) + " out of range";
-    if (task.access_begin != expected_begin) return where + ": accesses not contiguous";
+      return where() + ": object " + std::to_string(task.object) + " out of range";
+    if (task.access_begin != expected_begin) return where() + ": accesses not contiguous";
     expected_begin += task.access_count;
-    if (expected_begin > accesses.size()) return where + ": accesses out of range";
+    if (expected_begin > accesses.size()) return where() + ": accesses out of range";
     if (task.loop != kNoLoop && task.loop >= loops.size())
-      return where + ": loop " + std::to_string(task.loop) + " out of range";
+      return where() + ": loop " + std::to_string(task.loop) + " out of range";
   }
   if (expected_begin != accesses.size()) return "accesses not all owned by tasks";
   for (std::size_t i = 0; i < accesses.size(); ++i) {
@@ -97,9 +97,13 @@ std::string StepGraph::validate() const {
     if (l != kNoLoop && (t < loops[l].first || t >= loops[l].last))
       return "task " + std::to_string(t) + ": marked in loop " + std::to_string(l) + " but outside its body";
   }
-  for (const Contact& c : contacts)
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const Contact& c = contacts[i];
     if (c.a >= objects.size() || c.b >= objects.size()) return "contact object out of range";
-  if (!groups.empty() && groups.size() != objects.size()) return "groups size differs from objects";
+    if (c.a >= c.b) return "contact " + std::to_string(i) + ": expected a < b";
+    if (i > 0 && !(contacts[i - 1] < c)) return "contacts not sorted and unique";
+  }
+  if (groups.size() > objects.size()) return "more collision groups than objects";
   return {};
 }
 

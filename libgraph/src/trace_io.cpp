@@ -460,7 +460,11 @@ class TraceDecoder {
     read_step_values(p, g);
     p.expect_end();
     check_valid(g, frame);
-    g.derive_edges();
+    const std::uint64_t left = budget_ > decoded_ ? budget_ - decoded_ : 0;
+    if (!g.derive_edges(static_cast<std::size_t>(left / sizeof(Edge))))
+      fail(frame, "step " + std::to_string(trace_.steps.size()) +
+                      " has more dependencies than the memory bound allows: expected at most " +
+                      std::to_string(left / sizeof(Edge)) + " edges");
     charge(structure_memory(g) + values_memory(g), frame);
     shape_memory_.push_back(structure_memory(g));
     trace_.steps.push_back(std::move(g));

@@ -114,7 +114,9 @@ class StepGraph {
   std::vector<Access> accesses;       ///< all tasks' accesses, task by task
   std::vector<Loop> loops;            ///< sorted by first task, not nested
   std::vector<Contact> contacts;      ///< sorted, unique
-  std::vector<std::uint32_t> groups;  ///< collision group per object (empty: all in one)
+  /// Collision group of objects [0, groups.size()) (bodies; interaction objects declared
+  /// after them may have none). Empty: one group.
+  std::vector<std::uint32_t> groups;
 
   /// Derived by derive_edges(): intra-step edges (within one loop iteration for loop bodies).
   std::vector<Edge> edges;
@@ -143,6 +145,10 @@ class StepGraph {
 
   /// Recomputes `edges` and `carried_edges` from program order and accesses.
   void derive_edges();
+  /// Same, giving up (both lists left empty, returns false) when either list would exceed
+  /// `max_edges`: CW groups followed by many readers grow as writers x readers, so readers
+  /// of untrusted files bound it.
+  bool derive_edges(std::size_t max_edges);
   /// Checks internal consistency (ids in range, loops well formed); returns an empty
   /// string when valid, else a one-line reason.
   std::string validate() const;
@@ -154,6 +160,9 @@ class StepGraph {
   bool same_structure(const StepGraph& other) const;
 
   friend bool operator==(const StepGraph&, const StepGraph&) = default;
+
+ private:
+  void derive_edges_unchecked(std::size_t max_edges);
 };
 
 }  // namespace tgraph
