@@ -23,7 +23,7 @@ namespace tp = tgraph::partition;
 // Flags shared by `partition` and `compare`.
 struct StrategyFlags {
   double imbalance = 1.03;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = 0;
   std::string objective = "cut";
   std::uint32_t phases = 0;
   std::string scotch = "quality";
@@ -34,7 +34,7 @@ struct StrategyFlags {
 
   void add(CLI::App* cmd) {
     cmd->add_option("--imbalance", imbalance, "Tolerated max/mean load for METIS and Scotch (default 1.03)");
-    cmd->add_option("--seed", seed, "Seed of METIS, Scotch and random (default 1)");
+    cmd->add_option("--seed", seed, "Seed of METIS, Scotch and random (default 0: METIS's own, as gpmetis)");
     cmd->add_option("--objective", objective, "METIS objective: cut or vol")
         ->check(CLI::IsMember({"cut", "vol"}));
     cmd->add_option("--phases", phases,

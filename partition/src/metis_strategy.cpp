@@ -38,7 +38,8 @@ std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std:
   idx_t opts[METIS_NOPTIONS];
   METIS_SetDefaultOptions(opts);
   opts[METIS_OPTION_NUMBERING] = 0;
-  opts[METIS_OPTION_SEED] = static_cast<idx_t>(options.seed % 0x7fffffff);
+  // Seed 0 keeps METIS's default (-1), so that results equal gpmetis's without -seed.
+  if (options.seed != 0) opts[METIS_OPTION_SEED] = static_cast<idx_t>(options.seed % 0x7fffffff);
   opts[METIS_OPTION_OBJTYPE] = options.objective == Objective::kVolume ? METIS_OBJTYPE_VOL : METIS_OBJTYPE_CUT;
   opts[METIS_OPTION_UFACTOR] =
       static_cast<idx_t>(std::lround(std::max(0.0, options.imbalance - 1.0) * 1000.0));

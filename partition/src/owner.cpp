@@ -37,7 +37,57 @@ ObjectId owner_of(const StepGraph& g, TaskId t) {
   return g.tasks[t].object;
 }
 
-/// Objects (with the tasks that work on them) spread over K processors by measured cost.
+// Improves an LPT placement: moves one object off the most loaded processor, or swaps one of
+// its objects with a lighter one elsewhere, whichever lowers the pair's maximum most; stops
+// when nothing lowers the maximum.
+void refine(const std::vector<std::pair<ObjectId, std::uint64_t>>& objs, std::vector<ProcId>& where,
+            std::vector<std::uint64_t>& load) {
+  const auto k = static_cast<ProcId>(load.size());
+  for (std::size_t round = 0; round < 4 * objs.size() + 16; ++round) {
+    const auto p = static_cast<ProcId>(std::max_element(load.begin(), load.end()) - load.begin());
+    std::uint64_t best_peak = load[p];
+    std::size_t best_a = SIZE_MAX, best_b = SIZE_MAX;
+    ProcId best_q = p;
+    for (std::size_t a = 0; a < objs.size(); ++a) {
+      if (where[a] != p) continue;
+      const std::uint64_t wa = objs[a].second;
+      for (ProcId q = 0; q < k; ++q) {
+        if (q == p) continue;
+        const std::uint64_t peak = std::max(load[p] - wa, load[q] + wa);
+        if (peak < best_peak) {
+          best_peak = peak;
+          best_a = a;
+          best_b = SIZE_MAX;
+          best_q = q;
+        }
+      }
+      for (std::size_t b = 0; b < objs.size(); ++b) {
+        const std::uint64_t wb = objs[b].second;
+        if (where[b] == p || wb >= wa) continue;
+        const ProcId q = where[b];
+        const std::uint64_t peak = std::max(load[p] - wa + wb, load[q] + wa - wb);
+        if (peak < best_peak) {
+          best_peak = peak;
+          best_a = a;
+          best_b = b;
+          best_q = q;
+        }
+      }
+    }
+    if (best_a == SIZE_MAX) return;
+    load[p] -= objs[best_a].second;
+    load[best_q] += objs[best_a].second;
+    where[best_a] = best_q;
+    if (best_b != SIZE_MAX) {
+      load[best_q] -= objs[best_b].second;
+      load[p] += objs[best_b].second;
+      where[best_b] = p;
+    }
+  }
+}
+
+/// Objects (with the tasks that work on them) spread over K processors by measured cost:
+/// longest processing time first, then moves and swaps that lower the maximum load.
 class Owner final : public Strategy {
  public:
   std::string_view name() const override { return "owner"; }
@@ -62,12 +112,14 @@ class Owner final : public Strategy {
     auto least_loaded = [&] {
       return static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
     };
-    std::unordered_map<ObjectId, ProcId> proc_of_object;
-    for (const auto& [obj, w] : objs) {
-      const ProcId p = least_loaded();
-      proc_of_object[obj] = p;
-      load[p] += w;
+    std::vector<ProcId> where(objs.size());
+    for (std::size_t i = 0; i < objs.size(); ++i) {
+      where[i] = least_loaded();
+      load[where[i]] += objs[i].second;
     }
+    refine(objs, where, load);
+    std::unordered_map<ObjectId, ProcId> proc_of_object;
+    for (std::size_t i = 0; i < objs.size(); ++i) proc_of_object[objs[i].first] = where[i];
 
     Result r;
     r.assignment.k = k;

@@ -140,14 +140,21 @@ class Sticky final : public Strategy {
     }
     Result r;
     r.assignment.k = k;
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    const std::vector<std::uint64_t> work = task_work(g);
     if (g.same_structure(*prev.graph)) {
+      // Same graph: reuse as is, unless measured costs drifted past the threshold.
       r.assignment = *prev.assignment;
-      r.stats.reused = true;
+      if (k == 1 || n <= k || imbalance(loads(work, r.assignment.proc, k)) <= options.sticky_threshold) {
+        r.stats.reused = true;
+        return r;
+      }
+      r.assignment.order.clear();
+      greedy_rebalance(g, work, k, options.imbalance, r.assignment.proc);
+      r.stats.rebalanced = true;
       return r;
     }
 
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    const std::vector<std::uint64_t> work = task_work(g);
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);
     std::vector<ProcId>& proc = r.assignment.proc;
     proc.assign(n, 0);

@@ -43,7 +43,7 @@ Rebalance parse_rebalance(std::string_view s);
 /// Knobs of the strategies; each strategy reads the ones it understands.
 struct Options {
   double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
-  std::uint64_t seed = 1;           ///< METIS / Scotch / random seed
+  std::uint64_t seed = 0;           ///< METIS / Scotch / random seed (0: METIS's own default, as gpmetis)
   Objective objective = Objective::kCut;  ///< METIS objective
   std::uint32_t phases = 0;         ///< METIS multi-constraint: phases balanced separately (<2: off)
   ScotchFlavour scotch = ScotchFlavour::kQuality;
