@@ -127,37 +127,42 @@ std::vector<Spring> grid_springs(const HexMesh& mesh, double stiffness) {
 }
 
 RigidSurface box_surface(const Vec3& size, int res) {
+  // res points along the longest edge; the other edges get the same spacing (at least 2).
+  const double spacing = size.maxCoeff() / (res - 1);
+  std::array<int, 3> n{};
+  for (int a = 0; a < 3; ++a) n[static_cast<std::size_t>(a)] = std::max(2, static_cast<int>(std::lround(size[a] / spacing)) + 1);
   RigidSurface s;
-  std::vector<Index> id(static_cast<std::size_t>(res * res * res), -1);
+  auto lin = [&](int i, int j, int k) { return static_cast<std::size_t>(i + n[0] * (j + n[1] * k)); };
+  std::vector<Index> id(static_cast<std::size_t>(n[0] * n[1] * n[2]), -1);
   std::vector<Vec3> pts;
-  auto on_boundary = [&](int i, int j, int k) {
-    return i == 0 || j == 0 || k == 0 || i == res - 1 || j == res - 1 || k == res - 1;
-  };
-  for (int k = 0; k < res; ++k)
-    for (int j = 0; j < res; ++j)
-      for (int i = 0; i < res; ++i) {
-        if (!on_boundary(i, j, k)) continue;
-        id[static_cast<std::size_t>(i + res * (j + res * k))] = static_cast<Index>(pts.size());
-        pts.push_back(Vec3(i, j, k) / (res - 1) - Vec3::Constant(0.5));
+  for (int k = 0; k < n[2]; ++k)
+    for (int j = 0; j < n[1]; ++j)
+      for (int i = 0; i < n[0]; ++i) {
+        if (!(i == 0 || j == 0 || k == 0 || i == n[0] - 1 || j == n[1] - 1 || k == n[2] - 1)) continue;
+        id[lin(i, j, k)] = static_cast<Index>(pts.size());
+        pts.push_back(Vec3(static_cast<double>(i) / (n[0] - 1), static_cast<double>(j) / (n[1] - 1),
+                           static_cast<double>(k) / (n[2] - 1)) -
+                      Vec3::Constant(0.5));
       }
   s.points.resize(3, static_cast<Index>(pts.size()));
   for (std::size_t p = 0; p < pts.size(); ++p) s.points.col(static_cast<Index>(p)) = pts[p].cwiseProduct(size);
-  auto at = [&](int i, int j, int k) { return id[static_cast<std::size_t>(i + res * (j + res * k))]; };
-  // Each face: fix one axis at 0 or res-1, walk the other two.
-  for (int axis = 0; axis < 3; ++axis)
-    for (int side : {0, res - 1})
-      for (int u = 0; u + 1 < res; ++u)
-        for (int v = 0; v + 1 < res; ++v) {
+  // Each face: fix one axis at its first or last layer, walk the other two.
+  for (int axis = 0; axis < 3; ++axis) {
+    const int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+    for (int side : {0, n[static_cast<std::size_t>(axis)] - 1})
+      for (int u = 0; u + 1 < n[static_cast<std::size_t>(a1)]; ++u)
+        for (int v = 0; v + 1 < n[static_cast<std::size_t>(a2)]; ++v) {
           auto idx = [&](int du, int dv) {
             std::array<int, 3> c{};
             c[static_cast<std::size_t>(axis)] = side;
-            c[static_cast<std::size_t>((axis + 1) % 3)] = u + du;
-            c[static_cast<std::size_t>((axis + 2) % 3)] = v + dv;
-            return at(c[0], c[1], c[2]);
+            c[static_cast<std::size_t>(a1)] = u + du;
+            c[static_cast<std::size_t>(a2)] = v + dv;
+            return id[lin(c[0], c[1], c[2])];
           };
           s.triangles.push_back({idx(0, 0), idx(1, 0), idx(1, 1)});
           s.triangles.push_back({idx(0, 0), idx(1, 1), idx(0, 1)});
         }
+  }
   s.spacing = max_edge(s.points, s.triangles) / std::sqrt(2.0);
   return s;
 }

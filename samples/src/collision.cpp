@@ -82,7 +82,7 @@ void detect_collisions(Scene& scene, Scene::Impl& m) {
     const Body& b = *floor->body_a();
     const std::size_t i = static_cast<std::size_t>(m.body_index.at(&b));
     std::vector<Index> pts;
-    if (!surf[i].points.empty() && surf[i].box.min().y() - b.contact_radius - floor->height() < cs.alarm_distance)
+    if (m.immobile[i] == 0 && !surf[i].points.empty() && surf[i].box.min().y() - b.contact_radius - floor->height() < cs.alarm_distance)
       for (std::size_t k = 0; k < b.surface.size(); ++k)
         if (surf[i].points[k].y() - b.contact_radius - floor->height() < cs.alarm_distance)
           pts.push_back(b.surface[k]);
@@ -98,7 +98,8 @@ void detect_collisions(Scene& scene, Scene::Impl& m) {
       const double reach = a.contact_radius + b.contact_radius + cs.alarm_distance;
       std::vector<ContactPair> pairs;
       const bool same_layer = a.collision_layer != 0 && a.collision_layer == b.collision_layer;
-      if (!same_layer && !surf[i].points.empty() && !surf[j].points.empty()) {
+      const bool both_fixed = m.immobile[i] != 0 && m.immobile[j] != 0;
+      if (!same_layer && !both_fixed && !surf[i].points.empty() && !surf[j].points.empty()) {
         Eigen::AlignedBox3d grown = surf[i].box;
         grown.min().array() -= reach;
         grown.max().array() += reach;
@@ -132,7 +133,7 @@ void detect_collisions(Scene& scene, Scene::Impl& m) {
       if (it == m.contacts.end())
         it = m.contacts
                  .emplace(key, std::make_unique<ContactForceField>("contact[" + a.name() + "|" + b.name() + "]", &a,
-                                                                   &b, cs.stiffness))
+                                                                   &b, cs.stiffness, cs.damping, cs.friction))
                  .first;
       it->second->set_pairs(std::move(pairs));
     }

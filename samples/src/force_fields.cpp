@@ -108,8 +108,9 @@ double SpringForceField::potential_energy() const {
 
 // ---------------------------------------------------------------- ContactForceField
 
-ContactForceField::ContactForceField(std::string name, Body* a, Body* b, double stiffness)
-    : ForceField(std::move(name), a, b), stiffness_(stiffness) {}
+ContactForceField::ContactForceField(std::string name, Body* a, Body* b, double stiffness, double damping,
+                                     double friction)
+    : ForceField(std::move(name), a, b), stiffness_(stiffness), damping_(damping), friction_(friction) {}
 
 std::uint64_t ContactForceField::state_bytes() const {
   return std::max<std::uint64_t>(1, cache_.size()) * sizeof(Cache);
@@ -133,7 +134,12 @@ void ContactForceField::add_force() {
     c.active = dist < r && dist > 1e-12;
     if (!c.active) continue;
     c.n = d / dist;
-    const Vec3 F = (stiffness_ * (r - dist)) * c.n;
+    Vec3 F = (stiffness_ * (r - dist)) * c.n;
+    if (damping_ > 0.0 || friction_ > 0.0) {
+      const Vec3 rel = a.point_velocity(pairs_[k].i) - b.point_velocity(pairs_[k].j);
+      const double vn = rel.dot(c.n);
+      F -= damping_ * vn * c.n + friction_ * (rel - vn * c.n);
+    }
     a.add_point_force(fa, pairs_[k].i, F);
     b.add_point_force(fb, pairs_[k].j, -F);
   }
@@ -171,11 +177,13 @@ double ContactForceField::potential_energy() const {
 // ---------------------------------------------------------------- FloorContactForceField
 
 FloorContactForceField::FloorContactForceField(std::string name, Body* body, double height,
-                                               double stiffness, double friction_damping)
+                                               double stiffness, double friction_damping,
+                                               double normal_damping)
     : ForceField(std::move(name), body),
       height_(height),
       stiffness_(stiffness),
-      friction_damping_(friction_damping) {}
+      friction_damping_(friction_damping),
+      normal_damping_(normal_damping) {}
 
 std::uint64_t FloorContactForceField::state_bytes() const {
   return std::max<std::uint64_t>(1, active_.size());
@@ -197,8 +205,9 @@ void FloorContactForceField::add_force() {
     active_[k] = pen > 0.0;
     if (!active_[k]) continue;
     Vec3 F(0.0, stiffness_ * pen, 0.0);
-    if (friction_damping_ > 0.0) {
+    if (friction_damping_ > 0.0 || normal_damping_ > 0.0) {
       Vec3 vt = a.point_motion(v, points_[k]);
+      F.y() -= normal_damping_ * vt.y();
       vt.y() = 0.0;
       F -= friction_damping_ * vt;
     }

@@ -2,7 +2,6 @@
 // Corotational hexahedral FEM (linear elasticity in each element's rotated frame).
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
-#include <Eigen/SVD>
 #include <array>
 #include <cmath>
 #include <map>
@@ -65,25 +64,32 @@ void fill_b(Eigen::Ref<Eigen::Matrix<double, 6, 3>> b, const Vec3& g) {
   b(5, 2) = g.x();
 }
 
-// Rotation of the polar decomposition F = R S (Higham's scaled Newton iteration; SVD when
-// the element is inverted or degenerate).
-Mat3 polar_rotation(const Mat3& f) {
-  const double det = f.determinant();
-  if (!(det > 1e-12 * std::pow(f.norm() + 1e-300, 3))) {
-    Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Mat3 u = svd.matrixU();
-    const Mat3& v = svd.matrixV();
-    if ((u * v.transpose()).determinant() < 0) u.col(2) = -u.col(2);
-    return u * v.transpose();
-  }
-  Mat3 r = f;
-  for (int it = 0; it < 30; ++it) {
-    const Mat3 inv_t = r.inverse().transpose();
-    const double g = std::sqrt(std::sqrt(inv_t.squaredNorm() / r.squaredNorm()));
-    const Mat3 next = 0.5 * (g * r + inv_t / g);
-    const double change = (next - r).squaredNorm();
-    r = next;
-    if (change < 1e-24) break;
+// Rotation R of the polar decomposition F = R S, warm-started with the element's previous
+// rotation q. Newton iteration on the rotation vector: with M = R^T F and S = sym(M), the
+// correction theta solving (tr(S) I - S) theta = axial(M - M^T) makes R exp(theta)^T F
+// symmetric to first order (quadratic convergence: one or two iterations per step). Where
+// tr(S) I - S is not safely positive (inverted or strongly sheared elements), a damped
+// step of Mueller et al. (MIG 2016) is taken instead, which maximises tr(R^T F).
+Mat3 extract_rotation(const Mat3& f, Eigen::Quaterniond& q) {
+  Mat3 r = q.toRotationMatrix();
+  for (int it = 0; it < 40; ++it) {
+    const Mat3 m = r.transpose() * f;
+    const Vec3 skew(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1));
+    const Mat3 sym = 0.5 * (m + m.transpose());
+    const double tr = sym.trace();
+    const Mat3 jac = tr * Mat3::Identity() - sym;
+    Vec3 theta;
+    const double det = jac.determinant();
+    if (tr > 0.0 && det > 1e-3 * tr * tr * tr && (jac.diagonal().array() > 0.0).all())
+      theta = jac.inverse() * skew;
+    else
+      theta = skew / (std::abs(tr) + 1e-300);
+    const double w = theta.norm();
+    if (!(w > 1e-12)) break;  // also stops on NaN input
+    if (w > 1.0) theta /= w;  // at most one radian per iteration
+    q = q * Eigen::Quaterniond(1.0, 0.5 * theta.x(), 0.5 * theta.y(), 0.5 * theta.z());
+    q.normalize();
+    r = q.toRotationMatrix();
   }
   return r;
 }
@@ -132,6 +138,7 @@ HexFemForceField::HexFemForceField(std::string name, ParticleBody* body,
   grad_.resize(ne);
   ke_index_.resize(ne);
   rotations_.assign(ne, Mat3::Identity());
+  quats_.assign(ne, Eigen::Quaterniond::Identity());
   // Elements of identical rest shape (up to translation) share one stiffness matrix.
   std::map<std::array<long long, 24>, std::uint32_t> shapes;
   for (std::size_t e = 0; e < ne; ++e) {
@@ -148,40 +155,69 @@ HexFemForceField::HexFemForceField(std::string name, ParticleBody* body,
     if (inserted) ke_.push_back(element_stiffness(r, material));
     ke_index_[e] = it->second;
   }
+  batches_.resize(ke_.size());
+  for (std::size_t k = 0; k < ke_.size(); ++k) batches_[k].first = static_cast<std::uint32_t>(k);
+  for (std::size_t e = 0; e < ne; ++e) batches_[ke_index_[e]].second.push_back(static_cast<std::uint32_t>(e));
 }
 
 std::uint64_t HexFemForceField::state_bytes() const { return rotations_.size() * sizeof(Mat3); }
 
+// Elements sharing one stiffness matrix are processed in batches of kBatch: their local
+// (rotated) displacements form a 24 x kBatch matrix multiplied by K_e at once, which keeps
+// K_e in registers and cache instead of streaming it once per element.
+namespace {
+constexpr int kBatch = 32;
+using Batch = Eigen::Matrix<double, 24, kBatch>;
+}  // namespace
+
 void HexFemForceField::add_force() {
   const StateVec& x = body_->vec(VecId::kX);
   StateVec& f = body_->vec(VecId::kF);
-  for (std::size_t e = 0; e < elements_.size(); ++e) {
-    const auto& nodes = elements_[e];
-    Mat38 xe;
-    for (int i = 0; i < 8; ++i) xe.col(i) = x.col(nodes[static_cast<std::size_t>(i)]);
-    // Polar decomposition relative to the previous rotation converges in a few iterations.
-    const Mat3 f_grad = xe * grad_[e].transpose();
-    Mat3& rot = rotations_[e];
-    rot = rot * polar_rotation(rot.transpose() * f_grad);
-    Mat38 u = rot.transpose() * xe - rest_[e];
-    Vec24 fe = -(ke_[ke_index_[e]] * Eigen::Map<const Vec24>(u.data()));
-    const Mat38 fw = rot * Eigen::Map<const Mat38>(fe.data());
-    for (int i = 0; i < 8; ++i) f.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+  Batch u, fe;
+  for (const auto& [ke, elems] : batches_) {
+    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
+      const int n = static_cast<int>(std::min<std::size_t>(kBatch, elems.size() - start));
+      for (int c = 0; c < n; ++c) {
+        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        const auto& nodes = elements_[e];
+        Mat38 xe;
+        for (int i = 0; i < 8; ++i) xe.col(i) = x.col(nodes[static_cast<std::size_t>(i)]);
+        rotations_[e] = extract_rotation(xe * grad_[e].transpose(), quats_[e]);
+        Eigen::Map<Mat38>(u.col(c).data()) = rotations_[e].transpose() * xe - rest_[e];
+      }
+      fe.leftCols(n).noalias() = ke_[ke] * u.leftCols(n);
+      for (int c = 0; c < n; ++c) {
+        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        const auto& nodes = elements_[e];
+        const Mat38 fw = -(rotations_[e] * Eigen::Map<const Mat38>(fe.col(c).data()));
+        for (int i = 0; i < 8; ++i) f.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+      }
+    }
   }
 }
 
 void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor) {
   const StateVec& in = body_->vec(dx);
   StateVec& out = body_->vec(df);
-  for (std::size_t e = 0; e < elements_.size(); ++e) {
-    const auto& nodes = elements_[e];
-    const Mat3& rot = rotations_[e];
-    Mat38 de;
-    for (int i = 0; i < 8; ++i) de.col(i) = in.col(nodes[static_cast<std::size_t>(i)]);
-    const Mat38 local = rot.transpose() * de;
-    const Vec24 fe = ke_[ke_index_[e]] * Eigen::Map<const Vec24>(local.data());
-    const Mat38 fw = (-k_factor) * (rot * Eigen::Map<const Mat38>(fe.data()));
-    for (int i = 0; i < 8; ++i) out.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+  Batch local, fe;
+  for (const auto& [ke, elems] : batches_) {
+    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
+      const int n = static_cast<int>(std::min<std::size_t>(kBatch, elems.size() - start));
+      for (int c = 0; c < n; ++c) {
+        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        const auto& nodes = elements_[e];
+        Mat38 de;
+        for (int i = 0; i < 8; ++i) de.col(i) = in.col(nodes[static_cast<std::size_t>(i)]);
+        Eigen::Map<Mat38>(local.col(c).data()) = rotations_[e].transpose() * de;
+      }
+      fe.leftCols(n).noalias() = ke_[ke] * local.leftCols(n);
+      for (int c = 0; c < n; ++c) {
+        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        const auto& nodes = elements_[e];
+        const Mat38 fw = (-k_factor) * (rotations_[e] * Eigen::Map<const Mat38>(fe.col(c).data()));
+        for (int i = 0; i < 8; ++i) out.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
+      }
+    }
   }
 }
 
@@ -191,7 +227,8 @@ double HexFemForceField::potential_energy() const {
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     Mat38 xe;
     for (int i = 0; i < 8; ++i) xe.col(i) = x.col(elements_[e][static_cast<std::size_t>(i)]);
-    const Mat3 rot = polar_rotation(xe * grad_[e].transpose());
+    Eigen::Quaterniond q = quats_[e];
+    const Mat3 rot = extract_rotation(xe * grad_[e].transpose(), q);
     Mat38 u = rot.transpose() * xe - rest_[e];
     const auto uv = Eigen::Map<const Vec24>(u.data());
     energy += 0.5 * uv.dot(ke_[ke_index_[e]] * uv);

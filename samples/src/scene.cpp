@@ -366,13 +366,20 @@ void Scene::finalize() {
   }
   for (const auto& c : constraints_)
     m.body_constraints[static_cast<std::size_t>(m.body_index.at(c->body()))].push_back(c.get());
+  m.immobile.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::vector<char> fixed(static_cast<std::size_t>(bodies_[i]->columns()), 0);
+    for (const FixedConstraint* c : m.body_constraints[i])
+      for (Index col : c->columns()) fixed[static_cast<std::size_t>(col)] = 1;
+    m.immobile[i] = std::all_of(fixed.begin(), fixed.end(), [](char f) { return f != 0; }) ? 1 : 0;
+  }
   if (collision_.enabled && collision_.floor) {
     for (std::size_t i = 0; i < n; ++i) {
       Body* b = bodies_[i].get();
       if (b->surface.empty()) continue;
       m.floors.push_back(std::make_unique<FloorContactForceField>(
           b->name() + ".floor", b, collision_.floor_height, collision_.floor_stiffness,
-          collision_.floor_friction));
+          collision_.floor_friction, collision_.damping));
       m.body_fields[i].push_back(m.floors.back().get());
     }
   }

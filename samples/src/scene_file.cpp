@@ -268,6 +268,8 @@ class SceneBuilder {
     c.enabled = true;
     c.stiffness = d.positive("stiffness", 1e4);
     c.alarm_distance = d.non_negative("alarm", 0.01);
+    c.damping = d.non_negative("damping", 0.0);
+    c.friction = d.non_negative("friction", 0.0);
     if (d.has("floor")) {
       c.floor = true;
       c.floor_height = d.number("floor");

@@ -69,6 +69,7 @@ struct Scene::Impl {
   std::unordered_map<const Body*, int> body_index;
   std::vector<std::vector<ForceField*>> body_fields;  // internal fields per body, floor included
   std::vector<std::vector<FixedConstraint*>> body_constraints;
+  std::vector<char> immobile;  // every column of the body is fixed
   std::vector<ForceField*> interactions;  // permanent interaction fields
   std::vector<std::unique_ptr<FloorContactForceField>> floors;
   std::map<std::pair<int, int>, std::unique_ptr<ContactForceField>> contacts;

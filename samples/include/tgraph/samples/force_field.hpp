@@ -5,6 +5,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tgraph/samples/body.hpp"
@@ -119,8 +120,8 @@ struct FemMaterial {
 };
 
 /// Hexahedral finite elements, linear elasticity with the corotational formulation: each
-/// element's rotation R is extracted by polar decomposition of its deformation gradient at
-/// the element centre, and f_e = -R K_e (R^T x_e - X_e), K = -R K_e R^T. The 24x24 element
+/// element's rotation R is the rotation of the polar decomposition of its deformation
+/// gradient at the element centre (extracted iteratively, warm-started per element), and f_e = -R K_e (R^T x_e - X_e), K = -R K_e R^T. The 24x24 element
 /// stiffness matrices are precomputed (shared by elements of identical rest shape).
 class HexFemForceField final : public ForceField {
  public:
@@ -148,7 +149,9 @@ class HexFemForceField final : public ForceField {
   std::vector<Eigen::Matrix<double, 3, 8>> grad_;        // shape gradients at the centre
   std::vector<Mat24, Eigen::aligned_allocator<Mat24>> ke_;  // distinct element matrices
   std::vector<std::uint32_t> ke_index_;                  // element -> matrix
+  std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> batches_;  // matrix -> elements
   std::vector<Mat3> rotations_;                          // cached by add_force
+  std::vector<Eigen::Quaterniond> quats_;                // same, warm start of the extraction
 };
 
 /// One penalty contact between point i of body a and point j of body b.
@@ -158,11 +161,15 @@ struct ContactPair {
 };
 
 /// Penalty contact springs between two bodies' surface points (sphere proxies of radius
-/// ra + rb): f = k max(0, ra + rb - d) n, K = -k n n^T while in contact. The pairs are
-/// maintained by the collision pipeline; the field exists while the bodies are in proximity.
+/// ra + rb): f = k max(0, ra + rb - d) n, K = -k n n^T while in contact, plus viscous
+/// damping of the relative normal velocity and of the sliding velocity (explicit terms).
+/// The pairs are maintained by the collision pipeline; the field exists while the bodies
+/// are in proximity.
 class ContactForceField final : public ForceField {
  public:
-  ContactForceField(std::string name, Body* a, Body* b, double stiffness);
+  ContactForceField(std::string name, Body* a, Body* b, double stiffness, double damping = 0.0,
+                    double friction = 0.0);
+  bool reads_velocity() const override { return damping_ > 0.0 || friction_ > 0.0; }
   void add_force() override;
   void add_dforce(VecId df, VecId dx, double k_factor) override;
   bool has_stiffness() const override { return true; }
@@ -180,19 +187,22 @@ class ContactForceField final : public ForceField {
     bool active = false;
   };
   double stiffness_;
+  double damping_;
+  double friction_;
   std::vector<ContactPair> pairs_;
   std::vector<Cache> cache_;
 };
 
-/// Penalty contact of a body's surface points with a static floor plane y = height.
+/// Penalty contact of a body's surface points with a static floor plane y = height, with
+/// viscous damping of the normal velocity and of the sliding velocity (explicit terms).
 class FloorContactForceField final : public ForceField {
  public:
   FloorContactForceField(std::string name, Body* body, double height, double stiffness,
-                         double friction_damping);
+                         double friction_damping, double normal_damping = 0.0);
   void add_force() override;
   void add_dforce(VecId df, VecId dx, double k_factor) override;
   bool has_stiffness() const override { return true; }
-  bool reads_velocity() const override { return friction_damping_ > 0.0; }
+  bool reads_velocity() const override { return friction_damping_ > 0.0 || normal_damping_ > 0.0; }
   std::uint64_t state_bytes() const override;
   void* state_ptr() override { return active_.data(); }
   double potential_energy() const override;
@@ -207,6 +217,7 @@ class FloorContactForceField final : public ForceField {
   double height_;
   double stiffness_;
   double friction_damping_;
+  double normal_damping_;
   std::vector<Index> points_;
   std::vector<char> active_;
 };

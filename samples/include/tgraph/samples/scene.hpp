@@ -27,6 +27,8 @@ struct CollisionSettings {
   bool enabled = false;
   double alarm_distance = 0.01;  ///< a pair is kept while d < ra + rb + alarm_distance
   double stiffness = 1e4;        ///< penalty stiffness of one contact pair (N/m)
+  double damping = 0.0;          ///< normal damping of one contact pair (N s/m)
+  double friction = 0.0;         ///< tangential (viscous) damping of one contact pair (N s/m)
   bool floor = false;            ///< a static floor plane y = floor_height
   double floor_height = 0.0;
   double floor_stiffness = 1e4;  ///< penalty stiffness of one point on the floor (N/m)
