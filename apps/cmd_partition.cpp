@@ -28,7 +28,7 @@ struct StrategyFlags {
   std::uint32_t phases = 0;
   std::string scotch = "quality";
   std::string sticky_base = "metis";
-  double threshold = 1.10;
+  double threshold = 1.20;
   double migration_cost = 1.0;
   std::string rebalance = "greedy";
 
@@ -42,7 +42,7 @@ struct StrategyFlags {
     cmd->add_option("--scotch-strategy", scotch, "Scotch flavour: default, quality, speed, balance")
         ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
     cmd->add_option("--sticky-base", sticky_base, "sticky: method for the first step (default metis)");
-    cmd->add_option("--threshold", threshold, "sticky: rebalance above this imbalance (default 1.10)");
+    cmd->add_option("--threshold", threshold, "sticky: rebalance when imbalance exceeds this x the last partition's (default 1.20)");
     cmd->add_option("--rebalance", rebalance, "sticky: greedy (move whole objects) or scotch (graphRepart)")
         ->check(CLI::IsMember({"greedy", "scotch"}));
     cmd->add_option("--migration-cost", migration_cost,

@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `metis`: METIS 5.1 k-way partitioning of the undirected task graph.
+#include <fcntl.h>
 #include <metis.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -21,6 +24,32 @@ std::mutex& metis_mutex() {
   static std::mutex m;
   return m;
 }
+
+// METIS 5.1 prints diagnostics ("***Cannot bisect a graph with 0 vertices!") with printf on
+// stdout when K is large for the graph, which would corrupt `--json` output: stdout is
+// pointed at /dev/null for the duration of the call (under the METIS mutex).
+class SilenceStdout {
+ public:
+  SilenceStdout() {
+    std::fflush(stdout);
+    saved_ = dup(STDOUT_FILENO);
+    const int null = open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) dup2(null, STDOUT_FILENO);
+    if (null >= 0) close(null);
+  }
+  ~SilenceStdout() {
+    std::fflush(stdout);
+    if (saved_ >= 0) {
+      dup2(saved_, STDOUT_FILENO);
+      close(saved_);
+    }
+  }
+  SilenceStdout(const SilenceStdout&) = delete;
+  SilenceStdout& operator=(const SilenceStdout&) = delete;
+
+ private:
+  int saved_ = -1;
+};
 
 }  // namespace
 
@@ -47,6 +76,7 @@ std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std:
   int status;
   {
     std::lock_guard<std::mutex> lock(metis_mutex());
+    SilenceStdout quiet;
     status = METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.empty() ? nullptr : adjncy.data(),
                                  vwgt.data(), nullptr, adjwgt.empty() ? nullptr : adjwgt.data(),
                                  &nparts, nullptr, ubvec.data(), opts, &objval, out.data());

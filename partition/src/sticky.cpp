@@ -9,12 +9,15 @@ namespace tgraph::partition::detail {
 
 namespace {
 
-// Moves whole units (the tasks of one object on one processor; a task without object is a
-// unit of its own) from the most loaded to the least loaded processor, each time the unit
-// that best evens the pair (ties: the one with most data on the destination), until the
-// imbalance is within `tolerance` or no move improves it. Few, large, local moves.
+// Moves work off the most loaded processor while that pays: candidates are whole units
+// (the tasks of one object on one processor; a task without object is a unit of its own)
+// and single tasks, towards any less loaded processor. A move's gain is how much it lowers
+// the larger of the two loads; its price is the synchronisation and transfer time (cost
+// model) of the dependencies it cuts minus those it joins, per execution (a loop body edge
+// counts every iteration). The best move with gain > price is applied until the imbalance
+// is within `tolerance` or no move pays.
 void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
-                      double tolerance, std::vector<ProcId>& proc) {
+                      double tolerance, const CostModel& model, std::vector<ProcId>& proc) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   struct Unit {
     ProcId proc;
@@ -40,12 +43,16 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
     units[u].tasks.push_back(t);
     unit_of[t] = u;
   }
-  std::vector<std::vector<std::pair<TaskId, std::uint64_t>>> adj(n);
+  // Price of cutting each dependency, per execution of the step.
+  std::vector<std::vector<std::pair<TaskId, double>>> adj(n);
   auto link = [&](const Edge& e) {
     if (e.from == e.to) return;
-    const std::uint64_t b = std::max<std::uint64_t>(1, g.data[e.datum].bytes);
-    adj[e.from].push_back({e.to, b});
-    adj[e.to].push_back({e.from, b});
+    const LoopId l = g.tasks[e.to].loop;
+    const double runs = l != kNoLoop && g.tasks[e.from].loop == l ? g.loops[l].iterations : 1.0;
+    const double c =
+        (model.sync_latency_ns + model.per_byte_ns * static_cast<double>(g.data[e.datum].bytes)) * runs;
+    adj[e.from].push_back({e.to, c});
+    adj[e.to].push_back({e.from, c});
   };
   for (const Edge& e : g.edges) link(e);
   for (const Edge& e : g.carried_edges) link(e);
@@ -54,37 +61,54 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
   std::uint64_t total = 0;
   for (std::uint64_t l : load) total += l;
   const double limit = static_cast<double>(total) / k * tolerance;
-  for (std::size_t step = 0; step < units.size(); ++step) {
+  std::vector<char> in_set(n, 0);
+  for (std::size_t step = 0; step < 4 * static_cast<std::size_t>(n); ++step) {
     const auto p = static_cast<ProcId>(std::max_element(load.begin(), load.end()) - load.begin());
-    const auto q = static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
-    if (static_cast<double>(load[p]) <= limit || p == q) break;
-    std::size_t best = SIZE_MAX;
-    std::uint64_t best_peak = load[p];
-    std::int64_t best_affinity = 0;
-    for (std::size_t u = 0; u < units.size(); ++u) {
-      const Unit& un = units[u];
-      if (un.proc != p || un.work == 0 || un.work >= load[p] - load[q]) continue;
-      const std::uint64_t peak = std::max(load[p] - un.work, load[q] + un.work);
-      if (peak > best_peak) continue;
-      std::int64_t affinity = 0;  // bytes to q minus bytes kept on p
-      for (TaskId t : un.tasks)
-        for (const auto& [o, b] : adj[t]) {
-          if (unit_of[o] == u) continue;
-          if (proc[o] == q) affinity += static_cast<std::int64_t>(b);
-          if (proc[o] == p) affinity -= static_cast<std::int64_t>(b);
+    if (static_cast<double>(load[p]) <= limit) break;
+    double best_score = 0.0;
+    std::size_t best_unit = SIZE_MAX;
+    TaskId best_task = kNoTask;
+    ProcId best_q = p;
+    auto consider = [&](std::size_t u, TaskId single, std::uint64_t w, const std::vector<TaskId>& tasks) {
+      if (w == 0) return;
+      for (TaskId t : tasks) in_set[t] = 1;
+      for (ProcId q = 0; q < k; ++q) {
+        if (q == p || load[q] + w >= load[p]) continue;
+        const double gain = static_cast<double>(load[p] - std::max(load[p] - w, load[q] + w));
+        double price = 0.0;
+        for (TaskId t : tasks)
+          for (const auto& [o, c] : adj[t]) {
+            if (in_set[o]) continue;
+            if (proc[o] == p) price += c;
+            if (proc[o] == q) price -= c;
+          }
+        if (gain - price > best_score) {
+          best_score = gain - price;
+          best_unit = u;
+          best_task = single;
+          best_q = q;
         }
-      if (best == SIZE_MAX || peak < best_peak || (peak == best_peak && affinity > best_affinity)) {
-        best = u;
-        best_peak = peak;
-        best_affinity = affinity;
       }
+      for (TaskId t : tasks) in_set[t] = 0;
+    };
+    for (std::size_t u = 0; u < units.size(); ++u)
+      if (units[u].proc == p) consider(u, kNoTask, units[u].work, units[u].tasks);
+    for (TaskId t = 0; t < n; ++t)
+      if (proc[t] == p && units[unit_of[t]].tasks.size() > 1) consider(unit_of[t], t, work[t], {t});
+    if (best_unit == SIZE_MAX) break;
+    if (best_task != kNoTask) {  // split the task off its unit
+      Unit& from = units[best_unit];
+      from.work -= work[best_task];
+      from.tasks.erase(std::find(from.tasks.begin(), from.tasks.end(), best_task));
+      best_unit = units.size();
+      units.push_back({p, work[best_task], {best_task}});
+      unit_of[best_task] = best_unit;
     }
-    if (best == SIZE_MAX) break;
-    Unit& un = units[best];
-    for (TaskId t : un.tasks) proc[t] = q;
-    un.proc = q;
+    Unit& un = units[best_unit];
+    for (TaskId t : un.tasks) proc[t] = best_q;
+    un.proc = best_q;
     load[p] -= un.work;
-    load[q] += un.work;
+    load[best_q] += un.work;
   }
 }
 
@@ -117,11 +141,34 @@ void scotch_rebalance(const StepGraph& g, std::uint32_t k, const Options& option
   proc.assign(part.begin(), part.end());
 }
 
+// Renames the parts of a fresh partition so that as many tasks (by work) as possible keep
+// their previous processor: greedy maximum-weight matching on the K x K overlap.
+void relabel_to_previous(const std::vector<TaskId>& match, const std::vector<ProcId>& old,
+                         const std::vector<std::uint64_t>& work, std::uint32_t k,
+                         std::vector<ProcId>& proc) {
+  std::vector<std::uint64_t> overlap(static_cast<std::size_t>(k) * k, 0);
+  for (TaskId t = 0; t < proc.size(); ++t)
+    if (match[t] != kNoTask) overlap[static_cast<std::size_t>(proc[t]) * k + old[match[t]]] += work[t] + 1;
+  std::vector<std::size_t> cells(overlap.size());
+  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = i;
+  std::stable_sort(cells.begin(), cells.end(), [&](std::size_t a, std::size_t b) { return overlap[a] > overlap[b]; });
+  std::vector<ProcId> rename(k, k);
+  std::vector<bool> taken(k, false);
+  for (std::size_t c : cells) {
+    const auto from = static_cast<ProcId>(c / k), to = static_cast<ProcId>(c % k);
+    if (rename[from] != k || taken[to]) continue;
+    rename[from] = to;
+    taken[to] = true;
+  }
+  for (ProcId& p : proc) p = rename[p];
+}
+
 /// Reuses the previous step's assignment while the structure is unchanged; otherwise keeps
 /// every task found again (by stable key) on its processor, places new tasks by affinity to
-/// the data they touch, and only when imbalance exceeds the threshold rebalances so that
-/// few existing tasks move: greedy moves of whole objects (default) or Scotch
-/// repartitioning with a migration cost.
+/// the data they touch, and only when imbalance exceeds `threshold` times the imbalance the
+/// last full partition (or rebalance) reached rebalances so that few existing tasks move:
+/// greedy moves of whole objects (default) or Scotch repartitioning with a migration cost.
+/// An instance remembers that baseline between the steps of one trace.
 ///
 ///   Options o;  o.sticky_threshold = 1.10;  o.rebalance = Rebalance::kGreedy;
 ///   TracePartition tp = partition_trace(trace, "sticky", 8, o);
@@ -132,30 +179,54 @@ class Sticky final : public Strategy {
  private:
   Result do_partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
                       const Options& options) override {
+    const std::vector<std::uint64_t> work = task_work(g);
     if (prev.graph == nullptr || prev.assignment->k != k) {
       const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
       Result r = make_strategy(base)->partition(g, k, {}, options);
       r.assignment.order.clear();
+      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
       return r;
     }
+    // The imbalance the last full partition or rebalance reached: what the graph's
+    // granularity allows. Rebalance only when the current one is `threshold` times worse.
+    const double baseline = prev.assignment->proc == last_proc_
+                                ? baseline_
+                                : imbalance(loads(task_work(*prev.graph), prev.assignment->proc, k));
+    const double trigger = std::max(options.sticky_threshold, baseline * options.sticky_threshold);
+    const double target = std::max(options.imbalance, baseline);
     Result r;
     r.assignment.k = k;
     const auto n = static_cast<TaskId>(g.tasks.size());
-    const std::vector<std::uint64_t> work = task_work(g);
     if (g.same_structure(*prev.graph)) {
-      // Same graph: reuse as is, unless measured costs drifted past the threshold.
+      // Same graph: reuse as is, unless measured costs drifted past the trigger.
       r.assignment = *prev.assignment;
-      if (k == 1 || n <= k || imbalance(loads(work, r.assignment.proc, k)) <= options.sticky_threshold) {
+      if (k == 1 || n <= k || imbalance(loads(work, r.assignment.proc, k)) <= trigger) {
         r.stats.reused = true;
+        remember(r.assignment.proc, baseline);
         return r;
       }
       r.assignment.order.clear();
-      greedy_rebalance(g, work, k, options.imbalance, r.assignment.proc);
+      greedy_rebalance(g, work, k, target, options.model, r.assignment.proc);
       r.stats.rebalanced = true;
+      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
       return r;
     }
 
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);
+    std::size_t matched = 0;
+    for (TaskId m : match) matched += m != kNoTask ? 1 : 0;
+    if (g.loops.size() != prev.graph->loops.size() || 4 * matched < 3 * static_cast<std::size_t>(n)) {
+      // The shape changed too much to patch (solver loops merged or split, or over a quarter
+      // of the tasks are new): partition afresh, then rename the parts so that as many
+      // tasks as possible stay where they were.
+      const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
+      r = make_strategy(base)->partition(g, k, {}, options);
+      r.assignment.order.clear();
+      relabel_to_previous(match, prev.assignment->proc, work, k, r.assignment.proc);
+      r.stats.rebalanced = true;
+      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
+      return r;
+    }
     std::vector<ProcId>& proc = r.assignment.proc;
     proc.assign(n, 0);
     std::vector<std::uint64_t> load(k, 0);
@@ -187,19 +258,31 @@ class Sticky final : public Strategy {
       hold(t, best);
     }
 
-    const double before = imbalance(load);
-    if (before <= options.sticky_threshold || k == 1 || n <= k) return r;
+    if (imbalance(load) <= trigger || k == 1 || n <= k) {
+      remember(proc, baseline);
+      return r;
+    }
     switch (options.rebalance) {
       case Rebalance::kGreedy:
-        greedy_rebalance(g, work, k, options.imbalance, proc);
+        greedy_rebalance(g, work, k, target, options.model, proc);
         break;
       case Rebalance::kScotch:
         scotch_rebalance(g, k, options, match, proc);
         break;
     }
     r.stats.rebalanced = true;
+    remember(proc, imbalance(loads(work, proc, k)));
     return r;
   }
+
+  void remember(const std::vector<ProcId>& proc, double baseline) {
+    last_proc_ = proc;
+    baseline_ = baseline;
+  }
+
+  // The assignment returned last and the imbalance baseline it carries (see do_partition).
+  std::vector<ProcId> last_proc_;
+  double baseline_ = 1.0;
 };
 
 }  // namespace

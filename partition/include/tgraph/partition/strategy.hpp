@@ -48,7 +48,7 @@ struct Options {
   std::uint32_t phases = 0;         ///< METIS multi-constraint: phases balanced separately (<2: off)
   ScotchFlavour scotch = ScotchFlavour::kQuality;
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
-  double sticky_threshold = 1.10;   ///< sticky: rebalance above this imbalance
+  double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
   Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
   double migration_cost = 1.0;      ///< sticky + scotch rebalance: emraval (quantised to 0.01)
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
