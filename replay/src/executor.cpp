@@ -90,7 +90,7 @@ struct Executor::CacheEntry {
   bool has_assignment = false;
   ExecGraph exec;
   std::shared_ptr<void> plan;
-  const Workload* bound = nullptr;
+  std::uint64_t bound = 0;  // Workload::instance() holding this plan's buffers
 };
 
 Executor::Executor(Policy policy, ExecOptions options) : options_(options), policy_(policy) {}
@@ -175,11 +175,11 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
     if (cache_.size() >= 16) cache_.erase(cache_.begin());
     cache_.push_back(entry);
   }
-  const bool fresh = entry->bound != &w;
+  const bool fresh = entry->bound != w.instance();
   if (fresh) {
-    for (auto& e : cache_) e->bound = nullptr;  // the workload now holds this plan's buffers
+    for (auto& e : cache_) e->bound = 0;  // the workload now holds this plan's buffers
     w.bind(entry->exec);
-    entry->bound = &w;
+    entry->bound = w.instance();
   }
   const std::int64_t t_built = now_ns();
   if (stats.rebuilt) stats.build_ns = t_built - t0;

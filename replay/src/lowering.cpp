@@ -34,10 +34,18 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
   std::unordered_map<std::uint64_t, bool> serialize_acc;  // (task, datum) -> CW becomes RW
   std::vector<std::vector<PendingReducer>> after(n);      // reducers emitted after task t
   if (mode == CwMode::kReduce && a != nullptr && a->k > 1) {
-    std::vector<Segment> open(g.data.size());
+    // A CW group of derive_edges() can run on across a loop boundary (into the body, out of
+    // it, or from the end of one iteration into the next): its members there have no edge
+    // between them. A segment cut by such a boundary is therefore kept pending until the
+    // next access to its datum: if that access is CW too, the segment is serialised (CW ->
+    // RW, which orders it before the following writers); otherwise it is lowered normally.
+    std::vector<Segment> open(g.data.size()), pending(g.data.size());
     std::vector<DatumId> open_list;
-    auto close = [&](DatumId d) {
-      Segment& s = open[d];
+    auto serialize = [&](Segment& s, DatumId d) {
+      for (TaskId m : s.members) serialize_acc[pair_key(m, d)] = true;
+      s.members.clear();
+    };
+    auto lower_segment = [&](Segment& s, DatumId d) {
       if (s.members.empty()) return;
       std::vector<ProcId> procs;
       for (TaskId m : s.members) procs.push_back(proc(m));
@@ -46,44 +54,68 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
       if (procs.size() > 1) {
         const TaskId last = s.members.back();
         const LoopId l = g.tasks[last].loop;
-        const bool ends_body = l != kNoLoop && last + 1 == g.loops[l].last;
-        if (ends_body) {
-          // A break task with a CW access: no room for a reducer after it; serialise.
-          for (TaskId m : s.members) serialize_acc[pair_key(m, d)] = true;
-        } else {
-          PendingReducer r;
-          r.target = d;
-          r.home = proc(s.members.front());
-          for (ProcId p : procs)
-            if (p != r.home) r.procs.push_back(p);
-          for (TaskId m : s.members)
-            if (proc(m) != r.home) redirect[pair_key(m, d)] = proc(m);
-          after[last].push_back(std::move(r));
+        if (l != kNoLoop && last + 1 == g.loops[l].last) {
+          serialize(s, d);  // a break task with a CW access: no room for a reducer after it
+          return;
         }
+        PendingReducer r;
+        r.target = d;
+        r.home = proc(s.members.front());
+        for (ProcId p : procs)
+          if (p != r.home) r.procs.push_back(p);
+        for (TaskId m : s.members)
+          if (proc(m) != r.home) redirect[pair_key(m, d)] = proc(m);
+        after[last].push_back(std::move(r));
       }
       s.members.clear();
     };
-    auto close_all = [&] {
-      for (DatumId d : open_list) close(d);
+    // First access mode of each datum in each loop body (for the wrap-around).
+    std::vector<std::unordered_map<DatumId, AccessMode>> first_in_body(g.loops.size());
+    for (LoopId l = 0; l < g.loops.size(); ++l)
+      for (TaskId t = g.loops[l].first; t < g.loops[l].last; ++t)
+        for (const Access& acc : g.accesses_of(t)) first_in_body[l].emplace(acc.datum, acc.mode);
+    auto cut_all = [&](LoopId leaving) {
+      for (DatumId d : open_list) {
+        Segment& s = open[d];
+        if (s.members.empty()) continue;
+        if (leaving != kNoLoop) {
+          auto it = first_in_body[leaving].find(d);
+          if (it != first_in_body[leaving].end() && it->second == AccessMode::CW) {
+            serialize(s, d);  // continues into the next iteration's CW writers
+            continue;
+          }
+        }
+        pending[d] = std::move(s);
+        s.members.clear();
+      }
       open_list.clear();
     };
     LoopId region = kNoLoop;
     for (TaskId t = 0; t < n; ++t) {
       const LoopId l = g.tasks[t].loop;
       const bool body_start = l != kNoLoop && g.loops[l].first == t;
-      if (l != region || body_start) close_all();
+      if (l != region || body_start) cut_all(region);
       region = l;
       for (const Access& acc : g.accesses_of(t)) {
-        Segment& s = open[acc.datum];
+        const DatumId d = acc.datum;
+        if (!pending[d].members.empty()) {
+          if (acc.mode == AccessMode::CW) {
+            serialize(pending[d], d);
+          } else {
+            lower_segment(pending[d], d);
+          }
+        }
+        Segment& s = open[d];
         if (acc.mode == AccessMode::CW) {
-          if (s.members.empty()) open_list.push_back(acc.datum);
+          if (s.members.empty()) open_list.push_back(d);
           if (s.members.empty() || s.members.back() != t) s.members.push_back(t);
         } else {
-          close(acc.datum);
+          lower_segment(s, d);
         }
       }
     }
-    close_all();
+    cut_all(region);
+    for (DatumId d = 0; d < g.data.size(); ++d) lower_segment(pending[d], d);
   }
 
   // 2. Emit the exec graph.

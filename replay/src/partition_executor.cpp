@@ -315,6 +315,7 @@ class PartitionExecutor final : public Executor {
     exec_ = &x;
     workload_ = &w;
     fresh_ = fresh;
+    if (fresh) ++touch_rounds_;
     error_ = nullptr;
     // relaxed: published to the workers by the release in signal(step_seq_) below.
     abort_.store(false, std::memory_order_relaxed);
@@ -377,8 +378,11 @@ class PartitionExecutor final : public Executor {
     }
     // seq_cst: Dekker with the waiters' abort check before they sleep (sync.hpp).
     if (abort_.exchange(true, std::memory_order_seq_cst)) return;
-    for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.wake(done_[t].v);
-    for (std::size_t l = 0; l < plan_->loops; ++l) parking_.wake(loop_[l].v);
+    // std::atomic::wait only promises to wake a sleeper whose value changed, so each
+    // counter is bumped (within this epoch: below every later target) before the notify;
+    // a woken waiter sees abort_ and leaves.
+    for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.poke(done_[t].v);
+    for (std::size_t l = 0; l < plan_->loops; ++l) parking_.poke(loop_[l].v);
   }
 
   // Waits until ok(c); false when the step is aborting.
@@ -412,9 +416,17 @@ class PartitionExecutor final : public Executor {
     const std::uint64_t E = epoch_;
     const bool observe = !observers_.empty();
     try {
-      if (fresh_)
+      if (fresh_) {
         for (DatumId d : pp.owned)
           if (w.needs_touch(d)) w.first_touch(d);
+        // Every buffer exists before any task runs: a barrier over the k threads.
+        // seq_cst RMW (a release): our allocations reach the threads acquiring the total.
+        touched_.fetch_add(1, std::memory_order_seq_cst);
+        if (parking_.parked() != 0) parking_.wake(touched_);
+        const std::uint64_t all = touch_rounds_ * options_.threads;
+        std::uint64_t seen = 0;
+        if (!wait(touched_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, seen)) goto out;
+      }
       std::uint32_t iter = 0;
       std::uint64_t v = 0;
       for (std::size_t pc = 0; pc < pp.ops.size();) {
@@ -509,6 +521,8 @@ class PartitionExecutor final : public Executor {
   std::uint64_t steps_ = 0;
   alignas(64) std::atomic<std::uint64_t> step_seq_{0};
   alignas(64) std::atomic<std::uint64_t> finished_{0};
+  alignas(64) std::atomic<std::uint64_t> touched_{0};  // first-touch barrier arrivals
+  std::uint64_t touch_rounds_ = 0;
   alignas(64) std::atomic<bool> abort_{false};
   std::atomic<bool> shutdown_{false};
   const std::atomic<bool> never_abort_{false};

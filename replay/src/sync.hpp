@@ -47,8 +47,15 @@ class Parking {
     if (parked_.load(std::memory_order_seq_cst) != 0) c.notify_all();
   }
 
-  /// Wakes every sleeper of `c` (abort, shutdown) without changing it.
+  /// Wakes every sleeper of `c` after a change of its value made by the caller.
   void wake(std::atomic<std::uint64_t>& c) { c.notify_all(); }
+
+  /// Changes `c` (adds 2^31, staying within its epoch) and wakes every sleeper (abort).
+  void poke(std::atomic<std::uint64_t>& c) {
+    // seq_cst: ordered after the abort flag the woken waiters then read.
+    c.fetch_add(1ull << 31, std::memory_order_seq_cst);
+    c.notify_all();
+  }
 
   /// Waits until ok(c) or `abort` is set; returns the last value read and whether it slept.
   /// `spun_ns` receives the time spent (0 when ok at once).

@@ -138,19 +138,23 @@ void SyntheticWorkload::run(const TaskRun& r) {
   }
   std::uint64_t acc = (static_cast<std::uint64_t>(r.origin) << 20) ^ r.iteration;
   std::uint64_t bytes = 0;
+  // Data from the exec graph (a CW writer may be redirected to a temporary), modes from the
+  // original step (serialisation turns CW into RW for ordering only).
   const auto acc_list = x.graph.accesses_of(r.task);
-  for (const Access& a : acc_list) {
-    if (!reads(a.mode)) continue;
-    const Buffer* b = buffers_[a.datum].get();
+  const auto orig = step_ ? step_->accesses_of(r.origin) : acc_list;
+  const std::size_t na = std::min(acc_list.size(), orig.size());
+  for (std::size_t i = 0; i < na; ++i) {
+    if (!reads(orig[i].mode)) continue;
+    const Buffer* b = buffers_[acc_list[i].datum].get();
     if (!b) continue;
     acc = acc * 31 + read_pass(b->w.get(), b->words);
     bytes += b->words * 8;
   }
-  for (const Access& a : acc_list) {
-    if (!writes(a.mode)) continue;
-    Buffer* b = buffers_[a.datum].get();
+  for (std::size_t i = 0; i < na; ++i) {
+    if (!writes(orig[i].mode)) continue;
+    Buffer* b = buffers_[acc_list[i].datum].get();
     if (!b) continue;
-    write_pass(a.mode, b->w.get(), b->words, acc);
+    write_pass(orig[i].mode, b->w.get(), b->words, acc);
     bytes += b->words * 8;
   }
   const Calibration& c = calibration();

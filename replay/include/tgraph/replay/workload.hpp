@@ -2,6 +2,7 @@
 // What an executor runs: the body of each task and the break condition of each loop.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -24,7 +25,12 @@ struct TaskRun {
 /// the thread that ran the loop's break task, after that task.
 class Workload {
  public:
+  Workload() : instance_(next_instance()) {}
+  Workload(const Workload&) : instance_(next_instance()) {}
+  Workload& operator=(const Workload&) { return *this; }
   virtual ~Workload() = default;
+  /// Unique number of this object (executors rebind when it changes).
+  std::uint64_t instance() const { return instance_; }
   /// Called on the executor's calling thread when a new structure (plan) is installed.
   virtual void bind(const ExecGraph& exec) { (void)exec; }
   /// Called on the thread that owns datum `d` (exec id) before the first step of a plan,
@@ -39,6 +45,14 @@ class Workload {
   virtual void run(const TaskRun& r) = 0;
   /// After iteration `iteration` (0-based) of loop `loop`: true = leave the loop.
   virtual bool stop_after(LoopId loop, std::uint32_t iteration) = 0;
+
+ private:
+  static std::uint64_t next_instance() {
+    static std::atomic<std::uint64_t> counter{0};
+    // relaxed: only uniqueness matters, which the atomic increment gives.
+    return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+  }
+  std::uint64_t instance_;
 };
 
 }  // namespace tgraph::replay

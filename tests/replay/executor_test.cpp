@@ -1,0 +1,376 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "random_graph.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/synthetic.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+struct Variant {
+  Policy policy;
+  bool serial;
+  const char* name;
+};
+
+const Variant kVariants[] = {
+    {Policy::kPartition, false, "partition"},
+    {Policy::kPartition, true, "partition_serial"},
+    {Policy::kWorksteal, false, "worksteal"},
+    {Policy::kBarrier, false, "barrier"},
+};
+
+ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
+  ExecOptions o;
+  o.threads = k;
+  o.serial = serial;
+  o.spin_ns = spin_ns;
+  return o;
+}
+
+ExecOptions options_for(const Variant& v, std::uint32_t k) {
+  ExecOptions o;
+  o.threads = k;
+  o.serial = v.serial;
+  o.spin_ns = 20'000;
+  return o;
+}
+
+/// Final words of the original data after running `steps` steps of g.
+std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w, const StepGraph& g) {
+  std::vector<std::vector<std::uint64_t>> s;
+  for (DatumId d = 0; d < g.data.size(); ++d) {
+    auto words = w.words(d);
+    s.emplace_back(words.begin(), words.end());
+  }
+  return s;
+}
+
+std::vector<std::vector<std::uint64_t>> sequential_state(const StepGraph& g, int steps) {
+  auto ex = make_executor(Policy::kSequential, {});
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  for (int s = 0; s < steps; ++s) ex->run_step(g, nullptr, w);
+  return final_state(w, g);
+}
+
+class EveryPolicy : public ::testing::TestWithParam<std::tuple<int, std::uint32_t>> {};
+
+TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
+  const auto [vi, k] = GetParam();
+  const Variant& v = kVariants[vi];
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    const StepGraph g = test::random_graph(seed * 7919 + k);
+    const Assignment a = test::random_assignment(g, k, seed);
+    auto ex = make_executor(v.policy, options_for(v, k));
+    TimelineObserver timeline;
+    ex->add_observer(timeline);
+    SyntheticWorkload w({.cost_scale = 0.2});
+    w.set_step(g);
+    for (int step = 0; step < 2; ++step) {
+      const StepStats s = ex->run_step(g, &a, w);
+      EXPECT_EQ(s.rebuilt, step == 0);
+      for (LoopId l = 0; l < g.loops.size(); ++l) EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
+      ASSERT_NE(ex->last_exec(), nullptr);
+      test::expect_valid_order(ex->last_exec()->graph, timeline.events(), static_cast<std::uint32_t>(step), true);
+      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step), false, true);
+    }
+    EXPECT_EQ(ex->plans_built(), 1u);
+    const auto got = final_state(w, g), want = sequential_state(g, 2);
+    for (DatumId d = 0; d < g.data.size(); ++d)
+      EXPECT_TRUE(got[d] == want[d]) << v.name << " seed " << seed << " k " << k << ": datum "
+                                     << g.data[d].name << " differs from the sequential run";
+    if (::testing::Test::HasFailure()) return;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Threads1To8, EveryPolicy,
+                         ::testing::Combine(::testing::Range(0, 4), ::testing::Range(1u, 9u)),
+                         [](const auto& param_info) {
+                           return std::string(kVariants[std::get<0>(param_info.param)].name) + "_k" +
+                                  std::to_string(std::get<1>(param_info.param));
+                         });
+
+/// A graph where four tasks add into one datum, then one task reads it.
+StepGraph cw_fan_in(int writers) {
+  StepGraph g;
+  g.intern_kind("add");
+  g.intern_kind("read");
+  g.objects.push_back({"o"});
+  g.data.push_back({"f", 0, 8});
+  g.data.push_back({"out", 0, 8});
+  for (int i = 0; i < writers; ++i) {
+    const Access acc[] = {{0, AccessMode::CW}};
+    g.add_task(0, 0, acc, 100, static_cast<StableKey>(i + 1));
+  }
+  const Access acc[] = {{0, AccessMode::R}, {1, AccessMode::W}};
+  g.add_task(1, 0, acc, 100, 99);
+  g.derive_edges();
+  return g;
+}
+
+/// Doubles: CW adds 0.1 * (task + 1) / 3, which depends on the summation order.
+class DoubleWorkload : public Workload {
+ public:
+  void bind(const ExecGraph& x) override { v_.assign(x.graph.data.size(), 0.0); }
+  void run(const TaskRun& r) override {
+    const ExecGraph& x = *r.exec;
+    if (r.origin == kNoTask) {
+      const Reduction& red = x.reductions[x.reduction[r.task]];
+      for (DatumId t : red.temps) {
+        v_[red.target] += v_[t];
+        v_[t] = 0.0;
+      }
+      return;
+    }
+    double in = 0;
+    for (const Access& a : x.graph.accesses_of(r.task))
+      if (reads(a.mode)) in += v_[a.datum];
+    for (const Access& a : x.graph.accesses_of(r.task)) {
+      if (a.mode == AccessMode::CW || a.mode == AccessMode::RW) v_[a.datum] += 0.1 * (r.origin + 1) / 3.0;
+      if (a.mode == AccessMode::W) v_[a.datum] = in;
+    }
+  }
+  bool stop_after(LoopId, std::uint32_t) override { return true; }
+  double value(DatumId d) const { return v_[d]; }
+
+ private:
+  std::vector<double> v_;
+};
+
+TEST(CwReduction, CrossProcessorWritesGoThroughTemporariesAndOneReducer) {
+  const StepGraph g = cw_fan_in(6);
+  Assignment a;
+  a.k = 3;
+  a.proc = {0, 1, 2, 1, 2, 0, 0};
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  ASSERT_EQ(x.reductions.size(), 1u);
+  EXPECT_EQ(x.reductions[0].target, 0u);
+  ASSERT_EQ(x.reductions[0].temps.size(), 2u);  // processors 1 and 2
+  EXPECT_EQ(x.graph.data[x.reductions[0].temps[0]].name, "f@1");
+  EXPECT_EQ(x.graph.data[x.reductions[0].temps[1]].name, "f@2");
+  EXPECT_EQ(x.graph.tasks.size(), g.tasks.size() + 1);
+  const TaskId reducer = x.exec_of[5] + 1;
+  EXPECT_EQ(x.origin[reducer], kNoTask);
+  EXPECT_EQ(x.assignment.proc[reducer], 0u);
+  // The reader depends on the reducer, and on no writer off the home processor.
+  bool reader_after_reducer = false;
+  for (const Edge& e : x.graph.edges) {
+    if (e.to != x.exec_of[6]) continue;
+    reader_after_reducer |= e.from == reducer;
+    EXPECT_EQ(x.assignment.proc[e.from], 0u);
+  }
+  EXPECT_TRUE(reader_after_reducer);
+  // On one processor nothing is lowered.
+  Assignment one;
+  one.k = 1;
+  one.proc.assign(g.tasks.size(), 0);
+  EXPECT_TRUE(lower(g, &one, CwMode::kReduce).reductions.empty());
+}
+
+TEST(CwReduction, IsDeterministicAcrossRunsAndEqualsTheSerialTwin) {
+  const StepGraph g = cw_fan_in(12);
+  Assignment a;
+  a.k = 3;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back((t * 7) % 3);
+  double expected = 0;
+  {
+    ExecOptions o = opts(3, true);
+    auto ex = make_executor(Policy::kPartition, o);
+    DoubleWorkload w;
+    ex->run_step(g, &a, w);
+    expected = w.value(0);
+  }
+  std::uint64_t expected_bits = 0;
+  std::memcpy(&expected_bits, &expected, 8);
+  auto ex = make_executor(Policy::kPartition, opts(3, false, 5'000));
+  for (int run = 0; run < 30; ++run) {
+    DoubleWorkload w;
+    ex->run_step(g, &a, w);
+    const double got = w.value(0);
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &got, 8);
+    ASSERT_EQ(bits, expected_bits) << "run " << run;
+  }
+  double plain = 0;
+  for (TaskId t = 0; t < 12; ++t) plain += 0.1 * (t + 1) / 3.0;
+  EXPECT_NEAR(expected, plain, 1e-12);
+}
+
+class Throwing : public Workload {
+ public:
+  explicit Throwing(TaskId bad) : bad_(bad) {}
+  void run(const TaskRun& r) override {
+    if (r.origin == bad_ && r.iteration == 0) throw std::runtime_error("task " + std::to_string(bad_) + " failed");
+  }
+  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
+
+ private:
+  TaskId bad_;
+};
+
+TEST(Executor, RethrowsATaskExceptionAfterJoiningAndStaysUsable) {
+  const StepGraph g = test::random_graph(42);
+  for (const Variant& v : kVariants) {
+    for (std::uint32_t k : {1u, 2u, 4u}) {
+      const Assignment a = test::random_assignment(g, k, 3);
+      auto ex = make_executor(v.policy, options_for(v, k));
+      for (TaskId bad : {TaskId{0}, static_cast<TaskId>(g.tasks.size() / 2), g.loops[0].last - 2}) {
+        Throwing w(bad);
+        try {
+          ex->run_step(g, &a, w);
+          ADD_FAILURE() << v.name << " k=" << k << ": no exception";
+        } catch (const std::runtime_error& e) {
+          EXPECT_EQ(std::string(e.what()), "task " + std::to_string(bad) + " failed") << v.name;
+        }
+      }
+      SyntheticWorkload ok({.cost_scale = 0.0});
+      ok.set_step(g);
+      EXPECT_NO_THROW(ex->run_step(g, &a, ok)) << v.name << " k=" << k;
+    }
+  }
+}
+
+TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
+  StepGraph g = test::random_graph(5);
+  const Assignment a = test::random_assignment(g, 2, 1);
+  auto ex = make_executor(Policy::kPartition, opts(2));
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  const StepStats first = ex->run_step(g, &a, w);
+  EXPECT_TRUE(first.rebuilt);
+  EXPECT_GT(first.build_ns, 0);
+  EXPECT_GE(first.wall_ns, first.build_ns);
+  StepGraph g2 = g;  // new costs and iteration counts: same structure
+  for (Task& t : g2.tasks) t.cost_ns += 7;
+  g2.loops[0].iterations = 1;
+  w.set_step(g2);
+  const StepStats second = ex->run_step(g2, &a, w);
+  EXPECT_FALSE(second.rebuilt);
+  EXPECT_EQ(second.build_ns, 0);
+  EXPECT_EQ(second.loop_iterations[0], 1u);
+  Assignment b = a;
+  b.proc[0] = 1 - b.proc[0];
+  EXPECT_TRUE(ex->run_step(g2, &b, w).rebuilt);
+  EXPECT_FALSE(ex->run_step(g2, &a, w).rebuilt);  // still cached
+  EXPECT_EQ(ex->plans_built(), 2u);
+}
+
+TEST(Executor, RejectsBadAssignments) {
+  const StepGraph g = test::random_graph(9);
+  auto ex = make_executor(Policy::kPartition, opts(2));
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  EXPECT_THROW(ex->run_step(g, nullptr, w), UsageError);
+  Assignment a = test::random_assignment(g, 3, 1);
+  EXPECT_THROW(ex->run_step(g, &a, w), UsageError);  // k != threads
+  a = test::random_assignment(g, 2, 1);
+  a.proc.pop_back();
+  EXPECT_THROW(ex->run_step(g, &a, w), UsageError);
+  EXPECT_THROW(make_executor(Policy::kWorksteal, opts(0)), UsageError);
+}
+
+TEST(Executor, RejectsATaskOrderThatWouldDeadlock) {
+  // t0 (p0) writes d0, t1 (p1) reads d0 and writes d1, t2 (p0) reads d1.
+  StepGraph g;
+  g.intern_kind("k");
+  g.data = {{"d0", kNoObject, 8}, {"d1", kNoObject, 8}};
+  const Access a0[] = {{0, AccessMode::W}};
+  const Access a1[] = {{0, AccessMode::R}, {1, AccessMode::W}};
+  const Access a2[] = {{1, AccessMode::R}};
+  g.add_task(0, kNoObject, a0);
+  g.add_task(0, kNoObject, a1);
+  g.add_task(0, kNoObject, a2);
+  g.derive_edges();
+  Assignment a;
+  a.k = 2;
+  a.proc = {0, 1, 0};
+  a.order = {{2, 0}, {1}};  // p0 runs t2 before t0: t2 waits for t1, t1 for t0
+  auto ex = make_executor(Policy::kPartition, opts(2));
+  SyntheticWorkload w;
+  w.set_step(g);
+  try {
+    ex->run_step(g, &a, w);
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("deadlock"), std::string::npos) << e.what();
+  }
+  a.order = {{0, 2}, {1}};
+  EXPECT_NO_THROW(ex->run_step(g, &a, w));
+}
+
+TEST(Locality, CountsRemoteReadsAndMigratedData) {
+  StepGraph g;
+  g.intern_kind("k");
+  g.data = {{"d", kNoObject, 1000}};
+  const Access w0[] = {{0, AccessMode::W}};
+  const Access r1[] = {{0, AccessMode::R}};
+  g.add_task(0, kNoObject, w0);
+  g.add_task(0, kNoObject, r1);
+  g.derive_edges();
+  auto ex = make_executor(Policy::kPartition, opts(2, true));
+  LocalityObserver loc;
+  ex->add_observer(loc);
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  Assignment a{2, {0, 1}, {}};
+  ex->run_step(g, &a, w);
+  EXPECT_EQ(loc.remote_bytes(), 1000u);
+  EXPECT_EQ(loc.migrated_bytes(), 0u);
+  ex->run_step(g, &a, w);
+  EXPECT_EQ(loc.migrated_bytes(), 0u);
+  Assignment b{2, {1, 1}, {}};
+  ex->run_step(g, &b, w);
+  EXPECT_EQ(loc.remote_bytes(), 0u);
+  EXPECT_EQ(loc.migrated_bytes(), 1000u);  // the writer moved from thread 0 to thread 1
+}
+
+TEST(Timeline, ExportsEveryTaskToJsonAndChromeTraceEvents) {
+  const StepGraph g = test::random_graph(11);
+  const Assignment a = test::random_assignment(g, 2, 2);
+  auto ex = make_executor(Policy::kPartition, opts(2));
+  TimelineObserver tl;
+  ex->add_observer(tl);
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  ex->run_step(g, &a, w);
+  std::size_t instances = 0;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) instances += g.runs(t);
+  std::size_t original = 0;
+  for (const TimelineEvent& e : tl.events()) original += e.origin != kNoTask ? 1 : 0;
+  EXPECT_EQ(original, instances);
+  const std::string json = tl.to_json();
+  EXPECT_NE(json.find("\"tasks\""), std::string::npos);
+  EXPECT_NE(json.find("\"start_ns\""), std::string::npos);
+  const std::string chrome = tl.to_chrome_json();
+  EXPECT_NE(chrome.find("\"traceEvents\""), std::string::npos);
+  EXPECT_NE(chrome.find("\"ph\":\"X\""), std::string::npos);
+}
+
+TEST(Synthetic, SpinsForTheRecordedCost) {
+  StepGraph g;
+  g.intern_kind("k");
+  g.data = {{"d", kNoObject, 4096}};
+  const Access acc[] = {{0, AccessMode::RW}};
+  g.add_task(0, kNoObject, acc, 2'000'000);  // 2 ms
+  g.derive_edges();
+  auto ex = make_executor(Policy::kSequential, {});
+  SyntheticWorkload w;
+  w.set_step(g);
+  std::vector<std::int64_t> walls;
+  for (int i = 0; i < 5; ++i) walls.push_back(ex->run_step(g, nullptr, w).wall_ns);
+  std::sort(walls.begin(), walls.end());
+  EXPECT_GT(walls[2], 1'500'000);  // the median is near 2 ms (noisy shared machine)
+  EXPECT_LT(walls[0], 4'000'000);
+  EXPECT_GT(SyntheticWorkload::calibration().spin_iterations_per_ns, 0.0);
+}
+
+}  // namespace
+}  // namespace tgraph::replay

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: MIT
+// Random step graphs with CW groups and loops, and the execution-order check, for tests.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/observer.hpp"
+
+namespace tgraph::replay::test {
+
+/// A random program: straight-line segments and do-while loops whose body ends with a task
+/// writing the condition and the break reading it. Accesses: R 40%, CW 30%, W 15%, RW 15%.
+inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segment = 10,
+                              int data = 8) {
+  std::mt19937 rng(seed);
+  auto pick = [&](int n) { return static_cast<int>(rng() % static_cast<unsigned>(n)); };
+  StepGraph g;
+  for (const char* k : {"a", "b", "c", "f"}) g.intern_kind(k);
+  const KindId brk = g.intern_kind("loop.break");
+  for (int o = 0; o < 4; ++o) g.objects.push_back({"obj" + std::to_string(o)});
+  for (int d = 0; d < data; ++d)
+    g.data.push_back({"d" + std::to_string(d), static_cast<ObjectId>(d % 4),
+                      static_cast<std::uint64_t>(64 + 64 * pick(16))});
+  auto add_random = [&](LoopId loop) {
+    std::vector<Access> acc;
+    const int n = 1 + pick(3);
+    for (int i = 0; i < n; ++i) {
+      const auto d = static_cast<DatumId>(pick(data));
+      bool dup = false;
+      for (const Access& a : acc) dup = dup || a.datum == d;
+      if (dup) continue;
+      const int r = pick(100);
+      const AccessMode m = r < 40 ? AccessMode::R : r < 70 ? AccessMode::CW : r < 85 ? AccessMode::W : AccessMode::RW;
+      acc.push_back({d, m});
+    }
+    const TaskId t = g.add_task(static_cast<KindId>(pick(4)), static_cast<ObjectId>(pick(4)), acc,
+                                static_cast<std::uint64_t>(pick(2000)));
+    g.tasks[t].loop = loop;
+  };
+  for (int s = 0; s < segments; ++s) {
+    if (s % 2 == 1) {
+      const auto cond = static_cast<DatumId>(g.data.size());
+      g.data.push_back({"cond" + std::to_string(s), kNoObject, 8});
+      const auto l = static_cast<LoopId>(g.loops.size());
+      Loop loop;
+      loop.condition = cond;
+      loop.first = static_cast<TaskId>(g.tasks.size());
+      loop.iterations = 1 + static_cast<std::uint32_t>(pick(4));
+      loop.max_iterations = pick(2) == 0 ? 0 : loop.iterations + static_cast<std::uint32_t>(pick(3));
+      for (int i = 0; i < per_segment; ++i) add_random(l);
+      // The residual: reads some data, writes the condition.
+      const Access res[] = {{static_cast<DatumId>(pick(data)), AccessMode::R}, {cond, AccessMode::W}};
+      g.tasks[g.add_task(3, kNoObject, res, 300)].loop = l;
+      const Access b[] = {{cond, AccessMode::R}};
+      g.tasks[g.add_task(brk, kNoObject, b, 50)].loop = l;
+      loop.last = static_cast<TaskId>(g.tasks.size());
+      g.loops.push_back(loop);
+    } else {
+      for (int i = 0; i < per_segment; ++i) add_random(kNoLoop);
+    }
+  }
+  for (TaskId t = 0; t < g.tasks.size(); ++t) g.tasks[t].key = t + 1;
+  g.derive_edges();
+  EXPECT_EQ(g.validate(), "");
+  return g;
+}
+
+/// A random assignment on k processors (program order).
+inline Assignment random_assignment(const StepGraph& g, std::uint32_t k, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  Assignment a;
+  a.k = k;
+  for (std::size_t t = 0; t < g.tasks.size(); ++t) a.proc.push_back(static_cast<ProcId>(rng() % k));
+  return a;
+}
+
+/// Checks from a timeline (one step) that every original task ran exactly runs(t) times and
+/// after all its predecessors: intra-step and loop-carried edges, the loop gate (iteration
+/// i + 1 after the break of iteration i) and its own previous iteration.
+/// With `exec` = true the events are matched by exec task id (g is the exec graph, whose
+/// edges the executors promise); else by original task id, and `raw_only` restricts the
+/// check to read-after-write edges (lowering may relax WAR/WAW edges of CW writers that
+/// it redirects to temporaries; true data dependencies always hold).
+inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineEvent>& events,
+                               std::uint32_t step, bool exec = false, bool raw_only = false) {
+  std::map<std::pair<TaskId, std::uint32_t>, std::pair<std::int64_t, std::int64_t>> when;
+  std::vector<std::uint32_t> count(g.tasks.size(), 0);
+  for (const TimelineEvent& e : events) {
+    if (e.step != step || (!exec && e.origin == kNoTask)) continue;
+    const TaskId id = exec ? e.task : e.origin;
+    ASSERT_LT(id, g.tasks.size());
+    ++count[id];
+    ASSERT_TRUE(when.emplace(std::make_pair(id, e.iteration), std::make_pair(e.start_ns, e.end_ns)).second)
+        << "task " << id << " iteration " << e.iteration << " ran twice";
+  }
+  for (TaskId t = 0; t < g.tasks.size(); ++t)
+    ASSERT_EQ(count[t], g.runs(t)) << "task " << t << " ran " << count[t] << " times";
+  auto end_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).second; };
+  auto start_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).first; };
+  for (const Edge& e : g.edges) {
+    if (raw_only && e.kind != EdgeKind::RAW) continue;
+    const LoopId lu = g.tasks[e.from].loop, lv = g.tasks[e.to].loop;
+    for (std::uint32_t i = 0; i < g.runs(e.to); ++i) {
+      const std::uint32_t iu = (lu != kNoLoop && lu == lv) ? i : static_cast<std::uint32_t>(g.runs(e.from) - 1);
+      EXPECT_GE(start_of(e.to, i), end_of(e.from, iu))
+          << "edge " << e.from << " -> " << e.to << " violated at iteration " << i;
+    }
+  }
+  for (const Edge& e : g.carried_edges) {
+    if (raw_only && e.kind != EdgeKind::RAW) continue;
+    for (std::uint32_t i = 1; i < g.runs(e.to); ++i)
+      EXPECT_GE(start_of(e.to, i), end_of(e.from, i - 1))
+          << "carried edge " << e.from << " -> " << e.to << " violated at iteration " << i;
+  }
+  for (const Loop& l : g.loops)
+    for (TaskId v = l.first; v < l.last; ++v)
+      for (std::uint32_t i = 1; i < l.iterations; ++i) {
+        EXPECT_GE(start_of(v, i), end_of(l.last - 1, i - 1)) << "gate of loop, task " << v;
+        EXPECT_GE(start_of(v, i), end_of(v, i - 1)) << "task " << v << " overtook itself";
+      }
+}
+
+}  // namespace tgraph::replay::test
