@@ -10,7 +10,7 @@ namespace tgraph::samples {
 
 ForceField::ForceField(std::string name, Body* a, Body* b) : name_(std::move(name)), a_(a), b_(b) {}
 
-void ForceField::add_dforce(VecId, VecId, double) {}
+void ForceField::add_dforce(VecId, VecId, double, double) {}
 
 // ---------------------------------------------------------------- GravityForceField
 
@@ -85,7 +85,7 @@ void SpringForceField::add_force() {
     spring_forces(springs_, cache_, *a, *b);
 }
 
-void SpringForceField::add_dforce(VecId df, VecId dx, double k_factor) {
+void SpringForceField::add_dforce(VecId df, VecId dx, double k_factor, double /*b_factor*/) {
   Body* a = body_a();
   Body* b = body_b() ? body_b() : body_a();
   if (particles_)
@@ -145,18 +145,21 @@ void ContactForceField::add_force() {
   }
 }
 
-void ContactForceField::add_dforce(VecId df, VecId dx, double k_factor) {
+void ContactForceField::add_dforce(VecId df, VecId dx, double k_factor, double b_factor) {
   Body& a = *body_a();
   Body& b = *body_b();
   StateVec& dfa = a.vec(df);
   StateVec& dfb = b.vec(df);
   const StateVec& dxa = a.vec(dx);
   const StateVec& dxb = b.vec(dx);
+  const double cn = -k_factor * stiffness_ - b_factor * damping_;  // along n
+  const double ct = -b_factor * friction_;                          // tangential
   for (std::size_t k = 0; k < pairs_.size(); ++k) {
     const Cache& c = cache_[k];
     if (!c.active) continue;
     const Vec3 dd = a.point_motion(dxa, pairs_[k].i) - b.point_motion(dxb, pairs_[k].j);
-    const Vec3 dF = (-k_factor * stiffness_ * c.n.dot(dd)) * c.n;
+    const double dn = c.n.dot(dd);
+    const Vec3 dF = cn * dn * c.n + ct * (dd - dn * c.n);
     a.add_point_force(dfa, pairs_[k].i, dF);
     b.add_point_force(dfb, pairs_[k].j, -dF);
   }
@@ -215,14 +218,16 @@ void FloorContactForceField::add_force() {
   }
 }
 
-void FloorContactForceField::add_dforce(VecId df, VecId dx, double k_factor) {
+void FloorContactForceField::add_dforce(VecId df, VecId dx, double k_factor, double b_factor) {
   Body& a = *body_a();
   StateVec& out = a.vec(df);
   const StateVec& in = a.vec(dx);
+  const double cn = -k_factor * stiffness_ - b_factor * normal_damping_;
+  const double ct = -b_factor * friction_damping_;
   for (std::size_t k = 0; k < points_.size(); ++k) {
     if (!active_[k]) continue;
-    const double dy = a.point_motion(in, points_[k]).y();
-    a.add_point_force(out, points_[k], Vec3(0.0, -k_factor * stiffness_ * dy, 0.0));
+    const Vec3 d = a.point_motion(in, points_[k]);
+    a.add_point_force(out, points_[k], Vec3(ct * d.x(), cn * d.y(), ct * d.z()));
   }
 }
 

@@ -196,7 +196,7 @@ void HexFemForceField::add_force() {
   }
 }
 
-void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor) {
+void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor, double /*b_factor*/) {
   const StateVec& in = body_->vec(dx);
   StateVec& out = body_->vec(df);
   Batch local, fe;

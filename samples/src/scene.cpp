@@ -149,15 +149,15 @@ class Stepper {
     issue(rec_, b_.add_force, field_object(ff), acc, [ff] { ff->add_force(); });
   }
 
-  // addDForce of one field: df += k K dx.
-  void add_dforce(ForceField* ff, VecId df, VecId dx, double k) {
+  // addDForce of one field: df += (k K + kb B) dx.
+  void add_dforce(ForceField* ff, VecId df, VecId dx, double k, double kb) {
     AccessList acc;
     for (Body* bd : {ff->body_a(), ff->body_b()})
       if (bd != nullptr) acc.add(vec(bd, dx), R);
     if (const DatumId st = field_state(ff); st != kNoDatum) acc.add(st, R);
     for (Body* bd : {ff->body_a(), ff->body_b()})
       if (bd != nullptr) acc.add(vec(bd, df), CW);
-    issue(rec_, b_.add_dforce, field_object(ff), acc, [ff, df, dx, k] { ff->add_dforce(df, dx, k); });
+    issue(rec_, b_.add_dforce, field_object(ff), acc, [ff, df, dx, k, kb] { ff->add_dforce(df, dx, k, kb); });
   }
 
   void project(FixedConstraint* c, VecId id) {
@@ -201,8 +201,8 @@ class Stepper {
     }
   }
 
-  // Backward Euler: (M (1 + h alpha) - h^2 K) dv = h (f - alpha M v + h K v), solved by
-  // conjugate gradient as a dynamic loop (paper section 3.3); v += dv; x += h v.
+  // Backward Euler: (M (1 + h alpha) - h B - h^2 K) dv = h (f - alpha M v + h K v), solved
+  // by conjugate gradient as a dynamic loop (paper section 3.3); v += dv; x += h v.
   void implicit_euler(const Group& g) {
     GroupSolver* s = g.solver;
     declare_solver(*s);
@@ -211,7 +211,7 @@ class Stepper {
     reset_forces(g);
     for (ForceField* ff : g.fields) add_force(ff, true);
     for (ForceField* ff : g.fields)
-      if (ff->has_stiffness()) add_dforce(ff, VecId::kF, VecId::kV, h);
+      if (ff->has_stiffness()) add_dforce(ff, VecId::kF, VecId::kV, h, 0.0);
     rec_.task(b_.cg_init, s->object,
               {{s->d_rho, W}, {s->d_den, W}, {s->d_rho_new, W}, {s->d_beta, W}}, [s] {
                 s->rho = s->den = s->rho_new = s->beta = 0.0;
@@ -261,7 +261,7 @@ class Stepper {
                   });
       }
       for (ForceField* ff : g.fields)
-        if (ff->has_stiffness()) add_dforce(ff, VecId::kQ, VecId::kP, -h * h);
+        if (ff->has_stiffness()) add_dforce(ff, VecId::kQ, VecId::kP, -h * h, -h);
       for (FixedConstraint* c : g.constraints) project(c, VecId::kQ);
       for (int i : g.bodies) {
         Body* bd = body(i);

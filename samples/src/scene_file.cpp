@@ -320,11 +320,20 @@ class SceneBuilder {
     }
     static const std::map<std::string, std::pair<int, int>> kFaces = {
         {"xmin", {0, -1}}, {"xmax", {0, 1}}, {"ymin", {1, -1}}, {"ymax", {1, 1}}, {"zmin", {2, -1}}, {"zmax", {2, 1}}};
-    auto it = kFaces.find(spec);
-    if (it == kFaces.end()) d.fail("fix: '" + spec + "' is not none, all, nodes:i,j,..., xmin, xmax, ymin, ymax, zmin or zmax");
+    // A face, optionally with a band depth: "ymax" or "ymax:0.03" (nodes within 3 cm).
+    const std::string face = spec.substr(0, spec.find(':'));
+    double band = 0.0;
+    if (face.size() != spec.size()) {
+      const auto v = d.numbers("fix", 1, spec.substr(face.size() + 1));
+      if (!(v[0] >= 0.0)) d.fail("fix: the band depth must be >= 0");
+      band = v[0];
+    }
+    auto it = kFaces.find(face);
+    if (it == kFaces.end())
+      d.fail("fix: '" + spec + "' is not none, all, nodes:i,j,..., or a face xmin, xmax, ymin, ymax, zmin, zmax (optionally face:depth)");
     const auto [axis, side] = it->second;
     const double target = side < 0 ? x.row(axis).minCoeff() : x.row(axis).maxCoeff();
-    const double tol = 1e-9 * (1.0 + (x.row(axis).maxCoeff() - x.row(axis).minCoeff()));
+    const double tol = band + 1e-9 * (1.0 + (x.row(axis).maxCoeff() - x.row(axis).minCoeff()));
     for (Index i = 0; i < x.cols(); ++i)
       if (std::abs(x(axis, i) - target) <= tol) out.push_back(i);
     return out;

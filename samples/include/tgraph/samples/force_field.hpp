@@ -35,8 +35,9 @@ class ForceField {
 
   /// f += f(x, v) on the field's bodies; caches what addDForce needs (state()).
   virtual void add_force() = 0;
-  /// vec(df) += k_factor * K * vec(dx) on the field's bodies, K from the last add_force().
-  virtual void add_dforce(VecId df, VecId dx, double k_factor);
+  /// vec(df) += (k_factor K + b_factor B) vec(dx) on the field's bodies, with K = df/dx and
+  /// B = df/dv (damping) from the last add_force().
+  virtual void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0);
   /// True when add_dforce does anything (fields with stiffness).
   virtual bool has_stiffness() const { return false; }
   /// True when add_force reads velocities.
@@ -87,7 +88,7 @@ class SpringForceField final : public ForceField {
   /// Springs within `a` (b == nullptr) or between `a` and `b`.
   SpringForceField(std::string name, Body* a, Body* b, std::vector<Spring> springs);
   void add_force() override;
-  void add_dforce(VecId df, VecId dx, double k_factor) override;
+  void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0) override;
   bool has_stiffness() const override { return true; }
   std::uint64_t state_bytes() const override;
   void* state_ptr() override { return cache_.data(); }
@@ -130,7 +131,7 @@ class HexFemForceField final : public ForceField {
   HexFemForceField(std::string name, ParticleBody* body, std::vector<std::array<Index, 8>> elements,
                    const FemMaterial& material);
   void add_force() override;
-  void add_dforce(VecId df, VecId dx, double k_factor) override;
+  void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0) override;
   bool has_stiffness() const override { return true; }
   std::uint64_t state_bytes() const override;
   void* state_ptr() override { return rotations_.data(); }
@@ -162,7 +163,8 @@ struct ContactPair {
 
 /// Penalty contact springs between two bodies' surface points (sphere proxies of radius
 /// ra + rb): f = k max(0, ra + rb - d) n, K = -k n n^T while in contact, plus viscous
-/// damping of the relative normal velocity and of the sliding velocity (explicit terms).
+/// damping of the relative normal velocity (c_n) and of the sliding velocity (c_t):
+/// B = -c_n n n^T - c_t (I - n n^T), treated implicitly by the implicit solver.
 /// The pairs are maintained by the collision pipeline; the field exists while the bodies
 /// are in proximity.
 class ContactForceField final : public ForceField {
@@ -171,7 +173,7 @@ class ContactForceField final : public ForceField {
                     double friction = 0.0);
   bool reads_velocity() const override { return damping_ > 0.0 || friction_ > 0.0; }
   void add_force() override;
-  void add_dforce(VecId df, VecId dx, double k_factor) override;
+  void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0) override;
   bool has_stiffness() const override { return true; }
   std::uint64_t state_bytes() const override;
   void* state_ptr() override { return cache_.data(); }
@@ -194,13 +196,13 @@ class ContactForceField final : public ForceField {
 };
 
 /// Penalty contact of a body's surface points with a static floor plane y = height, with
-/// viscous damping of the normal velocity and of the sliding velocity (explicit terms).
+/// viscous damping of the normal velocity and of the sliding velocity (B as for contacts).
 class FloorContactForceField final : public ForceField {
  public:
   FloorContactForceField(std::string name, Body* body, double height, double stiffness,
                          double friction_damping, double normal_damping = 0.0);
   void add_force() override;
-  void add_dforce(VecId df, VecId dx, double k_factor) override;
+  void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0) override;
   bool has_stiffness() const override { return true; }
   bool reads_velocity() const override { return friction_damping_ > 0.0 || normal_damping_ > 0.0; }
   std::uint64_t state_bytes() const override;
