@@ -2,6 +2,7 @@
 // `owner`: the owner-compute rule (paper section 3.2).
 #include <algorithm>
 #include <numeric>
+#include <string_view>
 #include <unordered_map>
 
 #include "strategies.hpp"
@@ -37,14 +38,15 @@ ObjectId owner_of(const StepGraph& g, TaskId t) {
   return g.tasks[t].object;
 }
 
-// Improves an LPT placement: moves one object off the most loaded processor, or swaps one of
-// its objects with a lighter one elsewhere, whichever lowers the pair's maximum most; stops
-// when nothing lowers the maximum.
+// Improves a placement: moves one object off the most loaded processor, or swaps one of its
+// objects with a lighter one elsewhere, whichever lowers the pair's maximum most; stops when
+// the maximum is within `limit` or nothing lowers it.
 void refine(const std::vector<std::pair<ObjectId, std::uint64_t>>& objs, std::vector<ProcId>& where,
-            std::vector<std::uint64_t>& load) {
+            std::vector<std::uint64_t>& load, double limit) {
   const auto k = static_cast<ProcId>(load.size());
   for (std::size_t round = 0; round < 4 * objs.size() + 16; ++round) {
     const auto p = static_cast<ProcId>(std::max_element(load.begin(), load.end()) - load.begin());
+    if (static_cast<double>(load[p]) <= limit) return;
     std::uint64_t best_peak = load[p];
     std::size_t best_a = SIZE_MAX, best_b = SIZE_MAX;
     ProcId best_q = p;
@@ -86,14 +88,37 @@ void refine(const std::vector<std::pair<ObjectId, std::uint64_t>>& objs, std::ve
   }
 }
 
+// Processor of each object (by name) in a previous assignment: where most of its work ran.
+std::unordered_map<std::string_view, ProcId> object_processors(const StepGraph& g, const Assignment& a) {
+  std::unordered_map<ObjectId, std::unordered_map<ProcId, std::uint64_t>> work;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    const ObjectId o = owner_of(g, t);
+    if (o != kUnowned && o < g.objects.size()) work[o][a.proc[t]] += g.tasks[t].cost_ns * g.runs(t) + 1;
+  }
+  std::unordered_map<std::string_view, ProcId> out;
+  for (const auto& [o, per] : work) {
+    ProcId best = 0;
+    std::uint64_t w = 0;
+    for (const auto& [p, x] : per)
+      if (x > w || (x == w && p < best)) {
+        best = p;
+        w = x;
+      }
+    out[g.objects[o].name] = best;
+  }
+  return out;
+}
+
 /// Objects (with the tasks that work on them) spread over K processors by measured cost:
-/// longest processing time first, then moves and swaps that lower the maximum load.
+/// longest processing time first, then moves and swaps that lower the maximum load. Given
+/// the previous step, objects stay where they were unless the tolerance is exceeded.
 class Owner final : public Strategy {
  public:
   std::string_view name() const override { return "owner"; }
 
  private:
-  Result do_partition(const StepGraph& g, std::uint32_t k, const Previous&, const Options&) override {
+  Result do_partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
+                      const Options& options) override {
     const auto n = static_cast<TaskId>(g.tasks.size());
     const std::vector<std::uint64_t> work = task_work(g);
     std::vector<ObjectId> owner(n);
@@ -112,12 +137,29 @@ class Owner final : public Strategy {
     auto least_loaded = [&] {
       return static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
     };
-    std::vector<ProcId> where(objs.size());
+    // Objects keep the processor they had in the previous step (matched by name), so that
+    // an unchanged scene does not migrate; the others go by LPT.
+    std::unordered_map<std::string_view, ProcId> before;
+    if (prev.graph != nullptr && prev.assignment->k == k) before = object_processors(*prev.graph, *prev.assignment);
+    std::vector<ProcId> where(objs.size(), k);
     for (std::size_t i = 0; i < objs.size(); ++i) {
-      where[i] = least_loaded();
+      if (objs[i].first >= g.objects.size()) continue;
+      auto it = before.find(g.objects[objs[i].first].name);
+      if (it == before.end()) continue;
+      where[i] = it->second;
       load[where[i]] += objs[i].second;
     }
-    refine(objs, where, load);
+    for (std::size_t i = 0; i < objs.size(); ++i)
+      if (where[i] == k) {
+        where[i] = least_loaded();
+        load[where[i]] += objs[i].second;
+      }
+    std::uint64_t total = 0;
+    for (std::uint64_t l : load) total += l;
+    // From scratch: as balanced as moves and swaps get; with a previous placement: only
+    // until the imbalance tolerance is met, so that few objects move.
+    const double limit = before.empty() ? 0.0 : static_cast<double>(total) / k * options.imbalance;
+    refine(objs, where, load, limit);
     std::unordered_map<ObjectId, ProcId> proc_of_object;
     for (std::size_t i = 0; i < objs.size(); ++i) proc_of_object[objs[i].first] = where[i];
 

@@ -248,6 +248,17 @@ StepGraph objects_scene(int objects, const std::vector<std::pair<int, int>>& con
   return b.done();
 }
 
+TEST(Owner, KeepsObjectsOnTheirProcessorAcrossStepsWhileBalanced) {
+  const StepGraph g0 = objects_scene(12, {});
+  StepGraph g1 = objects_scene(12, {{1, 2}});
+  for (TaskId t = 0; t < g1.tasks.size(); ++t) g1.tasks[t].cost_ns += t % 3;  // cost noise
+  auto s = make_strategy("owner");
+  const Result r0 = s->partition(g0, 4, {}, {});
+  const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, {});
+  EXPECT_EQ(r1.stats.moved_tasks, 0u);
+  EXPECT_EQ(r1.stats.matched_tasks, g0.tasks.size());
+}
+
 TEST(Sticky, ReusesThePreviousAssignmentWhileTheStructureIsUnchanged) {
   const StepGraph g0 = objects_scene(8, {{0, 1}});
   StepGraph g1 = g0;
