@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+// Replaying a trace under one policy and measuring it against sequential in the same run.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/observer.hpp"
+#include "tgraph/replay/synthetic.hpp"
+
+namespace tgraph::replay {
+
+/// Hardware cache-miss counter of this process's threads (perf_event_open), where the
+/// kernel allows it.
+class CacheMissCounter {
+ public:
+  /// Opens the counter (inherit: threads created afterwards are counted too).
+  CacheMissCounter();
+  ~CacheMissCounter();
+  CacheMissCounter(const CacheMissCounter&) = delete;
+  CacheMissCounter& operator=(const CacheMissCounter&) = delete;
+  /// False where the kernel refused (containers, VMs without PMU): report "unavailable".
+  bool available() const { return fd_ >= 0; }
+  /// Why it is unavailable (errno text), empty when available.
+  const std::string& reason() const { return reason_; }
+  /// Misses counted so far (0 when unavailable).
+  std::uint64_t read() const;
+
+ private:
+  int fd_ = -1;
+  std::string reason_;
+};
+
+/// What to replay and how.
+struct ReplayOptions {
+  Policy policy = Policy::kPartition;
+  ExecOptions exec;                 ///< threads, spin, pinning, CW mode
+  SyntheticOptions synthetic;
+  std::uint32_t first_step = 0;
+  std::uint32_t steps = 0;          ///< 0: every step from first_step
+  std::uint32_t repeat = 3;         ///< timed passes per policy (medians reported)
+  bool sequential_baseline = true;  ///< also time sequential passes, interleaved
+  bool observe = true;              ///< one extra pass with observers (busy/wait/idle, locality)
+};
+
+/// One step's figures (wall times: medians over the timed passes).
+struct StepMeasure {
+  std::uint32_t step = 0;
+  std::int64_t wall_ns = 0;
+  std::int64_t sequential_wall_ns = 0;
+  std::int64_t build_ns = 0;             ///< plan build in the first pass (0: reused)
+  std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
+  std::int64_t wait_ns = 0;
+  std::uint64_t remote_bytes = 0, migrated_bytes = 0;  ///< from the observed pass
+  std::uint64_t work_ns = 0, span_ns = 0;
+  std::optional<std::uint64_t> predicted_makespan_ns;
+  std::vector<StatsObserver::Thread> threads;          ///< from the observed pass
+};
+
+/// The whole replay.
+struct ReplayResult {
+  Policy policy = Policy::kPartition;
+  std::uint32_t threads = 1;
+  std::vector<StepMeasure> steps;
+  std::int64_t wall_ns = 0;             ///< median over passes of the pass total
+  std::int64_t sequential_wall_ns = 0;  ///< same for sequential
+  std::vector<std::int64_t> pass_wall_ns, sequential_pass_wall_ns;
+  double speedup = 0;                   ///< sequential_wall_ns / wall_ns
+  double bound = 1;                     ///< min(threads, work / span)
+  double efficiency = 0;                ///< speedup / bound
+  std::uint64_t work_ns = 0, span_ns = 0;
+  std::uint64_t plans_built = 0;
+  std::optional<std::uint64_t> cache_misses;
+  std::string cache_misses_note;
+  Calibration calibration;
+  std::uint64_t signals() const;
+  std::uint64_t waits() const;
+  std::int64_t wait_ns() const;
+  std::int64_t build_ns() const;
+  std::uint64_t remote_bytes() const;
+  std::uint64_t migrated_bytes() const;
+  std::optional<std::uint64_t> predicted_makespan_ns() const;
+};
+
+/// Replays steps of `trace` with synthetic bodies under `options.policy`, timing
+/// `options.repeat` passes of it and of sequential, interleaved (pass by pass) so that both
+/// see the same machine noise. `assignments` (one per step) is required for the partition
+/// policy. `predicted` (optional, per step) is the evaluator's makespan shown beside the
+/// measured one. A `timeline` observer, if given, records the observed pass.
+ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments,
+                          const ReplayOptions& options,
+                          const std::vector<std::uint64_t>* predicted = nullptr,
+                          TimelineObserver* timeline = nullptr);
+
+/// The result as one JSON object (keys: policy, threads, steps, wall_ns, per_step, speedup,
+/// efficiency, signals, wait_ns, remote_bytes, migrated_bytes, predicted_makespan_ns, ...).
+std::string to_json(const ReplayResult& r);
+
+}  // namespace tgraph::replay

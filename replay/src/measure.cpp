@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/replay/measure.hpp"
+
+#include <linux/perf_event.h>
+#include <sys/ioctl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <nlohmann/json.hpp>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/metrics.hpp"
+
+namespace tgraph::replay {
+
+CacheMissCounter::CacheMissCounter() {
+  perf_event_attr attr;
+  std::memset(&attr, 0, sizeof attr);
+  attr.size = sizeof attr;
+  attr.type = PERF_TYPE_HARDWARE;
+  attr.config = PERF_COUNT_HW_CACHE_MISSES;
+  attr.disabled = 0;
+  attr.inherit = 1;
+  attr.exclude_kernel = 1;
+  attr.exclude_hv = 1;
+  const long fd = syscall(SYS_perf_event_open, &attr, 0, -1, -1, 0);
+  if (fd < 0) {
+    reason_ = std::strerror(errno);
+    return;
+  }
+  fd_ = static_cast<int>(fd);
+}
+
+CacheMissCounter::~CacheMissCounter() {
+  if (fd_ >= 0) close(fd_);
+}
+
+std::uint64_t CacheMissCounter::read() const {
+  if (fd_ < 0) return 0;
+  std::uint64_t v = 0;
+  if (::read(fd_, &v, sizeof v) != static_cast<ssize_t>(sizeof v)) return 0;
+  return v;
+}
+
+namespace {
+
+std::int64_t median(std::vector<std::int64_t> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
+}
+
+}  // namespace
+
+std::uint64_t ReplayResult::signals() const {
+  std::uint64_t s = 0;
+  for (const auto& m : steps) s += m.signals;
+  return s;
+}
+std::uint64_t ReplayResult::waits() const {
+  std::uint64_t s = 0;
+  for (const auto& m : steps) s += m.waits;
+  return s;
+}
+std::int64_t ReplayResult::wait_ns() const {
+  std::int64_t s = 0;
+  for (const auto& m : steps) s += m.wait_ns;
+  return s;
+}
+std::int64_t ReplayResult::build_ns() const {
+  std::int64_t s = 0;
+  for (const auto& m : steps) s += m.build_ns;
+  return s;
+}
+std::uint64_t ReplayResult::remote_bytes() const {
+  std::uint64_t s = 0;
+  for (const auto& m : steps) s += m.remote_bytes;
+  return s;
+}
+std::uint64_t ReplayResult::migrated_bytes() const {
+  std::uint64_t s = 0;
+  for (const auto& m : steps) s += m.migrated_bytes;
+  return s;
+}
+std::optional<std::uint64_t> ReplayResult::predicted_makespan_ns() const {
+  std::uint64_t s = 0;
+  for (const auto& m : steps) {
+    if (!m.predicted_makespan_ns) return std::nullopt;
+    s += *m.predicted_makespan_ns;
+  }
+  return s;
+}
+
+ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments,
+                          const ReplayOptions& o, const std::vector<std::uint64_t>* predicted,
+                          TimelineObserver* timeline) {
+  if (trace.steps.empty()) throw UsageError("the trace has no steps");
+  if (o.first_step >= trace.steps.size())
+    throw UsageError("--first-step " + std::to_string(o.first_step) + ": the trace has " +
+                     std::to_string(trace.steps.size()) + " steps");
+  const std::uint32_t last =
+      o.steps == 0 ? static_cast<std::uint32_t>(trace.steps.size())
+                   : std::min<std::uint32_t>(static_cast<std::uint32_t>(trace.steps.size()), o.first_step + o.steps);
+  const bool partition = o.policy == Policy::kPartition;
+  if (partition) {
+    if (!assignments) throw UsageError("the partition policy needs an assignment");
+    if (assignments->steps.size() < last)
+      throw UsageError("the assignment covers " + std::to_string(assignments->steps.size()) +
+                       " steps, " + std::to_string(last) + " are replayed");
+  }
+  if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
+
+  ReplayResult r;
+  r.policy = o.policy;
+  r.threads = o.exec.threads;
+  r.calibration = SyntheticWorkload::calibration();
+  CacheMissCounter misses;
+  const std::uint64_t misses0 = misses.read();
+
+  auto ex = make_executor(o.policy, o.exec);
+  std::unique_ptr<Executor> seq;
+  if (o.sequential_baseline) seq = make_executor(Policy::kSequential, o.exec);
+  SyntheticWorkload w(o.synthetic), ws(o.synthetic);
+
+  const std::uint32_t n = last - o.first_step;
+  r.steps.resize(n);
+  std::vector<std::vector<std::int64_t>> walls(n), seq_walls(n);
+  for (std::uint32_t i = 0; i < n; ++i) {
+    const StepGraph& g = trace.steps[o.first_step + i];
+    StepMeasure& m = r.steps[i];
+    m.step = o.first_step + i;
+    const Metrics met = compute_metrics(g);
+    m.work_ns = met.work_ns;
+    m.span_ns = met.span_ns;
+    if (predicted && m.step < predicted->size()) m.predicted_makespan_ns = (*predicted)[m.step];
+    r.work_ns += m.work_ns;
+    r.span_ns += m.span_ns;
+  }
+  auto assignment_of = [&](std::uint32_t s) -> const Assignment* {
+    return partition ? &assignments->steps[s] : nullptr;
+  };
+  for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
+    if (seq) {
+      std::int64_t total = 0;
+      for (std::uint32_t i = 0; i < n; ++i) {
+        const StepGraph& g = trace.steps[o.first_step + i];
+        ws.set_step(g);
+        const StepStats s = seq->run_step(g, nullptr, ws);
+        seq_walls[i].push_back(s.wall_ns);
+        total += s.wall_ns;
+      }
+      r.sequential_pass_wall_ns.push_back(total);
+    }
+    std::int64_t total = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const StepGraph& g = trace.steps[o.first_step + i];
+      w.set_step(g);
+      const StepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
+      walls[i].push_back(s.wall_ns);
+      total += s.wall_ns;
+      if (pass == 0) {
+        StepMeasure& m = r.steps[i];
+        m.build_ns = s.build_ns;
+        m.signals = s.signals();
+        m.waits = s.waits();
+        m.blocked_waits = s.blocked_waits();
+        m.parks = s.parks();
+        m.wait_ns = s.wait_ns();
+      }
+    }
+    r.pass_wall_ns.push_back(total);
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    r.steps[i].wall_ns = median(walls[i]);
+    r.steps[i].sequential_wall_ns = median(seq_walls[i]);
+  }
+  r.wall_ns = median(r.pass_wall_ns);
+  r.sequential_wall_ns = median(r.sequential_pass_wall_ns);
+  r.plans_built = ex->plans_built();
+  if (misses.available()) {
+    r.cache_misses = misses.read() - misses0;
+  } else {
+    r.cache_misses_note = "unavailable (" + misses.reason() + ")";
+  }
+
+  if (o.observe) {
+    StatsObserver stats;
+    LocalityObserver locality;
+    ex->add_observer(stats);
+    ex->add_observer(locality);
+    if (timeline) ex->add_observer(*timeline);
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const StepGraph& g = trace.steps[o.first_step + i];
+      w.set_step(g);
+      ex->run_step(g, assignment_of(o.first_step + i), w);
+      r.steps[i].threads = stats.threads();
+      r.steps[i].remote_bytes = locality.remote_bytes();
+      r.steps[i].migrated_bytes = locality.migrated_bytes();
+    }
+    ex->clear_observers();
+  }
+  const double parallelism = r.span_ns == 0 ? 1.0 : static_cast<double>(r.work_ns) / static_cast<double>(r.span_ns);
+  r.bound = std::max(1.0, std::min(static_cast<double>(r.threads), parallelism));
+  if (r.wall_ns > 0 && r.sequential_wall_ns > 0)
+    r.speedup = static_cast<double>(r.sequential_wall_ns) / static_cast<double>(r.wall_ns);
+  r.efficiency = r.speedup / r.bound;
+  return r;
+}
+
+std::string to_json(const ReplayResult& r) {
+  using nlohmann::json;
+  json per_step = json::array();
+  for (const StepMeasure& m : r.steps) {
+    json threads = json::array();
+    for (const auto& t : m.threads)
+      threads.push_back({{"busy_ns", t.busy_ns}, {"wait_ns", t.wait_ns}, {"idle_ns", t.idle_ns}, {"tasks", t.tasks}});
+    json s = {{"step", m.step},
+              {"wall_ns", m.wall_ns},
+              {"sequential_wall_ns", m.sequential_wall_ns},
+              {"build_ns", m.build_ns},
+              {"signals", m.signals},
+              {"waits", m.waits},
+              {"blocked_waits", m.blocked_waits},
+              {"parks", m.parks},
+              {"wait_ns", m.wait_ns},
+              {"remote_bytes", m.remote_bytes},
+              {"migrated_bytes", m.migrated_bytes},
+              {"work_ns", m.work_ns},
+              {"span_ns", m.span_ns},
+              {"threads", threads}};
+    s["predicted_makespan_ns"] = m.predicted_makespan_ns ? json(*m.predicted_makespan_ns) : json(nullptr);
+    per_step.push_back(std::move(s));
+  }
+  json j = {{"policy", std::string(to_string(r.policy))},
+            {"threads", r.threads},
+            {"steps", r.steps.size()},
+            {"wall_ns", r.wall_ns},
+            {"sequential_wall_ns", r.sequential_wall_ns},
+            {"pass_wall_ns", r.pass_wall_ns},
+            {"sequential_pass_wall_ns", r.sequential_pass_wall_ns},
+            {"speedup", r.speedup},
+            {"bound", r.bound},
+            {"efficiency", r.efficiency},
+            {"work_ns", r.work_ns},
+            {"span_ns", r.span_ns},
+            {"signals", r.signals()},
+            {"waits", r.waits()},
+            {"wait_ns", r.wait_ns()},
+            {"build_ns", r.build_ns()},
+            {"plans_built", r.plans_built},
+            {"remote_bytes", r.remote_bytes()},
+            {"migrated_bytes", r.migrated_bytes()},
+            {"calibration",
+             {{"spin_iterations_per_ns", r.calibration.spin_iterations_per_ns},
+              {"touch_ns_per_byte", r.calibration.touch_ns_per_byte}}},
+            {"per_step", per_step}};
+  j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
+  const auto pred = r.predicted_makespan_ns();
+  j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
+  // Ratio of measured to predicted, both without build: sum of per-step walls minus builds.
+  if (pred && *pred > 0) {
+    std::int64_t measured = 0;
+    for (const auto& m : r.steps) measured += m.wall_ns - m.build_ns;
+    j["measured_over_predicted"] = static_cast<double>(measured) / static_cast<double>(*pred);
+  } else {
+    j["measured_over_predicted"] = nullptr;
+  }
+  return j.dump();
+}
+
+}  // namespace tgraph::replay
