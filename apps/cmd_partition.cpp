@@ -264,7 +264,7 @@ void run_compare(const CompareCmd& c) {
       row.erase("per_step");
       rows.push_back(row);
       csv << m << ',' << k << ',' << t.partition_ms << ',' << t.cut_edges << ',' << t.cut_bytes << ','
-          << t.signals << ',' << t.imbalance << ',' << t.migrated_tasks << ',' << t.makespan_ns << ','
+          << t.signals << ',' << t.reducers << ',' << t.imbalance << ',' << t.migrated_tasks << ',' << t.makespan_ns << ','
           << t.lower_bound_ns << ',' << t.speedup << ',' << (t.quotient_acyclic ? 1 : 0) << '\n';
       if (!c.json)
         std::printf("%-11s %4u %12.3f %10llu %12llu %9llu %9.3f %9llu %14.3f %8.2f %8.2f\n", m.c_str(), k,
