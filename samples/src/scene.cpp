@@ -133,31 +133,46 @@ class Stepper {
     s.d_cond = scalar("converged", &s.converged, sizeof(bool));
   }
 
+  // Resolves the ids of a group's fields once per step (not once per CG iteration).
+  void prepare(Group& g) {
+    g.refs.clear();
+    for (ForceField* ff : g.fields) {
+      detail::FieldRef r;
+      r.ff = ff;
+      r.object = field_object(ff);
+      r.state = field_state(ff);
+      r.body_a = m_.body_index.at(ff->body_a());
+      r.body_b = ff->body_b() ? m_.body_index.at(ff->body_b()) : -1;
+      g.refs.push_back(r);
+    }
+  }
+
   // addForce of one field: reads x (and v) of its bodies, accumulates into their f; with
   // `state`, also writes the stiffness state that addDForce reads (implicit solver only).
-  void add_force(ForceField* ff, bool state) {
+  void add_force(const detail::FieldRef& r, bool state) {
+    ForceField* ff = r.ff;
     AccessList acc;
-    for (Body* bd : {ff->body_a(), ff->body_b()}) {
-      if (bd == nullptr) continue;
+    for (int bd : {r.body_a, r.body_b}) {
+      if (bd < 0) continue;
       if (ff->reads_position()) acc.add(vec(bd, VecId::kX), R);
       if (ff->reads_velocity()) acc.add(vec(bd, VecId::kV), R);
     }
-    for (Body* bd : {ff->body_a(), ff->body_b()})
-      if (bd != nullptr) acc.add(vec(bd, VecId::kF), CW);
-    if (state)
-      if (const DatumId st = field_state(ff); st != kNoDatum) acc.add(st, RW);
-    issue(rec_, b_.add_force, field_object(ff), acc, [ff] { ff->add_force(); });
+    for (int bd : {r.body_a, r.body_b})
+      if (bd >= 0) acc.add(vec(bd, VecId::kF), CW);
+    if (state && r.state != kNoDatum) acc.add(r.state, RW);
+    issue(rec_, b_.add_force, r.object, acc, [ff] { ff->add_force(); });
   }
 
   // addDForce of one field: df += (k K + kb B) dx.
-  void add_dforce(ForceField* ff, VecId df, VecId dx, double k, double kb) {
+  void add_dforce(const detail::FieldRef& r, VecId df, VecId dx, double k, double kb) {
+    ForceField* ff = r.ff;
     AccessList acc;
-    for (Body* bd : {ff->body_a(), ff->body_b()})
-      if (bd != nullptr) acc.add(vec(bd, dx), R);
-    if (const DatumId st = field_state(ff); st != kNoDatum) acc.add(st, R);
-    for (Body* bd : {ff->body_a(), ff->body_b()})
-      if (bd != nullptr) acc.add(vec(bd, df), CW);
-    issue(rec_, b_.add_dforce, field_object(ff), acc, [ff, df, dx, k, kb] { ff->add_dforce(df, dx, k, kb); });
+    for (int bd : {r.body_a, r.body_b})
+      if (bd >= 0) acc.add(vec(bd, dx), R);
+    if (r.state != kNoDatum) acc.add(r.state, R);
+    for (int bd : {r.body_a, r.body_b})
+      if (bd >= 0) acc.add(vec(bd, df), CW);
+    issue(rec_, b_.add_dforce, r.object, acc, [ff, df, dx, k, kb] { ff->add_dforce(df, dx, k, kb); });
   }
 
   void project(FixedConstraint* c, VecId id) {
@@ -176,10 +191,11 @@ class Stepper {
   }
 
   // Symplectic Euler (the paper's Algorithm 1 and Figure 2).
-  void explicit_euler(const Group& g) {
+  void explicit_euler(Group& g) {
+    prepare(g);
     const double h = h_;
     reset_forces(g);
-    for (ForceField* ff : g.fields) add_force(ff, false);
+    for (const detail::FieldRef& r : g.refs) add_force(r, false);
     for (FixedConstraint* c : g.constraints) project(c, VecId::kF);
     for (int i : g.bodies) {
       Body* bd = body(i);
@@ -203,15 +219,16 @@ class Stepper {
 
   // Backward Euler: (M (1 + h alpha) - h B - h^2 K) dv = h (f - alpha M v + h K v), solved
   // by conjugate gradient as a dynamic loop (paper section 3.3); v += dv; x += h v.
-  void implicit_euler(const Group& g) {
+  void implicit_euler(Group& g) {
+    prepare(g);
     GroupSolver* s = g.solver;
     declare_solver(*s);
     const double h = h_;
     const double tol2 = scene_.solver().tolerance * scene_.solver().tolerance;
     reset_forces(g);
-    for (ForceField* ff : g.fields) add_force(ff, true);
-    for (ForceField* ff : g.fields)
-      if (ff->has_stiffness()) add_dforce(ff, VecId::kF, VecId::kV, h, 0.0);
+    for (const detail::FieldRef& r : g.refs) add_force(r, true);
+    for (const detail::FieldRef& r : g.refs)
+      if (r.ff->has_stiffness()) add_dforce(r, VecId::kF, VecId::kV, h, 0.0);
     rec_.task(b_.cg_init, s->object,
               {{s->d_rho, W}, {s->d_den, W}, {s->d_rho_new, W}, {s->d_beta, W}}, [s] {
                 s->rho = s->den = s->rho_new = s->beta = 0.0;
@@ -260,8 +277,8 @@ class Stepper {
                     bd->add_mdx(q, bd->vec(VecId::kP), 1.0 + h * bd->mass_damping);
                   });
       }
-      for (ForceField* ff : g.fields)
-        if (ff->has_stiffness()) add_dforce(ff, VecId::kQ, VecId::kP, -h * h, -h);
+      for (const detail::FieldRef& r : g.refs)
+        if (r.ff->has_stiffness()) add_dforce(r, VecId::kQ, VecId::kP, -h * h, -h);
       for (FixedConstraint* c : g.constraints) project(c, VecId::kQ);
       for (int i : g.bodies) {
         Body* bd = body(i);
@@ -487,7 +504,7 @@ void Scene::step(Recorder& rec) {
     group_of[obj] = static_cast<std::uint32_t>(m.body_group[static_cast<std::size_t>(body)]);
   rec.set_contacts(std::move(contact_set), std::move(group_of));
 
-  for (const Group& g : m.groups) {
+  for (Group& g : m.groups) {
     switch (solver_.integrator) {
       case Integrator::kExplicitEuler: stepper.explicit_euler(g); break;
       case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;

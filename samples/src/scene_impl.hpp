@@ -52,11 +52,21 @@ struct Binding {
   std::unordered_map<ObjectId, int> object_body;            // object -> a body (for groups)
 };
 
+/// A force field with its recorder ids, resolved once per step.
+struct FieldRef {
+  ForceField* ff = nullptr;
+  ObjectId object = kNoObject;
+  DatumId state = kNoDatum;
+  int body_a = -1;
+  int body_b = -1;  // -1: not an interaction
+};
+
 /// One solver instance's share of the scene this step.
 struct Group {
   std::vector<int> bodies;
   std::vector<ForceField*> fields;
   std::vector<FixedConstraint*> constraints;
+  std::vector<FieldRef> refs;  // fields with their ids (filled by the stepper)
   GroupSolver* solver = nullptr;
 };
 
