@@ -133,14 +133,15 @@ class Stepper {
     s.d_cond = scalar("converged", &s.converged, sizeof(bool));
   }
 
-  // Resolves the ids of a group's fields once per step (not once per CG iteration).
-  void prepare(Group& g) {
+  // Resolves the ids of a group's fields once per step (not once per CG iteration); the
+  // stiffness state is a datum only for the implicit solver (explicit steps never read it).
+  void prepare(Group& g, bool with_state) {
     g.refs.clear();
     for (ForceField* ff : g.fields) {
       detail::FieldRef r;
       r.ff = ff;
       r.object = field_object(ff);
-      r.state = field_state(ff);
+      r.state = with_state ? field_state(ff) : kNoDatum;
       r.body_a = m_.body_index.at(ff->body_a());
       r.body_b = ff->body_b() ? m_.body_index.at(ff->body_b()) : -1;
       g.refs.push_back(r);
@@ -192,7 +193,7 @@ class Stepper {
 
   // Symplectic Euler (the paper's Algorithm 1 and Figure 2).
   void explicit_euler(Group& g) {
-    prepare(g);
+    prepare(g, false);
     const double h = h_;
     reset_forces(g);
     for (const detail::FieldRef& r : g.refs) add_force(r, false);
@@ -220,7 +221,7 @@ class Stepper {
   // Backward Euler: (M (1 + h alpha) - h B - h^2 K) dv = h (f - alpha M v + h K v), solved
   // by conjugate gradient as a dynamic loop (paper section 3.3); v += dv; x += h v.
   void implicit_euler(Group& g) {
-    prepare(g);
+    prepare(g, true);
     GroupSolver* s = g.solver;
     declare_solver(*s);
     const double h = h_;

@@ -214,6 +214,9 @@ class SceneBuilder {
       if (!positional.empty()) d.fail("'" + positional[0] + "' is not a key=value attribute");
       directive(d);
       d.finish();
+      std::uint64_t nodes = 0;
+      for (const auto& b : scene_->bodies()) nodes += static_cast<std::uint64_t>(b->columns());
+      if (nodes > (1u << 24)) d.fail("the scene exceeds 16777216 nodes");
     }
     if (!header) Directive(file_, number, "", {}).fail("empty scene file (the first line must be 'tgraph-scene 1')");
     if (!scene_) Directive(file_, number, "", {}).fail("no 'scene name=...' line");
@@ -434,6 +437,8 @@ class SceneBuilder {
     const bool fem = d.keyword() == "fem";
     const std::string name = d.text("name");
     const auto nodes = d.int3("nodes", std::nullopt, 2, 512);
+    if (static_cast<long long>(nodes[0]) * nodes[1] * nodes[2] > (1LL << 22))
+      d.fail("nodes: at most 4194304 nodes per object");
     const Vec3 size = d.vec3("size");
     if ((size.array() <= 0.0).any()) d.fail("size: every extent must be > 0");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -595,7 +600,7 @@ class SceneBuilder {
   // springs (the paper's domain decomposition, section 4.3).
   void cloth(Directive& d) {
     const std::string name = d.text("name");
-    const int n = d.integer("nodes", std::nullopt, 2, 8192);
+    const int n = d.integer("nodes", std::nullopt, 2, 2048);
     int split = d.integer("split", 4, 1, 1024);
     if (options_.subobjects) {
       const int s = static_cast<int>(std::lround(std::sqrt(static_cast<double>(*options_.subobjects))));
