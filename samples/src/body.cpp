@@ -100,6 +100,7 @@ void RigidBody::integrate_position(double dt) {
   x.col(0) += dt * v.col(0);
   const Vec3 w = v.col(1) * dt;
   const double angle = w.norm();
+  const Vec3 momentum = inertia_world_ * v.col(1);
   if (angle > 0.0) {
     q_ = Eigen::Quaterniond(Eigen::AngleAxisd(angle, w / angle)) * q_;
     q_.normalize();
@@ -107,6 +108,7 @@ void RigidBody::integrate_position(double dt) {
   // Column 1 of x holds the accumulated rotation vector (informative only).
   x.col(1) += w;
   update_frame();
+  vec(VecId::kV).col(1) = inertia_world_inv_ * momentum;
 }
 
 double RigidBody::kinetic_energy() const {

@@ -213,7 +213,8 @@ class Stepper {
     const double h = h_;
     for (int i : g.bodies) {
       Body* bd = body(i);
-      rec_.task(b_.update_position, object_of(i), {{vec(i, VecId::kV), R}, {vec(i, VecId::kX), RW}},
+      rec_.task(b_.update_position, object_of(i),
+                {{vec(i, VecId::kV), bd->position_update_writes_velocity() ? RW : R}, {vec(i, VecId::kX), RW}},
                 [bd, h] { bd->integrate_position(h); });
     }
   }

@@ -39,6 +39,9 @@ class Body {
   virtual void add_gravity(StateVec& f, const Vec3& g) const = 0;
   /// x += dt * v (rigid bodies integrate their orientation too).
   virtual void integrate_position(double dt) = 0;
+  /// True when integrate_position also updates v (rigid bodies keep their angular momentum
+  /// through the change of orientation).
+  virtual bool position_update_writes_velocity() const { return false; }
   /// Kinetic energy 1/2 v^T M v.
   virtual double kinetic_energy() const = 0;
   /// Potential energy of gravity -sum m g . x (reference 0 at the origin).
@@ -130,10 +133,15 @@ class RigidBody final : public Body {
   void add_mdx(StateVec& out, const StateVec& in, double factor) const override;
   void add_minv(StateVec& v, const StateVec& f, double dt) const override;
   void add_gravity(StateVec& f, const Vec3& g) const override;
+  /// Rotates by dt * omega, then sets omega = I_world^-1 L so that the angular momentum
+  /// L = I_world omega is unchanged by the rotation (torque-free precession).
   void integrate_position(double dt) override;
+  bool position_update_writes_velocity() const override { return true; }
   double kinetic_energy() const override;
   double gravity_energy(const Vec3& g) const override;
   double total_mass() const override { return mass_; }
+  /// Angular momentum about the centre of mass.
+  Vec3 angular_momentum() const { return inertia_world_ * vec(VecId::kV).col(1); }
   Index num_points() const override { return local_.cols(); }
   Vec3 point(Index i) const override;
   Vec3 point_motion(const StateVec& dx, Index i) const override;
