@@ -14,6 +14,7 @@
 
 #include "common.hpp"
 #include "sync.hpp"
+#include "tsan.hpp"
 #include "tgraph/replay/executor.hpp"
 
 namespace tgraph::replay {
@@ -104,22 +105,28 @@ class BarrierExecutor final : public Executor {
     std::vector<std::uint8_t> is_break(g.tasks.size(), 0);
     for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
 
+    char token = 0;  // TSan: libgomp's fork, barriers and join, seen as release/acquire
+    TGRAPH_TSAN_RELEASE(&token);
 #pragma omp parallel num_threads(k)
     {
+      TGRAPH_TSAN_ACQUIRE(&token);
       const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
       if (pin) detail::pin_current_thread(thread);
       ThreadCounters& tc = counters_[thread].c;
       if (fresh) {
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
         for (DatumId d = 0; d < g.data.size(); ++d)
           if (w.needs_touch(d)) w.first_touch(d);
+        TGRAPH_TSAN_RELEASE(&token);
+#pragma omp barrier
+        TGRAPH_TSAN_ACQUIRE(&token);
       }
       std::size_t ph = 0;
       std::uint32_t iter = 0;
       while (ph < plan.phases.size()) {
         const Phase& phase = plan.phases[ph];
         const auto size = static_cast<std::int64_t>(phase.tasks.size());
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
         for (std::int64_t i = 0; i < size; ++i) {
           const TaskId t = phase.tasks[static_cast<std::size_t>(i)];
           // relaxed: a hint to skip work once a task failed; the barriers order the rest.
@@ -151,7 +158,11 @@ class BarrierExecutor final : public Executor {
             decision[l][iter % 2] = stop ? 1 : 0;
             if (stop) iterations[l] = iter + 1;
           }
-        }  // implicit barrier: the phase's writes (and the decision) are visible to all
+        }
+        TGRAPH_TSAN_RELEASE(&token);
+#pragma omp barrier
+        TGRAPH_TSAN_ACQUIRE(&token);
+        // After the barrier the phase's writes (and the loop decision) are visible to all.
         ++tc.waits;
         if (phase.loop_end != kNoLoop && decision[phase.loop_end][iter % 2] == 0) {
           ++iter;
@@ -161,7 +172,9 @@ class BarrierExecutor final : public Executor {
           ++ph;
         }
       }
+      TGRAPH_TSAN_RELEASE(&token);
     }
+    TGRAPH_TSAN_ACQUIRE(&token);
     stats.threads.resize(options_.threads);
     for (int p = 0; p < k; ++p) stats.threads[static_cast<std::size_t>(p)] = counters_[p].c;
     stats.loop_iterations = iterations;

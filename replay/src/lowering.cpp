@@ -195,7 +195,10 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
   }
   out.derive_edges();
 
-  // 3. The assignment on exec tasks.
+  // 3. The assignment on exec tasks. With explicit orders, a reducer goes right after the
+  // last task of its processor it transitively depends on: in a deadlock-free order every
+  // such task precedes every task that depends on the reducer (they depended on the CW
+  // writers before lowering), so the new order stays deadlock-free.
   Assignment& ax = x.assignment;
   ax.k = a ? a->k : 1;
   ax.proc = std::move(exec_proc);
@@ -203,12 +206,30 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
     ax.order.assign(ax.k, {});
     for (ProcId p = 0; p < ax.k && p < a->order.size(); ++p)
       for (TaskId t : a->order[p]) ax.order[p].push_back(x.exec_of[t]);
-    for (TaskId r = 0; r < x.origin.size(); ++r) {
+    const auto ne = static_cast<TaskId>(out.tasks.size());
+    std::vector<std::vector<TaskId>> preds(ne);
+    for (const Edge& e : out.edges) preds[e.to].push_back(e.from);
+    std::vector<std::uint32_t> mark(ne, 0);
+    std::uint32_t stamp = 0;
+    std::vector<TaskId> stack;
+    for (TaskId r = 0; r < ne; ++r) {
       if (x.origin[r] != kNoTask) continue;
-      auto& ord = ax.order[ax.proc[r]];
+      const ProcId home = ax.proc[r];
+      ++stamp;
+      stack.assign(1, r);
+      while (!stack.empty()) {
+        const TaskId t = stack.back();
+        stack.pop_back();
+        for (TaskId u : preds[t])
+          if (mark[u] != stamp) {
+            mark[u] = stamp;
+            stack.push_back(u);
+          }
+      }
+      auto& ord = ax.order[home];
       std::size_t pos = 0;
       for (std::size_t i = 0; i < ord.size(); ++i)
-        if (ord[i] < r) pos = i + 1;
+        if (mark[ord[i]] == stamp) pos = i + 1;
       ord.insert(ord.begin() + static_cast<std::ptrdiff_t>(pos), r);
     }
   }

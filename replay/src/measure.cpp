@@ -124,6 +124,13 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   std::unique_ptr<Executor> seq;
   if (o.sequential_baseline) seq = make_executor(Policy::kSequential, o.exec);
   SyntheticWorkload w(o.synthetic), ws(o.synthetic);
+  std::uint64_t working_set = 0;
+  for (const Datum& d : trace.steps[o.first_step].data) working_set += d.bytes;
+  if (o.synthetic.touch) {
+    r.touch_ns_per_byte = ws.calibrate_touch(working_set);
+    w.calibrate_touch(working_set);
+  }
+  r.working_set_bytes = working_set;
 
   const std::uint32_t n = last - o.first_step;
   r.steps.resize(n);
@@ -255,7 +262,9 @@ std::string to_json(const ReplayResult& r) {
             {"migrated_bytes", r.migrated_bytes()},
             {"calibration",
              {{"spin_iterations_per_ns", r.calibration.spin_iterations_per_ns},
-              {"touch_ns_per_byte", r.calibration.touch_ns_per_byte}}},
+              {"touch_ns_per_byte_in_cache", r.calibration.touch_ns_per_byte},
+              {"touch_ns_per_byte", r.touch_ns_per_byte},
+              {"working_set_bytes", r.working_set_bytes}}},
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
   const auto pred = r.predicted_makespan_ns();

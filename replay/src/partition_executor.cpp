@@ -16,6 +16,7 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <queue>
 #include <string>
 #include <thread>
 #include <vector>
@@ -63,16 +64,47 @@ struct ProcPlan {
 
 struct Plan {
   std::vector<ProcPlan> procs;
+  bool program_order = true;  // false: the assignment's explicit order is followed
   std::size_t tasks = 0;
   std::size_t loops = 0;
 };
 
+/// `order` made consistent with the dependencies among its own tasks (a stable topological
+/// sort: lowering can add edges between tasks of one processor, e.g. serialised CW writers,
+/// that an order computed on the original graph did not have to respect).
+std::vector<TaskId> local_topological(const ExecGraph& x, const std::vector<TaskId>& order) {
+  const StepGraph& g = x.graph;
+  std::vector<std::uint32_t> pos(g.tasks.size(), UINT32_MAX);
+  for (std::uint32_t i = 0; i < order.size(); ++i) pos[order[i]] = i;
+  std::vector<std::uint32_t> indeg(order.size(), 0);
+  std::vector<std::vector<std::uint32_t>> succ(order.size());
+  for (const Edge& e : g.edges)
+    if (pos[e.from] != UINT32_MAX && pos[e.to] != UINT32_MAX) {
+      succ[pos[e.from]].push_back(pos[e.to]);
+      ++indeg[pos[e.to]];
+    }
+  std::priority_queue<std::uint32_t, std::vector<std::uint32_t>, std::greater<>> ready;
+  for (std::uint32_t i = 0; i < order.size(); ++i)
+    if (indeg[i] == 0) ready.push(i);
+  std::vector<TaskId> out;
+  out.reserve(order.size());
+  while (!ready.empty()) {
+    const std::uint32_t i = ready.top();
+    ready.pop();
+    out.push_back(order[i]);
+    for (std::uint32_t j : succ[i])
+      if (--indeg[j] == 0) ready.push(j);
+  }
+  return out.size() == order.size() ? out : order;
+}
+
 /// Builds the per-processor programs.
-Plan build_plan(const ExecGraph& x, std::uint32_t k) {
+Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
   const StepGraph& g = x.graph;
   const auto n = static_cast<TaskId>(g.tasks.size());
   const Assignment& a = x.assignment;
   Plan plan;
+  plan.program_order = !use_order || a.order.empty();
   plan.tasks = n;
   plan.loops = g.loops.size();
   plan.procs.resize(k);
@@ -81,7 +113,13 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k) {
 
   // 1. Ops per processor: its tasks in order, each loop's body tasks gathered in one block.
   for (ProcId p = 0; p < k; ++p) {
-    std::vector<TaskId> seq = tasks_of(a, p);
+    std::vector<TaskId> seq;
+    if (use_order && !a.order.empty()) {
+      seq = local_topological(x, a.order[p]);
+    } else {
+      for (TaskId t = 0; t < n; ++t)
+        if (a.proc[t] == p) seq.push_back(t);
+    }
     std::vector<std::vector<TaskId>> in_loop(g.loops.size());
     for (TaskId t : seq)
       if (g.tasks[t].loop != kNoLoop) in_loop[g.tasks[t].loop].push_back(t);
@@ -286,8 +324,16 @@ class PartitionExecutor final : public Executor {
   };
 
   std::shared_ptr<void> build(const ExecGraph& x) override {
-    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads));
-    run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
+    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true));
+    try {
+      run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
+    } catch (const UsageError&) {
+      if (plan->program_order) throw;
+      // The explicit order cannot be kept with the lowered graph's extra edges (serialised
+      // CW writers): fall back to program order on each processor, which never deadlocks.
+      plan = std::make_shared<Plan>(build_plan(x, options_.threads, false));
+      ++order_fallbacks_;
+    }
     return plan;
   }
 
@@ -523,6 +569,7 @@ class PartitionExecutor final : public Executor {
   alignas(64) std::atomic<std::uint64_t> finished_{0};
   alignas(64) std::atomic<std::uint64_t> touched_{0};  // first-touch barrier arrivals
   std::uint64_t touch_rounds_ = 0;
+  std::uint64_t order_fallbacks_ = 0;
   alignas(64) std::atomic<bool> abort_{false};
   std::atomic<bool> shutdown_{false};
   const std::atomic<bool> never_abort_{false};

@@ -56,9 +56,15 @@ Topology& topology() {
 
 }  // namespace
 
+std::mutex& hwloc_mutex() {
+  static std::mutex m;
+  return m;
+}
+
 bool pin_current_thread(std::uint32_t p) {
   Topology& t = topology();
   if (!t.topo || t.order.empty()) return false;
+  std::lock_guard<std::mutex> lock(hwloc_mutex());  // hwloc calls are rare; keep them serial
   hwloc_obj_t pu = t.order[p % t.order.size()];
   return hwloc_set_cpubind(t.topo, pu->cpuset, HWLOC_CPUBIND_THREAD) == 0;
 }
@@ -66,6 +72,7 @@ bool pin_current_thread(std::uint32_t p) {
 void save_binding(SavedBinding& s) {
   Topology& t = topology();
   if (!t.topo) return;
+  std::lock_guard<std::mutex> lock(hwloc_mutex());
   hwloc_bitmap_t set = hwloc_bitmap_alloc();
   if (hwloc_get_cpubind(t.topo, set, HWLOC_CPUBIND_THREAD) == 0) {
     s.set = set;
@@ -77,6 +84,7 @@ void save_binding(SavedBinding& s) {
 void restore_binding(SavedBinding& s) {
   Topology& t = topology();
   if (!t.topo || !s.set) return;
+  std::lock_guard<std::mutex> lock(hwloc_mutex());
   hwloc_set_cpubind(t.topo, static_cast<hwloc_bitmap_t>(s.set), HWLOC_CPUBIND_THREAD);
 }
 

@@ -86,7 +86,29 @@ const Calibration& SyntheticWorkload::calibration() {
   return c;
 }
 
-SyntheticWorkload::SyntheticWorkload(SyntheticOptions options) : options_(options) { (void)calibration(); }
+SyntheticWorkload::SyntheticWorkload(SyntheticOptions options)
+    : options_(options), touch_ns_per_byte_(calibration().touch_ns_per_byte) {}
+
+double SyntheticWorkload::calibrate_touch(std::uint64_t bytes) {
+  // Half read, half read-modify-write, in chunks of 8 KiB (a task's data), cycling through
+  // the whole working set as a step does.
+  const std::uint64_t words = std::clamp<std::uint64_t>(bytes / 8, 4096, 32ull << 20) / 2;
+  std::vector<std::uint64_t> a(words, 1), b(words, 2);
+  const std::uint64_t chunk = 1024;
+  double best = 1e30;
+  for (int r = 0; r < 5; ++r) {
+    const std::int64_t t0 = now_ns();
+    std::uint64_t s = 0;
+    for (std::uint64_t i = 0; i + chunk <= words; i += chunk) {
+      s += read_pass(a.data() + i, chunk);
+      write_pass(AccessMode::RW, b.data() + i, chunk, s);
+    }
+    asm volatile("" : : "r"(b.data()) : "memory");
+    best = std::min(best, static_cast<double>(now_ns() - t0));
+  }
+  touch_ns_per_byte_ = best / static_cast<double>(2 * (words / chunk) * chunk * 8);
+  return touch_ns_per_byte_;
+}
 SyntheticWorkload::~SyntheticWorkload() = default;
 
 void SyntheticWorkload::bind(const ExecGraph& exec) {
@@ -159,7 +181,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
   }
   const Calibration& c = calibration();
   const double cost = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0) * options_.cost_scale;
-  const double rest = cost - static_cast<double>(bytes) * c.touch_ns_per_byte;
+  const double rest = cost - static_cast<double>(bytes) * touch_ns_per_byte_;
   if (rest > 0) {
     const auto n = static_cast<std::uint64_t>(rest * c.spin_iterations_per_ns);
     volatile std::uint64_t sink = spin_iterations(n, acc);

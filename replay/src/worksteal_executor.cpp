@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "tsan.hpp"
 #include "tgraph/replay/executor.hpp"
 
 namespace tgraph::replay {
@@ -118,7 +119,12 @@ class WorkstealExecutor final : public Executor {
   }
 
   void spawn(TaskId t, std::uint32_t it) {
-    tg_->run([this, t, it] { run_instance(t, it); });
+    TGRAPH_TSAN_RELEASE(&tokens_[t]);  // TBB's hand-off to the thread running the task
+    tg_->run([this, t, it] {
+      TGRAPH_TSAN_ACQUIRE(&tokens_[t]);
+      run_instance(t, it);
+      TGRAPH_TSAN_RELEASE(&join_token_);  // TBB's task_group::wait()
+    });
   }
 
   // acq_rel: the last decrement acquires every earlier decrementer's writes (their tasks'
@@ -207,6 +213,7 @@ class WorkstealExecutor final : public Executor {
       ls.table[1].store(new_block(ls, false), std::memory_order_relaxed);  // (task_group::run releases)
     }
     std::exception_ptr error;
+    tokens_.resize(plan.n);
     arena_.execute([&] {
       tbb::task_group tg;
       tg_ = &tg;
@@ -217,6 +224,7 @@ class WorkstealExecutor final : public Executor {
       } catch (...) {
         error = std::current_exception();
       }
+      TGRAPH_TSAN_ACQUIRE(&join_token_);
     });
     for (LoopState& ls : plan.loops)
       for (auto& e : ls.table) {
@@ -239,6 +247,8 @@ class WorkstealExecutor final : public Executor {
   Workload* workload_ = nullptr;
   tbb::task_group* tg_ = nullptr;
   std::vector<std::uint32_t> iterations_;
+  std::vector<char> tokens_;  // TSan hand-off addresses, one per task
+  char join_token_ = 0;
 };
 
 }  // namespace

@@ -78,6 +78,8 @@ struct ReplayResult {
   std::optional<std::uint64_t> cache_misses;
   std::string cache_misses_note;
   Calibration calibration;
+  double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
+  std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data
   std::uint64_t signals() const;
   std::uint64_t waits() const;
   std::int64_t wait_ns() const;

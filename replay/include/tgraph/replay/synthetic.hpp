@@ -60,6 +60,12 @@ class SyntheticWorkload : public Workload {
 
   /// The calibration in use (measured on first call, about 20 ms).
   static const Calibration& calibration();
+  /// Measures the memory pass at a working set of `bytes` (the step's data: beyond the
+  /// caches it costs more per byte) and uses that from now on, so that a task run where
+  /// the sequential program ran it costs its recorded time; returns the ns per byte.
+  double calibrate_touch(std::uint64_t bytes);
+  /// Touch cost per byte in use.
+  double touch_ns_per_byte() const { return touch_ns_per_byte_; }
 
  private:
   struct Buffer;
@@ -68,6 +74,7 @@ class SyntheticWorkload : public Workload {
   std::vector<std::unique_ptr<Buffer>> buffers_;  // by exec datum
   std::vector<std::uint64_t> want_words_;         // by exec datum
   std::vector<bool> is_temp_;                     // by exec datum
+  double touch_ns_per_byte_ = 0;
 };
 
 /// Busy loop of `iterations` dependent multiply-adds; returns a value to keep it alive.

@@ -1,0 +1,151 @@
+// SPDX-License-Identifier: MIT
+// Replay benchmarks, side by side in one run:
+//  * Handoff/<work_ns>/<spin_ns>: a loop whose body alternates two processors, so every
+//    iteration is two cross-thread hand-offs after `work_ns` of work each. Per hand-off
+//    overhead = time per iteration / 2 - work. Where the spin budget is shorter than the
+//    wait, the waiter parks (futex) and the hand-off costs microseconds: the switch point.
+//  * Policy/<policy>/<threads>: a synthetic bars64-like step (64 bars, a CG loop of 25
+//    iterations with per-bar matrix products and global dot products) under each policy.
+#include <benchmark/benchmark.h>
+
+#include <string>
+#include <vector>
+
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/synthetic.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+/// x -> y ping-pong: A (p0) reads y writes x, B (p1) reads x writes y, then the break (p0).
+StepGraph ping_pong(std::uint64_t work_ns, std::uint32_t iterations) {
+  StepGraph g;
+  g.intern_kind("a");
+  g.intern_kind("b");
+  g.intern_kind("loop.break");
+  g.data = {{"x", kNoObject, 8}, {"y", kNoObject, 8}, {"cond", kNoObject, 8}};
+  const Access a[] = {{1, AccessMode::R}, {0, AccessMode::W}};
+  const Access b[] = {{0, AccessMode::R}, {1, AccessMode::W}, {2, AccessMode::W}};
+  const Access brk[] = {{2, AccessMode::R}};
+  g.add_task(0, kNoObject, a, work_ns, 1);
+  g.add_task(1, kNoObject, b, work_ns, 2);
+  g.add_task(2, kNoObject, brk, 0, 3);
+  for (Task& t : g.tasks) t.loop = 0;
+  g.loops.push_back({2, 0, 3, iterations, 0});
+  g.derive_edges();
+  return g;
+}
+
+void BM_Handoff(benchmark::State& state) {
+  const auto work = static_cast<std::uint64_t>(state.range(0));
+  const std::int64_t spin = state.range(1);
+  const std::uint32_t iterations = 200;
+  const StepGraph g = ping_pong(work, iterations);
+  Assignment a{2, {0, 1, 1}, {}};  // the break runs on p1 so p0 waits for it too
+  ExecOptions o;
+  o.threads = 2;
+  o.spin_ns = spin;
+  auto ex = make_executor(Policy::kPartition, o);
+  SyntheticWorkload w({.cost_scale = 1.0, .touch = false});
+  w.set_step(g);
+  ex->run_step(g, &a, w);
+  std::int64_t parks = 0;
+  for (auto _ : state) parks += static_cast<std::int64_t>(ex->run_step(g, &a, w).parks());
+  state.SetItemsProcessed(state.iterations() * iterations * 2);
+  state.counters["handoff_ns"] = benchmark::Counter(
+      static_cast<double>(state.iterations() * iterations * 2),
+      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["parks_per_step"] = static_cast<double>(parks) / static_cast<double>(state.iterations());
+}
+BENCHMARK(BM_Handoff)
+    ->ArgNames({"work_ns", "spin_ns"})
+    ->ArgsProduct({{0, 2'000, 20'000}, {0, 1'000, 5'000, 20'000, 50'000, 200'000}})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+/// A bars64-like step: per bar b: addForce (CW f_b); CG loop: per bar addDForce (R p_b,
+/// W q_b), dot pq (R p_b q_b, CW pq), scalars, per bar cgUpdate (R q_b, RW x_b r_b), dot rr
+/// (R r_b, CW rr), residual (R rr, W cond), per bar cgDirection (R r_b, RW p_b), break.
+StepGraph bars_like(std::uint32_t bars, std::uint32_t iterations) {
+  StepGraph g;
+  const KindId kf = g.intern_kind("addForce"), kd = g.intern_kind("addDForce"), kpq = g.intern_kind("dotPQ"),
+               ks = g.intern_kind("cgScalars"), ku = g.intern_kind("cgUpdate"), krr = g.intern_kind("dotRR"),
+               kres = g.intern_kind("residual"), kdir = g.intern_kind("cgDirection"),
+               kb = g.intern_kind("loop.break");
+  const std::uint64_t vec = 256 * 3 * 8;  // 256 nodes x 3 doubles
+  std::vector<DatumId> f, p, q, x, r;
+  for (std::uint32_t b = 0; b < bars; ++b) {
+    g.objects.push_back({"bar" + std::to_string(b)});
+    for (auto* v : {&f, &p, &q, &x, &r}) {
+      v->push_back(static_cast<DatumId>(g.data.size()));
+      g.data.push_back({"bar" + std::to_string(b) + ".v" + std::to_string(v->size()), b, vec});
+    }
+  }
+  const auto pq = static_cast<DatumId>(g.data.size());
+  g.data.push_back({"pq", kNoObject, 8});
+  g.data.push_back({"alpha", kNoObject, 8});
+  g.data.push_back({"rr", kNoObject, 8});
+  g.data.push_back({"cond", kNoObject, 8});
+  const DatumId alpha = pq + 1, rr = pq + 2, cond = pq + 3;
+  for (std::uint32_t b = 0; b < bars; ++b) {
+    const Access acc[] = {{x[b], AccessMode::R}, {f[b], AccessMode::CW}};
+    g.add_task(kf, b, acc, 5000);
+  }
+  Loop loop;
+  loop.condition = cond;
+  loop.first = static_cast<TaskId>(g.tasks.size());
+  loop.iterations = iterations;
+  auto add = [&](KindId k, ObjectId o, std::initializer_list<Access> acc, std::uint64_t cost) {
+    const std::vector<Access> v(acc);
+    g.tasks[g.add_task(k, o, v, cost)].loop = 0;
+  };
+  for (std::uint32_t b = 0; b < bars; ++b) add(kd, b, {{p[b], AccessMode::R}, {q[b], AccessMode::W}}, 7000);
+  for (std::uint32_t b = 0; b < bars; ++b)
+    add(kpq, b, {{p[b], AccessMode::R}, {q[b], AccessMode::R}, {pq, AccessMode::CW}}, 300);
+  add(ks, kNoObject, {{pq, AccessMode::R}, {rr, AccessMode::R}, {alpha, AccessMode::W}}, 100);
+  for (std::uint32_t b = 0; b < bars; ++b)
+    add(ku, b, {{alpha, AccessMode::R}, {q[b], AccessMode::R}, {x[b], AccessMode::RW}, {r[b], AccessMode::RW}}, 600);
+  for (std::uint32_t b = 0; b < bars; ++b) add(krr, b, {{r[b], AccessMode::R}, {rr, AccessMode::CW}}, 300);
+  add(kres, kNoObject, {{rr, AccessMode::R}, {cond, AccessMode::W}}, 100);
+  for (std::uint32_t b = 0; b < bars; ++b) add(kdir, b, {{r[b], AccessMode::R}, {rr, AccessMode::R}, {p[b], AccessMode::RW}}, 400);
+  add(kb, kNoObject, {{cond, AccessMode::R}}, 50);
+  loop.last = static_cast<TaskId>(g.tasks.size());
+  g.loops.push_back(loop);
+  g.derive_edges();
+  return g;
+}
+
+/// Owner-compute: bar b on processor b * k / bars, shared scalar tasks on processor 0.
+Assignment owner_like(const StepGraph& g, std::uint32_t k, std::uint32_t bars) {
+  Assignment a;
+  a.k = k;
+  for (const Task& t : g.tasks) a.proc.push_back(t.object == kNoObject ? 0 : t.object * k / bars);
+  return a;
+}
+
+void BM_Policy(benchmark::State& state) {
+  const auto policy = static_cast<Policy>(state.range(0));
+  const auto k = static_cast<std::uint32_t>(state.range(1));
+  const StepGraph g = bars_like(64, 25);
+  const Assignment a = owner_like(g, k, 64);
+  ExecOptions o;
+  o.threads = k;
+  auto ex = make_executor(policy, o);
+  SyntheticWorkload w;
+  w.set_step(g);
+  ex->run_step(g, &a, w);
+  for (auto _ : state) ex->run_step(g, &a, w);
+  state.SetLabel(std::string(to_string(policy)));
+}
+BENCHMARK(BM_Policy)
+    ->ArgNames({"policy", "threads"})
+    ->Args({0, 1})
+    ->ArgsProduct({{1, 2, 3}, {2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
+
+}  // namespace
+}  // namespace tgraph::replay
+
+BENCHMARK_MAIN();
