@@ -153,6 +153,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
       if (acc.mode == AccessMode::CW) {
         if (mode == CwMode::kSerialize || serialize_acc.count(pair_key(t, acc.datum)) != 0) {
           acc.mode = AccessMode::RW;
+          x.added_edges = true;
         } else if (auto it = redirect.find(pair_key(t, acc.datum)); it != redirect.end()) {
           acc.datum = temp(acc.datum, it->second);
         }

@@ -328,7 +328,7 @@ class PartitionExecutor final : public Executor {
     try {
       run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
     } catch (const UsageError&) {
-      if (plan->program_order) throw;
+      if (plan->program_order || !x.added_edges) throw;  // the order itself is invalid
       // The explicit order cannot be kept with the lowered graph's extra edges (serialised
       // CW writers): fall back to program order on each processor, which never deadlocks.
       plan = std::make_shared<Plan>(build_plan(x, options_.threads, false));

@@ -28,8 +28,9 @@ namespace {
 
 std::uint64_t read_pass(const std::uint64_t* w, std::uint64_t n) {
   std::uint64_t s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  const std::uint64_t n4 = n - n % 4;
   std::uint64_t i = 0;
-  for (; i + 4 <= n; i += 4) {
+  for (; i < n4; i += 4) {
     s0 += w[i];
     s1 += w[i + 1];
     s2 += w[i + 2];

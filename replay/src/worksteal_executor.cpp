@@ -19,6 +19,7 @@
 
 #include "common.hpp"
 #include "tsan.hpp"
+#include "worksteal_task.hpp"
 #include "tgraph/replay/executor.hpp"
 
 namespace tgraph::replay {
@@ -120,11 +121,14 @@ class WorkstealExecutor final : public Executor {
 
   void spawn(TaskId t, std::uint32_t it) {
     TGRAPH_TSAN_RELEASE(&tokens_[t]);  // TBB's hand-off to the thread running the task
-    tg_->run([this, t, it] {
-      TGRAPH_TSAN_ACQUIRE(&tokens_[t]);
-      run_instance(t, it);
-      TGRAPH_TSAN_RELEASE(&join_token_);  // TBB's task_group::wait()
-    });
+    tg_->run(detail::SpawnedInstance{&WorkstealExecutor::trampoline, this, t, it});
+  }
+
+  static void trampoline(void* self, TaskId t, std::uint32_t it) {
+    auto* ex = static_cast<WorkstealExecutor*>(self);
+    TGRAPH_TSAN_ACQUIRE(&ex->tokens_[t]);
+    ex->run_instance(t, it);
+    TGRAPH_TSAN_RELEASE(&ex->join_token_);  // TBB's task_group::wait()
   }
 
   // acq_rel: the last decrement acquires every earlier decrementer's writes (their tasks'

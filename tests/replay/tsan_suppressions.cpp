@@ -1,10 +1,18 @@
 // SPDX-License-Identifier: MIT
-// Under ThreadSanitizer: oneTBB's task objects are created by one thread and run by another
-// through libtbb's (uninstrumented) deques; the executors annotate the hand-off of their own
-// data (replay/src/tsan.hpp), but TBB's task object itself is only reachable here.
+// Under ThreadSanitizer: oneTBB and libgomp are not instrumented, so the hand-offs they
+// perform are invisible to TSan. The executors annotate the hand-off of their own data
+// (replay/src/tsan.hpp); what the libraries themselves pass between threads (their task
+// objects, the functor's fields, the omp shared-variable block) is only reachable here.
+// The partitioned executor (std::thread + atomics) needs no suppression.
 #if defined(__SANITIZE_THREAD__)
 extern "C" const char* __tsan_default_suppressions() {
-  return "race_top:tbb::detail::d1::function_task\n"
-         "race_top:tbb::detail::d1::task_ptr_or_nullptr\n";
+  return
+      // TBB's own task object, created by the spawner, destroyed by the runner.
+      "race_top:task_group.h\n"
+      // Reading the spawned functor's fields (replay/src/worksteal_task.cpp).
+      "race_top:worksteal_task.cpp\n"
+      // libgomp hands the shared-variable block of `omp parallel` to its threads; the
+      // region's own data is annotated (replay/src/tsan.hpp).
+      "race_top:BarrierExecutor::execute\n";
 }
 #endif

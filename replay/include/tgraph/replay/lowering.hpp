@@ -37,6 +37,8 @@ struct ExecGraph {
   std::vector<DatumId> datum_origin;     ///< exec datum -> original datum (a temp: its target)
   std::vector<TaskId> exec_of;           ///< original task -> exec task
   Assignment assignment;                 ///< the assignment on exec tasks (k = 1 when none)
+  /// Lowering added dependencies the original graph did not have (a CW writer made RW).
+  bool added_edges = false;
 };
 
 /// Lowers `g` (edges derived) for assignment `a` (nullptr: everything on processor 0).
