@@ -120,13 +120,13 @@ class WorkstealExecutor final : public Executor {
   }
 
   void spawn(TaskId t, std::uint32_t it) {
-    TGRAPH_TSAN_RELEASE(&tokens_[t]);  // TBB's hand-off to the thread running the task
+    TGRAPH_TSAN_RELEASE(&spawn_token_);  // TBB's hand-off to the thread running the task
     tg_->run(detail::SpawnedInstance{&WorkstealExecutor::trampoline, this, t, it});
   }
 
   static void trampoline(void* self, TaskId t, std::uint32_t it) {
     auto* ex = static_cast<WorkstealExecutor*>(self);
-    TGRAPH_TSAN_ACQUIRE(&ex->tokens_[t]);
+    TGRAPH_TSAN_ACQUIRE(&ex->spawn_token_);
     ex->run_instance(t, it);
     TGRAPH_TSAN_RELEASE(&ex->join_token_);  // TBB's task_group::wait()
   }
@@ -217,7 +217,6 @@ class WorkstealExecutor final : public Executor {
       ls.table[1].store(new_block(ls, false), std::memory_order_relaxed);  // (task_group::run releases)
     }
     std::exception_ptr error;
-    tokens_.resize(plan.n);
     arena_.execute([&] {
       tbb::task_group tg;
       tg_ = &tg;
@@ -251,7 +250,7 @@ class WorkstealExecutor final : public Executor {
   Workload* workload_ = nullptr;
   tbb::task_group* tg_ = nullptr;
   std::vector<std::uint32_t> iterations_;
-  std::vector<char> tokens_;  // TSan hand-off addresses, one per task
+  char spawn_token_ = 0;  // TSan: address standing for TBB's spawn hand-off
   char join_token_ = 0;
 };
 
