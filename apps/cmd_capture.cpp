@@ -57,6 +57,7 @@ void run_capture(const CaptureOptions& o) {
   const int steps = o.steps.value_or(scene->default_steps());
 
   capture::Recorder rec(o.no_capture ? capture::Mode::kOff : capture::Mode::kCapture);
+  rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
   std::unique_ptr<TraceWriter> writer;
   if (!o.no_capture) {
     TraceHeader header;

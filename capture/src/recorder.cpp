@@ -51,6 +51,18 @@ void Recorder::begin_step() {
   bodies_.clear();
   conditions_.clear();
   open_loop_ = kNoLoop;
+  step_clock_ = std::chrono::steady_clock::now();
+  step_ticks_ = detail::ticks();
+}
+
+std::uint64_t Recorder::name_hash(std::vector<std::uint64_t>& cache, std::size_t id, std::string_view name) {
+  if (cache.size() <= id) cache.resize(id + 1, 0);
+  if (cache[id] == 0) {
+    std::uint64_t h = 1469598103934665603ull;
+    for (unsigned char c : name) h = (h ^ c) * 1099511628211ull;
+    cache[id] = (h ^ 0xff) * 1099511628211ull;
+  }
+  return cache[id];
 }
 
 void Recorder::set_contacts(std::vector<Contact> contacts, std::vector<std::uint32_t> groups) {
@@ -58,19 +70,7 @@ void Recorder::set_contacts(std::vector<Contact> contacts, std::vector<std::uint
   cur_.groups = std::move(groups);
 }
 
-bool Recorder::record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ns) {
-  if (open_loop_ != kNoLoop && iteration_ > 0) {
-    // Later iteration: the body was recorded once; add the cost to the matching task.
-    const Loop& loop = cur_.loops[open_loop_];
-    const TaskId t = loop.first + replay_pos_;
-    if (t + 1 >= loop.last || cur_.tasks[t].kind != kind || cur_.tasks[t].object != obj) {
-      ++errors_;  // the body changed between iterations
-      return false;
-    }
-    cost_sum_[t] += ns;
-    ++replay_pos_;
-    return false;
-  }
+bool Recorder::append_task(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ns) {
   Task t;
   t.kind = kind;
   t.object = obj;
@@ -112,6 +112,8 @@ bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
     record(kind("loop.break"), kNoObject, &acc, 1, ns);
     if (mode_ == Mode::kDeferred) bodies_.emplace_back();  // the executor runs conditions[loop]
     loop.last = static_cast<TaskId>(cur_.tasks.size());
+    body_first_ = loop.first;
+    body_last_ = loop.last;
   } else {
     const TaskId t = loop.first + replay_pos_;
     if (t + 1 != loop.last) ++errors_;  // fewer tasks than in the first iteration
@@ -140,7 +142,17 @@ StepGraph Recorder::finish_step() {
     open_loop_ = kNoLoop;
   }
   if (mode_ == Mode::kOff) return {};
-  StepGraph g = cur_;
+  // Ticks -> ns from the steady_clock duration of the whole step.
+  const auto ns = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - step_clock_).count();
+  const std::uint64_t ticks = detail::ticks() - step_ticks_;
+  const double ns_per_tick = ticks == 0 ? 1.0 : static_cast<double>(ns) / static_cast<double>(ticks);
+  // Keep the step's buffers' capacity for the next step: the returned graph gets copies.
+  StepGraph g;
+  g.tasks = cur_.tasks;
+  g.accesses = cur_.accesses;
+  g.loops = cur_.loops;
+  g.contacts = std::move(cur_.contacts);
+  g.groups = std::move(cur_.groups);
   g.kinds = kinds_;
   g.objects = objects_;
   g.data = data_;
@@ -150,20 +162,17 @@ StepGraph Recorder::finish_step() {
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     Task& task = g.tasks[t];
     const std::uint64_t runs = g.runs(t);
-    task.cost_ns = runs == 0 ? cost_sum_[t] : cost_sum_[t] / runs;
+    const double sum_ns = static_cast<double>(cost_sum_[t]) * ns_per_tick;
+    task.cost_ns = static_cast<std::uint64_t>(sum_ns / static_cast<double>(runs == 0 ? 1 : runs) + 0.5);
     const std::uint64_t slot = (static_cast<std::uint64_t>(task.object) << 32) | task.kind;
     const std::uint32_t occ = occurrence[slot]++;
-    std::uint64_t h = 1469598103934665603ull;
-    auto mix = [&h](std::string_view s) {
-      for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-      h = (h ^ 0xff) * 1099511628211ull;
-    };
-    mix(task.object == kNoObject ? std::string_view("<none>") : std::string_view(g.objects[task.object].name));
-    mix(g.kinds[task.kind]);
+    std::uint64_t h = task.object == kNoObject ? 0x9e3779b97f4a7c15ull
+                                               : name_hash(object_hash_, task.object, g.objects[task.object].name);
+    h = (h ^ name_hash(kind_hash_, task.kind, g.kinds[task.kind])) * 1099511628211ull;
     h = (h ^ occ) * 1099511628211ull;
     task.key = h;
   }
-  g.derive_edges();
+  if (derive_edges_) g.derive_edges();
   return g;
 }
 

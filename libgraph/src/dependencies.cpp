@@ -158,9 +158,11 @@ void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
     if (next_loop < loops.size() && loops[next_loop].first == t) {
       const Loop& loop = loops[next_loop++];
       for (TaskId u = loop.first; u < loop.last; ++u) main.process(u);
-      // Second pass over the body from the end-of-body state, on a copy.
+      // Second pass over the body from the end-of-body state, on a copy of the states of
+      // the data the body touches (the others cannot produce carried edges).
       Extractor second(*this, carried_edges, max_edges);
-      second.state() = main.state();
+      for (TaskId u = loop.first; u < loop.last; ++u)
+        for (const Access& a : accesses_of(u)) second.state()[a.datum] = main.state()[a.datum];
       second.set_pass(n, loop.first, loop.last);
       for (TaskId u = loop.first; u < loop.last; ++u) second.process(u);
       t = loop.last;

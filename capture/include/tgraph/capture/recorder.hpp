@@ -14,7 +14,24 @@
 
 #include "tgraph/graph/step_graph.hpp"
 
+#if defined(__x86_64__) || defined(__i386__)
+#include <x86intrin.h>
+#endif
+
 namespace tgraph::capture {
+
+namespace detail {
+/// A cheap monotonic tick: the invariant TSC on x86 (about a third of a steady_clock read),
+/// else steady_clock nanoseconds. Ticks are converted to ns once per step (end_step), from
+/// the steady_clock time the step took.
+inline std::uint64_t ticks() {
+#if defined(__x86_64__) || defined(__i386__)
+  return __rdtsc();
+#else
+  return static_cast<std::uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+#endif
+}
+}  // namespace detail
 
 /// What a Recorder does with the tasks the coordination code issues.
 enum class Mode : std::uint8_t {
@@ -63,6 +80,10 @@ class Recorder {
 
   /// Current mode.
   Mode mode() const { return mode_; }
+  /// Whether end_step() derives the graph's edges (default true). A capture that only
+  /// streams steps to a trace file turns it off: traces do not store edges, readers derive
+  /// them, and the capture's hot path saves the time.
+  void set_derive_edges(bool on) { derive_edges_ = on; }
 
   /// Declares an object (or interaction) with a name that is stable across steps.
   /// Declaring an existing name returns its id.
@@ -93,12 +114,9 @@ class Recorder {
         body();
         return;
       case Mode::kCapture: {
-        const auto t0 = std::chrono::steady_clock::now();
+        const std::uint64_t t0 = detail::ticks();
         body();
-        const auto t1 = std::chrono::steady_clock::now();
-        record(kind, obj, acc.begin(), acc.size(),
-               static_cast<std::uint64_t>(
-                   std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count()));
+        record(kind, obj, acc.begin(), acc.size(), detail::ticks() - t0);
         return;
       }
       case Mode::kDeferred:
@@ -121,14 +139,11 @@ class Recorder {
         }
         acc_[n_++] = a;
       }
-      t0_ = std::chrono::steady_clock::now();
+      t0_ = detail::ticks();
     }
     ~Scope() {
       if (rec_.mode_ == Mode::kOff) return;
-      const auto t1 = std::chrono::steady_clock::now();
-      rec_.record(kind_, obj_, acc_.data(), n_,
-                  static_cast<std::uint64_t>(
-                      std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0_).count()));
+      rec_.record(kind_, obj_, acc_.data(), n_, detail::ticks() - t0_);
     }
     Scope(const Scope&) = delete;
     Scope& operator=(const Scope&) = delete;
@@ -140,7 +155,7 @@ class Recorder {
     ObjectId obj_;
     std::array<Access, kMaxAccesses> acc_{};
     std::size_t n_ = 0;
-    std::chrono::steady_clock::time_point t0_;
+    std::uint64_t t0_ = 0;
   };
 
   /// Opens a dynamic loop whose break condition is the shared datum `condition`.
@@ -155,12 +170,9 @@ class Recorder {
       conditions_.emplace_back(std::forward<P>(pred));
       return true;
     }
-    const auto t0 = std::chrono::steady_clock::now();
+    const std::uint64_t t0 = detail::ticks();
     const bool stop = pred();
-    const auto t1 = std::chrono::steady_clock::now();
-    return record_break(loop, static_cast<std::uint64_t>(
-                                  std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count())) ||
-           stop;
+    return record_break(loop, detail::ticks() - t0) || stop;
   }
   /// Closes the loop.
   void end_loop(LoopId loop);
@@ -170,10 +182,26 @@ class Recorder {
   std::uint64_t errors() const { return errors_; }
 
  private:
-  // Returns true when a new task was appended (false for later loop iterations).
-  bool record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ns);
+  // `ticks` are detail::ticks() units. Returns true when a new task was appended (false for
+  // later loop iterations, whose costs add to the task recorded in the first one).
+  bool record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ticks) {
+    if (open_loop_ != kNoLoop && iteration_ > 0) {
+      const TaskId t = body_first_ + replay_pos_;
+      if (t + 1 < body_last_ && cur_.tasks[t].kind == kind && cur_.tasks[t].object == obj) {
+        cost_sum_[t] += ticks;
+        ++replay_pos_;
+      } else {
+        ++errors_;  // the body changed between iterations
+      }
+      return false;
+    }
+    return append_task(kind, obj, acc, n, ticks);
+  }
+  bool append_task(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ticks);
   // Returns true when the loop has reached its maximum iteration count.
-  bool record_break(LoopId loop, std::uint64_t ns);
+  bool record_break(LoopId loop, std::uint64_t ticks);
+  // FNV-1a of a name, cached per object / kind id for stable keys.
+  std::uint64_t name_hash(std::vector<std::uint64_t>& cache, std::size_t id, std::string_view name);
   StepGraph finish_step();
 
   Mode mode_;
@@ -183,13 +211,18 @@ class Recorder {
   std::vector<Datum> data_;
   std::vector<void*> ptrs_;
   std::unordered_map<std::string, ObjectId> object_ids_;
-  std::vector<std::uint64_t> cost_sum_;  // per task, summed over iterations
+  std::vector<std::uint64_t> cost_sum_;  // per task, ticks summed over iterations
+  std::vector<std::uint64_t> object_hash_, kind_hash_;  // name hashes (0: not computed)
+  std::chrono::steady_clock::time_point step_clock_{};  // begin_step: ticks -> ns per step
+  std::uint64_t step_ticks_ = 0;
   std::vector<std::function<void()>> bodies_;
   std::vector<std::function<bool()>> conditions_;
   LoopId open_loop_ = kNoLoop;
   std::uint32_t iteration_ = 0;          // current iteration of the open loop (0-based)
   std::uint32_t replay_pos_ = 0;         // next body task to match in iterations > 0
+  TaskId body_first_ = 0, body_last_ = 0;  // body of the open loop, once recorded
   bool in_step_ = false;
+  bool derive_edges_ = true;
   std::uint64_t errors_ = 0;
 };
 
