@@ -200,6 +200,7 @@ void run_live(const RunCmd& c) {
   if (!c.policy.empty()) policy = policy_from(c.policy, "--policy");
   const std::uint32_t threads = policy == tr::Policy::kSequential ? 1 : c.threads;
 
+  std::uint64_t fallbacks = 0;
   auto run_scene = [&](tr::Policy pol, std::uint32_t k, bool observe_costs, std::vector<double>* step_ms,
                        tr::StateSnapshot* final_state, std::uint64_t* signals, std::uint32_t* cg) {
     std::unique_ptr<samples::Scene> scene = samples::make_scene(c.scene);
@@ -247,6 +248,7 @@ void run_live(const RunCmd& c) {
       last_graph = std::move(prog.graph);
     }
     if (final_state) *final_state = tr::snapshot(regions(rec, last_graph));
+    fallbacks += ex->order_fallbacks();
   };
 
   std::vector<double> step_ms;
@@ -264,7 +266,8 @@ void run_live(const RunCmd& c) {
                       {"steps", step_ms.size()},
                       {"wall_ns", static_cast<std::int64_t>(total * 1e6)},
                       {"signals", signals},
-                      {"first_loop_iterations", cg}};
+                      {"first_loop_iterations", cg},
+                      {"order_fallbacks", fallbacks}};
   nlohmann::json per_step = nlohmann::json::array();
   for (double ms : step_ms) per_step.push_back({{"wall_ns", static_cast<std::int64_t>(ms * 1e6)}});
   j["per_step"] = per_step;

@@ -187,6 +187,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   r.wall_ns = median(r.pass_wall_ns);
   r.sequential_wall_ns = median(r.sequential_pass_wall_ns);
   r.plans_built = ex->plans_built();
+  r.order_fallbacks = ex->order_fallbacks();
   if (misses.available()) {
     r.cache_misses = misses.read() - misses0;
   } else {
@@ -258,6 +259,7 @@ std::string to_json(const ReplayResult& r) {
             {"wait_ns", r.wait_ns()},
             {"build_ns", r.build_ns()},
             {"plans_built", r.plans_built},
+            {"order_fallbacks", r.order_fallbacks},
             {"remote_bytes", r.remote_bytes()},
             {"migrated_bytes", r.migrated_bytes()},
             {"calibration",

@@ -307,6 +307,8 @@ class PartitionExecutor final : public Executor {
     counters_ = std::make_unique<Slot[]>(o.threads);
   }
 
+  std::uint64_t order_fallbacks() const override { return order_fallbacks_; }
+
   ~PartitionExecutor() override {
     if (!workers_.empty()) {
       // release: the workers that see the new step value also see shutdown_.

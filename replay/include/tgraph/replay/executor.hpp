@@ -90,6 +90,9 @@ class Executor {
 
   /// Number of plans built so far.
   std::uint64_t plans_built() const { return plans_built_; }
+  /// Plans for which an explicit Assignment::order could not be kept (it contradicted
+  /// edges the lowering added, e.g. serialised CW writers) and program order was used.
+  virtual std::uint64_t order_fallbacks() const { return 0; }
   /// The exec graph of the last step.
   const ExecGraph* last_exec() const { return last_exec_; }
 

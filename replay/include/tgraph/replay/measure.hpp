@@ -75,6 +75,7 @@ struct ReplayResult {
   double efficiency = 0;                ///< speedup / bound
   std::uint64_t work_ns = 0, span_ns = 0;
   std::uint64_t plans_built = 0;
+  std::uint64_t order_fallbacks = 0;    ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;
   std::string cache_misses_note;
   Calibration calibration;
