@@ -311,8 +311,10 @@ class PartitionExecutor final : public Executor {
 
   ~PartitionExecutor() override {
     if (!workers_.empty()) {
-      // release: the workers that see the new step value also see shutdown_.
+      // relaxed: published by the seq_cst store of step_seq_ just below (a release); the
+      // workers read shutdown_ after acquiring that value.
       shutdown_.store(true, std::memory_order_relaxed);
+      // relaxed: only this thread writes step_seq_.
       parking_.signal(step_seq_, step_seq_.load(std::memory_order_relaxed) + 1);
       parking_.wake(step_seq_);
       for (auto& t : workers_) t.join();

@@ -113,6 +113,8 @@ class WorkstealExecutor final : public Executor {
     auto* b = new Block;
     const std::size_t size = ls.last - ls.first;
     b->count = std::make_unique<std::atomic<std::uint32_t>[]>(size);
+    // relaxed: the block is published afterwards by a release store of its table entry (or
+    // before any spawn, which TBB orders), so these initial values are seen by all users.
     for (std::size_t j = 0; j < size; ++j)
       b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j], std::memory_order_relaxed);
     b->remaining.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
@@ -192,7 +194,8 @@ class WorkstealExecutor final : public Executor {
         for (TaskId v = ls.first; v < ls.last; ++v) dec(next->count[v - ls.first], v, it + 1, tc);
       }
     }
-    // acq_rel: the last finisher of the iteration sees the decision and every instance's data.
+    // acq_rel: the last finisher of the iteration acquires every instance's release, the
+    // break's included, so the relaxed load of the decision after it reads the final value.
     if (cur->remaining.fetch_sub(1, std::memory_order_acq_rel) == 1 &&
         cur->decision.load(std::memory_order_relaxed) == 1) {
       for (TaskId s : ls.after) release_first(s, tc);
@@ -234,7 +237,7 @@ class WorkstealExecutor final : public Executor {
         Block* b = e.load(std::memory_order_relaxed);  // relaxed: all tasks finished
         if (!b) break;
         delete b;
-        e.store(nullptr, std::memory_order_relaxed);
+        e.store(nullptr, std::memory_order_relaxed);  // relaxed: no task runs now
       }
     stats.threads.resize(options_.threads);
     for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
