@@ -43,7 +43,9 @@ tp::CostModel load_model(const std::string& model, const std::string& calibratio
 
 tr::Policy policy_from(const std::string& name, const char* flag) {
   const auto p = tr::parse_policy(name);
-  if (!p) throw UsageError(std::string(flag) + " " + name + ": expected partition, worksteal, barrier or sequential");
+  if (!p)
+    throw UsageError(std::string(flag) + " " + name +
+                     ": expected partition, worksteal, barrier or sequential");
   return *p;
 }
 
@@ -99,9 +101,9 @@ void run_replay(const ReplayCmd& c) {
   }
   tr::TimelineObserver timeline;
   const bool want_timeline = !c.timeline.empty() || !c.chrome.empty();
-  const tr::ReplayResult r = tr::replay_trace(trace, assignment ? &*assignment : nullptr, o,
-                                              assignment ? &predicted : nullptr,
-                                              want_timeline ? &timeline : nullptr);
+  const tr::ReplayResult r =
+      tr::replay_trace(trace, assignment ? &*assignment : nullptr, o,
+                       assignment ? &predicted : nullptr, want_timeline ? &timeline : nullptr);
   if (!c.timeline.empty()) write_file_atomic(c.timeline, timeline.to_json());
   if (!c.chrome.empty()) write_file_atomic(c.chrome, timeline.to_chrome_json());
   if (c.json) {
@@ -117,23 +119,27 @@ void run_replay(const ReplayCmd& c) {
   for (const auto& m : r.steps) measured_nobuild += m.wall_ns - m.build_ns;
   std::printf("replay %s: %zu steps, policy %s, %u threads\n", c.trace.c_str(), r.steps.size(),
               std::string(tr::to_string(r.policy)).c_str(), r.threads);
-  std::printf("  wall            %10.3f ms (median of %u passes)\n", static_cast<double>(r.wall_ns) / 1e6, c.repeat);
+  std::printf("  wall            %10.3f ms (median of %u passes)\n",
+              static_cast<double>(r.wall_ns) / 1e6, c.repeat);
   if (r.sequential_wall_ns > 0)
     std::printf("  sequential      %10.3f ms   speed-up %.2f   efficiency %.2f (bound %.2f)\n",
                 static_cast<double>(r.sequential_wall_ns) / 1e6, r.speedup, r.efficiency, r.bound);
   std::printf("  work / span     %10.3f / %.3f ms\n", static_cast<double>(r.work_ns) / 1e6,
               static_cast<double>(r.span_ns) / 1e6);
   std::printf("  signals %llu, waits %llu, wait time %.3f ms, plan builds %llu (%.3f ms)\n",
-              static_cast<unsigned long long>(r.signals()), static_cast<unsigned long long>(r.waits()),
-              static_cast<double>(r.wait_ns()) / 1e6, static_cast<unsigned long long>(r.plans_built),
+              static_cast<unsigned long long>(r.signals()),
+              static_cast<unsigned long long>(r.waits()), static_cast<double>(r.wait_ns()) / 1e6,
+              static_cast<unsigned long long>(r.plans_built),
               static_cast<double>(r.build_ns()) / 1e6);
-  std::printf("  remote bytes %llu, migrated bytes %llu\n", static_cast<unsigned long long>(r.remote_bytes()),
+  std::printf("  remote bytes %llu, migrated bytes %llu\n",
+              static_cast<unsigned long long>(r.remote_bytes()),
               static_cast<unsigned long long>(r.migrated_bytes()));
   if (pred)
-    std::printf("  predicted       %10.3f ms   measured/predicted %.3f\n", static_cast<double>(*pred) / 1e6,
+    std::printf("  predicted       %10.3f ms   measured/predicted %.3f\n",
+                static_cast<double>(*pred) / 1e6,
                 *pred ? static_cast<double>(measured_nobuild) / static_cast<double>(*pred) : 0.0);
   std::printf("  cache misses    %s\n", r.cache_misses ? std::to_string(*r.cache_misses).c_str()
-                                                        : r.cache_misses_note.c_str());
+                                                       : r.cache_misses_note.c_str());
 }
 
 // ---- run (live) -------------------------------------------------------------------------
@@ -156,7 +162,9 @@ class CostObserver : public tr::Observer {
     sum_.assign(exec.graph.tasks.size(), 0);
     runs_.assign(exec.graph.tasks.size(), 0);
   }
-  void on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t) override { begin_[thread * 8] = t; }
+  void on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t) override {
+    begin_[thread * 8] = t;
+  }
   void on_end(std::uint32_t thread, TaskId task, std::uint32_t, std::int64_t t) override {
     sum_[task] += static_cast<std::uint64_t>(t - begin_[thread * 8]);  // one writer per task
     ++runs_[task];
@@ -201,8 +209,9 @@ void run_live(const RunCmd& c) {
   const std::uint32_t threads = policy == tr::Policy::kSequential ? 1 : c.threads;
 
   std::uint64_t fallbacks = 0;
-  auto run_scene = [&](tr::Policy pol, std::uint32_t k, bool observe_costs, std::vector<double>* step_ms,
-                       tr::StateSnapshot* final_state, std::uint64_t* signals, std::uint32_t* cg) {
+  auto run_scene = [&](tr::Policy pol, std::uint32_t k, bool observe_costs,
+                       std::vector<double>* step_ms, tr::StateSnapshot* final_state,
+                       std::uint64_t* signals, std::uint32_t* cg) {
     std::unique_ptr<samples::Scene> scene = samples::make_scene(c.scene);
     const int steps = c.steps.value_or(scene->default_steps());
     capture::Recorder rec(capture::Mode::kDeferred);
@@ -214,7 +223,8 @@ void run_live(const RunCmd& c) {
     auto ex = tr::make_executor(pol, eo);
     CostObserver costs;
     if (observe_costs) ex->add_observer(costs);
-    std::unique_ptr<tp::Strategy> strategy = pol == tr::Policy::kPartition ? tp::make_strategy(method) : nullptr;
+    std::unique_ptr<tp::Strategy> strategy =
+        pol == tr::Policy::kPartition ? tp::make_strategy(method) : nullptr;
     StepGraph prev_graph;
     Assignment prev_assignment;
     bool have_prev = false;
@@ -223,7 +233,8 @@ void run_live(const RunCmd& c) {
     for (int s = 0; s < steps; ++s) {
       scene->step(rec);
       capture::StepProgram prog = rec.end_step_program();
-      if (rec.errors() != 0) throw Failure("the recorder counted " + std::to_string(rec.errors()) + " API misuses");
+      if (rec.errors() != 0)
+        throw Failure("the recorder counted " + std::to_string(rec.errors()) + " API misuses");
       for (Task& t : prog.graph.tasks) {
         auto it = last_costs.find(t.key);
         t.cost_ns = it != last_costs.end() ? std::max<std::uint64_t>(1, it->second) : 1;
@@ -259,15 +270,16 @@ void run_live(const RunCmd& c) {
             &signals, &cg);
   double total = 0;
   for (double ms : step_ms) total += ms;
-  nlohmann::json j = {{"scene", c.scene},
-                      {"policy", std::string(tr::to_string(policy))},
-                      {"method", policy == tr::Policy::kPartition ? method : std::string(tr::to_string(policy))},
-                      {"threads", threads},
-                      {"steps", step_ms.size()},
-                      {"wall_ns", static_cast<std::int64_t>(total * 1e6)},
-                      {"signals", signals},
-                      {"first_loop_iterations", cg},
-                      {"order_fallbacks", fallbacks}};
+  nlohmann::json j = {
+      {"scene", c.scene},
+      {"policy", std::string(tr::to_string(policy))},
+      {"method", policy == tr::Policy::kPartition ? method : std::string(tr::to_string(policy))},
+      {"threads", threads},
+      {"steps", step_ms.size()},
+      {"wall_ns", static_cast<std::int64_t>(total * 1e6)},
+      {"signals", signals},
+      {"first_loop_iterations", cg},
+      {"order_fallbacks", fallbacks}};
   nlohmann::json per_step = nlohmann::json::array();
   for (double ms : step_ms) per_step.push_back({{"wall_ns", static_cast<std::int64_t>(ms * 1e6)}});
   j["per_step"] = per_step;
@@ -282,20 +294,26 @@ void run_live(const RunCmd& c) {
     j["sequential_wall_ns"] = static_cast<std::int64_t>(seq_total * 1e6);
     j["check"] = diff ? "differs" : "identical";
     j["data_compared"] = reference.names.size();
-    if (diff) j["first_difference"] = {{"datum", diff->datum}, {"offset", diff->offset}, {"differing_bytes", diff->differing_bytes}};
+    if (diff)
+      j["first_difference"] = {{"datum", diff->datum},
+                               {"offset", diff->offset},
+                               {"differing_bytes", diff->differing_bytes}};
   }
   if (c.json) {
     print_json(j);
   } else {
-    std::printf("run %s: %zu steps, %s (%s), %u threads: %.3f ms\n", c.scene.c_str(), step_ms.size(),
-                std::string(tr::to_string(policy)).c_str(), j["method"].get<std::string>().c_str(), threads, total);
+    std::printf("run %s: %zu steps, %s (%s), %u threads: %.3f ms\n", c.scene.c_str(),
+                step_ms.size(), std::string(tr::to_string(policy)).c_str(),
+                j["method"].get<std::string>().c_str(), threads, total);
     if (c.check)
-      std::printf("  check against sequential: %s (%zu data compared)\n", diff ? "DIFFERS" : "identical bit for bit",
+      std::printf("  check against sequential: %s (%zu data compared)\n",
+                  diff ? "DIFFERS" : "identical bit for bit",
                   static_cast<std::size_t>(j["data_compared"]));
   }
   if (diff)
-    throw Failure("state differs from the sequential run: first differing datum " + diff->datum + " (byte " +
-                  std::to_string(diff->offset) + ", " + std::to_string(diff->differing_bytes) + " bytes differ)");
+    throw Failure("state differs from the sequential run: first differing datum " + diff->datum +
+                  " (byte " + std::to_string(diff->offset) + ", " +
+                  std::to_string(diff->differing_bytes) + " bytes differ)");
 }
 
 }  // namespace
@@ -303,22 +321,27 @@ void run_live(const RunCmd& c) {
 void add_replay_verbs(CLI::App& app) {
   {
     auto c = std::make_shared<ReplayCmd>();
-    auto* cmd = app.add_subcommand("replay", "Replay a trace's steps on real threads (synthetic bodies)");
+    auto* cmd =
+        app.add_subcommand("replay", "Replay a trace's steps on real threads (synthetic bodies)");
     cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
-    cmd->add_option("assignment", c->assignment, "Assignment file (.tga; partition policy; default: --method)");
+    cmd->add_option("assignment", c->assignment,
+                    "Assignment file (.tga; partition policy; default: --method)");
     cmd->add_option("--threads,-k", c->threads, "Threads (processors)");
     cmd->add_option("--policy", c->policy, "partition (default), worksteal, barrier or sequential");
-    cmd->add_option("--method", c->method, "Strategy used when no assignment file is given (default owner)");
+    cmd->add_option("--method", c->method,
+                    "Strategy used when no assignment file is given (default owner)");
     cmd->add_option("--steps", c->steps, "Steps to replay (default: all)");
     cmd->add_option("--first-step", c->first_step, "First step replayed");
     cmd->add_option("--repeat", c->repeat, "Timed passes (medians reported; default 3)");
     cmd->add_option("--timeline", c->timeline, "Write the observed pass's timeline (JSON)");
-    cmd->add_option("--chrome", c->chrome, "Write the observed pass as Chrome/Perfetto trace events");
+    cmd->add_option("--chrome", c->chrome,
+                    "Write the observed pass as Chrome/Perfetto trace events");
     cmd->add_option("--spin-ns", c->spin_ns, "Spin this long before parking a waiting thread");
     cmd->add_option("--cw", c->cw, "CW writes across threads: reduce or serialize")
         ->check(CLI::IsMember({"reduce", "serialize"}));
     cmd->add_option("--scale", c->scale, "Multiply every recorded cost");
-    cmd->add_option("--model", c->model, "Cost model of the prediction: calibrated (default) or ideal")
+    cmd->add_option("--model", c->model,
+                    "Cost model of the prediction: calibrated (default) or ideal")
         ->check(CLI::IsMember({"ideal", "calibrated"}));
     cmd->add_option("--calibration", c->calibration, "Calibration file for the prediction");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
@@ -332,13 +355,15 @@ void add_replay_verbs(CLI::App& app) {
     auto* cmd = app.add_subcommand("run", "Run a scene live through the executor (engine bodies)");
     cmd->add_option("--scene", c->scene, "Built-in scene or scene file")->required();
     cmd->add_option("--threads,-k", c->threads, "Threads");
-    cmd->add_option("--method", c->method,
-                    "Partitioning strategy (owner, metis, scotch, sticky, list, roundrobin) or a baseline "
-                    "(worksteal, barrier, sequential)");
+    cmd->add_option(
+        "--method", c->method,
+        "Partitioning strategy (owner, metis, scotch, sticky, list, roundrobin) or a baseline "
+        "(worksteal, barrier, sequential)");
     cmd->add_option("--policy", c->policy, "Override the policy");
     cmd->add_option("--steps", c->steps, "Steps (default: the scene's)");
     cmd->add_option("--spin-ns", c->spin_ns, "Spin this long before parking a waiting thread");
-    cmd->add_flag("--check", c->check, "Compare the final state with a sequential run, bit for bit");
+    cmd->add_flag("--check", c->check,
+                  "Compare the final state with a sequential run, bit for bit");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
     cmd->add_flag("--json", c->json, "Print one JSON object");
     cmd->callback([c] { run_live(*c); });

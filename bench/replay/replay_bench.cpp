@@ -52,10 +52,11 @@ void BM_Handoff(benchmark::State& state) {
   std::int64_t parks = 0;
   for (auto _ : state) parks += static_cast<std::int64_t>(ex->run_step(g, &a, w).parks());
   state.SetItemsProcessed(state.iterations() * iterations * 2);
-  state.counters["handoff_ns"] = benchmark::Counter(
-      static_cast<double>(state.iterations() * iterations * 2),
-      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-  state.counters["parks_per_step"] = static_cast<double>(parks) / static_cast<double>(state.iterations());
+  state.counters["handoff_ns"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * iterations * 2),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["parks_per_step"] =
+      static_cast<double>(parks) / static_cast<double>(state.iterations());
 }
 BENCHMARK(BM_Handoff)
     ->ArgNames({"work_ns", "spin_ns"})
@@ -68,8 +69,9 @@ BENCHMARK(BM_Handoff)
 /// (R r_b, CW rr), residual (R rr, W cond), per bar cgDirection (R r_b, RW p_b), break.
 StepGraph bars_like(std::uint32_t bars, std::uint32_t iterations) {
   StepGraph g;
-  const KindId kf = g.intern_kind("addForce"), kd = g.intern_kind("addDForce"), kpq = g.intern_kind("dotPQ"),
-               ks = g.intern_kind("cgScalars"), ku = g.intern_kind("cgUpdate"), krr = g.intern_kind("dotRR"),
+  const KindId kf = g.intern_kind("addForce"), kd = g.intern_kind("addDForce"),
+               kpq = g.intern_kind("dotPQ"), ks = g.intern_kind("cgScalars"),
+               ku = g.intern_kind("cgUpdate"), krr = g.intern_kind("dotRR"),
                kres = g.intern_kind("residual"), kdir = g.intern_kind("cgDirection"),
                kb = g.intern_kind("loop.break");
   const std::uint64_t vec = 256 * 3 * 8;  // 256 nodes x 3 doubles
@@ -99,15 +101,23 @@ StepGraph bars_like(std::uint32_t bars, std::uint32_t iterations) {
     const std::vector<Access> v(acc);
     g.tasks[g.add_task(k, o, v, cost)].loop = 0;
   };
-  for (std::uint32_t b = 0; b < bars; ++b) add(kd, b, {{p[b], AccessMode::R}, {q[b], AccessMode::W}}, 7000);
+  for (std::uint32_t b = 0; b < bars; ++b)
+    add(kd, b, {{p[b], AccessMode::R}, {q[b], AccessMode::W}}, 7000);
   for (std::uint32_t b = 0; b < bars; ++b)
     add(kpq, b, {{p[b], AccessMode::R}, {q[b], AccessMode::R}, {pq, AccessMode::CW}}, 300);
   add(ks, kNoObject, {{pq, AccessMode::R}, {rr, AccessMode::R}, {alpha, AccessMode::W}}, 100);
   for (std::uint32_t b = 0; b < bars; ++b)
-    add(ku, b, {{alpha, AccessMode::R}, {q[b], AccessMode::R}, {x[b], AccessMode::RW}, {r[b], AccessMode::RW}}, 600);
-  for (std::uint32_t b = 0; b < bars; ++b) add(krr, b, {{r[b], AccessMode::R}, {rr, AccessMode::CW}}, 300);
+    add(ku, b,
+        {{alpha, AccessMode::R},
+         {q[b], AccessMode::R},
+         {x[b], AccessMode::RW},
+         {r[b], AccessMode::RW}},
+        600);
+  for (std::uint32_t b = 0; b < bars; ++b)
+    add(krr, b, {{r[b], AccessMode::R}, {rr, AccessMode::CW}}, 300);
   add(kres, kNoObject, {{rr, AccessMode::R}, {cond, AccessMode::W}}, 100);
-  for (std::uint32_t b = 0; b < bars; ++b) add(kdir, b, {{r[b], AccessMode::R}, {rr, AccessMode::R}, {p[b], AccessMode::RW}}, 400);
+  for (std::uint32_t b = 0; b < bars; ++b)
+    add(kdir, b, {{r[b], AccessMode::R}, {rr, AccessMode::R}, {p[b], AccessMode::RW}}, 400);
   add(kb, kNoObject, {{cond, AccessMode::R}}, 50);
   loop.last = static_cast<TaskId>(g.tasks.size());
   g.loops.push_back(loop);

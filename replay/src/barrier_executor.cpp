@@ -14,8 +14,8 @@
 
 #include "common.hpp"
 #include "sync.hpp"
-#include "tsan.hpp"
 #include "tgraph/replay/executor.hpp"
+#include "tsan.hpp"
 
 namespace tgraph::replay {
 namespace {
@@ -56,7 +56,8 @@ class BarrierExecutor final : public Executor {
     bool open = false;
     for (TaskId t = 0; t < n; ++t) {
       const Task& task = g.tasks[t];
-      const bool region_change = task.loop != region || (task.loop != kNoLoop && g.loops[task.loop].first == t);
+      const bool region_change =
+          task.loop != region || (task.loop != kNoLoop && g.loops[task.loop].first == t);
       if (region_change) {
         open = false;
         region = task.loop;
@@ -83,7 +84,8 @@ class BarrierExecutor final : public Executor {
     return plan;
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
+               StepStats& stats) override {
     const BarrierPlan& plan = *static_cast<BarrierPlan*>(plan_ptr);
     const StepGraph& g = x.graph;
     const auto k = static_cast<int>(options_.threads);

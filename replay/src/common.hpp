@@ -17,7 +17,8 @@ inline constexpr std::uint32_t kIterationCap = 1u << 16;
 inline bool leave_loop(const ExecGraph& x, LoopId l, std::uint32_t i, Workload& w) {
   const bool stop = w.stop_after(l, i);
   const Loop& loop = x.graph.loops[l];
-  return stop || (loop.max_iterations != 0 && i + 1 >= loop.max_iterations) || i + 1 >= kIterationCap;
+  return stop || (loop.max_iterations != 0 && i + 1 >= loop.max_iterations) ||
+         i + 1 >= kIterationCap;
 }
 
 /// Calls every observer's on_begin.

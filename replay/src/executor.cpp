@@ -119,20 +119,21 @@ void validate_assignment(const StepGraph& g, const Assignment& a, std::uint32_t 
     throw UsageError("assignment has k = " + std::to_string(a.k) + " processors but " +
                      std::to_string(threads) + " threads were asked for");
   if (a.proc.size() != g.tasks.size())
-    throw UsageError("assignment covers " + std::to_string(a.proc.size()) + " tasks, the step has " +
-                     std::to_string(g.tasks.size()));
+    throw UsageError("assignment covers " + std::to_string(a.proc.size()) +
+                     " tasks, the step has " + std::to_string(g.tasks.size()));
   for (std::size_t t = 0; t < a.proc.size(); ++t)
     if (a.proc[t] >= a.k)
       throw UsageError("assignment puts task " + std::to_string(t) + " on processor " +
                        std::to_string(a.proc[t]) + " >= k");
   if (a.order.empty()) return;
-  if (a.order.size() != a.k) throw UsageError("assignment order has the wrong number of processors");
+  if (a.order.size() != a.k)
+    throw UsageError("assignment order has the wrong number of processors");
   std::vector<bool> seen(g.tasks.size(), false);
   for (ProcId p = 0; p < a.k; ++p)
     for (TaskId t : a.order[p]) {
       if (t >= g.tasks.size() || a.proc[t] != p || seen[t])
-        throw UsageError("assignment order of processor " + std::to_string(p) +
-                         " lists task " + std::to_string(t) + " wrongly");
+        throw UsageError("assignment order of processor " + std::to_string(p) + " lists task " +
+                         std::to_string(t) + " wrongly");
       seen[t] = true;
     }
   if (std::find(seen.begin(), seen.end(), false) != seen.end())
@@ -259,9 +260,12 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
       o.threads = 1;
       return std::make_unique<SequentialExecutor>(o);
     }
-    case Policy::kPartition: return make_partition_executor(options);
-    case Policy::kWorksteal: return make_worksteal_executor(options);
-    case Policy::kBarrier: return make_barrier_executor(options);
+    case Policy::kPartition:
+      return make_partition_executor(options);
+    case Policy::kWorksteal:
+      return make_worksteal_executor(options);
+    case Policy::kBarrier:
+      return make_barrier_executor(options);
   }
   throw UsageError("unknown policy");
 }

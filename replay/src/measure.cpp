@@ -103,7 +103,8 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
                      std::to_string(trace.steps.size()) + " steps");
   const std::uint32_t last =
       o.steps == 0 ? static_cast<std::uint32_t>(trace.steps.size())
-                   : std::min<std::uint32_t>(static_cast<std::uint32_t>(trace.steps.size()), o.first_step + o.steps);
+                   : std::min<std::uint32_t>(static_cast<std::uint32_t>(trace.steps.size()),
+                                             o.first_step + o.steps);
   const bool partition = o.policy == Policy::kPartition;
   if (partition) {
     if (!assignments) throw UsageError("the partition policy needs an assignment");
@@ -210,7 +211,8 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
     }
     ex->clear_observers();
   }
-  const double parallelism = r.span_ns == 0 ? 1.0 : static_cast<double>(r.work_ns) / static_cast<double>(r.span_ns);
+  const double parallelism =
+      r.span_ns == 0 ? 1.0 : static_cast<double>(r.work_ns) / static_cast<double>(r.span_ns);
   r.bound = std::max(1.0, std::min(static_cast<double>(r.threads), parallelism));
   if (r.wall_ns > 0 && r.sequential_wall_ns > 0)
     r.speedup = static_cast<double>(r.sequential_wall_ns) / static_cast<double>(r.wall_ns);
@@ -224,7 +226,10 @@ std::string to_json(const ReplayResult& r) {
   for (const StepMeasure& m : r.steps) {
     json threads = json::array();
     for (const auto& t : m.threads)
-      threads.push_back({{"busy_ns", t.busy_ns}, {"wait_ns", t.wait_ns}, {"idle_ns", t.idle_ns}, {"tasks", t.tasks}});
+      threads.push_back({{"busy_ns", t.busy_ns},
+                         {"wait_ns", t.wait_ns},
+                         {"idle_ns", t.idle_ns},
+                         {"tasks", t.tasks}});
     json s = {{"step", m.step},
               {"wall_ns", m.wall_ns},
               {"sequential_wall_ns", m.sequential_wall_ns},
@@ -239,7 +244,8 @@ std::string to_json(const ReplayResult& r) {
               {"work_ns", m.work_ns},
               {"span_ns", m.span_ns},
               {"threads", threads}};
-    s["predicted_makespan_ns"] = m.predicted_makespan_ns ? json(*m.predicted_makespan_ns) : json(nullptr);
+    s["predicted_makespan_ns"] =
+        m.predicted_makespan_ns ? json(*m.predicted_makespan_ns) : json(nullptr);
     per_step.push_back(std::move(s));
   }
   json j = {{"policy", std::string(to_string(r.policy))},

@@ -38,7 +38,8 @@ void LocalityObserver::on_step_begin(const ExecGraph& exec, std::uint32_t, std::
   for (auto& w : where_) w.clear();
 }
 
-void LocalityObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t) {
+void LocalityObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                              std::int64_t) {
   // Instances of one task never overlap, so only this thread touches where_[task] now.
   auto& w = where_[task];
   if (w.size() <= iteration) w.resize(iteration + 1, 0xffff);
@@ -54,8 +55,11 @@ void LocalityObserver::on_step_end(std::int64_t) {
     const auto& w = where_[t];
     return it < w.size() ? w[it] : 0xffffu;
   };
-  auto iterations = [&](TaskId t) -> std::uint32_t { return static_cast<std::uint32_t>(where_[t].size()); };
-  auto add = [&](const Edge& e, TaskId from, std::uint32_t it_from, TaskId to, std::uint32_t it_to) {
+  auto iterations = [&](TaskId t) -> std::uint32_t {
+    return static_cast<std::uint32_t>(where_[t].size());
+  };
+  auto add = [&](const Edge& e, TaskId from, std::uint32_t it_from, TaskId to,
+                 std::uint32_t it_to) {
     const std::uint32_t a = thread_of(from, it_from), b = thread_of(to, it_to);
     if (a != 0xffffu && b != 0xffffu && a != b) remote_ += g.data[e.datum].bytes;
   };
@@ -79,9 +83,10 @@ void LocalityObserver::on_step_end(std::int64_t) {
   }
   // Owner of each original datum: thread of its first writer in program order (else of its
   // first reader); temporaries count for their target.
-  const std::size_t n_orig = exec_->datum_origin.empty()
-                                 ? g.data.size()
-                                 : *std::max_element(exec_->datum_origin.begin(), exec_->datum_origin.end()) + 1;
+  const std::size_t n_orig =
+      exec_->datum_origin.empty()
+          ? g.data.size()
+          : *std::max_element(exec_->datum_origin.begin(), exec_->datum_origin.end()) + 1;
   std::vector<std::uint32_t> owner(n_orig, 0xffffffffu), reader(n_orig, 0xffffffffu);
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     if (exec_->origin[t] == kNoTask || where_[t].empty()) continue;
@@ -104,7 +109,8 @@ void LocalityObserver::on_step_end(std::int64_t) {
   prev_owner_ = std::move(owner);
 }
 
-void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) {
+void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads,
+                                     std::int64_t t_ns) {
   exec_ = &exec;
   recording_ = step_ < max_steps_;
   threads_ = std::max(threads_, threads);
@@ -120,15 +126,18 @@ void TimelineObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std
   open_[thread * 8] = t_ns;
 }
 
-void TimelineObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+void TimelineObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                              std::int64_t t_ns) {
   if (!recording_) return;
   per_thread_[thread].push_back({step_, thread, task, exec_->origin[task], iteration,
                                  open_[thread * 8] - step_begin_, t_ns - step_begin_});
 }
 
-void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) {
+void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
+                               bool parked) {
   if (!recording_) return;
-  waits_per_thread_[thread].push_back({step_, thread, task, t0 - step_begin_, t1 - step_begin_, parked});
+  waits_per_thread_[thread].push_back(
+      {step_, thread, task, t0 - step_begin_, t1 - step_begin_, parked});
 }
 
 void TimelineObserver::on_step_end(std::int64_t) {
@@ -138,8 +147,9 @@ void TimelineObserver::on_step_end(std::int64_t) {
       events_.insert(events_.end(), v.begin(), v.end());
       v.clear();
     }
-    std::sort(events_.begin() + static_cast<std::ptrdiff_t>(first), events_.end(),
-              [](const TimelineEvent& a, const TimelineEvent& b) { return a.start_ns < b.start_ns; });
+    std::sort(
+        events_.begin() + static_cast<std::ptrdiff_t>(first), events_.end(),
+        [](const TimelineEvent& a, const TimelineEvent& b) { return a.start_ns < b.start_ns; });
     for (auto& v : waits_per_thread_) {
       waits_.insert(waits_.end(), v.begin(), v.end());
       v.clear();
@@ -151,14 +161,15 @@ void TimelineObserver::on_step_end(std::int64_t) {
 std::string TimelineObserver::to_json() const {
   nlohmann::json tasks = nlohmann::json::array(), waits = nlohmann::json::array();
   for (const TimelineEvent& e : events_)
-    tasks.push_back({{"step", e.step},
-                     {"thread", e.thread},
-                     {"task", e.task},
-                     {"origin", e.origin == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(e.origin)},
-                     {"kind", e.task < labels_.size() ? labels_[e.task] : std::string()},
-                     {"iteration", e.iteration},
-                     {"start_ns", e.start_ns},
-                     {"end_ns", e.end_ns}});
+    tasks.push_back(
+        {{"step", e.step},
+         {"thread", e.thread},
+         {"task", e.task},
+         {"origin", e.origin == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(e.origin)},
+         {"kind", e.task < labels_.size() ? labels_[e.task] : std::string()},
+         {"iteration", e.iteration},
+         {"start_ns", e.start_ns},
+         {"end_ns", e.end_ns}});
   for (const TimelineWait& w : waits_)
     waits.push_back({{"step", w.step},
                      {"thread", w.thread},
@@ -191,7 +202,10 @@ std::string TimelineObserver::to_chrome_json() const {
                   {"args", {{"step", e.step}, {"task", e.task}, {"iteration", e.iteration}}}});
   }
   for (std::uint32_t t = 0; t < threads_; ++t)
-    ev.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 0}, {"tid", t},
+    ev.push_back({{"name", "thread_name"},
+                  {"ph", "M"},
+                  {"pid", 0},
+                  {"tid", t},
                   {"args", {{"name", "thread " + std::to_string(t)}}}});
   nlohmann::json j = {{"traceEvents", ev}, {"displayTimeUnit", "ns"}};
   return j.dump();

@@ -228,9 +228,12 @@ void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
   }
   auto ready = [&](const WaitPoint& wp, std::uint32_t iter) {
     switch (wp.kind) {
-      case WaitKind::kOnce: return done[wp.producer] >= 1;
-      case WaitKind::kSameIter: return done[wp.producer] >= iter + 1;
-      case WaitKind::kPrevIter: return iter == 0 || done[wp.producer] >= iter;
+      case WaitKind::kOnce:
+        return done[wp.producer] >= 1;
+      case WaitKind::kSameIter:
+        return done[wp.producer] >= iter + 1;
+      case WaitKind::kPrevIter:
+        return iter == 0 || done[wp.producer] >= iter;
       case WaitKind::kAfterLoop:
         return loop_stop[wp.loop] && done[wp.producer] >= loop_iters[wp.loop];
     }
@@ -261,9 +264,11 @@ void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
           if (!ok) break;
           const auto thread = static_cast<std::uint32_t>(p);
           if (w) {
-            if (observers && !observers->empty()) detail::notify_begin(*observers, thread, op.task, c.iter);
+            if (observers && !observers->empty())
+              detail::notify_begin(*observers, thread, op.task, c.iter);
             w->run(TaskRun{&x, op.task, x.origin[op.task], c.iter, thread});
-            if (observers && !observers->empty()) detail::notify_end(*observers, thread, op.task, c.iter);
+            if (observers && !observers->empty())
+              detail::notify_end(*observers, thread, op.task, c.iter);
           }
           if (stats) {
             auto& tc = stats->threads[p];
@@ -302,8 +307,7 @@ void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
 class PartitionExecutor final : public Executor {
  public:
   explicit PartitionExecutor(const ExecOptions& o)
-      : Executor(Policy::kPartition, o),
-        parking_(o.spin_ns, o.threads > detail::hardware_pus()) {
+      : Executor(Policy::kPartition, o), parking_(o.spin_ns, o.threads > detail::hardware_pus()) {
     counters_ = std::make_unique<Slot[]>(o.threads);
   }
 
@@ -341,7 +345,8 @@ class PartitionExecutor final : public Executor {
     return plan;
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
+               StepStats& stats) override {
     Plan& plan = *static_cast<Plan*>(plan_ptr);
     const std::uint32_t k = options_.threads;
     if (options_.serial) {
@@ -378,8 +383,9 @@ class PartitionExecutor final : public Executor {
       std::int64_t waited = 0;
       const std::uint64_t target = seq * (k - 1);
       // acquire (inside wait): every worker's counters and writes are visible afterwards.
-      parking_.wait(finished_, [target](std::uint64_t v) { return v >= target; }, never_abort_,
-                    parked, waited);
+      parking_.wait(
+          finished_, [target](std::uint64_t v) { return v >= target; }, never_abort_, parked,
+          waited);
     }
     stats.threads.resize(k);
     for (std::uint32_t p = 0; p < k; ++p) stats.threads[p] = counters_[p].c;
@@ -387,7 +393,8 @@ class PartitionExecutor final : public Executor {
     for (std::size_t l = 0; l < plan.loops; ++l) {
       // relaxed: all writers finished (acquire on finished_ above).
       const std::uint64_t v = loop_[l].v.load(std::memory_order_relaxed);
-      stats.loop_iterations[l] = (v >> 32) == seq ? static_cast<std::uint32_t>((v & 0xffffffffu) >> 1) : 0;
+      stats.loop_iterations[l] =
+          (v >> 32) == seq ? static_cast<std::uint32_t>((v & 0xffffffffu) >> 1) : 0;
     }
     if (error_) std::rethrow_exception(error_);
   }
@@ -410,8 +417,8 @@ class PartitionExecutor final : public Executor {
       bool parked = false;
       std::int64_t waited = 0;
       // acquire (inside wait): the step context written before the store is visible.
-      seen = parking_.wait(step_seq_, [seen](std::uint64_t v) { return v > seen; }, never_abort_,
-                           parked, waited);
+      seen = parking_.wait(
+          step_seq_, [seen](std::uint64_t v) { return v > seen; }, never_abort_, parked, waited);
       // relaxed: ordered by the acquire of step_seq_ above.
       if (shutdown_.load(std::memory_order_relaxed)) return;
       run_proc(p);
@@ -475,7 +482,9 @@ class PartitionExecutor final : public Executor {
         if (parking_.parked() != 0) parking_.wake(touched_);
         const std::uint64_t all = touch_rounds_ * options_.threads;
         std::uint64_t seen = 0;
-        if (!wait(touched_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, seen)) goto out;
+        if (!wait(
+                touched_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, seen))
+          goto out;
       }
       std::uint32_t iter = 0;
       std::uint64_t v = 0;
@@ -488,7 +497,9 @@ class PartitionExecutor final : public Executor {
             break;
           case OpKind::kLoopEnd: {
             const std::uint64_t need = E | (static_cast<std::uint64_t>(iter + 1) << 1);
-            if (!wait(loop_[op.loop].v, [need](std::uint64_t s) { return s >= need; }, p, kNoTask, tc, v))
+            if (!wait(
+                    loop_[op.loop].v, [need](std::uint64_t s) { return s >= need; }, p, kNoTask, tc,
+                    v))
               goto out;
             const std::uint64_t decided = (v & 0xffffffffu) >> 1;
             if (decided > iter + 1 || (v & 1u) == 0) {
@@ -505,24 +516,32 @@ class PartitionExecutor final : public Executor {
               const WaitPoint& wp = pp.waits[i];
               std::uint64_t target = E + 1;
               switch (wp.kind) {
-                case WaitKind::kOnce: target = E + 1; break;
-                case WaitKind::kSameIter: target = E + iter + 1; break;
+                case WaitKind::kOnce:
+                  target = E + 1;
+                  break;
+                case WaitKind::kSameIter:
+                  target = E + iter + 1;
+                  break;
                 case WaitKind::kPrevIter:
                   if (iter == 0) continue;
                   target = E + iter;
                   break;
                 case WaitKind::kAfterLoop: {
                   const std::uint64_t epoch = E;
-                  if (!wait(loop_[wp.loop].v,
-                            [epoch](std::uint64_t s) { return (s >> 32) == (epoch >> 32) && (s & 1u); },
-                            p, op.task, tc, v))
+                  if (!wait(
+                          loop_[wp.loop].v,
+                          [epoch](std::uint64_t s) {
+                            return (s >> 32) == (epoch >> 32) && (s & 1u);
+                          },
+                          p, op.task, tc, v))
                     goto out;
                   target = E + ((v & 0xffffffffu) >> 1);
                   break;
                 }
               }
-              if (!wait(done_[wp.producer].v, [target](std::uint64_t s) { return s >= target; }, p,
-                        op.task, tc, v))
+              if (!wait(
+                      done_[wp.producer].v, [target](std::uint64_t s) { return s >= target; }, p,
+                      op.task, tc, v))
                 goto out;
             }
             if (observe) detail::notify_begin(observers_, p, op.task, iter);

@@ -5,10 +5,14 @@ namespace tgraph::replay {
 
 std::string_view to_string(Policy policy) {
   switch (policy) {
-    case Policy::kSequential: return "sequential";
-    case Policy::kPartition: return "partition";
-    case Policy::kWorksteal: return "worksteal";
-    case Policy::kBarrier: return "barrier";
+    case Policy::kSequential:
+      return "sequential";
+    case Policy::kPartition:
+      return "partition";
+    case Policy::kWorksteal:
+      return "worksteal";
+    case Policy::kBarrier:
+      return "barrier";
   }
   return "?";
 }
@@ -21,8 +25,10 @@ std::optional<Policy> parse_policy(std::string_view name) {
 
 std::string_view to_string(CwMode mode) {
   switch (mode) {
-    case CwMode::kReduce: return "reduce";
-    case CwMode::kSerialize: return "serialize";
+    case CwMode::kReduce:
+      return "reduce";
+    case CwMode::kSerialize:
+      return "serialize";
   }
   return "?";
 }

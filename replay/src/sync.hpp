@@ -89,9 +89,9 @@ class Parking {
     // seq_cst: Dekker with signal() (class comment).
     parked_.fetch_add(1, std::memory_order_seq_cst);
     for (;;) {
-      v = c.load(std::memory_order_seq_cst);  // seq_cst: Dekker with signal()
+      v = c.load(std::memory_order_seq_cst);                      // seq_cst: Dekker with signal()
       if (ok(v) || abort.load(std::memory_order_seq_cst)) break;  // seq_cst: Dekker with abort
-      c.wait(v, std::memory_order_acquire);  // acquire: as the loads above
+      c.wait(v, std::memory_order_acquire);                       // acquire: as the loads above
     }
     // relaxed: only signallers read it, and a stale non-zero value costs one notify.
     parked_.fetch_sub(1, std::memory_order_relaxed);

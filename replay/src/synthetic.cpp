@@ -42,7 +42,8 @@ std::uint64_t read_pass(const std::uint64_t* w, std::uint64_t n) {
 
 void write_pass(AccessMode mode, std::uint64_t* w, std::uint64_t n, std::uint64_t v) {
   switch (mode) {
-    case AccessMode::R: return;
+    case AccessMode::R:
+      return;
     case AccessMode::W:
       for (std::uint64_t i = 0; i < n; ++i) w[i] = v + i * 0x9e3779b97f4a7c15ull;
       return;
@@ -119,7 +120,8 @@ void SyntheticWorkload::bind(const ExecGraph& exec) {
   is_temp_.assign(n, false);
   for (DatumId d = 0; d < n; ++d) {
     const bool temp = exec.datum_origin[d] != d;
-    const std::uint64_t bytes = options_.touch ? std::min(exec.graph.data[d].bytes, options_.max_datum_bytes) : 0;
+    const std::uint64_t bytes =
+        options_.touch ? std::min(exec.graph.data[d].bytes, options_.max_datum_bytes) : 0;
     want_words_[d] = (bytes + 7) / 8;
     is_temp_[d] = temp;
     if (buffers_[d] && (temp || buffers_[d]->temp)) buffers_[d].reset();  // temps are per plan
@@ -138,7 +140,8 @@ void SyntheticWorkload::first_touch(DatumId d) {
   b->temp = is_temp_[d];
   // Temporaries start at zero; original data with a deterministic pattern.
   if (!b->temp)
-    for (std::uint64_t i = 0; i < b->words; ++i) b->w[i] = (static_cast<std::uint64_t>(d) << 32) + i;
+    for (std::uint64_t i = 0; i < b->words; ++i)
+      b->w[i] = (static_cast<std::uint64_t>(d) << 32) + i;
   buffers_[d] = std::move(b);
 }
 
@@ -181,7 +184,8 @@ void SyntheticWorkload::run(const TaskRun& r) {
     bytes += b->words * 8;
   }
   const Calibration& c = calibration();
-  const double cost = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0) * options_.cost_scale;
+  const double cost =
+      static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0) * options_.cost_scale;
   const double rest = cost - static_cast<double>(bytes) * touch_ns_per_byte_;
   if (rest > 0) {
     const auto n = static_cast<std::uint64_t>(rest * c.spin_iterations_per_ns);

@@ -18,9 +18,9 @@
 #include <vector>
 
 #include "common.hpp"
+#include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 #include "worksteal_task.hpp"
-#include "tgraph/replay/executor.hpp"
 
 namespace tgraph::replay {
 namespace {
@@ -93,7 +93,8 @@ class WorkstealExecutor final : public Executor {
         } else if (lu == lv) {
           ++c0;
           ++cn;
-        } else if (std::find(counted_loops.begin(), counted_loops.end(), lu) == counted_loops.end()) {
+        } else if (std::find(counted_loops.begin(), counted_loops.end(), lu) ==
+                   counted_loops.end()) {
           counted_loops.push_back(lu);
           ++c0;
           plan->loops[lu].after.push_back(v);
@@ -116,7 +117,8 @@ class WorkstealExecutor final : public Executor {
     // relaxed: the block is published afterwards by a release store of its table entry (or
     // before any spawn, which TBB orders), so these initial values are seen by all users.
     for (std::size_t j = 0; j < size; ++j)
-      b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j], std::memory_order_relaxed);
+      b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j],
+                        std::memory_order_relaxed);
     b->remaining.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
     return b;
   }
@@ -202,7 +204,8 @@ class WorkstealExecutor final : public Executor {
     }
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
+               StepStats& stats) override {
     WsPlan& plan = *static_cast<WsPlan*>(plan_ptr);
     const StepGraph& g = x.graph;
     if (fresh)
@@ -216,8 +219,9 @@ class WorkstealExecutor final : public Executor {
     for (TaskId t = 0; t < plan.n; ++t)
       plan.count0[t].store(plan.init0[t], std::memory_order_relaxed);  // relaxed: before any spawn
     for (LoopState& ls : plan.loops) {
-      ls.table[0].store(new_block(ls, true), std::memory_order_relaxed);   // relaxed: before spawns
-      ls.table[1].store(new_block(ls, false), std::memory_order_relaxed);  // (task_group::run releases)
+      ls.table[0].store(new_block(ls, true), std::memory_order_relaxed);  // relaxed: before spawns
+      ls.table[1].store(new_block(ls, false),
+                        std::memory_order_relaxed);  // (task_group::run releases)
     }
     std::exception_ptr error;
     arena_.execute([&] {

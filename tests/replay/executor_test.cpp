@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+#include "tgraph/replay/executor.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 
 #include "random_graph.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay {
@@ -44,7 +45,8 @@ ExecOptions options_for(const Variant& v, std::uint32_t k) {
 }
 
 /// Final words of the original data after running `steps` steps of g.
-std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w, const StepGraph& g) {
+std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w,
+                                                    const StepGraph& g) {
   std::vector<std::vector<std::uint64_t>> s;
   for (DatumId d = 0; d < g.data.size(); ++d) {
     auto words = w.words(d);
@@ -77,9 +79,11 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
     for (int step = 0; step < 2; ++step) {
       const StepStats s = ex->run_step(g, &a, w);
       EXPECT_EQ(s.rebuilt, step == 0);
-      for (LoopId l = 0; l < g.loops.size(); ++l) EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
+      for (LoopId l = 0; l < g.loops.size(); ++l)
+        EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
       ASSERT_NE(ex->last_exec(), nullptr);
-      test::expect_valid_order(ex->last_exec()->graph, timeline.events(), static_cast<std::uint32_t>(step), true);
+      test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
+                               static_cast<std::uint32_t>(step), true);
       test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step), false, true);
     }
     EXPECT_EQ(ex->plans_built(), 1u);
@@ -94,8 +98,8 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
 INSTANTIATE_TEST_SUITE_P(Threads1To8, EveryPolicy,
                          ::testing::Combine(::testing::Range(0, 4), ::testing::Range(1u, 9u)),
                          [](const auto& param_info) {
-                           return std::string(kVariants[std::get<0>(param_info.param)].name) + "_k" +
-                                  std::to_string(std::get<1>(param_info.param));
+                           return std::string(kVariants[std::get<0>(param_info.param)].name) +
+                                  "_k" + std::to_string(std::get<1>(param_info.param));
                          });
 
 /// A graph where four tasks add into one datum, then one task reads it.
@@ -134,7 +138,8 @@ class DoubleWorkload : public Workload {
     for (const Access& a : x.graph.accesses_of(r.task))
       if (reads(a.mode)) in += v_[a.datum];
     for (const Access& a : x.graph.accesses_of(r.task)) {
-      if (a.mode == AccessMode::CW || a.mode == AccessMode::RW) v_[a.datum] += 0.1 * (r.origin + 1) / 3.0;
+      if (a.mode == AccessMode::CW || a.mode == AccessMode::RW)
+        v_[a.datum] += 0.1 * (r.origin + 1) / 3.0;
       if (a.mode == AccessMode::W) v_[a.datum] = in;
     }
   }
@@ -208,7 +213,8 @@ class Throwing : public Workload {
  public:
   explicit Throwing(TaskId bad) : bad_(bad) {}
   void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0) throw std::runtime_error("task " + std::to_string(bad_) + " failed");
+    if (r.origin == bad_ && r.iteration == 0)
+      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
   }
   bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
 

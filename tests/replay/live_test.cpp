@@ -42,7 +42,8 @@ StateSnapshot run_live(const std::string& scene_name, Policy policy, std::uint32
   }
   std::vector<StateRegion> regions;
   for (DatumId d = 0; d < last.data.size(); ++d)
-    if (rec.datum_ptr(d)) regions.push_back({last.data[d].name, rec.datum_ptr(d), last.data[d].bytes});
+    if (rec.datum_ptr(d))
+      regions.push_back({last.data[d].name, rec.datum_ptr(d), last.data[d].bytes});
   return snapshot(regions);
 }
 

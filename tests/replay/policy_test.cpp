@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-#include <gtest/gtest.h>
-
 #include "tgraph/replay/policy.hpp"
+
+#include <gtest/gtest.h>
 
 namespace tgraph::replay {
 

@@ -38,7 +38,10 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
       for (const Access& a : acc) dup = dup || a.datum == d;
       if (dup) continue;
       const int r = pick(100);
-      const AccessMode m = r < 40 ? AccessMode::R : r < 70 ? AccessMode::CW : r < 85 ? AccessMode::W : AccessMode::RW;
+      const AccessMode m = r < 40   ? AccessMode::R
+                           : r < 70 ? AccessMode::CW
+                           : r < 85 ? AccessMode::W
+                                    : AccessMode::RW;
       acc.push_back({d, m});
     }
     const TaskId t = g.add_task(static_cast<KindId>(pick(4)), static_cast<ObjectId>(pick(4)), acc,
@@ -54,10 +57,12 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
       loop.condition = cond;
       loop.first = static_cast<TaskId>(g.tasks.size());
       loop.iterations = 1 + static_cast<std::uint32_t>(pick(4));
-      loop.max_iterations = pick(2) == 0 ? 0 : loop.iterations + static_cast<std::uint32_t>(pick(3));
+      loop.max_iterations =
+          pick(2) == 0 ? 0 : loop.iterations + static_cast<std::uint32_t>(pick(3));
       for (int i = 0; i < per_segment; ++i) add_random(l);
       // The residual: reads some data, writes the condition.
-      const Access res[] = {{static_cast<DatumId>(pick(data)), AccessMode::R}, {cond, AccessMode::W}};
+      const Access res[] = {{static_cast<DatumId>(pick(data)), AccessMode::R},
+                            {cond, AccessMode::W}};
       g.tasks[g.add_task(3, kNoObject, res, 300)].loop = l;
       const Access b[] = {{cond, AccessMode::R}};
       g.tasks[g.add_task(brk, kNoObject, b, 50)].loop = l;
@@ -98,7 +103,8 @@ inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineEve
     const TaskId id = exec ? e.task : e.origin;
     ASSERT_LT(id, g.tasks.size());
     ++count[id];
-    ASSERT_TRUE(when.emplace(std::make_pair(id, e.iteration), std::make_pair(e.start_ns, e.end_ns)).second)
+    ASSERT_TRUE(
+        when.emplace(std::make_pair(id, e.iteration), std::make_pair(e.start_ns, e.end_ns)).second)
         << "task " << id << " iteration " << e.iteration << " ran twice";
   }
   for (TaskId t = 0; t < g.tasks.size(); ++t)
@@ -109,7 +115,8 @@ inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineEve
     if (raw_only && e.kind != EdgeKind::RAW) continue;
     const LoopId lu = g.tasks[e.from].loop, lv = g.tasks[e.to].loop;
     for (std::uint32_t i = 0; i < g.runs(e.to); ++i) {
-      const std::uint32_t iu = (lu != kNoLoop && lu == lv) ? i : static_cast<std::uint32_t>(g.runs(e.from) - 1);
+      const std::uint32_t iu =
+          (lu != kNoLoop && lu == lv) ? i : static_cast<std::uint32_t>(g.runs(e.from) - 1);
       EXPECT_GE(start_of(e.to, i), end_of(e.from, iu))
           << "edge " << e.from << " -> " << e.to << " violated at iteration " << i;
     }

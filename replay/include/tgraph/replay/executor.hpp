@@ -22,10 +22,10 @@ inline constexpr std::int64_t kDefaultSpinNs = 50'000;
 
 /// How an executor runs.
 struct ExecOptions {
-  std::uint32_t threads = 1;          ///< threads (processors); partition: must equal Assignment::k
-  bool pin = true;                    ///< bind thread p to a core with hwloc (partition, barrier)
+  std::uint32_t threads = 1;  ///< threads (processors); partition: must equal Assignment::k
+  bool pin = true;            ///< bind thread p to a core with hwloc (partition, barrier)
   std::int64_t spin_ns = kDefaultSpinNs;  ///< spin this long before parking (0: park at once)
-  std::optional<CwMode> cw;           ///< default: kReduce for partition, kSerialize otherwise
+  std::optional<CwMode> cw;               ///< default: kReduce for partition, kSerialize otherwise
   /// Partition only: run the per-processor programs interleaved on the calling thread
   /// (deterministic, same plans and waits; the serial twin of the threaded executor).
   bool serial = false;
@@ -43,9 +43,9 @@ struct ThreadCounters {
 
 /// What one step cost.
 struct StepStats {
-  std::int64_t wall_ns = 0;        ///< whole step, structure build included
-  std::int64_t build_ns = 0;       ///< lowering + plan build (0 when the plan was reused)
-  bool rebuilt = false;            ///< a new plan was built for this step
+  std::int64_t wall_ns = 0;   ///< whole step, structure build included
+  std::int64_t build_ns = 0;  ///< lowering + plan build (0 when the plan was reused)
+  bool rebuilt = false;       ///< a new plan was built for this step
   std::vector<ThreadCounters> threads;
   std::vector<std::uint32_t> loop_iterations;  ///< iterations each loop ran
   /// Sums over threads.
@@ -101,7 +101,8 @@ class Executor {
   /// Builds the policy's plan for `x` (called on a cache miss). Returns an opaque plan.
   virtual std::shared_ptr<void> build(const ExecGraph& x) = 0;
   /// Runs one step with a plan. Fills `stats.threads` and `stats.loop_iterations`.
-  virtual void execute(void* plan, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) = 0;
+  virtual void execute(void* plan, const ExecGraph& x, Workload& w, bool fresh,
+                       StepStats& stats) = 0;
   /// The CW mode this executor uses.
   CwMode cw_mode() const;
 

@@ -48,8 +48,8 @@ StateSnapshot snapshot(std::span<const StateRegion> regions);
 
 /// First difference between two snapshots of the same regions.
 struct StateDifference {
-  std::string datum;        ///< name of the first differing region
-  std::uint64_t offset = 0; ///< first differing byte in it
+  std::string datum;                  ///< name of the first differing region
+  std::uint64_t offset = 0;           ///< first differing byte in it
   std::uint64_t differing_bytes = 0;  ///< in that region
 };
 

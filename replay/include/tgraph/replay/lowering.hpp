@@ -17,8 +17,8 @@ inline constexpr std::uint32_t kNoReduction = std::numeric_limits<std::uint32_t>
 /// A reducer task: target += temps[0] + temps[1] + ... (in this fixed order), then each
 /// temporary is reset to zero for its next use.
 struct Reduction {
-  DatumId target = 0;               ///< exec datum id (same as the original)
-  std::vector<DatumId> temps;       ///< exec datum ids, in increasing processor order
+  DatumId target = 0;          ///< exec datum id (same as the original)
+  std::vector<DatumId> temps;  ///< exec datum ids, in increasing processor order
 };
 
 /// A step graph after lowering, with the maps back to the original step.
@@ -34,9 +34,9 @@ struct ExecGraph {
   std::vector<TaskId> origin;            ///< exec task -> original task (kNoTask: reducer)
   std::vector<std::uint32_t> reduction;  ///< exec task -> index in reductions, or kNoReduction
   std::vector<Reduction> reductions;
-  std::vector<DatumId> datum_origin;     ///< exec datum -> original datum (a temp: its target)
-  std::vector<TaskId> exec_of;           ///< original task -> exec task
-  Assignment assignment;                 ///< the assignment on exec tasks (k = 1 when none)
+  std::vector<DatumId> datum_origin;  ///< exec datum -> original datum (a temp: its target)
+  std::vector<TaskId> exec_of;        ///< original task -> exec task
+  Assignment assignment;              ///< the assignment on exec tasks (k = 1 when none)
   /// Lowering added dependencies the original graph did not have (a CW writer made RW).
   bool added_edges = false;
 };

@@ -39,7 +39,7 @@ class CacheMissCounter {
 /// What to replay and how.
 struct ReplayOptions {
   Policy policy = Policy::kPartition;
-  ExecOptions exec;                 ///< threads, spin, pinning, CW mode
+  ExecOptions exec;  ///< threads, spin, pinning, CW mode
   SyntheticOptions synthetic;
   std::uint32_t first_step = 0;
   std::uint32_t steps = 0;          ///< 0: every step from first_step
@@ -53,13 +53,13 @@ struct StepMeasure {
   std::uint32_t step = 0;
   std::int64_t wall_ns = 0;
   std::int64_t sequential_wall_ns = 0;
-  std::int64_t build_ns = 0;             ///< plan build in the first pass (0: reused)
+  std::int64_t build_ns = 0;  ///< plan build in the first pass (0: reused)
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
   std::int64_t wait_ns = 0;
   std::uint64_t remote_bytes = 0, migrated_bytes = 0;  ///< from the observed pass
   std::uint64_t work_ns = 0, span_ns = 0;
   std::optional<std::uint64_t> predicted_makespan_ns;
-  std::vector<StatsObserver::Thread> threads;          ///< from the observed pass
+  std::vector<StatsObserver::Thread> threads;  ///< from the observed pass
 };
 
 /// The whole replay.
@@ -70,12 +70,12 @@ struct ReplayResult {
   std::int64_t wall_ns = 0;             ///< median over passes of the pass total
   std::int64_t sequential_wall_ns = 0;  ///< same for sequential
   std::vector<std::int64_t> pass_wall_ns, sequential_pass_wall_ns;
-  double speedup = 0;                   ///< sequential_wall_ns / wall_ns
-  double bound = 1;                     ///< min(threads, work / span)
-  double efficiency = 0;                ///< speedup / bound
+  double speedup = 0;     ///< sequential_wall_ns / wall_ns
+  double bound = 1;       ///< min(threads, work / span)
+  double efficiency = 0;  ///< speedup / bound
   std::uint64_t work_ns = 0, span_ns = 0;
   std::uint64_t plans_built = 0;
-  std::uint64_t order_fallbacks = 0;    ///< see Executor::order_fallbacks
+  std::uint64_t order_fallbacks = 0;  ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;
   std::string cache_misses_note;
   Calibration calibration;

@@ -32,16 +32,19 @@ class Observer {
     (void)exec, (void)threads, (void)t_ns;
   }
   /// A task instance starts on `thread`.
-  virtual void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+  virtual void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                        std::int64_t t_ns) {
     (void)thread, (void)task, (void)iteration, (void)t_ns;
   }
   /// A task instance ends on `thread`.
-  virtual void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) {
+  virtual void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                      std::int64_t t_ns) {
     (void)thread, (void)task, (void)iteration, (void)t_ns;
   }
   /// `thread` waited from t0 to t1 before running `task` (only waits that did not succeed at
   /// once are reported; `parked` = it slept in the kernel).
-  virtual void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) {
+  virtual void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
+                       bool parked) {
     (void)thread, (void)task, (void)t0, (void)t1, (void)parked;
   }
   /// After the last task of the step, once every thread is done (calling thread).
@@ -59,9 +62,12 @@ class StatsObserver : public Observer {
     std::uint64_t tasks = 0;
   };
   void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
-  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
-  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
-  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) override;
+  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+              std::int64_t t_ns) override;
+  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
+               bool parked) override;
   void on_step_end(std::int64_t t_ns) override;
   /// The last step's per-thread figures.
   const std::vector<Thread>& threads() const { return last_; }
@@ -83,7 +89,8 @@ class StatsObserver : public Observer {
 class LocalityObserver : public Observer {
  public:
   void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
-  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+              std::int64_t t_ns) override;
   void on_step_end(std::int64_t t_ns) override;
   /// Remote bytes of the last step.
   std::uint64_t remote_bytes() const { return remote_; }
@@ -102,8 +109,8 @@ class LocalityObserver : public Observer {
 struct TimelineEvent {
   std::uint32_t step = 0;
   std::uint32_t thread = 0;
-  TaskId task = 0;           ///< exec task
-  TaskId origin = kNoTask;   ///< original task (kNoTask: reducer)
+  TaskId task = 0;          ///< exec task
+  TaskId origin = kNoTask;  ///< original task (kNoTask: reducer)
   std::uint32_t iteration = 0;
   std::int64_t start_ns = 0;  ///< from the start of the step
   std::int64_t end_ns = 0;
@@ -123,9 +130,12 @@ struct TimelineWait {
 class TimelineObserver : public Observer {
  public:
   void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
-  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
-  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration, std::int64_t t_ns) override;
-  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1, bool parked) override;
+  void on_begin(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+                std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+              std::int64_t t_ns) override;
+  void on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
+               bool parked) override;
   void on_step_end(std::int64_t t_ns) override;
 
   /// Every event recorded so far, step by step, sorted by start time within a step.

@@ -21,9 +21,9 @@ struct Calibration {
 
 /// Options of the synthetic bodies.
 struct SyntheticOptions {
-  double cost_scale = 1.0;                       ///< multiplies every recorded cost
-  bool touch = true;                             ///< read/write the data buffers
-  std::uint64_t max_datum_bytes = 64ull << 20;   ///< larger data are touched only this far
+  double cost_scale = 1.0;                      ///< multiplies every recorded cost
+  bool touch = true;                            ///< read/write the data buffers
+  std::uint64_t max_datum_bytes = 64ull << 20;  ///< larger data are touched only this far
 };
 
 /// Bodies that cost what the trace recorded and move the memory the data would.
