@@ -101,11 +101,11 @@ void LocalityObserver::on_step_end(std::int64_t) {
   }
   for (DatumId d = 0; d < n_orig; ++d)
     if (owner[d] == 0xffffffffu) owner[d] = reader[d];
-  if (prev_owner_.size() == n_orig) {
-    for (DatumId d = 0; d < n_orig; ++d)
-      if (owner[d] != 0xffffffffu && prev_owner_[d] != 0xffffffffu && owner[d] != prev_owner_[d])
-        migrated_ += g.data[d].bytes;
-  }
+  // Data ids are stable across steps (a recorder only appends data): compare the common ids.
+  const std::size_t common = std::min(prev_owner_.size(), n_orig);
+  for (DatumId d = 0; d < common; ++d)
+    if (owner[d] != 0xffffffffu && prev_owner_[d] != 0xffffffffu && owner[d] != prev_owner_[d])
+      migrated_ += g.data[d].bytes;
   prev_owner_ = std::move(owner);
 }
 
