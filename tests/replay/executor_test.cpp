@@ -358,6 +358,10 @@ TEST(Timeline, ExportsEveryTaskToJsonAndChromeTraceEvents) {
   const std::string chrome = tl.to_chrome_json();
   EXPECT_NE(chrome.find("\"traceEvents\""), std::string::npos);
   EXPECT_NE(chrome.find("\"ph\":\"X\""), std::string::npos);
+  // A saved timeline converts to the same trace events.
+  EXPECT_EQ(chrome_from_timeline_json(json, "r.json"), chrome);
+  EXPECT_THROW(chrome_from_timeline_json("{\"x\": 1}", "bad.json"), InputError);
+  EXPECT_THROW(chrome_from_timeline_json("not json", "bad.json"), InputError);
 }
 
 TEST(Synthetic, SpinsForTheRecordedCost) {

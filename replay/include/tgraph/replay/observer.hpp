@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -154,6 +155,7 @@ class TimelineObserver : public Observer {
   std::string to_chrome_json() const;
 
  private:
+  friend std::string chrome_from_timeline_json(std::string_view, const std::string&);
   std::vector<std::vector<TimelineEvent>> per_thread_;
   std::vector<std::vector<TimelineWait>> waits_per_thread_;
   std::vector<TimelineEvent> events_;
@@ -167,5 +169,10 @@ class TimelineObserver : public Observer {
   std::uint32_t max_steps_ = 0xffffffffu;
   bool recording_ = false;
 };
+
+/// Chrome / Perfetto trace events from a timeline file's text (TimelineObserver::to_json,
+/// `tgraph replay --timeline`), for converters such as `tgraph export`. Throws InputError
+/// naming `name` when the text is not such a timeline.
+std::string chrome_from_timeline_json(std::string_view timeline_json, const std::string& name);
 
 }  // namespace tgraph::replay
