@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 // `tgraph export T.tgt --step S --format {json,metis,scotch} [-o F]`: one step's graph in an
-// interchange format (METIS: gpmetis input; Scotch: scotch_gpart source graph).
+// interchange format (METIS: gpmetis input; Scotch: scotch_gpart source graph);
+// `tgraph export R.json --format chrome`: a replay timeline as Chrome/Perfetto trace events.
 #include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/undirected.hpp"
+#include "tgraph/replay/observer.hpp"
 
 namespace tgraph::app {
 namespace {
@@ -86,7 +88,22 @@ std::string to_json(const StepGraph& g, std::size_t step) {
   return j.dump(1) + "\n";
 }
 
+void write_output(const ExportOptions& o, const std::string& text) {
+  if (o.out.empty() || o.out == "-") {
+    std::cout << text;
+  } else {
+    write_file_atomic(o.out, text);
+  }
+}
+
 void run_export(const ExportOptions& o) {
+  if (o.format == "chrome") {
+    // The input is a replay timeline (tgraph replay --timeline R.json).
+    const auto bytes = read_file_bytes(o.trace);
+    write_output(o, replay::chrome_from_timeline_json(
+                        std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), o.trace));
+    return;
+  }
   const Trace trace = load_trace(o.trace);
   if (o.step >= trace.steps.size())
     throw UsageError("--step " + std::to_string(o.step) + ": trace " + o.trace + " has " +
@@ -100,11 +117,7 @@ void run_export(const ExportOptions& o) {
   } else {
     text = to_scotch(make_undirected(g, kMaxTotalWeight, kMaxTotalWeight));
   }
-  if (o.out.empty() || o.out == "-") {
-    std::cout << text;
-  } else {
-    write_file_atomic(o.out, text);
-  }
+  write_output(o, text);
 }
 
 }  // namespace
@@ -112,10 +125,11 @@ void run_export(const ExportOptions& o) {
 void add_export(CLI::App& app) {
   auto o = std::make_shared<ExportOptions>();
   auto* cmd = app.add_subcommand("export", "Write one step's graph in an interchange format");
-  cmd->add_option("trace", o->trace, "Trace file (.tgt)")->required();
+  cmd->add_option("input", o->trace, "Trace file (.tgt); for chrome, a replay timeline (R.json)")->required();
   cmd->add_option("--step", o->step, "Step index (0-based)");
-  cmd->add_option("--format", o->format, "json, metis (gpmetis input) or scotch (scotch_gpart input)")
-      ->check(CLI::IsMember({"json", "metis", "scotch"}));
+  cmd->add_option("--format", o->format,
+                  "json, metis (gpmetis input), scotch (scotch_gpart input), chrome (timeline -> trace-event JSON)")
+      ->check(CLI::IsMember({"json", "metis", "scotch", "chrome"}));
   cmd->add_option("-o,--output", o->out, "Output file (default: standard output)");
   cmd->callback([o] { run_export(*o); });
 }

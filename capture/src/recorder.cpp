@@ -48,6 +48,7 @@ void Recorder::begin_step() {
   cur_.contacts.clear();
   cur_.groups.clear();
   cost_sum_.clear();
+  cost_max_.clear();
   bodies_.clear();
   conditions_.clear();
   open_loop_ = kNoLoop;
@@ -80,6 +81,7 @@ bool Recorder::append_task(KindId kind, ObjectId obj, const Access* acc, std::si
   cur_.accesses.insert(cur_.accesses.end(), acc, acc + n);
   cur_.tasks.push_back(t);
   cost_sum_.push_back(ns);
+  cost_max_.push_back(ns);
   return true;
 }
 
@@ -118,6 +120,7 @@ bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
     const TaskId t = loop.first + replay_pos_;
     if (t + 1 != loop.last) ++errors_;  // fewer tasks than in the first iteration
     cost_sum_[loop.last - 1] += ns;
+    if (ns > cost_max_[loop.last - 1]) cost_max_[loop.last - 1] = ns;
   }
   ++iteration_;
   replay_pos_ = 0;
@@ -162,8 +165,11 @@ StepGraph Recorder::finish_step() {
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     Task& task = g.tasks[t];
     const std::uint64_t runs = g.runs(t);
-    const double sum_ns = static_cast<double>(cost_sum_[t]) * ns_per_tick;
-    task.cost_ns = static_cast<std::uint64_t>(sum_ns / static_cast<double>(runs == 0 ? 1 : runs) + 0.5);
+    // Mean over iterations without the longest one (an OS preemption) from 3 runs on.
+    const bool trim = runs >= 3;
+    const double sum_ns = static_cast<double>(cost_sum_[t] - (trim ? cost_max_[t] : 0)) * ns_per_tick;
+    const double n_runs = static_cast<double>(trim ? runs - 1 : (runs == 0 ? 1 : runs));
+    task.cost_ns = static_cast<std::uint64_t>(sum_ns / n_runs + 0.5);
     const std::uint64_t slot = (static_cast<std::uint64_t>(task.object) << 32) | task.kind;
     const std::uint32_t occ = occurrence[slot]++;
     std::uint64_t h = task.object == kNoObject ? 0x9e3779b97f4a7c15ull

@@ -155,3 +155,47 @@ TEST(Recorder, ScopeRecordsOneTimedTask) {
 
 }  // namespace
 }  // namespace tgraph::capture
+
+namespace tgraph::capture {
+namespace {
+
+TEST(Recorder, LoopTaskCostLeavesOutItsLongestIteration) {
+  Recorder rec(Mode::kCapture);
+  const DatumId c = rec.datum("c", kNoObject, 1);
+  const KindId k = rec.kind("k");
+  rec.begin_step();
+  const LoopId l = rec.begin_loop(c, 5);
+  int it = 0;
+  do {
+    rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
+      if (it++ == 2) {  // one iteration "preempted" for 20 ms
+        const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
+        while (std::chrono::steady_clock::now() < until) {
+        }
+      }
+    });
+  } while (!rec.conditional_break(l, [] { return false; }));
+  rec.end_loop(l);
+  const StepGraph g = rec.end_step();
+  ASSERT_EQ(g.loops[0].iterations, 5u);
+  // With the outlier the mean would be >= 4 ms; without it, the empty body's cost.
+  EXPECT_LT(g.tasks[0].cost_ns, 1'000'000u);
+}
+
+TEST(Recorder, TaskCostsAreInNanoseconds) {
+  Recorder rec(Mode::kCapture);
+  const DatumId c = rec.datum("c", kNoObject, 1);
+  const KindId k = rec.kind("k");
+  rec.begin_step();
+  rec.task(k, kNoObject, {{c, AccessMode::W}}, [] {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(5);
+    while (std::chrono::steady_clock::now() < until) {
+    }
+  });
+  const StepGraph g = rec.end_step();
+  EXPECT_GE(g.tasks[0].cost_ns, 4'900'000u);
+  EXPECT_LT(g.tasks[0].cost_ns, 50'000'000u);
+}
+
+}  // namespace
+}  // namespace tgraph::capture

@@ -72,7 +72,9 @@ struct StepProgram {
 ///   rec.end_loop(l);
 ///
 /// In capture mode the body is recorded on the first iteration and later iterations add
-/// their measured cost to the same tasks; in deferred mode conditional_break returns true
+/// their measured cost to the same tasks (a loop task's cost is the mean over iterations,
+/// leaving out its longest one when it ran 3 times or more, so that one preemption by the
+/// OS does not inflate the span); in deferred mode conditional_break returns true
 /// after recording the body once, and the executor iterates.
 class Recorder {
  public:
@@ -189,6 +191,7 @@ class Recorder {
       const TaskId t = body_first_ + replay_pos_;
       if (t + 1 < body_last_ && cur_.tasks[t].kind == kind && cur_.tasks[t].object == obj) {
         cost_sum_[t] += ticks;
+        if (ticks > cost_max_[t]) cost_max_[t] = ticks;
         ++replay_pos_;
       } else {
         ++errors_;  // the body changed between iterations
@@ -212,6 +215,7 @@ class Recorder {
   std::vector<void*> ptrs_;
   std::unordered_map<std::string, ObjectId> object_ids_;
   std::vector<std::uint64_t> cost_sum_;  // per task, ticks summed over iterations
+  std::vector<std::uint64_t> cost_max_;  // per task, the longest iteration
   std::vector<std::uint64_t> object_hash_, kind_hash_;  // name hashes (0: not computed)
   std::chrono::steady_clock::time_point step_clock_{};  // begin_step: ticks -> ns per step
   std::uint64_t step_ticks_ = 0;
