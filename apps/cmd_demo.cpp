@@ -48,6 +48,7 @@ struct Row {
   double speedup = 0;
   double efficiency = 0;
   std::uint64_t signals = 0;
+  std::string failure;           // why the replay could not run (empty: it ran)
 };
 
 Trace capture_scene(const DemoOptions& o) {
@@ -123,6 +124,10 @@ std::string html_report(const DemoOptions& o, const Metrics& m, const Trace& tra
         << r.migrated_tasks << "</td><td>" << r.predicted_speedup << "</td>";
     else
       h << "<td>-</td><td>-</td><td>-</td><td>-</td><td>-</td>";
+    if (!r.failure.empty()) {
+      h << "<td colspan=\"5\">replay failed: " << html_escape(r.failure) << "</td></tr>";
+      continue;
+    }
     h << "<td>" << r.measured_ms << "</td><td>" << r.sequential_ms << "</td><td>" << r.speedup << "</td><td>"
       << r.efficiency << "</td><td>" << r.signals << "</td></tr>";
   }
@@ -189,7 +194,12 @@ void run_demo(const DemoOptions& o) {
     row.cut_bytes = ev.total.cut_bytes;
     row.migrated_tasks = ev.total.migrated_tasks;
     row.predicted_speedup = ev.total.speedup;
-    fill_measured(row, replay(trace, &part.assignment, tr::Policy::kPartition, o));
+    try {
+      fill_measured(row, replay(trace, &part.assignment, tr::Policy::kPartition, o));
+    } catch (const Error& e) {
+      row.failure = e.what();  // reported in the table, the other methods still run
+      say("  replay failed: " + row.failure);
+    }
     rows.push_back(row);
   }
   for (tr::Policy p : {tr::Policy::kWorksteal, tr::Policy::kBarrier}) {
@@ -210,7 +220,8 @@ void run_demo(const DemoOptions& o) {
                            {"imbalance", r.imbalance}, {"cut_bytes", r.cut_bytes},
                            {"migrated_tasks", r.migrated_tasks}, {"predicted_speedup", r.predicted_speedup},
                            {"wall_ns", r.measured_ms * 1e6}, {"sequential_wall_ns", r.sequential_ms * 1e6},
-                           {"speedup", r.speedup}, {"efficiency", r.efficiency}, {"signals", r.signals}});
+                           {"speedup", r.speedup}, {"efficiency", r.efficiency}, {"signals", r.signals},
+                           {"replay_failure", r.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.failure)}});
     print_json(j);
     return;
   }
@@ -226,7 +237,10 @@ void run_demo(const DemoOptions& o) {
                   r.predicted_speedup);
     else
       std::printf("%-11s %10s %9s %12s %9s %10s", r.name.c_str(), "-", "-", "-", "-", "-");
-    std::printf(" %11.2f %11.2f %7.2fx %6.2f\n", r.measured_ms, r.sequential_ms, r.speedup, r.efficiency);
+    if (!r.failure.empty())
+      std::printf("  replay failed: %s\n", r.failure.c_str());
+    else
+      std::printf(" %11.2f %11.2f %7.2fx %6.2f\n", r.measured_ms, r.sequential_ms, r.speedup, r.efficiency);
   }
   std::printf("\ntrace: %s\nreport: %s\n", trace_path.c_str(), report_path.c_str());
 }

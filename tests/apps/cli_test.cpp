@@ -169,4 +169,25 @@ TEST_F(Cli, ExportWritesNothingOnBadInput) {
   EXPECT_FALSE(fs::exists(dir_ / "out.metis"));
 }
 
+TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
+  const Result r = run("demo --scene fig2 --steps 3 --repeat 1 --threads 2 --out d --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  std::vector<std::string> names;
+  for (const auto& row : j["rows"]) {
+    names.push_back(row["method"]);
+    if (row["replay_failure"].is_null()) {
+      EXPECT_GT(row["wall_ns"].get<double>(), 0.0) << row.dump();
+      EXPECT_GT(row["sequential_wall_ns"].get<double>(), 0.0) << row.dump();
+    }
+    if (row["partitioned"].get<bool>()) EXPECT_GE(row["imbalance"].get<double>(), 1.0) << row.dump();
+  }
+  for (const char* m : {"owner", "metis", "scotch", "sticky", "list", "roundrobin", "random", "worksteal", "barrier"})
+    EXPECT_NE(std::find(names.begin(), names.end(), m), names.end()) << m;
+  EXPECT_TRUE(fs::exists(dir_ / "d" / "fig2.tgt"));
+  const std::string html = slurp(dir_ / "d" / "report.html");
+  EXPECT_NE(html.find("<table>"), std::string::npos);
+  EXPECT_NE(html.find("worksteal"), std::string::npos);
+}
+
 }  // namespace
