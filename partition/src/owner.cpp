@@ -166,34 +166,15 @@ class Owner final : public Strategy {
     Result r;
     r.assignment.k = k;
     r.assignment.proc.assign(n, 0);
-    // Which processors hold each datum (bytes of affinity), from the owned tasks.
-    std::vector<std::vector<ProcId>> holders(g.data.size());
-    auto hold = [&](TaskId t, ProcId p) {
-      for (const Access& acc : g.accesses_of(t)) {
-        auto& h = holders[acc.datum];
-        if (std::find(h.begin(), h.end(), p) == h.end()) h.push_back(p);
-      }
-    };
+    // Owned tasks go with their object; tasks on shared data only go where most bytes of
+    // their data are (ties and no affinity: the least loaded processor).
+    std::vector<bool> placed(n, false);
     for (TaskId t = 0; t < n; ++t)
       if (owner[t] != kUnowned) {
         r.assignment.proc[t] = proc_of_object[owner[t]];
-        hold(t, r.assignment.proc[t]);
+        placed[t] = true;
       }
-    // Tasks on shared data only: the processor holding most bytes of their data; ties and
-    // no affinity go to the least loaded one.
-    std::vector<std::uint64_t> score(k);
-    for (TaskId t = 0; t < n; ++t) {
-      if (owner[t] != kUnowned) continue;
-      std::fill(score.begin(), score.end(), 0);
-      for (const Access& acc : g.accesses_of(t))
-        for (ProcId p : holders[acc.datum]) score[p] += std::max<std::uint64_t>(g.data[acc.datum].bytes, 1);
-      ProcId best = least_loaded();
-      for (ProcId p = 0; p < k; ++p)
-        if (score[p] > score[best] || (score[p] == score[best] && load[p] < load[best])) best = p;
-      r.assignment.proc[t] = best;
-      load[best] += work[t];
-      hold(t, best);
-    }
+    place_by_affinity(g, work, k, placed, r.assignment.proc, load);
     return r;
   }
 };

@@ -230,33 +230,15 @@ class Sticky final : public Strategy {
     std::vector<ProcId>& proc = r.assignment.proc;
     proc.assign(n, 0);
     std::vector<std::uint64_t> load(k, 0);
-    std::vector<std::vector<ProcId>> holders(g.data.size());
-    auto hold = [&](TaskId t, ProcId p) {
-      for (const Access& acc : g.accesses_of(t)) {
-        auto& h = holders[acc.datum];
-        if (std::find(h.begin(), h.end(), p) == h.end()) h.push_back(p);
-      }
-    };
+    std::vector<bool> placed(n, false);
     for (TaskId t = 0; t < n; ++t)
       if (match[t] != kNoTask) {
         proc[t] = prev.assignment->proc[match[t]];
         load[proc[t]] += work[t];
-        hold(t, proc[t]);
+        placed[t] = true;
       }
     // New tasks, in program order: the processor holding most bytes of their data.
-    std::vector<std::uint64_t> score(k);
-    for (TaskId t = 0; t < n; ++t) {
-      if (match[t] != kNoTask) continue;
-      std::fill(score.begin(), score.end(), 0);
-      for (const Access& acc : g.accesses_of(t))
-        for (ProcId p : holders[acc.datum]) score[p] += std::max<std::uint64_t>(g.data[acc.datum].bytes, 1);
-      ProcId best = static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
-      for (ProcId p = 0; p < k; ++p)
-        if (score[p] > score[best] || (score[p] == score[best] && load[p] < load[best])) best = p;
-      proc[t] = best;
-      load[best] += work[t];
-      hold(t, best);
-    }
+    place_by_affinity(g, work, k, placed, proc, load);
 
     if (imbalance(load) <= trigger || k == 1 || n <= k) {
       remember(proc, baseline);

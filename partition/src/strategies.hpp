@@ -28,6 +28,14 @@ std::vector<std::uint64_t> loads(const std::vector<std::uint64_t>& work,
 /// max load / mean load (1 for zero work).
 double imbalance(const std::vector<std::uint64_t>& load);
 
+/// Places every task with `placed[t]` false, in program order, on the processor that holds
+/// most bytes of the data it touches (holders: the processors of placed tasks and of tasks
+/// placed before it); ties and no affinity go to the least loaded processor. `proc` holds
+/// the placed tasks' processors; `load` is updated with each placed task's work.
+void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& work,
+                       std::uint32_t k, const std::vector<bool>& placed,
+                       std::vector<ProcId>& proc, std::vector<std::uint64_t>& load);
+
 /// Assignment for K >= n: task i on processor i. Empty graph: empty assignment.
 Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k);
 

@@ -165,6 +165,34 @@ double imbalance(const std::vector<std::uint64_t>& load) {
   return static_cast<double>(max) * static_cast<double>(load.size()) / static_cast<double>(total);
 }
 
+void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& work,
+                       std::uint32_t k, const std::vector<bool>& placed,
+                       std::vector<ProcId>& proc, std::vector<std::uint64_t>& load) {
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  std::vector<std::vector<ProcId>> holders(g.data.size());  // processors holding each datum
+  auto hold = [&](TaskId t, ProcId p) {
+    for (const Access& acc : g.accesses_of(t)) {
+      auto& h = holders[acc.datum];
+      if (std::find(h.begin(), h.end(), p) == h.end()) h.push_back(p);
+    }
+  };
+  for (TaskId t = 0; t < n; ++t)
+    if (placed[t]) hold(t, proc[t]);
+  std::vector<std::uint64_t> score(k);
+  for (TaskId t = 0; t < n; ++t) {
+    if (placed[t]) continue;
+    std::fill(score.begin(), score.end(), 0);
+    for (const Access& acc : g.accesses_of(t))
+      for (ProcId p : holders[acc.datum]) score[p] += std::max<std::uint64_t>(g.data[acc.datum].bytes, 1);
+    ProcId best = static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
+    for (ProcId p = 0; p < k; ++p)
+      if (score[p] > score[best] || (score[p] == score[best] && load[p] < load[best])) best = p;
+    proc[t] = best;
+    load[best] += work[t];
+    hold(t, best);
+  }
+}
+
 Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k) {
   Assignment a;
   a.k = k;
