@@ -3,6 +3,7 @@
 #include "tgraph/replay/lowering.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 #include <unordered_map>
 
@@ -196,20 +197,47 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
   }
   out.derive_edges();
 
-  // 3. The assignment on exec tasks. With explicit orders, a reducer goes right after the
-  // last task of its processor it transitively depends on: in a deadlock-free order every
-  // such task precedes every task that depends on the reducer (they depended on the CW
-  // writers before lowering), so the new order stays deadlock-free.
+  // 3. The assignment on exec tasks. With explicit orders, each processor's order is first
+  // put in the form the partitioned executor runs (a loop's tasks gathered into one block at
+  // the first of them), then each reducer goes right after the last task of its home
+  // processor that it transitively depends on, inside its loop's block there when it has a
+  // loop. "Depends" follows what a processor actually waits for: the graph's edges, its
+  // predecessor in its processor's order, and, for a task that follows a loop (by an edge or
+  // in its processor's order), the loop's break task (the exit decision). The orders plus
+  // these relations are acyclic (the orders do not deadlock); inserting a task after all its
+  // ancestors on one processor keeps them acyclic. The graph's edges alone are not enough:
+  // reducers placed early on two processors can each wait for tasks behind the other's
+  // (bars64 under `list`), and a reducer placed before its loop's block drags the whole
+  // block ahead of other loops whose exit it needs (falling under `list`).
   Assignment& ax = x.assignment;
   ax.k = a ? a->k : 1;
   ax.proc = std::move(exec_proc);
   if (a != nullptr && !a->order.empty()) {
-    ax.order.assign(ax.k, {});
-    for (ProcId p = 0; p < ax.k && p < a->order.size(); ++p)
-      for (TaskId t : a->order[p]) ax.order[p].push_back(x.exec_of[t]);
     const auto ne = static_cast<TaskId>(out.tasks.size());
+    const StepGraph& xg = out;
+    auto loop_of = [&](TaskId t) { return xg.tasks[t].loop; };
+    ax.order.assign(ax.k, {});
+    for (ProcId p = 0; p < ax.k && p < a->order.size(); ++p) {
+      std::vector<std::vector<TaskId>> body(xg.loops.size());
+      for (TaskId t : a->order[p])
+        if (g.tasks[t].loop != kNoLoop) body[g.tasks[t].loop].push_back(x.exec_of[t]);
+      std::vector<bool> opened(xg.loops.size(), false);
+      for (TaskId t : a->order[p]) {
+        const LoopId l = g.tasks[t].loop;
+        if (l == kNoLoop) {
+          ax.order[p].push_back(x.exec_of[t]);
+        } else if (!opened[l]) {
+          opened[l] = true;
+          ax.order[p].insert(ax.order[p].end(), body[l].begin(), body[l].end());
+        }
+      }
+    }
     std::vector<std::vector<TaskId>> preds(ne);
     for (const Edge& e : out.edges) preds[e.to].push_back(e.from);
+    // Position of each ordered task in its processor's order (UINT32_MAX: not placed yet).
+    std::vector<std::uint32_t> at(ne, UINT32_MAX);
+    for (const auto& ord : ax.order)
+      for (std::uint32_t i = 0; i < ord.size(); ++i) at[ord[i]] = i;
     std::vector<std::uint32_t> mark(ne, 0);
     std::uint32_t stamp = 0;
     std::vector<TaskId> stack;
@@ -218,20 +246,41 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
       const ProcId home = ax.proc[r];
       ++stamp;
       stack.assign(1, r);
+      auto visit = [&](TaskId u) {
+        if (mark[u] != stamp) {
+          mark[u] = stamp;
+          stack.push_back(u);
+        }
+      };
+      // t waits for u; when u is in a loop that t is not in, t also waits for its exit.
+      auto waits_for = [&](TaskId t, TaskId u) {
+        visit(u);
+        const LoopId lu = loop_of(u);
+        if (lu != kNoLoop && lu != loop_of(t)) visit(xg.loops[lu].last - 1);
+      };
       while (!stack.empty()) {
         const TaskId t = stack.back();
         stack.pop_back();
-        for (TaskId u : preds[t])
-          if (mark[u] != stamp) {
-            mark[u] = stamp;
-            stack.push_back(u);
-          }
+        for (TaskId u : preds[t]) waits_for(t, u);
+        if (t != r && at[t] != UINT32_MAX && at[t] > 0)
+          waits_for(t, ax.order[ax.proc[t]][at[t] - 1]);
       }
       auto& ord = ax.order[home];
       std::size_t pos = 0;
       for (std::size_t i = 0; i < ord.size(); ++i)
         if (mark[ord[i]] == stamp) pos = i + 1;
+      if (const LoopId l = loop_of(r); l != kNoLoop) {
+        // Inside the block of l on the home processor (which holds the group's first writer).
+        std::size_t begin = ord.size(), end = 0;
+        for (std::size_t i = 0; i < ord.size(); ++i)
+          if (loop_of(ord[i]) == l) {
+            begin = std::min(begin, i);
+            end = i + 1;
+          }
+        if (begin < end) pos = std::clamp(pos, begin, end);
+      }
       ord.insert(ord.begin() + static_cast<std::ptrdiff_t>(pos), r);
+      for (std::size_t i = pos; i < ord.size(); ++i) at[ord[i]] = static_cast<std::uint32_t>(i);
     }
   }
   return x;

@@ -206,6 +206,17 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
   return plan;
 }
 
+/// How the deadlock message names exec task `t`: its original task id, or for a reducer
+/// added by lowering (no original task), the datum it reduces.
+std::string task_label(const ExecGraph& x, TaskId t) {
+  if (x.origin[t] != kNoTask) return "task " + std::to_string(x.origin[t]);
+  if (t < x.reduction.size() && x.reduction[t] != kNoReduction) {
+    const DatumId d = x.reductions[x.reduction[t]].target;
+    return "the reducer of datum " + std::to_string(d) + " '" + x.graph.data[d].name + "'";
+  }
+  return "exec task " + std::to_string(t);
+}
+
 /// Runs the per-processor programs interleaved on one thread (round robin, each processor
 /// advancing while its waits hold). With a workload: the serial executor (deterministic);
 /// without: the deadlock check of a plan (every loop runs two iterations).
@@ -296,7 +307,7 @@ void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
           const Op& op = plan.procs[p].ops[cur[p].pc];
           throw UsageError("the assignment's task order deadlocks: processor " + std::to_string(p) +
                            " cannot run " +
-                           (op.kind == OpKind::kTask ? "task " + std::to_string(x.origin[op.task])
+                           (op.kind == OpKind::kTask ? task_label(x, op.task)
                                                      : std::string("its loop control")) +
                            " (" + g.kind_name(op.kind == OpKind::kTask ? op.task : 0) + ")");
         }

@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/replay/lowering.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "random_graph.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/synthetic.hpp"
+#if defined(TGRAPH_HAVE_PARTITION)
+#include "tgraph/partition/strategy.hpp"
+#endif
+
+namespace tgraph::replay {
+namespace {
+
+/// Two CW groups whose reducers land on different processors, each fed only by the other
+/// processor (the shape of bars64's force accumulation under `list`):
+///   t0 W a (p0)   t1 W b (p1)          resets
+///   t2 CW a (p1)  t3 CW b (p0)         first writers: the homes (a: p1, b: p0)
+///   t4 CW a (p0)  t5 CW b (p1)         off-home writers -> temporaries a@0, b@1
+///   t6 R a (p1)   t7 R b (p0)          readers
+/// The reducer of a (home p1) depends, through the graph's edges, only on t0 and t4 (p0),
+/// the reducer of b (home p0) only on t1 and t5 (p1). Placed by edges alone, both went to
+/// the front of their processor's order and waited for each other's processor: a deadlock.
+/// With `in_loop`, the same tasks form a loop body, with a residual and a break on p0.
+StepGraph crossing_reducers(bool in_loop) {
+  StepGraph g;
+  g.intern_kind("reset");
+  g.intern_kind("add");
+  g.intern_kind("read");
+  g.intern_kind("loop.break");
+  g.objects.push_back({"o"});
+  g.data = {{"a", 0, 64}, {"b", 0, 64}, {"cond", kNoObject, 8}};
+  auto add = [&](KindId kind, std::vector<Access> acc) {
+    const auto t = static_cast<TaskId>(g.tasks.size());
+    g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(t + 1));
+    if (in_loop) g.tasks[t].loop = 0;
+  };
+  add(0, {{0, AccessMode::W}});
+  add(0, {{1, AccessMode::W}});
+  add(1, {{0, AccessMode::CW}});
+  add(1, {{1, AccessMode::CW}});
+  add(1, {{0, AccessMode::CW}});
+  add(1, {{1, AccessMode::CW}});
+  add(2, {{0, AccessMode::R}});
+  add(2, {{1, AccessMode::R}});
+  if (in_loop) {
+    add(2, {{0, AccessMode::R}, {2, AccessMode::W}});
+    add(3, {{2, AccessMode::R}});
+    Loop l;
+    l.condition = 2;
+    l.first = 0;
+    l.last = static_cast<TaskId>(g.tasks.size());
+    l.iterations = 3;
+    g.loops.push_back(l);
+  }
+  g.derive_edges();
+  EXPECT_EQ(g.validate(), "");
+  return g;
+}
+
+Assignment crossing_assignment(const StepGraph& g) {
+  Assignment a;
+  a.k = 2;
+  a.proc = {0, 1, 1, 0, 0, 1, 1, 0};
+  a.order = {{0, 3, 4, 7}, {1, 2, 5, 6}};
+  if (g.tasks.size() > 8) {
+    a.proc.insert(a.proc.end(), {0, 0});
+    a.order[0].insert(a.order[0].end(), {8, 9});
+  }
+  return a;
+}
+
+std::size_t index_in(const std::vector<TaskId>& order, TaskId t) {
+  return static_cast<std::size_t>(std::find(order.begin(), order.end(), t) - order.begin());
+}
+
+class CrossingReducers : public ::testing::TestWithParam<bool> {};
+
+TEST_P(CrossingReducers, AreOrderedAfterTheirAncestorsThroughOtherProcessorsOrders) {
+  const StepGraph g = crossing_reducers(GetParam());
+  const Assignment a = crossing_assignment(g);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  ASSERT_EQ(x.reductions.size(), 2u);
+  const TaskId ra = x.exec_of[4] + 1, rb = x.exec_of[5] + 1;  // reducers of a, b
+  ASSERT_EQ(x.reduction[ra], 0u);
+  ASSERT_EQ(x.reduction[rb], 1u);
+  EXPECT_EQ(x.assignment.proc[ra], 1u);
+  EXPECT_EQ(x.assignment.proc[rb], 0u);
+  const auto& o0 = x.assignment.order[0];
+  const auto& o1 = x.assignment.order[1];
+  ASSERT_EQ(o0.size() + o1.size(), x.graph.tasks.size());
+  // a's reducer waits for t4 on p0, which follows t3, which waits for t1 on p1: it goes
+  // right after t1 (not at the front of p1's order). b's reducer waits for t5 on p1, behind
+  // t2 and a's reducer, which waits for t4: it goes right after t4 on p0.
+  EXPECT_EQ(index_in(o1, ra), index_in(o1, x.exec_of[1]) + 1);
+  EXPECT_EQ(index_in(o0, rb), index_in(o0, x.exec_of[4]) + 1);
+}
+
+TEST_P(CrossingReducers, RunWithTheExplicitOrderAndMatchTheSequentialState) {
+  const StepGraph g = crossing_reducers(GetParam());
+  const Assignment a = crossing_assignment(g);
+  std::vector<std::vector<std::uint64_t>> want;
+  {
+    auto seq = make_executor(Policy::kSequential, {});
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    seq->run_step(g, nullptr, w);
+    for (DatumId d = 0; d < g.data.size(); ++d) {
+      auto words = w.words(d);
+      want.emplace_back(words.begin(), words.end());
+    }
+  }
+  for (bool serial : {true, false}) {
+    ExecOptions o;
+    o.threads = 2;
+    o.serial = serial;
+    o.spin_ns = 20'000;
+    auto ex = make_executor(Policy::kPartition, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    ASSERT_NO_THROW(ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
+    EXPECT_EQ(ex->order_fallbacks(), 0u);
+    for (DatumId d = 0; d < g.data.size(); ++d) {
+      auto words = w.words(d);
+      EXPECT_TRUE(std::vector<std::uint64_t>(words.begin(), words.end()) == want[d])
+          << (serial ? "serial" : "threads") << ": datum " << g.data[d].name;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(StraightAndLoop, CrossingReducers, ::testing::Bool(),
+                         [](const auto& p) { return p.param ? "InLoop" : "Straight"; });
+
+/// Two loops; processor 0 holds only loop A's break task and loop B's first CW writer of y
+/// (the home of y's group), processor 1 everything else (the shape of falling under `list`):
+///   loop A: a0 W x (p1), a1 R x W ca (p1), a2 break R ca (p0)
+///   loop B: b0 CW y (p0), b1 CW y (p1) -> y@1, b2 R y W cb (p1), b3 break R cb (p1)
+/// The reducer of y (loop B, home p0) waits for b1, which p1 runs after leaving loop A, that
+/// is after p0's a2 decided A's exit. By edges alone it had no ancestor on p0 and went to
+/// the front of p0's order, pulling p0's whole B block ahead of A: a deadlock.
+TEST(CwReduction, ReducerStaysInItsLoopBlockBehindTheExitOfEarlierLoops) {
+  StepGraph g;
+  g.intern_kind("k");
+  g.intern_kind("loop.break");
+  g.objects.push_back({"o"});
+  g.data = {{"x", 0, 64}, {"ca", kNoObject, 8}, {"y", 0, 64}, {"cb", kNoObject, 8}};
+  auto add = [&](KindId kind, LoopId l, std::vector<Access> acc) {
+    const auto t = static_cast<TaskId>(g.tasks.size());
+    g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(t + 1));
+    g.tasks[t].loop = l;
+  };
+  add(0, 0, {{0, AccessMode::W}});
+  add(0, 0, {{0, AccessMode::R}, {1, AccessMode::W}});
+  add(1, 0, {{1, AccessMode::R}});
+  add(0, 1, {{2, AccessMode::CW}});
+  add(0, 1, {{2, AccessMode::CW}});
+  add(0, 1, {{2, AccessMode::R}, {3, AccessMode::W}});
+  add(1, 1, {{3, AccessMode::R}});
+  g.loops.push_back({1, 0, 3, 2, 0});
+  g.loops.push_back({3, 3, 7, 2, 0});
+  g.derive_edges();
+  ASSERT_EQ(g.validate(), "");
+  Assignment a;
+  a.k = 2;
+  a.proc = {1, 1, 0, 0, 1, 1, 1};
+  a.order = {{2, 3}, {0, 1, 4, 5, 6}};
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  ASSERT_EQ(x.reductions.size(), 1u);
+  const TaskId r = x.exec_of[4] + 1;
+  ASSERT_EQ(x.origin[r], kNoTask);
+  EXPECT_EQ(x.assignment.order[0], (std::vector<TaskId>{x.exec_of[2], r, x.exec_of[3]}));
+  for (bool serial : {true, false}) {
+    ExecOptions o;
+    o.threads = 2;
+    o.serial = serial;
+    o.spin_ns = 20'000;
+    auto ex = make_executor(Policy::kPartition, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    StepStats s;
+    ASSERT_NO_THROW(s = ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
+    EXPECT_EQ(ex->order_fallbacks(), 0u);
+    EXPECT_EQ(s.loop_iterations, (std::vector<std::uint32_t>{2, 2}));
+  }
+}
+
+#if defined(TGRAPH_HAVE_PARTITION)
+// The `list` strategy's orders (loops as blocks) on random programs with CW groups and
+// loops: lowering's reducers must keep them runnable, without the program-order fallback.
+TEST(CwReduction, ListScheduleOrdersRunWithReducersOnRandomPrograms) {
+  auto list = partition::make_strategy("list");
+  std::size_t reducers = 0, in_loops = 0;
+  for (std::uint32_t seed = 1; seed <= 150; ++seed) {
+    const StepGraph g = test::random_graph(seed, 1 + static_cast<int>(seed % 4), 12, 10);
+    for (std::uint32_t k : {2u, 3u, 4u}) {
+      const Assignment a = list->partition(g, k, {}, partition::Options{}).assignment;
+      ASSERT_FALSE(a.order.empty());
+      ExecOptions o;
+      o.threads = k;
+      o.serial = true;
+      auto ex = make_executor(Policy::kPartition, o);
+      SyntheticWorkload w({.cost_scale = 0.0});
+      w.set_step(g);
+      ASSERT_NO_THROW(ex->run_step(g, &a, w)) << "seed " << seed << " k " << k;
+      const ExecGraph& x = *ex->last_exec();
+      // Serialised CW writers (added edges) may legitimately need program order; reducers
+      // alone never may.
+      if (x.added_edges) continue;
+      EXPECT_EQ(ex->order_fallbacks(), 0u) << "seed " << seed << " k " << k;
+      reducers += x.reductions.size();
+      for (TaskId t = 0; t < x.graph.tasks.size(); ++t)
+        if (x.origin[t] == kNoTask && x.graph.tasks[t].loop != kNoLoop) ++in_loops;
+    }
+  }
+  // The programs do exercise the reducer placement, in loops too (141 and 23 reducers).
+  EXPECT_GT(reducers, 100u);
+  EXPECT_GT(in_loops, 10u);
+}
+#endif
+
+}  // namespace
+}  // namespace tgraph::replay
