@@ -49,6 +49,8 @@ void Recorder::begin_step() {
   cur_.groups.clear();
   cost_sum_.clear();
   cost_max_.clear();
+  loop_timed_.clear();
+  time_task_ = true;
   bodies_.clear();
   conditions_.clear();
   open_loop_ = kNoLoop;
@@ -97,8 +99,10 @@ LoopId Recorder::begin_loop(DatumId condition, std::uint32_t max_iterations) {
   loop.iterations = 0;
   loop.max_iterations = max_iterations;
   cur_.loops.push_back(loop);
+  loop_timed_.push_back(0);
   open_loop_ = static_cast<LoopId>(cur_.loops.size() - 1);
   iteration_ = 0;
+  time_task_ = true;
   replay_pos_ = 0;
   return open_loop_;
 }
@@ -122,7 +126,9 @@ bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
     cost_sum_[loop.last - 1] += ns;
     if (ns > cost_max_[loop.last - 1]) cost_max_[loop.last - 1] = ns;
   }
+  if (time_task_) ++loop_timed_[loop_id];
   ++iteration_;
+  time_task_ = iteration_ < kAlwaysTimed || iteration_ % kTimeEvery == 0;
   replay_pos_ = 0;
   loop.iterations = iteration_;
   return loop.max_iterations != 0 && iteration_ >= loop.max_iterations;
@@ -135,6 +141,7 @@ void Recorder::end_loop(LoopId loop) {
   }
   if (cur_.loops[loop].iterations == 0) ++errors_;  // no conditional_break was recorded
   open_loop_ = kNoLoop;
+  time_task_ = true;
 }
 
 StepGraph Recorder::finish_step() {
@@ -164,8 +171,11 @@ StepGraph Recorder::finish_step() {
   occurrence.reserve(g.tasks.size());
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     Task& task = g.tasks[t];
-    const std::uint64_t runs = g.runs(t);
-    // Mean over iterations without the longest one (an OS preemption) from 3 runs on.
+    // Timed runs: every run, except for loop body tasks (the break is always timed).
+    const LoopId l = task.loop;
+    const std::uint64_t runs =
+        (l != kNoLoop && t + 1 != g.loops[l].last) ? loop_timed_[l] : g.runs(t);
+    // Mean over timed runs without the longest one (an OS preemption) from 3 runs on.
     const bool trim = runs >= 3;
     const double sum_ns = static_cast<double>(cost_sum_[t] - (trim ? cost_max_[t] : 0)) * ns_per_tick;
     const double n_runs = static_cast<double>(trim ? runs - 1 : (runs == 0 ? 1 : runs));

@@ -199,3 +199,33 @@ TEST(Recorder, TaskCostsAreInNanoseconds) {
 
 }  // namespace
 }  // namespace tgraph::capture
+
+namespace tgraph::capture {
+namespace {
+
+TEST(Recorder, SampledLoopTimingEstimatesThePerIterationCost) {
+  Recorder rec(Mode::kCapture);
+  const DatumId c = rec.datum("c", kNoObject, 1);
+  const KindId k = rec.kind("k");
+  rec.begin_step();
+  const LoopId l = rec.begin_loop(c, 20);
+  int runs = 0;
+  do {
+    rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
+      ++runs;
+      const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
+      while (std::chrono::steady_clock::now() < until) {
+      }
+    });
+  } while (!rec.conditional_break(l, [] { return false; }));
+  rec.end_loop(l);
+  const StepGraph g = rec.end_step();
+  EXPECT_EQ(runs, 20);  // every iteration ran, timed or not
+  ASSERT_EQ(g.loops[0].iterations, 20u);
+  // Timed: iterations 0, 1, 2, 4, 8, 12, 16; each cost at least 200 us.
+  EXPECT_GE(g.tasks[0].cost_ns, 200'000u);
+  EXPECT_LT(g.tasks[0].cost_ns, 2'000'000u);
+}
+
+}  // namespace
+}  // namespace tgraph::capture

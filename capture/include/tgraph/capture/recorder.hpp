@@ -72,12 +72,20 @@ struct StepProgram {
 ///   rec.end_loop(l);
 ///
 /// In capture mode the body is recorded on the first iteration and later iterations add
-/// their measured cost to the same tasks (a loop task's cost is the mean over iterations,
-/// leaving out its longest one when it ran 3 times or more, so that one preemption by the
-/// OS does not inflate the span); in deferred mode conditional_break returns true
+/// their measured cost to the same tasks. Loop bodies are timed in their first
+/// kAlwaysTimed iterations and then every kTimeEvery-th one (iterations of a solver loop do
+/// the same work; reading the clock around every run of a sub-microsecond task would cost
+/// several percent of the step); a loop task's cost is the mean over its timed iterations,
+/// leaving out the longest one when there are 3 or more, so that one preemption by the OS
+/// does not inflate the span; in deferred mode conditional_break returns true
 /// after recording the body once, and the executor iterates.
 class Recorder {
  public:
+  /// Loop iterations always timed in capture mode.
+  static constexpr std::uint32_t kAlwaysTimed = 3;
+  /// After those, one iteration in kTimeEvery is timed.
+  static constexpr std::uint32_t kTimeEvery = 4;
+
   explicit Recorder(Mode mode = Mode::kCapture);
 
   /// Current mode.
@@ -116,6 +124,11 @@ class Recorder {
         body();
         return;
       case Mode::kCapture: {
+        if (!time_task_) {  // an untimed loop iteration (see kTimeEvery)
+          body();
+          record(kind, obj, acc.begin(), acc.size(), 0);
+          return;
+        }
         const std::uint64_t t0 = detail::ticks();
         body();
         record(kind, obj, acc.begin(), acc.size(), detail::ticks() - t0);
@@ -227,6 +240,8 @@ class Recorder {
   TaskId body_first_ = 0, body_last_ = 0;  // body of the open loop, once recorded
   bool in_step_ = false;
   bool derive_edges_ = true;
+  bool time_task_ = true;                   // time the tasks of the current iteration
+  std::vector<std::uint32_t> loop_timed_;   // per loop: timed iterations so far
   std::uint64_t errors_ = 0;
 };
 
