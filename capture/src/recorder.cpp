@@ -175,8 +175,9 @@ StepGraph Recorder::finish_step() {
     const LoopId l = task.loop;
     const std::uint64_t runs =
         (l != kNoLoop && t + 1 != g.loops[l].last) ? loop_timed_[l] : g.runs(t);
-    // Mean over timed runs without the longest one (an OS preemption) from 3 runs on.
-    const bool trim = runs >= 3;
+    // Mean over timed runs; from 3 runs on, the longest one is left out when it is an
+    // outlier (over 4x the mean of the others: an OS preemption, not the task's cost).
+    const bool trim = runs >= 3 && (cost_sum_[t] - cost_max_[t]) < (cost_max_[t] / 4) * (runs - 1);
     const double sum_ns = static_cast<double>(cost_sum_[t] - (trim ? cost_max_[t] : 0)) * ns_per_tick;
     const double n_runs = static_cast<double>(trim ? runs - 1 : (runs == 0 ? 1 : runs));
     task.cost_ns = static_cast<std::uint64_t>(sum_ns / n_runs + 0.5);

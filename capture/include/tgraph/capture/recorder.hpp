@@ -76,8 +76,8 @@ struct StepProgram {
 /// kAlwaysTimed iterations and then every kTimeEvery-th one (iterations of a solver loop do
 /// the same work; reading the clock around every run of a sub-microsecond task would cost
 /// several percent of the step); a loop task's cost is the mean over its timed iterations,
-/// leaving out the longest one when there are 3 or more, so that one preemption by the OS
-/// does not inflate the span; in deferred mode conditional_break returns true
+/// leaving out the longest one when there are 3 or more and it is over 4x the mean of the
+/// others, so that one preemption by the OS does not inflate the span; in deferred mode conditional_break returns true
 /// after recording the body once, and the executor iterates.
 class Recorder {
  public:
