@@ -175,10 +175,7 @@ void run_demo(const DemoOptions& o) {
   write_trace(trace_path, trace);
   const Metrics m0 = compute_metrics(trace.steps.front());
 
-  tp::CostModel model = tp::CostModel::defaults();
-  const std::string calib = tp::default_calibration_path();
-  std::error_code ec;
-  if (std::filesystem::exists(calib, ec)) model = tp::load_calibration(calib);
+  const tp::CostModel model = tp::select_cost_model("calibrated", "");
 
   std::vector<Row> rows;
   for (const std::string& method : tp::strategy_names()) {

@@ -75,14 +75,7 @@ struct ModelFlags {
     cmd->add_option("--calibration", calibration,
                     "Calibration file (default: " + tp::default_calibration_path() + " if present)");
   }
-  tp::CostModel load() const {
-    if (model == "ideal") return tp::CostModel::ideal();
-    if (!calibration.empty()) return tp::load_calibration(calibration);
-    const std::string def = tp::default_calibration_path();
-    std::error_code ec;
-    if (std::filesystem::exists(def, ec)) return tp::load_calibration(def);
-    return tp::CostModel::defaults();
-  }
+  tp::CostModel load() const { return tp::select_cost_model(model, calibration); }
 };
 
 std::vector<std::uint64_t> structure_hashes(const Trace& trace) {

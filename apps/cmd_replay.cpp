@@ -32,15 +32,6 @@ namespace tr = tgraph::replay;
 
 std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 
-tp::CostModel load_model(const std::string& model, const std::string& calibration) {
-  if (model == "ideal") return tp::CostModel::ideal();
-  if (!calibration.empty()) return tp::load_calibration(calibration);
-  const std::string def = tp::default_calibration_path();
-  std::error_code ec;
-  if (std::filesystem::exists(def, ec)) return tp::load_calibration(def);
-  return tp::CostModel::defaults();
-}
-
 tr::Policy policy_from(const std::string& name, const char* flag) {
   const auto p = tr::parse_policy(name);
   if (!p)
@@ -95,7 +86,7 @@ void run_replay(const ReplayCmd& c) {
   }
   std::vector<std::uint64_t> predicted;
   if (assignment) {
-    const tp::CostModel model = load_model(c.model, c.calibration);
+    const tp::CostModel model = tp::select_cost_model(c.model, c.calibration);
     for (std::size_t s = 0; s < trace.steps.size(); ++s)
       predicted.push_back(tp::simulate(trace.steps[s], assignment->steps[s], model).makespan_ns);
   }

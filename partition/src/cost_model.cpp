@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -23,6 +24,15 @@ std::string default_calibration_path() {
   if (const char* home = std::getenv("HOME"); home != nullptr && *home != '\0')
     return std::string(home) + "/.config/tgraph/calibration.json";
   return "calibration.json";
+}
+
+CostModel select_cost_model(const std::string& model, const std::string& calibration) {
+  if (model == "ideal") return CostModel::ideal();
+  if (!calibration.empty()) return load_calibration(calibration);
+  const std::string def = default_calibration_path();
+  std::error_code ec;
+  if (std::filesystem::exists(def, ec)) return load_calibration(def);
+  return CostModel::defaults();
 }
 
 CostModel load_calibration(const std::string& path) {

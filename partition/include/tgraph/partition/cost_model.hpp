@@ -32,6 +32,9 @@ std::string default_calibration_path();
 /// Reads a calibration file written by `tgraph calibrate`; throws InputError naming the
 /// file for unreadable or malformed content.
 CostModel load_calibration(const std::string& path);
+/// The model the command line uses: `model` "ideal" -> CostModel::ideal(); else the file
+/// `calibration` if given, else the default calibration file if present, else defaults().
+CostModel select_cost_model(const std::string& model, const std::string& calibration);
 
 /// What `tgraph calibrate` measured.
 struct Calibration {
