@@ -9,6 +9,13 @@ namespace {
 
 using M = AccessMode;
 
+// Busy-waits (a task body that costs `d` of wall time).
+void busy_wait(std::chrono::nanoseconds d) {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < until) {
+  }
+}
+
 struct Scene {
   Recorder rec;
   double x = 0, v = 1, f = 0, res = 1;
@@ -169,9 +176,7 @@ TEST(Recorder, LoopTaskCostLeavesOutItsLongestIteration) {
   do {
     rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
       if (it++ == 2) {  // one iteration "preempted" for 20 ms
-        const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(20);
-        while (std::chrono::steady_clock::now() < until) {
-        }
+        busy_wait(std::chrono::milliseconds(20));
       }
     });
   } while (!rec.conditional_break(l, [] { return false; }));
@@ -188,9 +193,7 @@ TEST(Recorder, TaskCostsAreInNanoseconds) {
   const KindId k = rec.kind("k");
   rec.begin_step();
   rec.task(k, kNoObject, {{c, AccessMode::W}}, [] {
-    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(5);
-    while (std::chrono::steady_clock::now() < until) {
-    }
+    busy_wait(std::chrono::milliseconds(5));
   });
   const StepGraph g = rec.end_step();
   EXPECT_GE(g.tasks[0].cost_ns, 4'900'000u);
@@ -213,9 +216,7 @@ TEST(Recorder, SampledLoopTimingEstimatesThePerIterationCost) {
   do {
     rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
       ++runs;
-      const auto until = std::chrono::steady_clock::now() + std::chrono::microseconds(200);
-      while (std::chrono::steady_clock::now() < until) {
-      }
+      busy_wait(std::chrono::microseconds(200));
     });
   } while (!rec.conditional_break(l, [] { return false; }));
   rec.end_loop(l);
