@@ -103,21 +103,9 @@ class Metis final : public Strategy {
  private:
   Result do_partition(const StepGraph& g, std::uint32_t k, const Previous&,
                       const Options& options) override {
-    const auto n = static_cast<std::uint32_t>(g.tasks.size());
+    if (auto trivial = library_trivial_case(g, k)) return *trivial;
     Result r;
     r.assignment.k = k;
-    // METIS divides by log2(1) for K = 1 and returns incomplete partitions for K >= n.
-    if (k == 1 || n == 0) {
-      r.assignment.proc.assign(n, 0);
-      r.stats.edgecut = 0;
-      return r;
-    }
-    if (k >= n) {
-      r.assignment = one_task_per_processor(g, k);
-      const UndirectedGraph pg = library_graph(g);
-      r.stats.edgecut = edgecut(pg, r.assignment.proc);
-      return r;
-    }
     const UndirectedGraph pg = library_graph(g);
     std::vector<std::uint32_t> phase;
     std::uint32_t used = 1;

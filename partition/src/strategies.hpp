@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "tgraph/partition/partition_graph.hpp"
@@ -38,6 +39,11 @@ void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& wor
 
 /// Assignment for K >= n: task i on processor i. Empty graph: empty assignment.
 Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k);
+
+/// The cases METIS and Scotch must not be given (K = 1 divides by log2(1) in METIS, K >= n
+/// returns incomplete partitions, an empty graph): everything on processor 0, or one task
+/// per processor, with its edge cut. Empty when the library can be called.
+std::optional<Result> library_trivial_case(const StepGraph& g, std::uint32_t k);
 
 /// METIS k-way (serialised behind a process-wide mutex). `part` gets n entries; returns
 /// METIS's objval. Requires 2 <= k < n.

@@ -193,6 +193,21 @@ void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& wor
   }
 }
 
+std::optional<Result> library_trivial_case(const StepGraph& g, std::uint32_t k) {
+  const auto n = static_cast<std::uint32_t>(g.tasks.size());
+  if (k != 1 && n != 0 && k < n) return std::nullopt;
+  Result r;
+  if (k == 1 || n == 0) {
+    r.assignment.k = k;
+    r.assignment.proc.assign(n, 0);
+    r.stats.edgecut = 0;
+  } else {
+    r.assignment = one_task_per_processor(g, k);
+    r.stats.edgecut = edgecut(library_graph(g), r.assignment.proc);
+  }
+  return r;
+}
+
 Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k) {
   Assignment a;
   a.k = k;
