@@ -31,18 +31,6 @@ struct CaptureOptions {
   bool json = false;
 };
 
-std::string machine_description() {
-  std::string model;
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) {
-      if (auto colon = line.find(':'); colon != std::string::npos) model = line.substr(colon + 2);
-      break;
-    }
-  }
-  if (model.empty()) model = "unknown cpu";
-  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
-}
 
 void run_capture(const CaptureOptions& o) {
   if (!o.no_capture && o.output.empty()) throw UsageError("capture: -o/--output is required (or --no-capture)");
@@ -60,13 +48,7 @@ void run_capture(const CaptureOptions& o) {
   rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
   std::unique_ptr<TraceWriter> writer;
   if (!o.no_capture) {
-    TraceHeader header;
-    header.scene = scene->name();
-    header.engine = std::string("tgraph-samples ") + TGRAPH_VERSION + " (" + std::string(samples::to_string(scene->solver().integrator)) +
-                    " Euler, dt " + std::to_string(scene->solver().dt) + ", seed " + std::to_string(o.seed) + ")";
-    header.machine = machine_description();
-    header.tgraph_version = TGRAPH_VERSION;
-    writer = std::make_unique<TraceWriter>(o.output, header);
+    writer = std::make_unique<TraceWriter>(o.output, scene_header(*scene, o.seed));
   }
 
   const bool progress = isatty(STDERR_FILENO) != 0;
@@ -131,6 +113,17 @@ void run_capture(const CaptureOptions& o) {
 }
 
 }  // namespace
+
+TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed) {
+  TraceHeader header;
+  header.scene = scene.name();
+  header.engine = std::string("tgraph-samples ") + TGRAPH_VERSION + " (" +
+                  std::string(samples::to_string(scene.solver().integrator)) + " Euler, dt " +
+                  std::to_string(scene.solver().dt) + ", seed " + std::to_string(seed) + ")";
+  header.machine = machine_description();
+  header.tgraph_version = TGRAPH_VERSION;
+  return header;
+}
 
 void add_capture(CLI::App& app) {
   auto o = std::make_shared<CaptureOptions>();

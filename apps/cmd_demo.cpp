@@ -28,7 +28,7 @@ namespace tr = tgraph::replay;
 struct DemoOptions {
   std::string scene = "bars64";
   int steps = 10;
-  std::uint32_t threads = std::max(1u, std::thread::hardware_concurrency());
+  std::uint32_t threads = default_threads();
   std::uint32_t repeat = 3;
   std::string out_dir = "tgraph-demo";
   bool json = false;
@@ -55,10 +55,7 @@ Trace capture_scene(const DemoOptions& o) {
   auto scene = samples::make_scene(o.scene, {});
   capture::Recorder rec(capture::Mode::kCapture);
   Trace trace;
-  trace.header.scene = scene->name();
-  trace.header.engine = std::string("tgraph-samples ") + TGRAPH_VERSION;
-  trace.header.machine = std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
-  trace.header.tgraph_version = TGRAPH_VERSION;
+  trace.header = scene_header(*scene, 1);
   for (int s = 0; s < o.steps; ++s) {
     scene->step(rec);
     trace.steps.push_back(rec.end_step());

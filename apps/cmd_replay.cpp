@@ -30,8 +30,6 @@ namespace {
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
 
-std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
-
 tr::Policy policy_from(const std::string& name, const char* flag) {
   const auto p = tr::parse_policy(name);
   if (!p)

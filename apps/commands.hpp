@@ -12,6 +12,10 @@
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
 
+namespace tgraph::samples {
+class Scene;
+}
+
 namespace tgraph::app {
 
 /// The work itself failed (exit 1), as opposed to bad input (tgraph::Error, exit 2).
@@ -24,6 +28,12 @@ class Failure : public std::runtime_error {
 void print_json(const nlohmann::json& j);
 /// Reads a trace for a verb; malformed input throws InputError (exit 2).
 Trace load_trace(const std::string& path, bool recover = false);
+/// "<cpu model>, N hardware threads", for trace headers.
+std::string machine_description();
+/// Threads a verb uses by default: all hardware threads (at least 1).
+std::uint32_t default_threads();
+/// Header of a trace captured from `scene` (engine, integrator, dt, seed, machine).
+TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed);
 
 // Registration of each verb (one function per cmd_*.cpp).
 void add_info(CLI::App& app);
