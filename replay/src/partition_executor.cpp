@@ -483,6 +483,7 @@ class PartitionExecutor final : public Executor {
     const ProcPlan& pp = plan.procs[p];
     const std::uint64_t E = epoch_;
     const bool observe = !observers_.empty();
+    const std::uint32_t stride = observe_stride_;
     try {
       if (fresh_) {
         for (DatumId d : pp.owned)
@@ -555,9 +556,9 @@ class PartitionExecutor final : public Executor {
                       op.task, tc, v))
                 goto out;
             }
-            if (observe) detail::notify_begin(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers_, p, op.task, iter);
             w.run(TaskRun{&x, op.task, x.origin[op.task], iter, p});
-            if (observe) detail::notify_end(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride)) detail::notify_end(observers_, p, op.task, iter);
             ++tc.tasks;
             if (op.signal) {
               parking_.signal(done_[op.task].v, E + iter + 1);

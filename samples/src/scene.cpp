@@ -89,6 +89,7 @@ class Stepper {
       StateVec& v = bd.vec(id);
       d = rec_.datum(bd.name() + "." + std::string(to_string(id)), object_of(body),
                      static_cast<std::uint64_t>(v.size()) * sizeof(double), v.data());
+      rec_.accumulator(d, make_accumulator(v));  // force fields add through Body::vec
     }
     return d;
   }
@@ -128,6 +129,9 @@ class Stepper {
     s.d_rho = scalar("rho", &s.rho, sizeof(double));
     s.d_rho_new = scalar("rho_new", &s.rho_new, sizeof(double));
     s.d_den = scalar("den", &s.den, sizeof(double));
+    rec_.accumulator(s.d_rho, make_accumulator(s.rho));  // the dot products' partial sums
+    rec_.accumulator(s.d_rho_new, make_accumulator(s.rho_new));
+    rec_.accumulator(s.d_den, make_accumulator(s.den));
     s.d_beta = scalar("beta", &s.beta, sizeof(double));
     s.d_b2 = scalar("b2", &s.b2, sizeof(double));
     s.d_cond = scalar("converged", &s.converged, sizeof(bool));
@@ -253,7 +257,7 @@ class Stepper {
     for (int i : g.bodies) {
       Body* bd = body(i);
       rec_.task(b_.dot, object_of(i), {{vec(i, VecId::kR), R}, {s->d_rho, CW}},
-                [bd, s] { s->rho += dot(bd->vec(VecId::kR), bd->vec(VecId::kR)); });
+                [bd, s] { accumulate(s->rho) += dot(bd->vec(VecId::kR), bd->vec(VecId::kR)); });
     }
     rec_.task(b_.cg_start, s->object, {{s->d_rho, R}, {s->d_b2, W}, {s->d_cond, W}}, [s] {
       s->b2 = s->rho;
@@ -286,7 +290,7 @@ class Stepper {
         Body* bd = body(i);
         rec_.task(b_.dot, object_of(i),
                   {{vec(i, VecId::kP), R}, {vec(i, VecId::kQ), R}, {s->d_den, CW}},
-                  [bd, s] { s->den += dot(bd->vec(VecId::kP), bd->vec(VecId::kQ)); });
+                  [bd, s] { accumulate(s->den) += dot(bd->vec(VecId::kP), bd->vec(VecId::kQ)); });
       }
       for (int i : g.bodies) {
         Body* bd = body(i);
@@ -298,7 +302,7 @@ class Stepper {
                     bd->vec(VecId::kDv).noalias() += alpha * bd->vec(VecId::kP);
                     StateVec& r = bd->vec(VecId::kR);
                     r.noalias() -= alpha * bd->vec(VecId::kQ);
-                    s->rho_new += dot(r, r);
+                    accumulate(s->rho_new) += dot(r, r);
                   });
       }
       rec_.task(b_.cg_scalars, s->object,
