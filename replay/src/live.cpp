@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "tgraph/graph/error.hpp"
+#include "sync.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
@@ -154,14 +155,22 @@ class CostObserver : public Observer {
       for (Task& t : g.tasks) t.cost_ns = 1;
       return;
     }
+    if (&measured == &g || (g.tasks.size() == measured.tasks.size() && g.same_structure(measured))) {
+      // Same tasks: an exponential average with the costs already there (half weight to
+      // the new sample), so that one preempted step does not look like an imbalance.
+      for (TaskId t = 0; t < sum_.size(); ++t) {
+        const TaskId o = exec_->origin[t];
+        if (o == kNoTask || o >= g.tasks.size() || runs_[t] == 0) continue;
+        const std::uint64_t sample = sum_[t] / runs_[t];
+        const std::uint64_t old = measured.tasks[o].cost_ns;
+        g.tasks[o].cost_ns = std::max<std::uint64_t>(1, old > 1 ? (old + sample) / 2 : sample);
+      }
+      return;
+    }
     std::vector<std::uint64_t> cost(measured.tasks.size(), 0);
     for (TaskId t = 0; t < sum_.size(); ++t) {
       const TaskId o = exec_->origin[t];
       if (o != kNoTask && o < cost.size() && runs_[t] > 0) cost[o] = sum_[t] / runs_[t];
-    }
-    if (g.tasks.size() == measured.tasks.size() && g.same_structure(measured)) {
-      for (TaskId t = 0; t < g.tasks.size(); ++t) g.tasks[t].cost_ns = std::max<std::uint64_t>(1, cost[t]);
-      return;
     }
     std::unordered_map<StableKey, std::uint64_t> by_key;
     by_key.reserve(cost.size());
@@ -225,10 +234,34 @@ struct PassResult {
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
 };
 
+/// Imbalance (max over mean of the processors' work) of `a` on `g` (cost x runs).
+double imbalance(const StepGraph& g, const Assignment& a) {
+  std::vector<double> load(a.k, 0.0);
+  double total = 0;
+  for (TaskId t = 0; t < g.tasks.size() && t < a.proc.size(); ++t) {
+    const double w = static_cast<double>(g.tasks[t].cost_ns) * static_cast<double>(g.runs(t));
+    load[a.proc[t]] += w;
+    total += w;
+  }
+  if (total <= 0 || a.k == 0) return 1.0;
+  return *std::max_element(load.begin(), load.end()) / (total / a.k);
+}
+
+/// Loop iteration counts for the partitioner: the last step's, by loop index when the
+/// structure is the same, else their mean (a deferred recording runs no iteration).
+void apply_iterations(const std::vector<std::uint32_t>& last, bool same, StepGraph& g) {
+  if (last.empty()) return;
+  std::uint64_t sum = 0;
+  for (std::uint32_t i : last) sum += i;
+  const auto mean = static_cast<std::uint32_t>(std::max<std::uint64_t>(1, sum / last.size()));
+  for (LoopId l = 0; l < g.loops.size(); ++l)
+    g.loops[l].iterations = same && l < last.size() ? std::max(1u, last[l]) : mean;
+}
+
 // One pass of the engine through `ex`. `fixed` (optional): the assignment of each step
 // instead of the partitioner's.
 PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* partitioner,
-                    Executor& ex, std::uint32_t steps, bool feed_costs, bool keep_assignments,
+                    Executor& ex, const LiveOptions& o, bool feed_costs, bool keep_assignments,
                     bool keep_state, const std::vector<Assignment>* fixed,
                     StatsObserver* stats) {
   PassResult r;
@@ -237,36 +270,49 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
   CostObserver costs;
   if (feed_costs) ex.add_observer(costs);
   const bool partition = ex.policy() == Policy::kPartition;
-  StepGraph prev_graph;
-  Assignment prev_assignment;
+  LiveStep cur;             // the program in use
+  StepGraph prev_graph;     // the graph of the previous recorded program
+  Assignment assignment;    // the assignment in use
+  std::vector<std::uint32_t> last_iterations;
   bool have_prev = false;
-  LiveStep st;
   try {
-    for (std::uint32_t s = 0; s < steps; ++s) {
+    for (std::uint32_t s = 0; s < o.steps; ++s) {
       LiveStepMeasure m;
       const std::int64_t t0 = now_ns();
-      st = engine->record_step();
+      LiveStep next = engine->record_step();
+      const bool reused = next.reuse_previous && s > 0;
+      if (!reused) {
+        if (next.reuse_previous) throw UsageError("live run: the engine reused a program at step 0");
+        if (partition && s > 0) prev_graph = std::move(cur.graph);
+        cur = std::move(next);
+      }
+      m.recorded = !reused;
       const std::int64_t t1 = now_ns();
-      Assignment a;
       if (partition) {
-        if (fixed != nullptr) {
-          if (s >= fixed->size()) throw UsageError("live check: no assignment for step " + std::to_string(s));
-          a = (*fixed)[s];
-        } else {
-          if (feed_costs) {
-            if (have_prev) {
-              costs.apply(prev_graph, st.graph);
-            } else {
-              for (Task& t : st.graph.tasks) t.cost_ns = 1;
-            }
+        const StepGraph& measured = reused ? cur.graph : prev_graph;
+        if (feed_costs) {
+          if (have_prev) {
+            costs.apply(measured, cur.graph);
+          } else {
+            for (Task& t : cur.graph.tasks) t.cost_ns = 1;
           }
-          a = (*partitioner)(st.graph, ex.threads(), have_prev ? &prev_graph : nullptr,
-                             have_prev ? &prev_assignment : nullptr);
         }
+        apply_iterations(last_iterations, reused, cur.graph);
+        if (fixed != nullptr) {
+          if (s >= fixed->size())
+            throw UsageError("live check: no assignment for step " + std::to_string(s));
+          assignment = (*fixed)[s];
+        } else if (!have_prev || !reused || o.repartition_every_step ||
+                   imbalance(cur.graph, assignment) > 1.0 + o.rebalance_tolerance) {
+          assignment = (*partitioner)(cur.graph, ex.threads(), have_prev ? &measured : nullptr,
+                                      have_prev ? &assignment : nullptr);
+          m.partitioned = true;
+        }
+        have_prev = true;
       }
       const std::int64_t t2 = now_ns();
-      w.set_program(st.bodies, st.conditions, st.accumulators);
-      const StepStats ss = ex.run_step(st.graph, partition ? &a : nullptr, w);
+      w.set_program(cur.bodies, cur.conditions, cur.accumulators);
+      const StepStats ss = ex.run_step(cur.graph, partition ? &assignment : nullptr, w);
       const std::int64_t t3 = now_ns();
       m.record_ns = t1 - t0;
       m.partition_ns = t2 - t1;
@@ -276,6 +322,7 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
       m.wall_ns = t3 - t0;
       m.rebuilt = ss.rebuilt;
       m.loop_iterations = ss.loop_iterations;
+      last_iterations = ss.loop_iterations;
       if (stats != nullptr) m.threads = stats->threads();
       r.signals += ss.signals();
       r.waits += ss.waits();
@@ -283,12 +330,7 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
       r.parks += ss.parks();
       r.wall_ns += m.wall_ns;
       r.steps.push_back(std::move(m));
-      if (keep_assignments) r.assignments.push_back(a);
-      if (partition) {
-        prev_graph = std::move(st.graph);
-        prev_assignment = std::move(a);
-        have_prev = true;
-      }
+      if (keep_assignments) r.assignments.push_back(assignment);
     }
   } catch (...) {
     ex.clear_observers();
@@ -309,34 +351,62 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
     throw UsageError("the partition policy needs a partitioning method");
   LiveResult res;
   res.policy = o.policy;
-  auto ex = make_executor(o.policy, o.exec);
+  // A fresh executor per pass: its threads and pinning end with the pass, so the
+  // uninstrumented engine that follows runs where the OS puts it, as users run it (the
+  // partition executor pins the calling thread to the first core while it lives).
+  auto make = [&o] {
+    auto e = make_executor(o.policy, o.exec);
+    e->set_observe_stride(o.cost_stride);
+    return e;
+  };
+  std::unique_ptr<Executor> ex = make();
   res.threads = ex->threads();
   res.cw = ex->cw();
   res.scope = ex->scope();
-  ex->set_observe_stride(o.cost_stride);
+  ex.reset();
   const bool partition = o.policy == Policy::kPartition;
 
   std::vector<PassResult> passes;
   std::vector<std::vector<std::int64_t>> baseline_steps(o.steps);
+  const std::uint32_t baseline_cores =
+      o.exec.pin ? std::min<std::uint32_t>({res.threads, detail::hardware_pus(), 4}) : 1;
+  res.baseline_core_pass_wall_ns.assign(baseline_cores, {});
   for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
     if (o.baseline) {
-      std::unique_ptr<LiveEngine> engine = make_engine();
-      std::int64_t total = 0;
-      for (std::uint32_t s = 0; s < o.steps; ++s) {
-        const std::int64_t t0 = now_ns();
-        engine->plain_step();
-        const std::int64_t dt = now_ns() - t0;
-        baseline_steps[s].push_back(dt);
-        total += dt;
+      // The uninstrumented engine on each of the first cores the run uses (cores of a VM
+      // can differ in speed; a sequential run could land on either), the fastest kept.
+      std::int64_t best = 0;
+      std::vector<std::int64_t> best_steps;
+      detail::SavedBinding saved;
+      detail::save_binding(saved);
+      for (std::uint32_t c = 0; c < baseline_cores; ++c) {
+        if (o.exec.pin) detail::pin_current_thread(c);
+        std::unique_ptr<LiveEngine> engine = make_engine();
+        std::int64_t total = 0;
+        std::vector<std::int64_t> steps(o.steps);
+        for (std::uint32_t s = 0; s < o.steps; ++s) {
+          const std::int64_t t0 = now_ns();
+          engine->plain_step();
+          steps[s] = now_ns() - t0;
+          total += steps[s];
+        }
+        res.baseline_core_pass_wall_ns[c].push_back(total);
+        if (best == 0 || total < best) {
+          best = total;
+          best_steps = std::move(steps);
+        }
       }
-      res.baseline_pass_wall_ns.push_back(total);
+      detail::restore_binding(saved);
+      for (std::uint32_t s = 0; s < o.steps; ++s) baseline_steps[s].push_back(best_steps[s]);
     }
-    passes.push_back(run_pass(make_engine, partitioner, *ex, o.steps, partition, pass == 0 && o.check,
+    if (!ex) ex = make();
+    passes.push_back(run_pass(make_engine, partitioner, *ex, o, partition, pass == 0 && o.check,
                               pass == 0 && o.check, nullptr, nullptr));
+    res.plans_built += ex->plans_built();
+    res.order_fallbacks += ex->order_fallbacks();
+    ex.reset();
     res.pass_wall_ns.push_back(passes.back().wall_ns);
   }
-  res.plans_built = ex->plans_built();
-  res.order_fallbacks = ex->order_fallbacks();
   res.signals = passes[0].signals;
   res.waits = passes[0].waits;
   res.blocked_waits = passes[0].blocked_waits;
@@ -356,11 +426,19 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
     m.execute_ns = med(&LiveStepMeasure::execute_ns);
     m.build_ns = passes[0].steps[s].build_ns;
     m.rebuilt = passes[0].steps[s].rebuilt;
+    m.recorded = passes[0].steps[s].recorded;
+    m.partitioned = passes[0].steps[s].partitioned;
     m.loop_iterations = passes[0].steps[s].loop_iterations;
     m.baseline_ns = median(baseline_steps[s]);
   }
   res.wall_ns = median(res.pass_wall_ns);
-  res.baseline_wall_ns = median(res.baseline_pass_wall_ns);
+  for (const auto& core : res.baseline_core_pass_wall_ns) {
+    const std::int64_t m = median(core);
+    if (m > 0 && (res.baseline_wall_ns == 0 || m < res.baseline_wall_ns)) res.baseline_wall_ns = m;
+  }
+  if (res.baseline_wall_ns > 0 && baseline_cores == res.threads)
+    for (const auto& core : res.baseline_core_pass_wall_ns)
+      res.core_bound += static_cast<double>(res.baseline_wall_ns) / static_cast<double>(median(core));
   if (res.wall_ns > 0 && res.baseline_wall_ns > 0)
     res.speedup = static_cast<double>(res.baseline_wall_ns) / static_cast<double>(res.wall_ns);
 
@@ -368,13 +446,13 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
     // The policy with per-thread and per-kind observers (every instance), then sequential.
     StatsObserver stats;
     KindObserver kinds;
+    ex = make();
     ex->set_observe_stride(1);
     ex->add_observer(stats);
     ex->add_observer(kinds);
     PassResult observed;
     try {
-      observed = run_pass(make_engine, partitioner, *ex, o.steps, partition, false, false, nullptr,
-                          &stats);
+      observed = run_pass(make_engine, partitioner, *ex, o, partition, false, false, nullptr, &stats);
     } catch (...) {
       ex->clear_observers();
       throw;
@@ -387,7 +465,7 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
       so.threads = 1;
       auto seq = make_executor(Policy::kSequential, so);
       seq->add_observer(seq_kinds);
-      run_pass(make_engine, nullptr, *seq, o.steps, false, false, false, nullptr, nullptr);
+      run_pass(make_engine, nullptr, *seq, o, false, false, false, nullptr, nullptr);
     }
     for (const auto& [kind, t] : kinds.total()) {
       KindTime k;
@@ -426,7 +504,7 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
     }
     try {
       const PassResult reference =
-          run_pass(make_engine, partitioner, *ref, o.steps, false, false, true, fixed, nullptr);
+          run_pass(make_engine, partitioner, *ref, o, false, false, true, fixed, nullptr);
       res.difference = compare(reference.state, passes[0].state);
       res.data_compared = reference.state.names.size();
     } catch (const UsageError& e) {
@@ -470,6 +548,8 @@ std::string to_json(const LiveResult& r) {
                         {"build_ns", m.build_ns},
                         {"execute_ns", m.execute_ns},
                         {"rebuilt", m.rebuilt},
+                        {"recorded", m.recorded},
+                        {"partitioned", m.partitioned},
                         {"loop_iterations", m.loop_iterations},
                         {"threads", threads}});
   }
@@ -493,9 +573,10 @@ std::string to_json(const LiveResult& r) {
             {"wall_ns", r.wall_ns},
             {"pass_wall_ns", r.pass_wall_ns},
             {"engine_wall_ns", r.baseline_wall_ns},
-            {"engine_pass_wall_ns", r.baseline_pass_wall_ns},
+            {"engine_core_pass_wall_ns", r.baseline_core_pass_wall_ns},
             {"sequential_wall_ns", r.baseline_wall_ns},
             {"speedup", r.speedup},
+            {"core_bound", r.core_bound},
             {"breakdown",
              {{"record_ns", record},
               {"partition_ns", part},

@@ -14,14 +14,22 @@ class SceneEngine final : public replay::LiveEngine {
       : scene_(std::move(scene)), rec_(capture::Mode::kDeferred), plain_(capture::Mode::kOff) {}
 
   replay::LiveStep record_step() override {
-    scene_->step(rec_);
+    if (!scene_->step_if_changed(rec_)) {
+      replay::LiveStep same;
+      same.reuse_previous = true;
+      return same;
+    }
     capture::StepProgram p = rec_.end_step_program();
     if (rec_.errors() != 0)
       throw UsageError("scene " + scene_->name() + ": the recorder counted " +
                        std::to_string(rec_.errors()) + " API misuses");
     last_data_ = p.graph.data;
-    return {std::move(p.graph), std::move(p.bodies), std::move(p.conditions),
-            std::move(p.accumulators)};
+    replay::LiveStep step;
+    step.graph = std::move(p.graph);
+    step.bodies = std::move(p.bodies);
+    step.conditions = std::move(p.conditions);
+    step.accumulators = std::move(p.accumulators);
+    return step;
   }
 
   void plain_step() override {

@@ -408,7 +408,11 @@ void Scene::finalize() {
   }
 }
 
-void Scene::step(Recorder& rec) {
+void Scene::step(Recorder& rec) { advance(rec, false); }
+
+bool Scene::step_if_changed(Recorder& rec) { return advance(rec, true); }
+
+bool Scene::advance(Recorder& rec, bool allow_reuse) {
   finalize();
   Impl& m = *impl_;
   Binding& b = m.bind;
@@ -488,6 +492,22 @@ void Scene::step(Recorder& rec) {
     g.solver = slot.get();
   }
 
+  // The shape of this step: every interaction field, then each body's group.
+  std::vector<const void*> shape(interactions.begin(), interactions.end());
+  shape.push_back(nullptr);
+  for (std::size_t i = 0; i < n; ++i)
+    shape.push_back(m.groups[static_cast<std::size_t>(m.body_group[i])].solver);
+  const bool reuse = allow_reuse && b.rec == &rec && shape == m.recorded_shape;
+  if (!reuse) m.recorded_shape = std::move(shape);
+  stats_ = StepStats{};
+  stats_.groups = static_cast<std::uint32_t>(m.groups.size());
+  stats_.interactions = static_cast<std::uint32_t>(interactions.size());
+  stats_.contact_fields = static_cast<std::uint32_t>(m.contacts.size());
+  for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
+  time_ += solver_.dt;
+  ++steps_run_;
+  if (reuse) return false;
+
   rec.begin_step();
   Stepper stepper(*this, m, rec);
   // Declare everything this step touches before the contact set names the objects.
@@ -516,14 +536,7 @@ void Scene::step(Recorder& rec) {
       case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;
     }
   }
-
-  stats_ = StepStats{};
-  stats_.groups = static_cast<std::uint32_t>(m.groups.size());
-  stats_.interactions = static_cast<std::uint32_t>(interactions.size());
-  stats_.contact_fields = static_cast<std::uint32_t>(m.contacts.size());
-  for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
-  time_ += solver_.dt;
-  ++steps_run_;
+  return true;
 }
 
 StepStats Scene::last_stats() const {

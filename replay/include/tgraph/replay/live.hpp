@@ -81,6 +81,11 @@ std::optional<StateDifference> compare(const StateSnapshot& expected, const Stat
 
 /// One step of an engine recorded in deferred mode: nothing has run yet.
 struct LiveStep {
+  /// True: the engine recorded nothing because this step has the structure of the last one
+  /// it recorded (same tasks, same bodies, which read the state through the same pointers):
+  /// the runner executes the previous program again (paper section 3.2) and the other
+  /// fields are empty.
+  bool reuse_previous = false;
   StepGraph graph;                                ///< edges derived, costs may be 0
   std::vector<std::function<void()>> bodies;      ///< by task (empty for a loop's break)
   std::vector<std::function<bool()>> conditions;  ///< by loop: leave after this iteration?
@@ -92,7 +97,8 @@ struct LiveStep {
 class LiveEngine {
  public:
   virtual ~LiveEngine() = default;
-  /// Runs the coordination code of the next step in deferred mode.
+  /// Runs the coordination code of the next step in deferred mode (or reports that the
+  /// last recorded program applies again, LiveStep::reuse_previous).
   virtual LiveStep record_step() = 0;
   /// Runs the next step uninstrumented, in program order (the sequential engine).
   virtual void plain_step() = 0;
@@ -116,11 +122,18 @@ struct LiveOptions {
   ExecOptions exec;            ///< threads, pinning, spin, CW mode
   std::uint32_t steps = 10;
   std::uint32_t repeat = 1;    ///< timed passes (medians reported)
-  bool baseline = true;        ///< time the uninstrumented engine too, pass by pass interleaved
+  /// Time the uninstrumented engine too, pass by pass interleaved, on each of the first
+  /// min(threads, 4) cores the run uses (pinned), keeping the fastest.
+  bool baseline = true;
   bool observe = true;         ///< one more pass with observers (threads, kinds), plus a
                                ///< sequential one for the per-kind comparison
   bool check = false;          ///< compare the final state with a sequential reference
   std::uint32_t cost_stride = 8;  ///< cost feedback samples loop iterations 0, 1, every n-th
+  /// Partition policy: call the partitioner at every step. Default: only when the structure
+  /// changed or the last assignment's imbalance under the newly measured costs exceeds
+  /// 1 + rebalance_tolerance (otherwise the assignment, and so the plan, is kept).
+  bool repartition_every_step = false;
+  double rebalance_tolerance = 0.05;
 };
 
 /// Mean duration of the instances of one task kind.
@@ -141,6 +154,8 @@ struct LiveStepMeasure {
   std::int64_t execute_ns = 0;    ///< the executor running the tasks
   std::int64_t baseline_ns = 0;   ///< the same step of the uninstrumented engine
   bool rebuilt = false;           ///< a plan was built for this step (first pass)
+  bool recorded = true;           ///< the engine recorded the step (false: program reused)
+  bool partitioned = false;       ///< the partitioner was called (first pass)
   std::vector<std::uint32_t> loop_iterations;   ///< first pass
   std::vector<StatsObserver::Thread> threads;   ///< observed pass
 };
@@ -152,10 +167,19 @@ struct LiveResult {
   CwMode cw = CwMode::kReduce;
   ReduceScope scope = ReduceScope::kNone;
   std::vector<LiveStepMeasure> steps;
-  std::vector<std::int64_t> pass_wall_ns, baseline_pass_wall_ns;
+  std::vector<std::int64_t> pass_wall_ns;
+  /// Uninstrumented engine passes, by core (thread p's core, p < min(threads, 4); one
+  /// unpinned series when pinning is off).
+  std::vector<std::vector<std::int64_t>> baseline_core_pass_wall_ns;
   std::int64_t wall_ns = 0;           ///< median pass
-  std::int64_t baseline_wall_ns = 0;  ///< median uninstrumented pass (0: not timed)
+  /// The fastest core's median uninstrumented pass (0: not timed): the sequential engine
+  /// where it runs best, so that a slow core of a VM never flatters the speed-up.
+  std::int64_t baseline_wall_ns = 0;
   double speedup = 0;                 ///< baseline_wall_ns / wall_ns
+  /// The speed-up the measured cores allow: sum over the timed cores of baseline_wall_ns /
+  /// that core's median (2.0 for two equal cores; less when one is slower). 0 when fewer
+  /// cores than threads were timed.
+  double core_bound = 0;
   std::uint64_t plans_built = 0, order_fallbacks = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;  ///< first pass
   std::vector<KindTime> kinds;        ///< observed passes
