@@ -23,7 +23,6 @@ class SceneEngine final : public replay::LiveEngine {
     if (rec_.errors() != 0)
       throw UsageError("scene " + scene_->name() + ": the recorder counted " +
                        std::to_string(rec_.errors()) + " API misuses");
-    last_data_ = p.graph.data;
     replay::LiveStep step;
     step.graph = std::move(p.graph);
     step.bodies = std::move(p.bodies);
@@ -35,13 +34,15 @@ class SceneEngine final : public replay::LiveEngine {
   void plain_step() override {
     scene_->step(plain_);
     plain_.end_step();
+    used_ = &plain_;
   }
 
   std::vector<replay::StateRegion> state() const override {
     std::vector<replay::StateRegion> r;
-    for (DatumId d = 0; d < last_data_.size(); ++d)
-      if (rec_.datum_ptr(d) != nullptr)
-        r.push_back({last_data_[d].name, rec_.datum_ptr(d), last_data_[d].bytes});
+    const std::vector<Datum>& data = used_->data();
+    for (DatumId d = 0; d < data.size(); ++d)
+      if (used_->datum_ptr(d) != nullptr)
+        r.push_back({data[d].name, used_->datum_ptr(d), data[d].bytes});
     return r;
   }
 
@@ -49,7 +50,7 @@ class SceneEngine final : public replay::LiveEngine {
   std::unique_ptr<Scene> scene_;
   capture::Recorder rec_;
   capture::Recorder plain_;
-  std::vector<Datum> last_data_;
+  const capture::Recorder* used_ = &rec_;  // the recorder whose ids name the state
 };
 
 }  // namespace

@@ -109,6 +109,8 @@ class Recorder {
   /// Interns a task kind (method name).
   KindId kind(std::string_view name);
 
+  /// Every datum declared so far (persistent across steps).
+  const std::vector<Datum>& data() const { return data_; }
   /// Storage pointer given for datum `d` (nullptr if none).
   void* datum_ptr(DatumId d) const { return ptrs_[d]; }
   /// Declares that the CW writers of datum `d` add into `a.target` through
