@@ -139,9 +139,10 @@ struct RunCmd {
   std::string scene, method = "owner", policy, cw;
   std::uint32_t threads = default_threads();
   std::optional<int> steps;
-  std::uint32_t repeat = 1;
+  std::uint32_t repeat = 1, cost_stride = 8;
   std::int64_t spin_ns = tr::kDefaultSpinNs;
   bool check = false, no_pin = false, no_observe = false, json = false;
+  bool no_reuse = false, repartition_every_step = false, no_elide_waits = false;
 };
 
 void run_live(const RunCmd& c) {
@@ -170,6 +171,10 @@ void run_live(const RunCmd& c) {
   o.repeat = c.repeat;
   o.observe = !c.no_observe;
   o.check = c.check;
+  o.reuse_structure = !c.no_reuse;
+  o.repartition_every_step = c.repartition_every_step;
+  o.cost_stride = c.cost_stride;
+  o.exec.elide_waits = !c.no_elide_waits;
   const std::string scene = c.scene;
   const tr::EngineFactory make = [scene] { return samples::make_live_engine(scene); };
   tr::LivePartitioner partitioner = [strategy](const StepGraph& g, std::uint32_t k,
@@ -254,6 +259,15 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_option("--repeat", c->repeat, "Timed passes (medians reported; default 1)");
     cmd->add_option("--cw", c->cw, "CW writes across threads: reduce (default) or serialize")
         ->check(CLI::IsMember({"reduce", "serialize"}));
+    cmd->add_flag("--no-reuse", c->no_reuse,
+                  "Record every step (default: rerun the last program while the structure repeats)");
+    cmd->add_flag("--repartition-every-step", c->repartition_every_step,
+                  "Call the partitioner at every step (default: on change or imbalance)");
+    cmd->add_flag("--no-elide-waits", c->no_elide_waits,
+                  "One wait per cross-processor producer (default: waits implied by program "
+                  "order dropped)");
+    cmd->add_option("--cost-stride", c->cost_stride,
+                    "Cost feedback times loop iterations 0, 1 and every N-th (default 8)");
     cmd->add_flag("--no-observe", c->no_observe,
                   "Skip the observed passes (per-thread and per-kind figures)");
     cmd->add_flag("--check", c->check,

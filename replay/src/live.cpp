@@ -279,7 +279,7 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
     for (std::uint32_t s = 0; s < o.steps; ++s) {
       LiveStepMeasure m;
       const std::int64_t t0 = now_ns();
-      LiveStep next = engine->record_step();
+      LiveStep next = engine->record_step(o.reuse_structure);
       const bool reused = next.reuse_previous && s > 0;
       if (!reused) {
         if (next.reuse_previous) throw UsageError("live run: the engine reused a program at step 0");

@@ -100,7 +100,7 @@ std::vector<TaskId> local_topological(const ExecGraph& x, const std::vector<Task
 }
 
 /// Builds the per-processor programs.
-Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
+Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide) {
   const StepGraph& g = x.graph;
   const auto n = static_cast<TaskId>(g.tasks.size());
   const Assignment& a = x.assignment;
@@ -166,10 +166,15 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
   for (ProcId p = 0; p < k; ++p) {
     ProcPlan& pp = plan.procs[p];
     std::vector<std::int64_t> done_outside(k, kNever), done_iter(k, kNever), done_prev(k, kNever);
+    std::vector<std::uint8_t> seen_once, seen_iter, seen_prev;  // without elision only
+    std::vector<TaskId> marks;
+    if (!elide) seen_once.assign(n, 0), seen_iter.assign(n, 0), seen_prev.assign(n, 0);
     for (Op& op : pp.ops) {
       if (op.kind == OpKind::kLoopBegin) {
         std::fill(done_iter.begin(), done_iter.end(), kNever);
         std::fill(done_prev.begin(), done_prev.end(), kNever);
+        for (TaskId u : marks) seen_iter[u] = seen_prev[u] = 0;
+        marks.clear();
       }
       if (op.kind != OpKind::kTask) continue;
       const TaskId v = op.task;
@@ -217,6 +222,17 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
             done = &done_prev[c.proc];
             implied = c.at <= *done || done_iter[c.proc] != kNever;
             break;
+        }
+        if (!elide) {
+          // Only one wait per producer and context along the program (the dedupe every plan
+          // needs), as before the reduction.
+          std::vector<std::uint8_t>& seen = c.w.kind == WaitKind::kSameIter   ? seen_iter
+                                            : c.w.kind == WaitKind::kPrevIter ? seen_prev
+                                                                              : seen_once;
+          implied = seen[c.w.producer] != 0;
+          if (!implied && c.w.kind != WaitKind::kOnce && c.w.kind != WaitKind::kAfterLoop)
+            marks.push_back(c.w.producer);
+          seen[c.w.producer] = 1;
         }
         if (implied) continue;
         *done = c.at;
@@ -373,7 +389,7 @@ class PartitionExecutor final : public Executor {
   };
 
   std::shared_ptr<void> build(const ExecGraph& x) override {
-    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true));
+    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits));
     // Program order on every processor never deadlocks (every wait names an earlier task in
     // program order); only an explicit order needs the check.
     if (plan->program_order) return plan;
@@ -383,7 +399,7 @@ class PartitionExecutor final : public Executor {
       if (plan->program_order || !x.added_edges) throw;  // the order itself is invalid
       // The explicit order cannot be kept with the lowered graph's extra edges (serialised
       // CW writers): fall back to program order on each processor, which never deadlocks.
-      plan = std::make_shared<Plan>(build_plan(x, options_.threads, false));
+      plan = std::make_shared<Plan>(build_plan(x, options_.threads, false, options_.elide_waits));
       ++order_fallbacks_;
     }
     return plan;

@@ -13,8 +13,10 @@ class SceneEngine final : public replay::LiveEngine {
   explicit SceneEngine(std::unique_ptr<Scene> scene)
       : scene_(std::move(scene)), rec_(capture::Mode::kDeferred), plain_(capture::Mode::kOff) {}
 
-  replay::LiveStep record_step() override {
-    if (!scene_->step_if_changed(rec_)) {
+  replay::LiveStep record_step(bool allow_reuse) override {
+    if (!allow_reuse) {
+      scene_->step(rec_);
+    } else if (!scene_->step_if_changed(rec_)) {
       replay::LiveStep same;
       same.reuse_previous = true;
       return same;

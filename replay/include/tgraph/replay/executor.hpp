@@ -30,6 +30,10 @@ struct ExecOptions {
   /// dynamic policies (worksteal, barrier, starpu), kNone for sequential. A sequential run
   /// given the scope of another policy reproduces that policy's reduction order.
   std::optional<ReduceScope> reduce_scope;
+  /// Partition only: drop the waits that program order on the producing processor already
+  /// implies (a reducer waits for the last of another processor's writers). Off: one wait
+  /// per cross-processor producer (for measuring what the reduction saves).
+  bool elide_waits = true;
   /// Partition only: run the per-processor programs interleaved on the calling thread
   /// (deterministic, same plans and waits; the serial twin of the threaded executor).
   bool serial = false;

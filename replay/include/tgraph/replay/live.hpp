@@ -97,9 +97,9 @@ struct LiveStep {
 class LiveEngine {
  public:
   virtual ~LiveEngine() = default;
-  /// Runs the coordination code of the next step in deferred mode (or reports that the
-  /// last recorded program applies again, LiveStep::reuse_previous).
-  virtual LiveStep record_step() = 0;
+  /// Runs the coordination code of the next step in deferred mode (or, when `allow_reuse`,
+  /// reports that the last recorded program applies again: LiveStep::reuse_previous).
+  virtual LiveStep record_step(bool allow_reuse) = 0;
   /// Runs the next step uninstrumented, in program order (the sequential engine).
   virtual void plain_step() = 0;
   /// Storage of the state to compare bit for bit (after the steps).
@@ -134,6 +134,8 @@ struct LiveOptions {
   /// 1 + rebalance_tolerance (otherwise the assignment, and so the plan, is kept).
   bool repartition_every_step = false;
   double rebalance_tolerance = 0.05;
+  /// Let the engine skip recording while the structure repeats (false: record every step).
+  bool reuse_structure = true;
 };
 
 /// Mean duration of the instances of one task kind.
