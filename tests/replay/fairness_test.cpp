@@ -84,7 +84,7 @@ TEST_P(DynamicBaseline, SerializeIsStillAvailableAndOrdersTheWriters) {
 
 INSTANTIATE_TEST_SUITE_P(Policies, DynamicBaseline,
                          ::testing::Values(Policy::kWorksteal, Policy::kBarrier),
-                         [](const auto& info) { return std::string(to_string(info.param)); });
+                         [](const auto& p) { return std::string(to_string(p.param)); });
 
 // Sum of the synthetic CW bodies is exact integer arithmetic: every policy and scope must
 // reach the sequential result, and the per-writer reducer must add each temporary once.
