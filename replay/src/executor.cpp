@@ -250,6 +250,7 @@ class SequentialExecutor final : public Executor {
 std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
   if (options.threads == 0) throw UsageError("--threads must be at least 1");
@@ -266,6 +267,8 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
       return make_worksteal_executor(options);
     case Policy::kBarrier:
       return make_barrier_executor(options);
+    case Policy::kStarpu:
+      return make_starpu_executor(options);
   }
   throw UsageError("unknown policy");
 }
