@@ -38,6 +38,9 @@ namespace {
 
 // One StarPU runtime per process: set while a StarPU executor exists.
 std::atomic<bool> g_starpu_in_use{false};
+// TSan: address standing for StarPU's hand-off of a submitted task to a worker (the codelet
+// argument is read before the executor is known, hence not a member).
+char g_submit_token = 0;
 
 #if defined(__SANITIZE_THREAD__)
 constexpr bool kTsan = true;
@@ -257,6 +260,7 @@ class StarpuExecutor final : public Executor {
 
   static void body(void* buffers[], void* arg) {
     (void)buffers;  // void handles: the bodies reach their data through the workload
+    TGRAPH_TSAN_ACQUIRE(&g_submit_token);
     auto* in = static_cast<Instance*>(arg);
     in->ex->run_instance(*in);
   }
@@ -267,8 +271,7 @@ class StarpuExecutor final : public Executor {
     const StarpuPlan& p = *plan_;
     if constexpr (kTsan) {
       // StarPU's queues and dependency release are not instrumented: make the hand-off from
-      // the submitter and from the previous accessors of each handle visible to TSan.
-      TGRAPH_TSAN_ACQUIRE(&submit_token_);
+      // the previous accessors of each handle visible to TSan (the submitter's: see body).
       for (auto b = p.begin[in.task]; b < p.begin[in.task + 1]; ++b)
         TGRAPH_TSAN_ACQUIRE(&p.handles[p.buffer[b]]);
     }
@@ -335,7 +338,7 @@ class StarpuExecutor final : public Executor {
       STARPU_TASK_SET_MODE(task, p.mode[first + i], i);
     }
     if (wait) task->detach = 0;  // destroyed by starpu_task_wait
-    TGRAPH_TSAN_RELEASE(&submit_token_);
+    TGRAPH_TSAN_RELEASE(&g_submit_token);
     if (const int rc = starpu_task_submit(task); rc != 0) {
       starpu_task_destroy(task);
       throw Error("--policy starpu: starpu_task_submit failed (" + std::to_string(rc) + ")");
@@ -428,7 +431,6 @@ class StarpuExecutor final : public Executor {
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
-  char submit_token_ = 0;  // TSan: address standing for StarPU's hand-off to a worker
   char join_token_ = 0;    // TSan: address standing for starpu_task_wait(_for_all)
 };
 
