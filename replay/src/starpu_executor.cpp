@@ -431,7 +431,7 @@ class StarpuExecutor final : public Executor {
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
-  char join_token_ = 0;    // TSan: address standing for starpu_task_wait(_for_all)
+  char join_token_ = 0;  // TSan: address standing for starpu_task_wait(_for_all)
 };
 
 }  // namespace
