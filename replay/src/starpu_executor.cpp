@@ -3,7 +3,9 @@
 // one data handle per datum and the recorded access modes; StarPU's implicit (sequential
 // consistency) dependencies order them, its scheduler (default lws) places them.
 //
-// Modes: R -> STARPU_R, W -> STARPU_W, RW -> STARPU_RW, CW -> STARPU_RW | STARPU_COMMUTE.
+// Modes: R -> STARPU_R, W -> STARPU_W, RW -> STARPU_RW; CW -> STARPU_RW | STARPU_COMMUTE
+// where CW groups keep several writers per datum (reduce scope none), STARPU_RW under the
+// default per-writer lowering (one writer per datum and group, then the in-order reducer).
 // A loop whose iteration count the workload knows in advance (a replay) is unrolled at
 // submission; otherwise (live physics) one iteration is submitted, the host waits for its
 // break task and submits the next one or leaves, as StarPU applications do for CG.
@@ -77,7 +79,9 @@ struct StarpuPlan {
   }
 };
 
-starpu_data_access_mode to_starpu(AccessMode m) {
+/// StarPU's mode for `m`. `commute`: CW groups were left with several writers per datum
+/// (no per-writer temporaries), which StarPU may then run in any order, one at a time.
+starpu_data_access_mode to_starpu(AccessMode m, bool commute) {
   switch (m) {
     case AccessMode::R:
       return STARPU_R;
@@ -86,7 +90,8 @@ starpu_data_access_mode to_starpu(AccessMode m) {
     case AccessMode::RW:
       return STARPU_RW;
     case AccessMode::CW:
-      return static_cast<starpu_data_access_mode>(STARPU_RW | STARPU_COMMUTE);
+      return commute ? static_cast<starpu_data_access_mode>(STARPU_RW | STARPU_COMMUTE)
+                     : STARPU_RW;
   }
   return STARPU_RW;
 }
@@ -227,6 +232,11 @@ class StarpuExecutor final : public Executor {
     registry_->plans.push_back(plan.get());
     const auto n = static_cast<TaskId>(g.tasks.size());
     plan->begin.reserve(n + 1);
+    // Per-writer lowering (the default) leaves one CW writer per datum and group, followed
+    // by its reducer: program order there keeps the sum's order deterministic (as for
+    // worksteal and barrier; the reducer also waits for the first writer). Without it, StarPU
+    // commutes the writers.
+    const bool commute = x.scope != ReduceScope::kPerWriter;
     std::vector<Access> merged;
     for (TaskId t = 0; t < n; ++t) {
       plan->begin.push_back(static_cast<std::uint32_t>(plan->buffer.size()));
@@ -244,7 +254,7 @@ class StarpuExecutor final : public Executor {
       bool ordered = false;  // a W or RW access orders consecutive instances already
       for (const Access& m : merged) {
         plan->buffer.push_back(m.datum);
-        plan->mode.push_back(to_starpu(m.mode));
+        plan->mode.push_back(to_starpu(m.mode, commute));
         ordered |= m.mode == AccessMode::W || m.mode == AccessMode::RW;
       }
       if (g.tasks[t].loop != kNoLoop && !ordered) {

@@ -23,10 +23,27 @@ namespace {
 #define TGRAPH_NEED_STARPU() (void)0
 #endif
 
-ExecOptions starpu_options(std::uint32_t k, std::optional<CwMode> cw = std::nullopt) {
+/// How CW groups reach StarPU.
+enum class Cw { kPerWriter, kCommute, kSerialize };
+
+std::string cw_name(Cw c) {
+  switch (c) {
+    case Cw::kPerWriter:
+      return "per_writer";
+    case Cw::kCommute:
+      return "commute";
+    case Cw::kSerialize:
+      return "serialize";
+  }
+  return "?";
+}
+
+/// Per-writer temporaries (the default), CW left to STARPU_COMMUTE, or CW made RW.
+ExecOptions starpu_options(std::uint32_t k, Cw cw = Cw::kPerWriter) {
   ExecOptions o;
   o.threads = k;
-  o.cw = cw;
+  if (cw == Cw::kCommute) o.reduce_scope = ReduceScope::kNone;
+  if (cw == Cw::kSerialize) o.cw = CwMode::kSerialize;
   return o;
 }
 
@@ -96,7 +113,7 @@ void expect_dataflow_order(const StepGraph& g, const std::vector<TimelineEvent>&
 }
 
 class StarpuPolicy
-    : public ::testing::TestWithParam<std::tuple<std::uint32_t, CwMode, bool /*unknown*/>> {};
+    : public ::testing::TestWithParam<std::tuple<std::uint32_t, Cw, bool /*unknown*/>> {};
 
 TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
   TGRAPH_NEED_STARPU();
@@ -142,11 +159,12 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
 
 INSTANTIATE_TEST_SUITE_P(Threads1To4, StarpuPolicy,
                          ::testing::Combine(::testing::Range(1u, 5u),
-                                            ::testing::Values(CwMode::kReduce, CwMode::kSerialize),
+                                            ::testing::Values(Cw::kPerWriter, Cw::kCommute,
+                                                              Cw::kSerialize),
                                             ::testing::Bool()),
                          [](const auto& param_info) {
                            return "k" + std::to_string(std::get<0>(param_info.param)) + "_" +
-                                  std::string(to_string(std::get<1>(param_info.param))) +
+                                  cw_name(std::get<1>(param_info.param)) +
                                   (std::get<2>(param_info.param) ? "_host_sync" : "_unrolled");
                          });
 
@@ -168,15 +186,17 @@ TEST(Starpu, CommutingWritersWithManyHandlesMatchSequential) {
   const Access rd[] = {{0, AccessMode::R}, {1, AccessMode::W}};
   g.add_task(1, kNoObject, rd, 100, 99);
   g.derive_edges();
-  auto ex = make_executor(Policy::kStarpu, starpu_options(2, CwMode::kReduce));
-  TimelineObserver timeline;
-  ex->add_observer(timeline);
-  SyntheticWorkload w({.cost_scale = 1.0});
-  w.set_step(g);
-  ex->run_step(g, nullptr, w);
-  ex->run_step(g, nullptr, w);
-  EXPECT_EQ(final_state(w, g), sequential_state(g, 2));
-  expect_dataflow_order(ex->last_exec()->graph, timeline.events(), 1);
+  for (Cw cw : {Cw::kPerWriter, Cw::kCommute}) {
+    auto ex = make_executor(Policy::kStarpu, starpu_options(2, cw));
+    TimelineObserver timeline;
+    ex->add_observer(timeline);
+    SyntheticWorkload w({.cost_scale = 1.0});
+    w.set_step(g);
+    ex->run_step(g, nullptr, w);
+    ex->run_step(g, nullptr, w);
+    EXPECT_EQ(final_state(w, g), sequential_state(g, 2)) << cw_name(cw);
+    expect_dataflow_order(ex->last_exec()->graph, timeline.events(), 1);
+  }
 }
 
 class Throwing : public Workload {
