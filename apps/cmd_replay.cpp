@@ -35,7 +35,7 @@ tr::Policy policy_from(const std::string& name, const char* flag) {
   const auto p = tr::parse_policy(name);
   if (!p)
     throw UsageError(std::string(flag) + " " + name +
-                     ": expected partition, worksteal, barrier or sequential");
+                     ": expected partition, worksteal, barrier, starpu or sequential");
   return *p;
 }
 
@@ -43,7 +43,7 @@ tr::Policy policy_from(const std::string& name, const char* flag) {
 
 struct ReplayCmd {
   std::string trace, assignment, policy = "partition", method = "owner", timeline, chrome;
-  std::string cw, model = "calibrated", calibration;
+  std::string cw, model = "calibrated", calibration, starpu_sched = "lws";
   std::uint32_t threads = default_threads();
   std::uint32_t steps = 0, first_step = 0, repeat = 3;
   std::int64_t spin_ns = tr::kDefaultSpinNs;
@@ -58,6 +58,7 @@ void run_replay(const ReplayCmd& c) {
   o.exec.threads = c.threads;
   o.exec.pin = !c.no_pin;
   o.exec.spin_ns = c.spin_ns;
+  o.exec.starpu_sched = c.starpu_sched;
   if (c.cw == "reduce") o.exec.cw = tr::CwMode::kReduce;
   if (c.cw == "serialize") o.exec.cw = tr::CwMode::kSerialize;
   o.synthetic.cost_scale = c.scale;
@@ -136,7 +137,7 @@ void run_replay(const ReplayCmd& c) {
 // ---- run (live) -------------------------------------------------------------------------
 
 struct RunCmd {
-  std::string scene, method = "owner", policy, cw;
+  std::string scene, method = "owner", policy, cw, starpu_sched = "lws";
   std::uint32_t threads = default_threads();
   std::optional<int> steps;
   std::uint32_t repeat = 1, cost_stride = 8;
@@ -166,6 +167,7 @@ void run_live(const RunCmd& c) {
   o.exec.threads = policy == tr::Policy::kSequential ? 1 : c.threads;
   o.exec.pin = !c.no_pin;
   o.exec.spin_ns = c.spin_ns;
+  o.exec.starpu_sched = c.starpu_sched;
   if (c.cw == "serialize") o.exec.cw = tr::CwMode::kSerialize;
   o.steps = static_cast<std::uint32_t>(c.steps.value_or(scene_steps));
   o.repeat = c.repeat;
@@ -221,7 +223,8 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_option("assignment", c->assignment,
                     "Assignment file (.tga; partition policy; default: --method)");
     cmd->add_option("--threads,-k", c->threads, "Threads (processors)");
-    cmd->add_option("--policy", c->policy, "partition (default), worksteal, barrier or sequential");
+    cmd->add_option("--policy", c->policy,
+                    "partition (default), worksteal, barrier, starpu or sequential");
     cmd->add_option("--method", c->method,
                     "Strategy used when no assignment file is given (default owner)");
     cmd->add_option("--steps", c->steps, "Steps to replay (default: all)");
@@ -238,6 +241,8 @@ void add_replay_verbs(CLI::App& app) {
                     "Cost model of the prediction: calibrated (default) or ideal")
         ->check(CLI::IsMember({"ideal", "calibrated"}));
     cmd->add_option("--calibration", c->calibration, "Calibration file for the prediction");
+    cmd->add_option("--starpu-sched", c->starpu_sched,
+                    "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
     cmd->add_flag("--no-touch", c->no_touch, "Synthetic bodies only spin (no data buffers)");
     cmd->add_flag("--no-baseline", c->no_baseline, "Do not time sequential passes");
@@ -252,7 +257,7 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_option(
         "--method", c->method,
         "Partitioning strategy (owner, metis, scotch, sticky, list, roundrobin) or a baseline "
-        "(worksteal, barrier, sequential)");
+        "(worksteal, barrier, starpu, sequential)");
     cmd->add_option("--policy", c->policy, "Override the policy");
     cmd->add_option("--steps", c->steps, "Steps (default: the scene's)");
     cmd->add_option("--spin-ns", c->spin_ns, "Spin this long before parking a waiting thread");
@@ -273,6 +278,8 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_flag("--check", c->check,
                   "Compare the final state with a sequential run using the same reduction "
                   "order, bit for bit");
+    cmd->add_option("--starpu-sched", c->starpu_sched,
+                    "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
     cmd->add_flag("--json", c->json, "Print one JSON object");
     cmd->callback([c] { run_live(*c); });

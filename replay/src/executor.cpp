@@ -108,6 +108,7 @@ ReduceScope Executor::reduce_scope() const {
       return ReduceScope::kPerProcessor;
     case Policy::kWorksteal:
     case Policy::kBarrier:
+    case Policy::kStarpu:
       return ReduceScope::kPerWriter;
   }
   return ReduceScope::kNone;
@@ -271,6 +272,7 @@ class SequentialExecutor final : public Executor {
 std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
   if (options.threads == 0) throw UsageError("--threads must be at least 1");
@@ -287,6 +289,8 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
       return make_worksteal_executor(options);
     case Policy::kBarrier:
       return make_barrier_executor(options);
+    case Policy::kStarpu:
+      return make_starpu_executor(options);
   }
   throw UsageError("unknown policy");
 }

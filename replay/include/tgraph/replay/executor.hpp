@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
@@ -37,6 +38,8 @@ struct ExecOptions {
   /// Partition only: run the per-processor programs interleaved on the calling thread
   /// (deterministic, same plans and waits; the serial twin of the threaded executor).
   bool serial = false;
+  /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
+  std::string starpu_sched = "lws";
 };
 
 /// Counters of one thread in one step, kept by the executor itself.

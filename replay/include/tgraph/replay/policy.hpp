@@ -13,9 +13,10 @@ enum class Policy : unsigned char {
   kPartition = 1,   ///< one pinned thread per processor of an Assignment, signal/wait
   kWorksteal = 2,   ///< oneTBB, dependency counting over the dataflow graph, no affinity
   kBarrier = 3,     ///< a parallel loop per operation, barrier after each (OpenMP)
+  kStarpu = 4,      ///< StarPU tasks with one data handle per datum (implicit dependencies)
 };
 
-/// "sequential", "partition", "worksteal" or "barrier".
+/// "sequential", "partition", "worksteal", "barrier" or "starpu".
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -49,6 +50,13 @@ class Workload {
   virtual void run(const TaskRun& r) = 0;
   /// After iteration `iteration` (0-based) of loop `loop`: true = leave the loop.
   virtual bool stop_after(LoopId loop, std::uint32_t iteration) = 0;
+  /// The number of iterations loop `loop` will run this step when the workload knows it
+  /// before the loop starts (a replay of recorded counts), else nullopt (a live condition).
+  /// When known, stop_after must agree with it; executors may then unroll the loop.
+  virtual std::optional<std::uint32_t> known_iterations(LoopId loop) const {
+    (void)loop;
+    return std::nullopt;
+  }
 
  private:
   static std::uint64_t next_instance() {
