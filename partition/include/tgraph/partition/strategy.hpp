@@ -66,8 +66,9 @@ struct Stats {
   std::optional<std::int64_t> edgecut;  ///< library objective (METIS objval, Scotch cut), library units
   std::uint64_t matched_tasks = 0;      ///< tasks found in the previous step by stable key
   std::uint64_t moved_tasks = 0;        ///< matched tasks whose processor changed
-  bool reused = false;                  ///< sticky: previous assignment reused as is
-  bool rebalanced = false;              ///< sticky: repartitioned with a migration cost
+  bool reused = false;    ///< sticky: previous assignment reused as is
+  bool fallback = false;  ///< sticky: partitioned afresh and relabelled (shape changed too much)
+  bool rebalanced = false;  ///< sticky: kept the assignment, then moved tasks to fix imbalance
 };
 
 /// An assignment and its statistics.
@@ -112,6 +113,13 @@ struct TracePartition {
 /// step and its assignment (what `sticky` needs).
 TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
                                const Options& options = {});
+
+/// Renames the K part labels of `a` (a partition of `g`) so that as many tasks as possible,
+/// matched in `prev` by stable key and counted once each, keep their previous processor: an
+/// optimal assignment of labels (Hungarian algorithm on the K x K overlap), so no other
+/// renaming moves fewer tasks. Returns the matched tasks that kept their processor; does
+/// nothing (returns 0) without a previous step or when its K differs.
+std::uint64_t relabel_to_previous(const StepGraph& g, const Previous& prev, Assignment& a);
 
 /// Tasks of `g` matched in `prev` by stable key (the i-th task with a key matches the
 /// i-th task with the same key); match[t] = task in prev or kNoTask.
