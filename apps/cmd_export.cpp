@@ -3,11 +3,10 @@
 // interchange format (METIS: gpmetis input; Scotch: scotch_gpart source graph);
 // `tgraph export R.json --format chrome`: a replay timeline as Chrome/Perfetto trace events.
 #include <iostream>
-#include <sstream>
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/graph/undirected.hpp"
+#include "tgraph/partition/export.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::app {
@@ -19,32 +18,6 @@ struct ExportOptions {
   std::string out;
   std::size_t step = 0;
 };
-
-// METIS and Scotch index with 32-bit integers here: keep every total below 2^30.
-constexpr std::int64_t kMaxTotalWeight = std::int64_t{1} << 30;
-
-std::string to_metis(const UndirectedGraph& u) {
-  std::ostringstream s;
-  s << u.vertices() << ' ' << u.edges() << " 011\n";
-  for (std::uint32_t v = 0; v < u.vertices(); ++v) {
-    s << u.vwgt[v];
-    for (auto i = u.xadj[v]; i < u.xadj[v + 1]; ++i) s << ' ' << u.adjncy[i] + 1 << ' ' << u.adjwgt[i];
-    s << '\n';
-  }
-  return s.str();
-}
-
-std::string to_scotch(const UndirectedGraph& u) {
-  std::ostringstream s;
-  // Version, vertex and arc counts, base 0, flags 011 = edge loads and vertex loads.
-  s << "0\n" << u.vertices() << ' ' << u.adjncy.size() << "\n0 011\n";
-  for (std::uint32_t v = 0; v < u.vertices(); ++v) {
-    s << u.vwgt[v] << ' ' << (u.xadj[v + 1] - u.xadj[v]);
-    for (auto i = u.xadj[v]; i < u.xadj[v + 1]; ++i) s << ' ' << u.adjwgt[i] << ' ' << u.adjncy[i];
-    s << '\n';
-  }
-  return s.str();
-}
 
 nlohmann::json edges_json(const StepGraph& g, const std::vector<Edge>& edges) {
   nlohmann::json a = nlohmann::json::array();
@@ -113,9 +86,9 @@ void run_export(const ExportOptions& o) {
   if (o.format == "json") {
     text = to_json(g, o.step);
   } else if (o.format == "metis") {
-    text = to_metis(make_undirected(g, kMaxTotalWeight, kMaxTotalWeight));
+    text = partition::metis_graph_file(g);
   } else {
-    text = to_scotch(make_undirected(g, kMaxTotalWeight, kMaxTotalWeight));
+    text = partition::scotch_graph_file(g);
   }
   write_output(o, text);
 }

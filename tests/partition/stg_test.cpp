@@ -17,7 +17,7 @@ namespace {
 std::vector<std::string> stg_files() {
   std::vector<std::string> files;
   for (const char* dir : {"50", "100"}) {
-    const std::filesystem::path p = std::filesystem::path(TGRAPH_SHARED_DIR) / "data" / "stg" / dir;
+    const std::filesystem::path p = std::filesystem::path(TGRAPH_TEST_DATA) / "stg" / dir;
     std::error_code ec;
     for (const auto& e : std::filesystem::directory_iterator(p, ec))
       if (e.path().extension() == ".stg") files.push_back(e.path().string());
@@ -28,7 +28,7 @@ std::vector<std::string> stg_files() {
 
 TEST(Stg, ReproducesTheStatedCriticalPathOfEveryGraph) {
   const std::vector<std::string> files = stg_files();
-  ASSERT_EQ(files.size(), 20u) << "STG graphs expected under " << TGRAPH_SHARED_DIR;
+  ASSERT_EQ(files.size(), 20u) << "STG graphs expected under " << TGRAPH_TEST_DATA << "/stg";
   for (const std::string& f : files) {
     for (std::uint64_t unit : {1u, 1000u}) {
       const StgGraph s = read_stg(f, unit);
@@ -41,7 +41,7 @@ TEST(Stg, ReproducesTheStatedCriticalPathOfEveryGraph) {
 }
 
 TEST(Stg, KeepsDummyTasksAndEveryEdge) {
-  const std::string f = std::string(TGRAPH_SHARED_DIR) + "/data/stg/50/rand0000.stg";
+  const std::string f = std::string(TGRAPH_TEST_DATA) + "/stg/50/rand0000.stg";
   const StgGraph s = read_stg(f);
   const StepGraph& g = s.trace.steps[0];
   EXPECT_EQ(g.tasks.size(), 52u);
@@ -53,7 +53,7 @@ TEST(Stg, KeepsDummyTasksAndEveryEdge) {
 }
 
 TEST(Stg, SurvivesATraceFileRoundTrip) {
-  const StgGraph s = read_stg(std::string(TGRAPH_SHARED_DIR) + "/data/stg/100/rand0003.stg");
+  const StgGraph s = read_stg(std::string(TGRAPH_TEST_DATA) + "/stg/100/rand0003.stg");
   const std::string path = (std::filesystem::temp_directory_path() / "tgraph_stg_test.tgt").string();
   write_trace(path, s.trace);
   const Trace back = read_trace(path);
