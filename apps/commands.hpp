@@ -42,5 +42,6 @@ void add_capture(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
 void add_replay_verbs(CLI::App& app);     // replay, run
+void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)
 
 }  // namespace tgraph::app

@@ -48,6 +48,7 @@ int main(int argc, char** argv) {
   add_export(app);
   add_partition_verbs(app);
   add_replay_verbs(app);
+  add_validate(app);
   try {
     app.parse(argc, argv);
     if (app.get_subcommands().empty()) {

@@ -33,4 +33,16 @@ std::string_view to_string(CwMode mode) {
   return "?";
 }
 
+std::string_view to_string(ReduceScope scope) {
+  switch (scope) {
+    case ReduceScope::kNone:
+      return "none";
+    case ReduceScope::kPerProcessor:
+      return "per-processor";
+    case ReduceScope::kPerWriter:
+      return "per-writer";
+  }
+  return "?";
+}
+
 }  // namespace tgraph::replay

@@ -22,11 +22,12 @@ inline constexpr DatumId kNoDatum = std::numeric_limits<DatumId>::max();
 struct GroupSolver {
   std::string name;
   int first_body = 0;  // body whose group this solver serves
-  // CG scalars (each a shared datum of the graph).
-  double rho = 0.0;      // r.r of the previous iteration
-  double rho_new = 0.0;  // r.r of this iteration (partial sums CW)
-  double den = 0.0;      // p.q (partial sums CW)
-  double beta = 0.0;     // rho_new / rho
+  // CG scalars (each a shared datum of the graph). The two that CW writers add into while
+  // other threads read the rest have cache lines of their own (no false sharing).
+  double rho = 0.0;                   // r.r of the previous iteration
+  alignas(64) double rho_new = 0.0;   // r.r of this iteration (partial sums CW)
+  alignas(64) double den = 0.0;       // p.q (partial sums CW)
+  alignas(64) double beta = 0.0;      // rho_new / rho
   double b2 = 0.0;       // |b|^2 (tolerance reference)
   bool converged = false;  // the loop's condition datum
   std::uint32_t iterations = 0;
@@ -88,6 +89,9 @@ struct Scene::Impl {
   std::vector<int> body_group;
   detail::Binding bind;
   std::uint64_t next_generation = 1;
+  // What the step last recorded into `bind.rec` interacted and how bodies were grouped
+  // (Scene::step_if_changed reuses that recording while it repeats).
+  std::vector<const void*> recorded_shape;
 };
 
 namespace detail {

@@ -29,4 +29,17 @@ enum class CwMode : unsigned char {
 /// "reduce" or "serialize".
 std::string_view to_string(CwMode mode);
 
+/// Where the temporaries of a CW group whose writers may run on different threads live
+/// (CwMode::kReduce).
+enum class ReduceScope : unsigned char {
+  kNone = 0,          ///< no temporaries: the writers run on one thread (sequential)
+  kPerProcessor = 1,  ///< one temporary per processor off the group's home (partition)
+  /// One temporary per writer after the group's first, added in program order (the dynamic
+  /// policies: any writer may run on any thread, the combine stays deterministic).
+  kPerWriter = 2,
+};
+
+/// "none", "per-processor" or "per-writer".
+std::string_view to_string(ReduceScope scope);
+
 }  // namespace tgraph::replay

@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
 
@@ -41,6 +42,9 @@ class Workload {
     (void)d;
     return false;
   }
+  /// By original datum: whether CW writers of it can write a temporary instead (nullptr:
+  /// all can). Executors serialise the CW groups of the others.
+  virtual const std::vector<bool>* reducible() const { return nullptr; }
   /// Runs one task.
   virtual void run(const TaskRun& r) = 0;
   /// After iteration `iteration` (0-based) of loop `loop`: true = leave the loop.

@@ -95,6 +95,12 @@ class Scene {
   /// Runs one time step: collision detection (sequential, unrecorded), then
   /// rec.begin_step(), the contact set, and every solver's tasks. The step is left open.
   void step(capture::Recorder& rec);
+  /// For live runs that keep the program of the last step recorded into `rec` (deferred
+  /// mode): runs collision detection; when the step's interactions and collision groups
+  /// are those of that step, advances without recording and returns false (its bodies
+  /// point at the same state, so the caller runs the kept program again, as the paper
+  /// re-executes an unchanged graph); otherwise records like step() and returns true.
+  bool step_if_changed(capture::Recorder& rec);
 
   /// Scene name.
   const std::string& name() const { return name_; }
@@ -126,6 +132,7 @@ class Scene {
 
  private:
   void finalize();
+  bool advance(capture::Recorder& rec, bool allow_reuse);
   std::string name_;
   std::vector<std::unique_ptr<Body>> bodies_;
   std::vector<std::unique_ptr<ForceField>> fields_;
