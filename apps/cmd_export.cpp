@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/step_json.hpp"
 #include "tgraph/partition/export.hpp"
 #include "tgraph/replay/observer.hpp"
 
@@ -18,48 +19,6 @@ struct ExportOptions {
   std::string out;
   std::size_t step = 0;
 };
-
-nlohmann::json edges_json(const StepGraph& g, const std::vector<Edge>& edges) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const Edge& e : edges)
-    a.push_back({{"from", e.from}, {"to", e.to}, {"datum", e.datum}, {"kind", to_string(e.kind)},
-                 {"bytes", g.data[e.datum].bytes}});
-  return a;
-}
-
-std::string to_json(const StepGraph& g, std::size_t step) {
-  nlohmann::json tasks = nlohmann::json::array();
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    const Task& task = g.tasks[t];
-    nlohmann::json acc = nlohmann::json::array();
-    for (const Access& a : g.accesses_of(t)) acc.push_back({{"datum", a.datum}, {"mode", to_string(a.mode)}});
-    tasks.push_back({{"id", t},
-                     {"kind", g.kinds[task.kind]},
-                     {"object", task.object == kNoObject ? nlohmann::json(nullptr) : nlohmann::json(task.object)},
-                     {"cost_ns", task.cost_ns},
-                     {"loop", task.loop == kNoLoop ? nlohmann::json(nullptr) : nlohmann::json(task.loop)},
-                     {"key", task.key},
-                     {"accesses", acc}});
-  }
-  nlohmann::json data = nlohmann::json::array();
-  for (const Datum& d : g.data)
-    data.push_back({{"name", d.name},
-                    {"object", d.object == kNoObject ? nlohmann::json(nullptr) : nlohmann::json(d.object)},
-                    {"bytes", d.bytes}});
-  nlohmann::json objects = nlohmann::json::array();
-  for (const ObjectInfo& o : g.objects) objects.push_back(o.name);
-  nlohmann::json loops = nlohmann::json::array();
-  for (const Loop& l : g.loops)
-    loops.push_back({{"condition", l.condition}, {"first", l.first}, {"last", l.last},
-                     {"iterations", l.iterations}, {"max_iterations", l.max_iterations}});
-  nlohmann::json contacts = nlohmann::json::array();
-  for (const Contact& c : g.contacts) contacts.push_back({c.a, c.b});
-  const nlohmann::json j = {{"step", step},       {"objects", objects}, {"data", data},
-                            {"tasks", tasks},     {"loops", loops},     {"edges", edges_json(g, g.edges)},
-                            {"carried_edges", edges_json(g, g.carried_edges)},
-                            {"contacts", contacts}, {"groups", g.groups}};
-  return j.dump(1) + "\n";
-}
 
 void write_output(const ExportOptions& o, const std::string& text) {
   if (o.out.empty() || o.out == "-") {
@@ -84,7 +43,7 @@ void run_export(const ExportOptions& o) {
   const StepGraph& g = trace.steps[o.step];
   std::string text;
   if (o.format == "json") {
-    text = to_json(g, o.step);
+    text = step_graph_json(g, o.step);
   } else if (o.format == "metis") {
     text = partition::metis_graph_file(g);
   } else {

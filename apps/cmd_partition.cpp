@@ -8,11 +8,11 @@
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/stg.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
-#include "tgraph/partition/stg.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
@@ -188,7 +188,7 @@ struct ImportCmd {
 };
 
 void run_import(const ImportCmd& c) {
-  const tp::StgGraph stg = tp::read_stg(c.input, c.unit_ns, c.edge_bytes);
+  const StgGraph stg = read_stg(c.input, c.unit_ns, c.edge_bytes);
   write_trace(c.out, stg.trace);
   const StepGraph& g = stg.trace.steps[0];
   if (c.json) {

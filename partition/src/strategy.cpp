@@ -87,9 +87,9 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
   if (k == 0) throw UsageError("k must be at least 1");
   if ((prev.graph == nullptr) != (prev.assignment == nullptr))
     throw UsageError("previous step: graph and assignment must be given together");
-  if (prev.graph != nullptr && prev.assignment->proc.size() != prev.graph->tasks.size())
-    throw UsageError("previous step: assignment has " + std::to_string(prev.assignment->proc.size()) +
-                     " tasks, graph has " + std::to_string(prev.graph->tasks.size()));
+  if (prev.graph != nullptr)
+    if (std::string why = validate(*prev.graph, *prev.assignment, prev.assignment->k); !why.empty())
+      throw UsageError("previous step: " + why);
   if (!(options.imbalance >= 1.0)) throw UsageError("imbalance tolerance must be >= 1");
   if (const std::string why = g.validate(); !why.empty())
     throw UsageError("invalid step graph: " + why);
@@ -101,13 +101,8 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
 
   Assignment& a = r.assignment;
   a.k = k;
-  if (a.proc.size() != g.tasks.size())
-    throw std::logic_error("strategy " + std::string(name()) + " assigned " +
-                           std::to_string(a.proc.size()) + " of " + std::to_string(g.tasks.size()) +
-                           " tasks");
-  for (ProcId p : a.proc)
-    if (p >= k) throw std::logic_error("strategy " + std::string(name()) + " used processor " +
-                                       std::to_string(p) + " >= k");
+  if (std::string why = validate(g, a, k); !why.empty())
+    throw std::logic_error("strategy " + std::string(name()) + ": " + why);
 
   if (prev.graph != nullptr) {
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);

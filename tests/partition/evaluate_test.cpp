@@ -107,7 +107,7 @@ TEST(Evaluate, RejectsAnAssignmentThatDoesNotFitTheTrace) {
     evaluate(tr, one_step(2, {0, 1, 0, 1, 0}), CostModel::ideal(), "a.tga");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assigns 5 tasks, the trace has 6"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assignment covers 5 tasks, the step has 6"), std::string::npos)
         << e.what();
   }
   TraceAssignment two = one_step(2, {0, 1, 0, 1, 0, 1});

@@ -15,7 +15,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/partition/export.hpp"
 #include "tgraph/partition/partition_graph.hpp"
-#include "tgraph/partition/stg.hpp"
+#include "tgraph/graph/stg.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {

@@ -1,17 +1,17 @@
 // SPDX-License-Identifier: MIT
-// Standard Task Graph Set import: critical paths, and the list scheduler on real STG graphs.
+// Standard Task Graph Set import: critical paths, dummy tasks, round trip, malformed files.
+#include "tgraph/graph/stg.hpp"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/simulator.hpp"
-#include "tgraph/partition/stg.hpp"
-#include "tgraph/partition/strategy.hpp"
 
-namespace tgraph::partition {
+namespace tgraph {
 namespace {
 
 std::vector<std::string> stg_files() {
@@ -54,7 +54,8 @@ TEST(Stg, KeepsDummyTasksAndEveryEdge) {
 
 TEST(Stg, SurvivesATraceFileRoundTrip) {
   const StgGraph s = read_stg(std::string(TGRAPH_TEST_DATA) + "/stg/100/rand0003.stg");
-  const std::string path = (std::filesystem::temp_directory_path() / "tgraph_stg_test.tgt").string();
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "tgraph_stg_test.tgt").string();
   write_trace(path, s.trace);
   const Trace back = read_trace(path);
   std::filesystem::remove(path);
@@ -72,35 +73,19 @@ TEST(Stg, RejectsMalformedFilesWithTheOffset) {
     }
     return std::string("accepted");
   };
-  EXPECT_NE(message("").find("g.stg: offset 0: truncated: expected the task count"), std::string::npos);
-  EXPECT_NE(message("1\n0 0 0\n1 5 1 0\n").find("truncated: expected a task number"), std::string::npos);
-  EXPECT_NE(message("1\n0 0 0\n2 5 1 0\n2 0 1 1\n").find("expected task number 1, got 2"), std::string::npos);
-  EXPECT_NE(message("1\n0 0 0\n1 5 1 1\n2 0 1 1\n").find("predecessor numbered below 1"), std::string::npos);
-  EXPECT_NE(message("1\n0 0 0\n1 x 1 0\n").find("offset 10: expected a processing time"), std::string::npos);
+  EXPECT_NE(message("").find("g.stg: offset 0: truncated: expected the task count"),
+            std::string::npos);
+  EXPECT_NE(message("1\n0 0 0\n1 5 1 0\n").find("truncated: expected a task number"),
+            std::string::npos);
+  EXPECT_NE(message("1\n0 0 0\n2 5 1 0\n2 0 1 1\n").find("expected task number 1, got 2"),
+            std::string::npos);
+  EXPECT_NE(message("1\n0 0 0\n1 5 1 1\n2 0 1 1\n").find("predecessor numbered below 1"),
+            std::string::npos);
+  EXPECT_NE(message("1\n0 0 0\n1 x 1 0\n").find("offset 10: expected a processing time"),
+            std::string::npos);
   EXPECT_NE(message("1\n0 0 0\n1 5 1 0\n2 0 1 1\n7\n").find("'#' trailer"), std::string::npos);
   EXPECT_EQ(message("1\n0 0 0\n1 5 1 0\n2 0 1 1\n# CP Length : 5\n"), "accepted");
 }
 
-TEST(Stg, ListSchedulerBeatsRandomPlacementAndRespectsTheBound) {
-  std::uint64_t list_total = 0, random_total = 0;
-  for (const std::string& f : stg_files()) {
-    const StepGraph g = read_stg(f).trace.steps[0];
-    const Metrics m = compute_metrics(g);
-    for (std::uint32_t k : {2u, 4u}) {
-      Options o;
-      o.model = CostModel::ideal();
-      const Result list = make_strategy("list")->partition(g, k, {}, o);
-      const Result rnd = make_strategy("random")->partition(g, k, {}, o);
-      const std::uint64_t lm = simulate(g, list.assignment, CostModel::ideal()).makespan_ns;
-      const std::uint64_t rm = simulate(g, rnd.assignment, CostModel::ideal()).makespan_ns;
-      EXPECT_GE(lm, std::max<std::uint64_t>((m.work_ns + k - 1) / k, m.span_ns)) << f;
-      EXPECT_LE(lm, m.work_ns) << f;
-      list_total += lm;
-      random_total += rm;
-    }
-  }
-  EXPECT_LT(list_total, random_total);
-}
-
 }  // namespace
-}  // namespace tgraph::partition
+}  // namespace tgraph
