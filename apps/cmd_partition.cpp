@@ -78,12 +78,6 @@ struct ModelFlags {
   tp::CostModel load() const { return tp::select_cost_model(model, calibration); }
 };
 
-std::vector<std::uint64_t> structure_hashes(const Trace& trace) {
-  std::vector<std::uint64_t> h;
-  for (const StepGraph& g : trace.steps) h.push_back(g.structural_hash());
-  return h;
-}
-
 // ---- partition ----------------------------------------------------------------------
 
 struct PartitionCmd {
@@ -98,7 +92,7 @@ void run_partition(const PartitionCmd& c) {
   const Trace trace = load_trace(c.trace);
   if (c.k == 0) throw UsageError("-k: expected at least 1");
   const tp::TracePartition tp = tp::partition_trace(trace, c.method, c.k, c.flags.options(c.model.load()));
-  if (!c.out.empty()) tp::write_assignment(c.out, tp.assignment, structure_hashes(trace));
+  if (!c.out.empty()) tp::write_assignment(c.out, tp.assignment, trace);
   if (c.json) {
     std::cout << tp::partition_json(tp, c.out) << std::endl;
     return;
@@ -126,36 +120,12 @@ struct EvaluateCmd {
 
 void run_evaluate(const EvaluateCmd& c) {
   const Trace trace = load_trace(c.trace);
-  std::vector<std::uint64_t> hashes;
-  const TraceAssignment a = tp::read_assignment(c.assignment, &hashes);
-  tp::check_fits(trace, a, c.assignment);
-  for (std::size_t s = 0; s < hashes.size() && s < trace.steps.size(); ++s)
-    if (hashes[s] != 0 && hashes[s] != trace.steps[s].structural_hash())
-      throw InputError(c.assignment, std::nullopt,
-                       "step " + std::to_string(s) + " was partitioned for a graph of another structure than " +
-                           c.trace + "'s");
+  const TraceAssignment a = tp::load_assignment(c.assignment, trace, c.trace);
   const tp::Report rep = tp::evaluate(trace, a, c.model.load(), c.assignment);
-  if (c.json) {
+  if (c.json)
     std::cout << tp::report_json(rep) << std::endl;
-    return;
-  }
-  const tp::StepReport& t = rep.total;
-  std::printf("method %s, k = %u, %zu steps, cost model: %s\n", rep.method.c_str(), rep.k, rep.steps.size(),
-              rep.model.c_str());
-  std::printf("  cut: %llu edges, %llu bytes; %llu signals, %llu waits, %llu reducers, %llu bytes moved\n",
-              static_cast<unsigned long long>(t.cut_edges), static_cast<unsigned long long>(t.cut_bytes),
-              static_cast<unsigned long long>(t.signals), static_cast<unsigned long long>(t.waits),
-              static_cast<unsigned long long>(t.reducers), static_cast<unsigned long long>(t.transfer_bytes));
-  std::printf("  imbalance %.3f (worst step %.3f); migrations: %llu tasks, %llu bytes\n", t.imbalance,
-              rep.imbalance_max, static_cast<unsigned long long>(t.migrated_tasks),
-              static_cast<unsigned long long>(t.migrated_bytes));
-  std::printf("  predicted makespan %.3f ms, lower bound %.3f ms, work %.3f ms: speed-up %.2f "
-              "(%.2f with %.3f ms partitioning)\n",
-              static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
-              static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning, t.partition_ms);
-  std::printf("  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
-              t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),
-              static_cast<unsigned long long>(t.ping_pong_pairs));
+  else
+    std::fputs(tp::report_text(rep).c_str(), stdout);
 }
 
 // ---- compare ------------------------------------------------------------------------

@@ -10,6 +10,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/partition/evaluate.hpp"
 
 namespace tgraph::partition {
 
@@ -240,6 +241,26 @@ void write_assignment(const std::string& path, const TraceAssignment& a,
 TraceAssignment read_assignment(const std::string& path, std::vector<std::uint64_t>* hashes) {
   const std::vector<std::uint8_t> b = read_file_bytes(path);
   return decode_assignment(b, path, hashes);
+}
+
+void write_assignment(const std::string& path, const TraceAssignment& a, const Trace& trace) {
+  std::vector<std::uint64_t> hashes;
+  hashes.reserve(trace.steps.size());
+  for (const StepGraph& g : trace.steps) hashes.push_back(g.structural_hash());
+  write_assignment(path, a, hashes);
+}
+
+TraceAssignment load_assignment(const std::string& path, const Trace& trace,
+                                const std::string& trace_name) {
+  std::vector<std::uint64_t> hashes;
+  TraceAssignment a = read_assignment(path, &hashes);
+  check_fits(trace, a, path);
+  for (std::size_t s = 0; s < hashes.size() && s < trace.steps.size(); ++s)
+    if (hashes[s] != 0 && hashes[s] != trace.steps[s].structural_hash())
+      throw InputError(path, std::nullopt,
+                       "step " + std::to_string(s) + " was partitioned for a graph of another structure than " +
+                           trace_name + "'s");
+  return a;
 }
 
 }  // namespace tgraph::partition
