@@ -93,24 +93,30 @@ std::string report_text(const Report& rep) {
   std::string out;
   char line[512];
   auto add = [&](int n) { out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 511))); };
-  add(std::snprintf(line, sizeof line, "method %s, k = %u, %zu steps, cost model: %s\n", rep.method.c_str(),
-                    rep.k, rep.steps.size(), rep.model.c_str()));
-  add(std::snprintf(line, sizeof line,
-                    "  cut: %llu edges, %llu bytes; %llu signals, %llu waits, %llu reducers, %llu bytes moved\n",
-                    static_cast<unsigned long long>(t.cut_edges), static_cast<unsigned long long>(t.cut_bytes),
-                    static_cast<unsigned long long>(t.signals), static_cast<unsigned long long>(t.waits),
-                    static_cast<unsigned long long>(t.reducers), static_cast<unsigned long long>(t.transfer_bytes)));
-  add(std::snprintf(line, sizeof line, "  imbalance %.3f (worst step %.3f); migrations: %llu tasks, %llu bytes\n",
-                    t.imbalance, rep.imbalance_max, static_cast<unsigned long long>(t.migrated_tasks),
-                    static_cast<unsigned long long>(t.migrated_bytes)));
-  add(std::snprintf(line, sizeof line,
-                    "  predicted makespan %.3f ms, lower bound %.3f ms, work %.3f ms: speed-up %.2f "
-                    "(%.2f with %.3f ms partitioning)\n",
-                    static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
-                    static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning, t.partition_ms));
-  add(std::snprintf(line, sizeof line, "  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
-                    t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),
-                    static_cast<unsigned long long>(t.ping_pong_pairs)));
+  add(std::snprintf(line, sizeof line, "method %s, k = %u, %zu steps, cost model: %s\n",
+                    rep.method.c_str(), rep.k, rep.steps.size(), rep.model.c_str()));
+  add(std::snprintf(
+      line, sizeof line,
+      "  cut: %llu edges, %llu bytes; %llu signals, %llu waits, %llu reducers, %llu bytes moved\n",
+      static_cast<unsigned long long>(t.cut_edges), static_cast<unsigned long long>(t.cut_bytes),
+      static_cast<unsigned long long>(t.signals), static_cast<unsigned long long>(t.waits),
+      static_cast<unsigned long long>(t.reducers),
+      static_cast<unsigned long long>(t.transfer_bytes)));
+  add(std::snprintf(
+      line, sizeof line, "  imbalance %.3f (worst step %.3f); migrations: %llu tasks, %llu bytes\n",
+      t.imbalance, rep.imbalance_max, static_cast<unsigned long long>(t.migrated_tasks),
+      static_cast<unsigned long long>(t.migrated_bytes)));
+  add(std::snprintf(
+      line, sizeof line,
+      "  predicted makespan %.3f ms, lower bound %.3f ms, work %.3f ms: speed-up %.2f "
+      "(%.2f with %.3f ms partitioning)\n",
+      static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
+      static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning,
+      t.partition_ms));
+  add(std::snprintf(
+      line, sizeof line, "  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
+      t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),
+      static_cast<unsigned long long>(t.ping_pong_pairs)));
   return out;
 }
 
