@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "tgraph/graph/diff.hpp"
 #include "tgraph/graph/metrics.hpp"
 
 namespace tgraph {
@@ -33,6 +34,10 @@ TraceSummary summarize_trace(const Trace& trace) {
     st.collision_groups = g.groups.empty() ? (g.objects.empty() ? 0 : 1) : groups.size();
     st.contacts_changed = contacts_changed(trace, i);
     st.structure = g.structural_hash();
+    if (i > 0 && !g.same_structure(trace.steps[i - 1])) {
+      st.structure_changed = true;
+      st.change = step_diff_summary(diff_steps(trace.steps[i - 1], g));
+    }
 
     s.tasks += st.tasks;
     s.tasks_min = std::min(s.tasks_min, st.tasks);
@@ -59,7 +64,7 @@ TraceSummary summarize_trace(const Trace& trace) {
 
 std::string trace_summary_json(const TraceSummary& s, const std::string& trace_name) {
   using nlohmann::json;
-  json per_step = json::array();
+  json per_step = json::array(), changes = json::array();
   for (std::size_t i = 0; i < s.per_step.size(); ++i) {
     const StepSummary& st = s.per_step[i];
     per_step.push_back({{"step", i},
@@ -74,7 +79,9 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
                         {"contacts", st.contacts},
                         {"collision_groups", st.collision_groups},
                         {"contacts_changed", st.contacts_changed},
-                        {"structure", st.structure}});
+                        {"structure", st.structure},
+                        {"structure_changed", st.structure_changed}});
+    if (st.structure_changed) changes.push_back({{"step", i}, {"summary", st.change}});
   }
   const json j = {
       {"trace", trace_name},
@@ -96,6 +103,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"distinct_structures", s.distinct_structures},
       {"contact_changes", s.contact_changes},
       {"last_step_collision_groups", s.last_step_collision_groups},
+      {"structure_changes", changes},
       {"per_step", per_step},
   };
   return j.dump();
@@ -133,6 +141,13 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
       "contacts       %llu steps whose contact set changed; last step %llu collision group(s)\n",
       static_cast<unsigned long long>(s.contact_changes),
       static_cast<unsigned long long>(s.last_step_collision_groups)));
+  std::size_t changed = 0;
+  for (const StepSummary& st : s.per_step) changed += st.structure_changed ? 1 : 0;
+  if (changed > 0)
+    out += "changes        " + std::to_string(changed) + " steps whose structure changed:\n";
+  for (std::size_t i = 0; i < s.per_step.size(); ++i)
+    if (s.per_step[i].structure_changed)
+      out += "  step " + std::to_string(i) + ": " + s.per_step[i].change + "\n";
   return out;
 }
 

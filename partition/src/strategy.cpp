@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "strategies.hpp"
+#include "tgraph/graph/diff.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::partition {
@@ -67,19 +68,7 @@ Rebalance parse_rebalance(std::string_view s) {
 }
 
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
-  std::unordered_map<StableKey, std::vector<TaskId>> by_key;
-  by_key.reserve(prev.tasks.size());
-  for (TaskId t = 0; t < prev.tasks.size(); ++t) by_key[prev.tasks[t].key].push_back(t);
-  std::unordered_map<StableKey, std::size_t> seen;
-  std::vector<TaskId> match(g.tasks.size(), kNoTask);
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    auto it = by_key.find(g.tasks[t].key);
-    if (it == by_key.end()) continue;
-    std::size_t& i = seen[g.tasks[t].key];
-    if (i < it->second.size()) match[t] = it->second[i];
-    ++i;
-  }
-  return match;
+  return match_tasks_by_key(g, prev);
 }
 
 Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& prev,

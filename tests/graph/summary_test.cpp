@@ -80,6 +80,14 @@ TEST(TraceSummary, AddsUpTheStepsMetricsAndCountsContactChanges) {
   EXPECT_EQ(s.per_step[0].collision_groups, 2u);
   EXPECT_EQ(s.per_step[2].collision_groups, 1u);
   EXPECT_EQ(s.last_step_collision_groups, 2u);
+  // The structure changed where the contact appeared and vanished, each with its diff.
+  std::vector<bool> structure;
+  for (const StepSummary& st : s.per_step) structure.push_back(st.structure_changed);
+  EXPECT_EQ(structure, (std::vector<bool>{false, false, true, false, true}));
+  EXPECT_EQ(s.per_step[2].change,
+            "+1/-0 tasks, +3/-1 edges, contacts +a|b, groups merged: {a} + {b}");
+  EXPECT_EQ(s.per_step[4].change.rfind("+0/-1 tasks", 0), 0u) << s.per_step[4].change;
+  EXPECT_TRUE(s.per_step[1].change.empty());
 }
 
 TEST(TraceSummary, JsonAndTextCarryTheFigures) {
@@ -99,6 +107,9 @@ TEST(TraceSummary, JsonAndTextCarryTheFigures) {
   ASSERT_EQ(j["per_step"].size(), 2u);
   EXPECT_EQ(j["per_step"][1]["contacts_changed"], true);
   EXPECT_EQ(j["per_step"][1]["loop_iterations"], nlohmann::json::array({5}));
+  ASSERT_EQ(j["structure_changes"].size(), 1u);
+  EXPECT_EQ(j["structure_changes"][0]["step"], 1);
+  EXPECT_EQ(j["structure_changes"][0]["summary"], s.per_step[1].change);
   const std::string text = trace_summary_text(s, "t.tgt");
   EXPECT_NE(text.find("trace          t.tgt (scene two, engine test)\n"), std::string::npos)
       << text;

@@ -5,6 +5,7 @@
 
 #if TGRAPH_HAVE_SAMPLES
 #include "tgraph/capture/recorder.hpp"
+#include "tgraph/graph/diff.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -60,6 +61,33 @@ TEST(StickyOnFalling, MovesFewerTasksThanMetisRelabelledEveryStep) {
     for (std::size_t i = 0; i < trace.steps.size(); ++i)
       ASSERT_EQ(relabel.stats[i].edgecut, metis.stats[i].edgecut) << "step " << i;
   }
+}
+
+TEST(DiffOnFalling, NamesTheContactThatMergedTheGroupsAtEveryMerge) {
+  const Trace& trace = falling_trace();
+  int merges = 0;
+  for (std::size_t s = 1; s < trace.steps.size(); ++s) {
+    const StepGraph &a = trace.steps[s - 1], &b = trace.steps[s];
+    const StepDiff d = diff_steps(a, b);
+    EXPECT_EQ(d.same_structure, b.same_structure(a));
+    if (b.loops.size() >= a.loops.size()) continue;
+    ++merges;
+    // Solver loops merged: groups merged, by contacts that appeared this step, and every
+    // added contact's tasks say which contact they belong to.
+    ASSERT_FALSE(d.groups_merged.empty()) << "step " << s;
+    ASSERT_FALSE(d.contacts_added.empty()) << "step " << s;
+    for (const GroupChange& g : d.groups_merged) {
+      EXPECT_GE(g.from.size(), 2u);
+      ASSERT_FALSE(g.contacts.empty()) << "step " << s;
+      for (const std::string& c : g.contacts)
+        EXPECT_NE(std::find(d.contacts_added.begin(), d.contacts_added.end(), c),
+                  d.contacts_added.end());
+    }
+    std::size_t caused = 0;
+    for (const TaskRef& t : d.tasks_added) caused += t.caused_by.empty() ? 0 : 1;
+    EXPECT_GE(caused, d.contacts_added.size()) << "step " << s;
+  }
+  EXPECT_GE(merges, 2);
 }
 
 }  // namespace

@@ -24,6 +24,8 @@ struct StepSummary {
   std::uint64_t collision_groups = 0;  ///< distinct group ids (1 when none are recorded)
   bool contacts_changed = false;       ///< contact set differs from the previous step's
   std::uint64_t structure = 0;         ///< StepGraph::structural_hash
+  bool structure_changed = false;      ///< structure differs from the previous step's
+  std::string change;  ///< when it does: step_diff_summary of the previous step -> this one
 };
 
 /// The whole trace.
@@ -55,7 +57,8 @@ TraceSummary summarize_trace(const Trace& trace);
 
 /// `tgraph info --json`: one JSON object (header, totals, "per_step" array).
 std::string trace_summary_json(const TraceSummary& s, const std::string& trace_name);
-/// `tgraph info`'s text: one "name   value" line per figure.
+/// `tgraph info`'s text: one "name   value" line per figure, then one line per step whose
+/// structure changed.
 std::string trace_summary_text(const TraceSummary& s, const std::string& trace_name);
 
 }  // namespace tgraph
