@@ -31,6 +31,7 @@ struct StrategyFlags {
   double threshold = 1.20;
   double migration_cost = 1.0;
   std::string rebalance = "greedy";
+  std::string sticky_fallback = "fresh";
 
   void add(CLI::App* cmd) {
     cmd->add_option("--imbalance", imbalance, "Tolerated max/mean load for METIS and Scotch (default 1.03)");
@@ -45,6 +46,10 @@ struct StrategyFlags {
     cmd->add_option("--threshold", threshold, "sticky: rebalance when imbalance exceeds this x the last partition's (default 1.20)");
     cmd->add_option("--rebalance", rebalance, "sticky: greedy (move whole objects) or scotch (graphRepart)")
         ->check(CLI::IsMember({"greedy", "scotch"}));
+    cmd->add_option("--sticky-fallback", sticky_fallback,
+                    "sticky, when solver loops merge or split: fresh (base method + relabel) or "
+                    "repartition (Scotch graphRepart from the incremental placement)")
+        ->check(CLI::IsMember({"fresh", "repartition"}));
     cmd->add_option("--migration-cost", migration_cost,
                     "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
   }
@@ -59,6 +64,7 @@ struct StrategyFlags {
     o.sticky_threshold = threshold;
     o.migration_cost = migration_cost;
     o.rebalance = tp::parse_rebalance(rebalance);
+    o.sticky_fallback = tp::parse_sticky_fallback(sticky_fallback);
     o.model = model;
     return o;
   }
@@ -134,6 +140,7 @@ struct CompareCmd {
   std::string trace, csv;
   std::vector<std::string> methods = {"owner", "metis", "metis-relabel", "scotch", "sticky", "list", "roundrobin"};
   std::vector<std::uint32_t> ks = {2, 4, 8, 16};
+  std::vector<double> migration_costs;
   bool json = false;
   StrategyFlags flags;
   ModelFlags model;
@@ -141,7 +148,8 @@ struct CompareCmd {
 
 void run_compare(const CompareCmd& c) {
   const Trace trace = load_trace(c.trace);
-  const tp::Comparison cmp = tp::compare(trace, c.methods, c.ks, c.flags.options(c.model.load()));
+  const tp::Comparison cmp =
+      tp::compare(trace, c.methods, c.ks, c.flags.options(c.model.load()), c.migration_costs);
   if (!c.csv.empty()) write_file_atomic(c.csv, tp::comparison_csv(cmp));
   if (c.json)
     std::cout << tp::comparison_json(cmp, c.trace) << std::endl;
@@ -240,6 +248,10 @@ void add_partition_verbs(CLI::App& app) {
     cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
     cmd->add_option("--methods", c->methods, "Comma-separated methods")->delimiter(',');
     cmd->add_option("-k", c->ks, "Comma-separated processor counts (default 2,4,8,16)")->delimiter(',');
+    cmd->add_option("--sticky-migration-cost", c->migration_costs,
+                    "Also run sticky with --sticky-fallback repartition at each of these migration "
+                    "costs (comma-separated) and mark the Pareto points")
+        ->delimiter(',');
     cmd->add_option("--csv", c->csv, "Also write the table as CSV");
     cmd->add_flag("--json", c->json, "Print one JSON object");
     c->flags.add(cmd);

@@ -146,7 +146,11 @@ std::string comparison_json(const Comparison& c, const std::string& trace_name) 
   for (const CompareRow& r : c.rows) {
     json row = report_object(r.report, false);
     add_summary(row, r.partition);
-    if (r.method == "sticky")
+    row["label"] = row_label(r);
+    row["migration_cost"] = r.migration_cost ? json(*r.migration_cost) : json(nullptr);
+    row["pareto_makespan"] = r.pareto_makespan;
+    row["pareto_cut"] = r.pareto_cut;
+    if (r.method == "sticky" && !r.migration_cost)
       if (const StickyMoves* s = sticky_moves_at(c, r.k)) {
         row["moved_over_metis"] = optional_json(s->over_metis());
         row["moved_over_metis_relabel"] = optional_json(s->over_metis_relabel());
@@ -161,7 +165,24 @@ std::string comparison_json(const Comparison& c, const std::string& trace_name) 
                      {"metis_relabel", optional_json(s.metis_relabel)},
                      {"sticky_over_metis", optional_json(s.over_metis())},
                      {"sticky_over_metis_relabel", optional_json(s.over_metis_relabel())}});
-  return json{{"trace", trace_name}, {"model", c.model}, {"rows", rows}, {"sticky_moves", moves}}
+  json pareto = json::array();
+  for (std::size_t i = 0; i < c.rows.size(); ++i) {
+    bool first = true;  // one entry per K, at its first row
+    for (std::size_t j = 0; j < i; ++j) first = first && c.rows[j].k != c.rows[i].k;
+    if (!first) continue;
+    json makespan = json::array(), cut = json::array();
+    for (const CompareRow& r : c.rows) {
+      if (r.k != c.rows[i].k) continue;
+      if (r.pareto_makespan) makespan.push_back(row_label(r));
+      if (r.pareto_cut) cut.push_back(row_label(r));
+    }
+    pareto.push_back({{"k", c.rows[i].k}, {"makespan", makespan}, {"cut", cut}});
+  }
+  return json{{"trace", trace_name},
+              {"model", c.model},
+              {"rows", rows},
+              {"sticky_moves", moves},
+              {"pareto", pareto}}
       .dump();
 }
 
@@ -169,17 +190,21 @@ std::string comparison_csv(const Comparison& c) {
   std::ostringstream csv;
   csv << "method,k,partition_ms,cut_edges,cut_bytes,signals,reducers,imbalance,migrated_tasks,"
          "predicted_makespan_ns,lower_bound_ns,predicted_speedup,quotient_acyclic,reused_steps,"
-         "fallback_steps,rebalanced_steps,moved_over_metis,moved_over_metis_relabel\n";
+         "fallback_steps,rebalanced_steps,moved_over_metis,moved_over_metis_relabel,migration_cost,"
+         "pareto_makespan,pareto_cut\n";
   for (const CompareRow& r : c.rows) {
     const StepReport& t = r.report.total;
-    const StickyMoves* s = r.method == "sticky" ? sticky_moves_at(c, r.k) : nullptr;
+    const StickyMoves* s =
+        r.method == "sticky" && !r.migration_cost ? sticky_moves_at(c, r.k) : nullptr;
     csv << r.method << ',' << r.k << ',' << t.partition_ms << ',' << t.cut_edges << ','
         << t.cut_bytes << ',' << t.signals << ',' << t.reducers << ',' << t.imbalance << ','
         << t.migrated_tasks << ',' << t.makespan_ns << ',' << t.lower_bound_ns << ',' << t.speedup
         << ',' << (t.quotient_acyclic ? 1 : 0) << ',' << r.partition.reused_steps << ','
         << r.partition.fallback_steps << ',' << r.partition.rebalanced_steps << ','
         << csv_number(s ? s->over_metis() : std::nullopt) << ','
-        << csv_number(s ? s->over_metis_relabel() : std::nullopt) << '\n';
+        << csv_number(s ? s->over_metis_relabel() : std::nullopt) << ','
+        << csv_number(r.migration_cost) << ',' << (r.pareto_makespan ? 1 : 0) << ','
+        << (r.pareto_cut ? 1 : 0) << '\n';
   }
   return csv.str();
 }
@@ -198,7 +223,7 @@ std::string comparison_table(const Comparison& c) {
                                                      static_cast<double>(t.lower_bound_ns);
     std::snprintf(
         line, sizeof line, "%-14s %4u %12.3f %10llu %12llu %9llu %9.3f %9llu %14.3f %8.2f %8.2f\n",
-        r.method.c_str(), r.k, t.partition_ms, static_cast<unsigned long long>(t.cut_edges),
+        row_label(r).c_str(), r.k, t.partition_ms, static_cast<unsigned long long>(t.cut_edges),
         static_cast<unsigned long long>(t.cut_bytes), static_cast<unsigned long long>(t.signals),
         t.imbalance, static_cast<unsigned long long>(t.migrated_tasks),
         static_cast<double>(t.makespan_ns) / 1e6, t.speedup, bound);
@@ -207,13 +232,13 @@ std::string comparison_table(const Comparison& c) {
   for (const CompareRow& r : c.rows) {
     if (r.method != "sticky") continue;
     std::snprintf(
-        line, sizeof line,
-        "sticky k=%u: %llu steps reused, %llu fallback (fresh + relabel), %llu rebalanced", r.k,
-        static_cast<unsigned long long>(r.partition.reused_steps),
+        line, sizeof line, "%s k=%u: %llu steps reused, %llu fallback (%s), %llu rebalanced",
+        row_label(r).c_str(), r.k, static_cast<unsigned long long>(r.partition.reused_steps),
         static_cast<unsigned long long>(r.partition.fallback_steps),
+        r.migration_cost ? "repartition" : "fresh + relabel",
         static_cast<unsigned long long>(r.partition.rebalanced_steps));
     out += line;
-    if (const StickyMoves* s = sticky_moves_at(c, r.k)) {
+    if (const StickyMoves* s = r.migration_cost ? nullptr : sticky_moves_at(c, r.k)) {
       out += "; moved tasks ";
       out += std::to_string(s->sticky);
       auto against = [&](const char* name, const std::optional<std::uint64_t>& base,
@@ -231,6 +256,34 @@ std::string comparison_table(const Comparison& c) {
       against("metis-relabel", s->metis_relabel, s->over_metis_relabel());
     }
     out += '\n';
+  }
+  // Pareto points per K, when the grid compares several methods or costs.
+  for (std::size_t i = 0; i < c.rows.size(); ++i) {
+    bool first = true;
+    std::size_t at_k = 0;
+    for (std::size_t j = 0; j < c.rows.size(); ++j) {
+      if (c.rows[j].k != c.rows[i].k) continue;
+      first = first && j >= i;
+      ++at_k;
+    }
+    if (!first || at_k < 2) continue;
+    for (const bool by_makespan : {true, false}) {
+      out += "pareto k=" + std::to_string(c.rows[i].k) + ", moved tasks vs " +
+             (by_makespan ? "predicted makespan:" : "cut bytes:");
+      for (const CompareRow& r : c.rows) {
+        if (r.k != c.rows[i].k || !(by_makespan ? r.pareto_makespan : r.pareto_cut)) continue;
+        if (by_makespan)
+          std::snprintf(line, sizeof line, " %s (%llu, %.3f ms)", row_label(r).c_str(),
+                        static_cast<unsigned long long>(r.partition.moved_tasks),
+                        static_cast<double>(r.report.total.makespan_ns) / 1e6);
+        else
+          std::snprintf(line, sizeof line, " %s (%llu, %llu)", row_label(r).c_str(),
+                        static_cast<unsigned long long>(r.partition.moved_tasks),
+                        static_cast<unsigned long long>(r.report.total.cut_bytes));
+        out += line;
+      }
+      out += '\n';
+    }
   }
   return out;
 }

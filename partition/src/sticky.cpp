@@ -193,7 +193,9 @@ class Sticky final : public Strategy {
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);
     std::size_t matched = 0;
     for (TaskId m : match) matched += m != kNoTask ? 1 : 0;
-    if (g.loops.size() != prev.graph->loops.size() || 4 * matched < 3 * static_cast<std::size_t>(n)) {
+    const bool reshaped =
+        g.loops.size() != prev.graph->loops.size() || 4 * matched < 3 * static_cast<std::size_t>(n);
+    if (reshaped && options.sticky_fallback == StickyFallback::kFresh) {
       // The shape changed too much to patch (solver loops merged or split, or over a quarter
       // of the tasks are new): partition afresh, then rename the parts so that as many
       // tasks as possible stay where they were (as `metis-relabel` does every step).
@@ -218,6 +220,14 @@ class Sticky final : public Strategy {
     // New tasks, in program order: the processor holding most bytes of their data.
     place_by_affinity(g, work, k, placed, proc, load);
 
+    if (reshaped) {
+      // Repartition with the incremental placement as the old partition: Scotch trades the
+      // cut against migrated load (emraval x bytes each task touches).
+      if (k > 1 && n > k) scotch_rebalance(g, k, options, match, proc);
+      r.stats.fallback = true;
+      remember(proc, imbalance(loads(work, proc, k)));
+      return r;
+    }
     if (imbalance(load) <= trigger || k == 1 || n <= k) {
       remember(proc, baseline);
       return r;

@@ -67,6 +67,22 @@ Rebalance parse_rebalance(std::string_view s) {
   throw UsageError("--rebalance: expected greedy or scotch, got '" + std::string(s) + "'");
 }
 
+std::string_view to_string(StickyFallback f) {
+  switch (f) {
+    case StickyFallback::kFresh:
+      return "fresh";
+    case StickyFallback::kRepartition:
+      return "repartition";
+  }
+  return "?";
+}
+
+StickyFallback parse_sticky_fallback(std::string_view s) {
+  if (s == "fresh") return StickyFallback::kFresh;
+  if (s == "repartition") return StickyFallback::kRepartition;
+  throw UsageError("--sticky-fallback: expected fresh or repartition, got '" + std::string(s) + "'");
+}
+
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
   return match_tasks_by_key(g, prev);
 }

@@ -86,6 +86,71 @@ TEST(Compare, ReportsStickyMovesOnlyAgainstTheBaselinesInTheGrid) {
   EXPECT_FALSE(j["rows"][1].contains("moved_over_metis"));  // only sticky rows carry ratios
 }
 
+TEST(Compare, SweepsStickysMigrationCostAndMarksTheParetoPoints) {
+  const Trace trace = changing_trace();
+  const Comparison c = compare(trace, {"metis-relabel", "sticky"}, {2, 4}, {}, {0.01, 1.0, 10.0});
+  ASSERT_EQ(c.rows.size(), 2u * 2 + 3u * 2);
+  for (std::size_t i = 4; i < c.rows.size(); ++i) {
+    EXPECT_EQ(c.rows[i].method, "sticky");
+    ASSERT_TRUE(c.rows[i].migration_cost.has_value());
+    // Each sweep row is sticky with the repartition fallback at that cost.
+    Options o;
+    o.sticky_fallback = StickyFallback::kRepartition;
+    o.migration_cost = *c.rows[i].migration_cost;
+    const TracePartition tp = partition_trace(trace, "sticky", c.rows[i].k, o);
+    EXPECT_EQ(c.rows[i].partition.moved_tasks, summarize(tp.stats).moved_tasks);
+    EXPECT_EQ(c.rows[i].partition.fallback_steps, 3u);
+  }
+  EXPECT_EQ(row_label(c.rows[4]), "sticky@0.01");
+  EXPECT_EQ(row_label(c.rows[1]), "metis-relabel");
+  // Pareto flags: exactly the rows no other row of the same K dominates.
+  for (const CompareRow& r : c.rows) {
+    bool dominated = false, dominated_cut = false;
+    std::size_t same_k = 0;
+    for (const CompareRow& o : c.rows) {
+      if (o.k != r.k) continue;
+      ++same_k;
+      const auto m = o.partition.moved_tasks, mr = r.partition.moved_tasks;
+      const auto f = o.report.total.makespan_ns, fr = r.report.total.makespan_ns;
+      const auto b = o.report.total.cut_bytes, br = r.report.total.cut_bytes;
+      dominated = dominated || (m <= mr && f <= fr && (m < mr || f < fr));
+      dominated_cut = dominated_cut || (m <= mr && b <= br && (m < mr || b < br));
+    }
+    EXPECT_EQ(same_k, 5u);
+    EXPECT_EQ(r.pareto_makespan, !dominated) << row_label(r) << " k " << r.k;
+    EXPECT_EQ(r.pareto_cut, !dominated_cut) << row_label(r) << " k " << r.k;
+  }
+  // The fewest moves at each K are always a Pareto point.
+  for (std::uint32_t k : {2u, 4u}) {
+    const CompareRow* fewest = nullptr;
+    for (const CompareRow& r : c.rows)
+      if (r.k == k &&
+          (fewest == nullptr || r.partition.moved_tasks < fewest->partition.moved_tasks ||
+           (r.partition.moved_tasks == fewest->partition.moved_tasks &&
+            r.report.total.makespan_ns < fewest->report.total.makespan_ns)))
+        fewest = &r;
+    EXPECT_TRUE(fewest->pareto_makespan);
+  }
+  const nlohmann::json j = nlohmann::json::parse(comparison_json(c, "t.tgt"));
+  ASSERT_EQ(j["pareto"].size(), 2u);
+  std::size_t listed = 0;
+  for (const nlohmann::json& p : j["pareto"]) listed += p["makespan"].size();
+  std::size_t flagged = 0;
+  for (const CompareRow& r : c.rows) flagged += r.pareto_makespan ? 1 : 0;
+  EXPECT_EQ(listed, flagged);
+  EXPECT_EQ(j["rows"][4]["label"], "sticky@0.01");
+  EXPECT_EQ(j["rows"][4]["migration_cost"], 0.01);
+  EXPECT_TRUE(j["rows"][0]["migration_cost"].is_null());
+  // Sticky's moves against the baselines use the plain sticky row, not the sweep's.
+  ASSERT_EQ(c.sticky_moves.size(), 2u);
+  EXPECT_EQ(c.sticky_moves[0].sticky, c.rows[2].partition.moved_tasks);
+  const std::string table = comparison_table(c);
+  EXPECT_NE(table.find("sticky@10 k=4:"), std::string::npos) << table;
+  EXPECT_NE(table.find("pareto k=2, moved tasks vs predicted makespan:"), std::string::npos)
+      << table;
+  EXPECT_THROW(compare(trace, {"sticky"}, {2}, {}, {-1.0}), UsageError);
+}
+
 TEST(Compare, RejectsUnknownMethodsAndZeroProcessorsBeforeAnyWork) {
   const Trace trace = changing_trace();
   EXPECT_THROW(compare(trace, {"metis", "nope"}, {2}), UsageError);

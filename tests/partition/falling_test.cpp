@@ -63,6 +63,20 @@ TEST(StickyOnFalling, MovesFewerTasksThanMetisRelabelledEveryStep) {
   }
 }
 
+TEST(StickyOnFalling, RepartitioningAtMergesMovesFewerTasksThanMetisRelabel) {
+  const Trace& trace = falling_trace();
+  Options o;
+  o.sticky_fallback = StickyFallback::kRepartition;
+  for (std::uint32_t k : {2u, 4u, 8u}) {
+    const TracePartition sticky = partition_trace(trace, "sticky", k, o);
+    const TracePartition relabel = partition_trace(trace, "metis-relabel", k);
+    const PartitionSummary s = summarize(sticky.stats);
+    EXPECT_LT(s.moved_tasks, summarize(relabel.stats).moved_tasks) << "k " << k;
+    EXPECT_GE(s.fallback_steps, 2u);
+    EXPECT_NO_THROW(check_fits(trace, sticky.assignment, "sticky"));
+  }
+}
+
 TEST(DiffOnFalling, NamesTheContactThatMergedTheGroupsAtEveryMerge) {
   const Trace& trace = falling_trace();
   int merges = 0;

@@ -349,6 +349,34 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
   EXPECT_EQ(kind, (std::vector<int>{0, 1, 2, 1, 2}));
 }
 
+TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
+  using testing::grouped_scene;
+  const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
+  const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
+  Options o;
+  o.sticky_fallback = StickyFallback::kRepartition;
+  for (std::uint32_t k : {2u, 3u, 4u}) {
+    auto s = make_strategy("sticky");
+    const Result r0 = s->partition(apart, k, {}, o);
+    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, o);
+    EXPECT_TRUE(r1.stats.fallback) << k;
+    EXPECT_FALSE(r1.stats.rebalanced);
+    EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
+    // Balanced within the tolerance METIS gets, with fewer moves than a fresh partition
+    // relabelled: the previous placement is the starting point.
+    const auto l = loads_of(merged, r1.assignment);
+    std::uint64_t total = 0;
+    for (std::uint64_t x : l) total += x;
+    EXPECT_LE(static_cast<double>(*std::max_element(l.begin(), l.end())) * k / static_cast<double>(total), 1.1)
+        << k;
+    const Result fresh = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, o);
+    EXPECT_LE(r1.stats.moved_tasks, fresh.stats.moved_tasks) << k;
+  }
+  EXPECT_EQ(parse_sticky_fallback("repartition"), StickyFallback::kRepartition);
+  EXPECT_EQ(to_string(StickyFallback::kFresh), "fresh");
+  EXPECT_THROW(parse_sticky_fallback("magic"), UsageError);
+}
+
 TEST(Sticky, StartsFromItsBaseMethodAndWhenKChanges) {
   const StepGraph g = testing::two_halves(10);
   Options o;

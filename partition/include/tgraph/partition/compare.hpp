@@ -34,6 +34,14 @@ std::string partition_json(const TracePartition& tp, const std::string& output);
 struct CompareRow {
   std::string method;
   std::uint32_t k = 1;
+  /// Rows of the `sticky` migration-cost sweep: the cost (emraval) they ran with, falling
+  /// back by Scotch repartitioning from the incremental placement.
+  std::optional<double> migration_cost;
+  /// Not dominated, among the rows at this K, in (moved tasks, predicted makespan): no other
+  /// row moves no more tasks with no longer a makespan, one of the two strictly.
+  bool pareto_makespan = false;
+  /// Likewise in (moved tasks, cut bytes).
+  bool pareto_cut = false;
   PartitionSummary partition;
   Report report;  ///< evaluate() of the assignment (per-step reports included)
 };
@@ -58,19 +66,26 @@ struct Comparison {
 };
 
 /// Partitions `trace` with every method at every K (partition_trace) and evaluates each
-/// assignment with `options.model`. Throws UsageError for an unknown method or K = 0 before
-/// any work.
+/// assignment with `options.model`; then, for each cost in `sticky_migration_costs`, `sticky`
+/// at every K with `sticky_fallback = kRepartition` and that `migration_cost`. Marks each
+/// K's Pareto points. Throws UsageError for an unknown method, K = 0 or a negative cost
+/// before any work.
 ///
 ///   Comparison c = compare(trace, {"metis", "metis-relabel", "sticky"}, {2, 4, 8}, Options{});
 ///   std::cout << comparison_table(c);
 Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
-                   const std::vector<std::uint32_t>& ks, const Options& options = {});
+                   const std::vector<std::uint32_t>& ks, const Options& options = {},
+                   const std::vector<double>& sticky_migration_costs = {});
+
+/// The row's name in tables: the method, or "sticky@COST" for a sweep row.
+std::string row_label(const CompareRow& row);
 
 /// `tgraph compare --json`: {"trace", "model", "rows": [...], "sticky_moves": [...]}.
 std::string comparison_json(const Comparison& c, const std::string& trace_name);
 /// `tgraph compare --csv`: one header line, one line per row.
 std::string comparison_csv(const Comparison& c);
-/// `tgraph compare`'s text table, followed by sticky's step kinds and moves per K.
+/// `tgraph compare`'s text table, followed by sticky's step kinds and moves per K and the
+/// Pareto points of each K.
 std::string comparison_table(const Comparison& c);
 
 }  // namespace tgraph::partition

@@ -40,6 +40,17 @@ std::string_view to_string(Rebalance r);
 /// Parses a rebalance name; throws UsageError.
 Rebalance parse_rebalance(std::string_view s);
 
+/// What `sticky` does when a step's shape changed too much to patch (solver loops merged or
+/// split, or over a quarter of the tasks new).
+enum class StickyFallback : std::uint8_t {
+  kFresh = 0,        ///< the base method afresh, parts relabelled to the previous step's
+  kRepartition = 1,  ///< SCOTCH_graphRepart from the incremental placement, migration cost per task
+};
+/// "fresh" or "repartition".
+std::string_view to_string(StickyFallback f);
+/// Parses a fallback name; throws UsageError.
+StickyFallback parse_sticky_fallback(std::string_view s);
+
 /// Knobs of the strategies; each strategy reads the ones it understands.
 struct Options {
   double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
@@ -50,7 +61,10 @@ struct Options {
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
   Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
-  double migration_cost = 1.0;      ///< sticky + scotch rebalance: emraval (quantised to 0.01)
+  StickyFallback sticky_fallback = StickyFallback::kFresh;  ///< sticky: when the shape changed
+  /// sticky, Scotch repartitioning (rebalance or fallback): emraval, the weight of migrated
+  /// load against the cut (quantised to 0.01 by Scotch)
+  double migration_cost = 1.0;
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
 };
 
