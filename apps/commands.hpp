@@ -38,6 +38,7 @@ TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed);
 // Registration of each verb (one function per cmd_*.cpp).
 void add_info(CLI::App& app);
 void add_export(CLI::App& app);
+void add_diff(CLI::App& app);
 void add_capture(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate

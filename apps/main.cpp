@@ -46,6 +46,7 @@ int main(int argc, char** argv) {
   add_capture(app);
   add_info(app);
   add_export(app);
+  add_diff(app);
   add_partition_verbs(app);
   add_replay_verbs(app);
   add_validate(app);

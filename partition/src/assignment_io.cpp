@@ -10,15 +10,17 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/partition/evaluate.hpp"
 
 namespace tgraph::partition {
 
 namespace {
 
-static_assert(std::endian::native == std::endian::little, ".tga encoding assumes a little-endian host");
+static_assert(std::endian::native == std::endian::little,
+              ".tga encoding assumes a little-endian host");
 
 constexpr std::array<std::uint8_t, 4> kMagic = {'T', 'G', 'A', 'S'};
-constexpr std::size_t kHeaderBytes = 4 + 4 + 8;   // magic, version, total length
+constexpr std::size_t kHeaderBytes = 4 + 4 + 8;           // magic, version, total length
 constexpr std::size_t kMinBytes = kHeaderBytes + 12 + 4;  // + k, steps, method length; crc
 constexpr std::uint32_t kMaxMethod = 256;
 constexpr std::uint32_t kMaxK = 1u << 20;
@@ -149,8 +151,9 @@ TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std
   if (bytes.size() >= 4 && std::memcmp(bytes.data(), kMagic.data(), 4) != 0)
     throw InputError(name, 0, "expected magic \"TGAS\" (not a .tga assignment file)");
   if (bytes.size() < kMinBytes)
-    throw InputError(name, bytes.size(), "truncated: expected a header of at least " +
-                                             std::to_string(kMinBytes) + " bytes");
+    throw InputError(
+        name, bytes.size(),
+        "truncated: expected a header of at least " + std::to_string(kMinBytes) + " bytes");
   Reader head(bytes, bytes.size(), name);
   head.u32("magic");
   const std::uint32_t version = head.u32("version");
@@ -159,8 +162,9 @@ TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std
                         std::to_string(kAssignmentVersion) + ")");
   const std::uint64_t total = head.u64("total length");
   if (total > bytes.size())
-    throw InputError(name, bytes.size(), "truncated: header says " + std::to_string(total) +
-                                             " bytes, file has " + std::to_string(bytes.size()));
+    throw InputError(name, bytes.size(),
+                     "truncated: header says " + std::to_string(total) + " bytes, file has " +
+                         std::to_string(bytes.size()));
   if (total < bytes.size())
     throw InputError(name, total, "expected end of file after " + std::to_string(total) + " bytes");
   std::uint32_t stored_crc;
@@ -177,9 +181,11 @@ TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std
     r.fail_at(k_at, "expected k in [1, " + std::to_string(kMaxK) + "], got " + std::to_string(a.k));
   const std::uint32_t steps = r.u32("step count");
   const std::uint32_t method_len = r.u32("method length");
-  if (method_len > kMaxMethod) r.fail("method name longer than " + std::to_string(kMaxMethod) + " bytes");
+  if (method_len > kMaxMethod)
+    r.fail("method name longer than " + std::to_string(kMaxMethod) + " bytes");
   a.method = r.str(method_len, "method name");
-  if (steps > r.left() / kStepHeader) r.fail("step count " + std::to_string(steps) + " exceeds the file");
+  if (steps > r.left() / kStepHeader)
+    r.fail("step count " + std::to_string(steps) + " exceeds the file");
   a.steps.resize(steps);
   a.partition_ms.resize(steps);
   if (hashes != nullptr) hashes->assign(steps, 0);
@@ -206,13 +212,15 @@ TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std
                           std::to_string(as.proc[t]) + ", expected < k = " + std::to_string(a.k));
     }
     if (has_order == 0) continue;
-    if (a.k > r.left() / 4) r.fail(where + "truncated: expected " + std::to_string(a.k) + " order lists");
+    if (a.k > r.left() / 4)
+      r.fail(where + "truncated: expected " + std::to_string(a.k) + " order lists");
     as.order.resize(a.k);
     std::vector<bool> seen(n, false);
     std::size_t listed = 0;
     for (std::uint32_t p = 0; p < a.k; ++p) {
       const std::uint32_t count = r.u32("order length");
-      if (count > n - listed) r.fail(where + "order of processor " + std::to_string(p) + " too long");
+      if (count > n - listed)
+        r.fail(where + "order of processor " + std::to_string(p) + " too long");
       as.order[p].resize(count);
       for (std::uint32_t i = 0; i < count; ++i) {
         const std::size_t at = r.offset();
@@ -225,9 +233,12 @@ TraceAssignment decode_assignment(std::span<const std::uint8_t> bytes, const std
       }
       listed += count;
     }
-    if (listed != n) r.fail(where + "order lists " + std::to_string(listed) + " of " + std::to_string(n) + " tasks");
+    if (listed != n)
+      r.fail(where + "order lists " + std::to_string(listed) + " of " + std::to_string(n) +
+             " tasks");
   }
-  if (r.left() != 0) r.fail("expected the checksum, found " + std::to_string(r.left()) + " more bytes");
+  if (r.left() != 0)
+    r.fail("expected the checksum, found " + std::to_string(r.left()) + " more bytes");
   return a;
 }
 
@@ -240,6 +251,27 @@ void write_assignment(const std::string& path, const TraceAssignment& a,
 TraceAssignment read_assignment(const std::string& path, std::vector<std::uint64_t>* hashes) {
   const std::vector<std::uint8_t> b = read_file_bytes(path);
   return decode_assignment(b, path, hashes);
+}
+
+void write_assignment(const std::string& path, const TraceAssignment& a, const Trace& trace) {
+  std::vector<std::uint64_t> hashes;
+  hashes.reserve(trace.steps.size());
+  for (const StepGraph& g : trace.steps) hashes.push_back(g.structural_hash());
+  write_assignment(path, a, hashes);
+}
+
+TraceAssignment load_assignment(const std::string& path, const Trace& trace,
+                                const std::string& trace_name) {
+  std::vector<std::uint64_t> hashes;
+  TraceAssignment a = read_assignment(path, &hashes);
+  check_fits(trace, a, path);
+  for (std::size_t s = 0; s < hashes.size() && s < trace.steps.size(); ++s)
+    if (hashes[s] != 0 && hashes[s] != trace.steps[s].structural_hash())
+      throw InputError(path, std::nullopt,
+                       "step " + std::to_string(s) +
+                           " was partitioned for a graph of another structure than " + trace_name +
+                           "'s");
+  return a;
 }
 
 }  // namespace tgraph::partition

@@ -14,8 +14,8 @@ namespace tgraph::partition {
 
 CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal"}; }
 
-// Defaults: the middle of the cross-core spin handoff measured on this machine kind
-// (../shared/notes/machine.md: 70-150 ns) and 0.05 ns/byte (20 GB/s cross-core).
+// Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
+// servers (`tgraph calibrate` measures it) and 0.05 ns/byte (20 GB/s cross-core).
 CostModel CostModel::defaults() { return CostModel{100.0, 0.05, "default"}; }
 
 std::string default_calibration_path() {

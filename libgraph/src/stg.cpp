@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Standard Task Graph Set import (https://www.kasahara.cs.waseda.ac.jp/schedule/).
-#include "tgraph/partition/stg.hpp"
+#include "tgraph/graph/stg.hpp"
 
 #include <charconv>
 #include <vector>
@@ -8,7 +8,7 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
-namespace tgraph::partition {
+namespace tgraph {
 
 namespace {
 
@@ -136,4 +136,4 @@ StgGraph read_stg(const std::string& path, std::uint64_t unit_ns, std::uint64_t 
                    unit_ns, edge_bytes);
 }
 
-}  // namespace tgraph::partition
+}  // namespace tgraph
