@@ -32,6 +32,9 @@ namespace {
 using detail::HexMesh;
 using detail::Shape;
 
+// Up to this many particles, the contact radius comes from the exact closest pair.
+constexpr Index kExactSpacingPoints = 2048;
+
 // Deterministic uniform numbers in [-1, 1) from the scene seed (independent of the
 // standard library's distribution implementations).
 class Jitter {
@@ -214,9 +217,6 @@ class SceneBuilder {
       if (!positional.empty()) d.fail("'" + positional[0] + "' is not a key=value attribute");
       directive(d);
       d.finish();
-      std::uint64_t nodes = 0;
-      for (const auto& b : scene_->bodies()) nodes += static_cast<std::uint64_t>(b->columns());
-      if (nodes > (1u << 24)) d.fail("the scene exceeds 16777216 nodes");
     }
     if (!header) Directive(file_, number, "", {}).fail("empty scene file (the first line must be 'tgraph-scene 1')");
     if (!scene_) Directive(file_, number, "", {}).fail("no 'scene name=...' line");
@@ -286,6 +286,16 @@ class SceneBuilder {
     Body* b = scene_->find_body(name);
     if (b == nullptr) d.fail(key + ": no object named '" + name + "' (objects must be declared first)");
     return b;
+  }
+
+  // Counts `n` more points (nodes, particles, rigid surface points) against
+  // SceneOptions::max_nodes before they are built.
+  void add_points(Directive& d, std::uint64_t n) {
+    if (n > options_.max_nodes || points_ > options_.max_nodes - n)
+      d.fail("expected at most " + std::to_string(options_.max_nodes) +
+             " points (nodes, particles and rigid surface points) in the scene, this line brings "
+             "it to " + std::to_string(points_ + std::min<std::uint64_t>(n, UINT64_MAX - points_)));
+    points_ += n;
   }
 
   void check_new_name(Directive& d, const std::string& name) {
@@ -380,6 +390,7 @@ class SceneBuilder {
       const std::size_t semi = spec.find(';', start);
       const auto v = d.numbers("points", 3, spec.substr(start, semi == std::string::npos ? std::string::npos : semi - start));
       pts.emplace_back(v[0], v[1], v[2]);
+      add_points(d, 1);
       if (semi == std::string::npos) break;
       start = semi + 1;
     }
@@ -390,10 +401,14 @@ class SceneBuilder {
     for (Index i = 0; i < x.cols(); ++i) body->surface.push_back(i);
     Body& b = scene_->add_body(std::move(body));
     double spacing = 0.1;
-    if (x.cols() > 1) {
+    if (x.cols() > 1 && x.cols() <= kExactSpacingPoints) {
       spacing = 1e300;
       for (Index i = 0; i < x.cols(); ++i)
         for (Index j = i + 1; j < x.cols(); ++j) spacing = std::min(spacing, (x.col(i) - x.col(j)).norm());
+    } else if (x.cols() > kExactSpacingPoints) {
+      // The closest pair costs n^2/2 distances: estimate from the bounding box instead.
+      const Vec3 extent = x.rowwise().maxCoeff() - x.rowwise().minCoeff();
+      spacing = extent.norm() / std::cbrt(static_cast<double>(x.cols()));
     }
     common(d, b, spacing);
     add_gravity(b);
@@ -437,8 +452,10 @@ class SceneBuilder {
     const bool fem = d.keyword() == "fem";
     const std::string name = d.text("name");
     const auto nodes = d.int3("nodes", std::nullopt, 2, 512);
-    if (static_cast<long long>(nodes[0]) * nodes[1] * nodes[2] > (1LL << 22))
-      d.fail("nodes: at most 4194304 nodes per object");
+    const std::uint64_t grid_nodes = static_cast<std::uint64_t>(nodes[0]) * nodes[1] * nodes[2];
+    if (grid_nodes > (1u << 22)) d.fail("nodes: at most 4194304 nodes per object");
+    const auto copies = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+    add_points(d, grid_nodes * static_cast<std::uint64_t>(copies[0]) * copies[1] * copies[2]);
     const Vec3 size = d.vec3("size");
     if ((size.array() <= 0.0).any()) d.fail("size: every extent must be > 0");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -517,6 +534,10 @@ class SceneBuilder {
       mass = density * 4.0 / 3.0 * M_PI * r * r * r;
       inertia = Mat3::Identity() * (0.4 * mass * r * r);
     }
+    {
+      const auto copies = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+      add_points(d, static_cast<std::uint64_t>(surf.points.cols()) * copies[0] * copies[1] * copies[2]);
+    }
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
     if (d.has("rotation")) {
       const auto v = d.numbers("rotation", 4, d.text("rotation"));
@@ -567,6 +588,7 @@ class SceneBuilder {
     const std::string name = d.text("name");
     check_new_name(d, name);
     const int n = d.integer("nodes", std::nullopt, 3, 1000000);
+    add_points(d, static_cast<std::uint64_t>(n));
     const int rows = d.integer("rows", 1, 1, n);
     const double seg = d.positive("segment");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -609,6 +631,7 @@ class SceneBuilder {
       split = s;
     }
     if (split > n) d.fail("split must not exceed nodes");
+    add_points(d, static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n));
     const double size = d.positive("size");
     const Vec3 center = d.vec3("center", Vec3::Zero());
     const double k = d.positive("stiffness");
@@ -696,6 +719,7 @@ class SceneBuilder {
   Jitter jitter_;
   std::unique_ptr<Scene> scene_;
   std::set<std::string> names_;
+  std::uint64_t points_ = 0;  // counted by add_points()
   // Attributes shared by the instances of an array (parsed on the first one).
   double damping_ = 0.0;
   Vec3 velocity_ = Vec3::Zero();

@@ -698,7 +698,7 @@ TEST(TraceReader, RejectsFramesOutOfPlace) {
   EXPECT_READ_ERROR(extra_payload, "expected the frame payload to end here, found 1 unread bytes");
   const Bytes short_payload = trace_of({frame(2, s.structure())}, 1);
   EXPECT_READ_ERROR(short_payload,
-                    "truncated payload: expected u32 count (4 bytes), the frame has 0 left");
+                    "truncated: expected u32 count (4 bytes), the frame has 0 left");
 }
 
 TEST(TraceReader, RejectsInconsistentLists) {

@@ -41,6 +41,9 @@ struct SceneOptions {
   std::uint64_t seed = 1;            ///< random placement jitter (scenes that use it)
   std::optional<int> subobjects;     ///< cloth scenes: number of sub-objects (a square)
   std::optional<Coupling> coupling;  ///< solver sharing
+  /// Ceiling on the points of a scene file (nodes, particles, rigid surface points), checked
+  /// before each object is built.
+  std::uint64_t max_nodes = std::uint64_t{1} << 24;
 };
 
 /// What the last step did (known after the step in capture and off modes).
