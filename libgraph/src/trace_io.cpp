@@ -604,7 +604,8 @@ void write_all(int fd, const std::vector<std::uint8_t>& bytes, const std::string
 // TraceWriter
 
 struct TraceWriter::Impl {
-  std::string path;
+  std::string path;     // where close() puts the finished trace
+  std::string partial;  // what is written until then
   int fd = -1;
   StepEncoder encoder;
   std::vector<std::uint8_t> buffer;  // reused frame buffer
@@ -612,12 +613,16 @@ struct TraceWriter::Impl {
 
   std::string closed_because;  // why appends are refused once fd is closed
 
-  // Writes the buffered frame. After a failed write the file may end in a partial frame:
-  // the writer closes it and refuses further frames, so the partial frame stays the last.
+  // Writes the buffered frame. After a failed write (disk full, file size limit) the writer
+  // cuts the file back to the end of the last complete frame, closes it and refuses further
+  // frames, so the partial file holds exactly the frames written before.
   void flush_buffer() {
     try {
-      write_all(fd, buffer, path);
+      write_all(fd, buffer, partial);
     } catch (...) {
+      if (::ftruncate(fd, static_cast<::off_t>(written)) != 0) {
+        // Nothing more to do: the reader with --recover skips a partial last frame.
+      }
       ::close(fd);
       fd = -1;
       closed_because = "a failed write";
@@ -631,19 +636,22 @@ struct TraceWriter::Impl {
 TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header)
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
-  impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (impl_->fd < 0) throw Error(path + ": cannot create: " + std::strerror(errno));
+  impl_->partial = path + ".partial";
+  impl_->fd = ::open(impl_->partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (impl_->fd < 0) throw Error(impl_->partial + ": cannot create: " + std::strerror(errno));
   encode_file_header(impl_->buffer, header);
   impl_->flush_buffer();
 }
 
-// Without close() no end frame is written: the trace then reads as interrupted.
+// Without close() no end frame is written and nothing is renamed: the partial file reads
+// as an interrupted trace (with ReadOptions::recover).
 TraceWriter::~TraceWriter() {
   if (impl_ && impl_->fd >= 0) ::close(impl_->fd);
 }
 
 void TraceWriter::append(const StepGraph& step) {
-  if (impl_->fd < 0) throw UsageError(impl_->path + ": append() after " + impl_->closed_because);
+  if (impl_->fd < 0)
+    throw UsageError(impl_->partial + ": append() after " + impl_->closed_because);
   impl_->buffer.clear();
   impl_->encoder.encode(step, impl_->buffer);
   impl_->flush_buffer();
@@ -657,8 +665,21 @@ void TraceWriter::close() {
   const int fd = impl_->fd;
   impl_->fd = -1;
   impl_->closed_because = "close()";
-  if (::close(fd) != 0) throw Error(impl_->path + ": cannot close: " + std::strerror(errno));
+  // The data reach the disk before the rename makes them the trace (as write_file_atomic).
+  if (::fsync(fd) != 0 && errno != EINVAL) {
+    const int err = errno;
+    ::close(fd);
+    throw Error(impl_->partial + ": cannot sync: " + std::strerror(err));
+  }
+  if (::close(fd) != 0) throw Error(impl_->partial + ": cannot close: " + std::strerror(errno));
+  if (::rename(impl_->partial.c_str(), impl_->path.c_str()) != 0)
+    throw Error(impl_->path + ": cannot rename " + impl_->partial + " into place: " +
+                std::strerror(errno));
 }
+
+const std::string& TraceWriter::partial_path() const { return impl_->partial; }
+
+std::uint32_t TraceWriter::steps_written() const { return impl_->encoder.steps(); }
 
 std::uint64_t TraceWriter::bytes_written() const { return impl_->written; }
 

@@ -406,6 +406,7 @@ void Scene::finalize() {
 
 void Scene::step(Recorder& rec) {
   finalize();
+  detail::check_divergence(*this, *impl_);  // what the last step left (deferred: ran since)
   Impl& m = *impl_;
   Binding& b = m.bind;
   const std::size_t n = bodies_.size();
@@ -520,6 +521,7 @@ void Scene::step(Recorder& rec) {
   for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
   time_ += solver_.dt;
   ++steps_run_;
+  if (rec.mode() != capture::Mode::kDeferred) detail::check_divergence(*this, m);
 }
 
 StepStats Scene::last_stats() const {

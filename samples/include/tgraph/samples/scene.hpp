@@ -123,6 +123,12 @@ class Scene {
   StepStats last_stats() const;
   /// Total surface triangles of the bodies.
   std::uint64_t surface_triangles() const;
+  /// Settings the integrator may not handle well, found when the scene was built (a time
+  /// step above the explicit stability limit, a CG that cannot converge in max_iterations);
+  /// see samples/scenes/README.md. The command line prints them.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Adds a warning.
+  void add_warning(std::string warning) { warnings_.push_back(std::move(warning)); }
 
   /// Private state (defined in the library).
   struct Impl;
@@ -140,6 +146,7 @@ class Scene {
   double time_ = 0.0;
   std::uint64_t steps_run_ = 0;
   StepStats stats_;
+  std::vector<std::string> warnings_;
   std::unique_ptr<Impl> impl_;
 };
 
