@@ -414,6 +414,7 @@ bool Scene::step_if_changed(Recorder& rec) { return advance(rec, true); }
 
 bool Scene::advance(Recorder& rec, bool allow_reuse) {
   finalize();
+  detail::check_divergence(*this, *impl_);  // what the last step left (deferred: ran since)
   Impl& m = *impl_;
   Binding& b = m.bind;
   const std::size_t n = bodies_.size();
@@ -536,6 +537,7 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
       case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;
     }
   }
+  if (rec.mode() != capture::Mode::kDeferred) detail::check_divergence(*this, m);
   return true;
 }
 

@@ -32,6 +32,7 @@ struct GroupSolver {
   bool converged = false;  // the loop's condition datum
   std::uint32_t iterations = 0;
   double residual = 0.0;  // |r| / |b| reached
+  std::uint32_t stalled_steps = 0;  // consecutive steps ended at max_iterations unconverged
   // Recorder ids (valid for Binding::generation == generation).
   std::uint64_t generation = 0;
   ObjectId object = kNoObject;
@@ -73,10 +74,22 @@ struct Group {
 
 }  // namespace tgraph::samples::detail
 
+namespace tgraph::samples::detail {
+/// Reference values of the divergence checks (samples/src/divergence.cpp).
+struct DivergenceState {
+  bool have_baseline = false;
+  double kinetic0 = 0.0;    // kinetic energy at the first step
+  double internal0 = 0.0;   // potential energy of the fields other than gravity, then
+  double gravity0 = 0.0;    // gravity potential energy, then
+  std::uint64_t checked = 0;  // steps_run() when last checked
+};
+}  // namespace tgraph::samples::detail
+
 namespace tgraph::samples {
 
 struct Scene::Impl {
   bool finalized = false;
+  detail::DivergenceState divergence;
   std::unordered_map<const Body*, int> body_index;
   std::vector<std::vector<ForceField*>> body_fields;  // internal fields per body, floor included
   std::vector<std::vector<FixedConstraint*>> body_constraints;
@@ -97,6 +110,9 @@ struct Scene::Impl {
 namespace detail {
 /// Collision detection: updates the floor points and creates/removes contact fields.
 void detect_collisions(Scene& scene, Scene::Impl& impl);
+/// Divergence checks of the state the last executed step left (samples/src/divergence.cpp):
+/// throws DivergenceError; the first call records the reference energies.
+void check_divergence(const Scene& scene, Scene::Impl& impl);
 }  // namespace detail
 
 }  // namespace tgraph::samples

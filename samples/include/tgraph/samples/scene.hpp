@@ -41,6 +41,9 @@ struct SceneOptions {
   std::uint64_t seed = 1;            ///< random placement jitter (scenes that use it)
   std::optional<int> subobjects;     ///< cloth scenes: number of sub-objects (a square)
   std::optional<Coupling> coupling;  ///< solver sharing
+  /// Ceiling on the points of a scene file (nodes, particles, rigid surface points), checked
+  /// before each object is built.
+  std::uint64_t max_nodes = std::uint64_t{1} << 24;
 };
 
 /// What the last step did (known after the step in capture and off modes).
@@ -126,6 +129,12 @@ class Scene {
   StepStats last_stats() const;
   /// Total surface triangles of the bodies.
   std::uint64_t surface_triangles() const;
+  /// Settings the integrator may not handle well, found when the scene was built (a time
+  /// step above the explicit stability limit, a CG that cannot converge in max_iterations);
+  /// see samples/scenes/README.md. The command line prints them.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Adds a warning.
+  void add_warning(std::string warning) { warnings_.push_back(std::move(warning)); }
 
   /// Private state (defined in the library).
   struct Impl;
@@ -144,6 +153,7 @@ class Scene {
   double time_ = 0.0;
   std::uint64_t steps_run_ = 0;
   StepStats stats_;
+  std::vector<std::string> warnings_;
   std::unique_ptr<Impl> impl_;
 };
 
