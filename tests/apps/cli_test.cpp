@@ -183,6 +183,9 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
   }
   for (const char* m : {"owner", "metis", "scotch", "sticky", "list", "roundrobin", "random", "worksteal", "barrier"})
     EXPECT_NE(std::find(names.begin(), names.end(), m), names.end()) << m;
+#ifdef TGRAPH_HAVE_STARPU
+  EXPECT_NE(std::find(names.begin(), names.end(), "starpu"), names.end());
+#endif
   EXPECT_TRUE(fs::exists(dir_ / "d" / "fig2.tgt"));
   const std::string html = slurp(dir_ / "d" / "report.html");
   EXPECT_NE(html.find("<table>"), std::string::npos);
