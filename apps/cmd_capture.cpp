@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `tgraph capture`: runs the instrumented engine on a scene and streams every step's task
 // graph to a .tgt trace (or runs it uninstrumented with --no-capture).
+#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -14,6 +15,7 @@
 
 #include "commands.hpp"
 #include "tgraph/capture/recorder.hpp"
+#include "tgraph/samples/divergence.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::app {
@@ -42,7 +44,10 @@ void run_capture(const CaptureOptions& o) {
   if (o.coupling == "groups") so.coupling = samples::Coupling::kGroups;
   if (o.coupling == "shared") so.coupling = samples::Coupling::kShared;
   std::unique_ptr<samples::Scene> scene = samples::make_scene(o.scene, so);
+  for (const std::string& w : scene->warnings()) std::fprintf(stderr, "tgraph: warning: %s\n", w.c_str());
   const int steps = o.steps.value_or(scene->default_steps());
+  // A file size limit (RLIMIT_FSIZE) then fails the write with EFBIG instead of killing us.
+  ::signal(SIGXFSZ, SIG_IGN);
 
   capture::Recorder rec(o.no_capture ? capture::Mode::kOff : capture::Mode::kCapture);
   rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
@@ -58,9 +63,22 @@ void run_capture(const CaptureOptions& o) {
   std::uint64_t tasks = 0;
   double seconds = 0.0;
   auto last_report = std::chrono::steady_clock::now();
+  // A diverging simulation or a failed write stops the capture (exit 1); the steps written
+  // before stay in the partial file (TraceWriter: <output>.partial).
+  const auto stop = [&](const std::string& why) {
+    std::string kept;
+    if (writer)
+      kept = "; the " + std::to_string(writer->steps_written()) + " complete steps before it are in " +
+             writer->partial_path() + " (read with --recover)";
+    throw Failure("capture: " + why + kept);
+  };
   for (int s = 0; s < steps; ++s) {
     const auto t0 = std::chrono::steady_clock::now();
-    scene->step(rec);
+    try {
+      scene->step(rec);
+    } catch (const samples::DivergenceError& e) {
+      stop(e.what());
+    }
     StepGraph g = rec.end_step();
     const auto t1 = std::chrono::steady_clock::now();
     const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -70,7 +88,13 @@ void run_capture(const CaptureOptions& o) {
     cg_iterations.push_back(st.cg_iterations);
     groups.push_back(st.groups);
     tasks += g.tasks.size();
-    if (writer) writer->append(g);
+    if (writer) {
+      try {
+        writer->append(g);
+      } catch (const Error& e) {
+        stop("step " + std::to_string(s) + ": " + e.what());
+      }
+    }
     if (progress && (t1 - last_report > std::chrono::milliseconds(200) || s + 1 == steps)) {
       std::fprintf(stderr, "\rcapture %s: step %d/%d (%.1f ms/step)   ", scene->name().c_str(), s + 1, steps,
                    1000.0 * seconds / (s + 1));
@@ -80,7 +104,11 @@ void run_capture(const CaptureOptions& o) {
   if (progress) std::fprintf(stderr, "\n");
   std::uint64_t bytes = 0;
   if (writer) {
-    writer->close();
+    try {
+      writer->close();
+    } catch (const Error& e) {
+      stop(e.what());
+    }
     bytes = writer->bytes_written();
   }
   if (rec.errors() != 0)
@@ -112,6 +140,13 @@ void run_capture(const CaptureOptions& o) {
   }
 }
 
+// "%g" of a double (std::to_string prints 1e308 with 309 digits).
+std::string shortest(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
 }  // namespace
 
 TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed) {
@@ -119,7 +154,7 @@ TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed) {
   header.scene = scene.name();
   header.engine = std::string("tgraph-samples ") + TGRAPH_VERSION + " (" +
                   std::string(samples::to_string(scene.solver().integrator)) + " Euler, dt " +
-                  std::to_string(scene.solver().dt) + ", seed " + std::to_string(seed) + ")";
+                  shortest(scene.solver().dt) + ", seed " + std::to_string(seed) + ")";
   header.machine = machine_description();
   header.tgraph_version = TGRAPH_VERSION;
   return header;

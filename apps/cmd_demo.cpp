@@ -196,11 +196,22 @@ void run_demo(const DemoOptions& o) {
     }
     rows.push_back(row);
   }
-  for (tr::Policy p : {tr::Policy::kWorksteal, tr::Policy::kBarrier}) {
+  std::vector<tr::Policy> baselines = {tr::Policy::kWorksteal, tr::Policy::kBarrier};
+#ifdef TGRAPH_HAVE_STARPU
+  baselines.push_back(tr::Policy::kStarpu);
+#else
+  say("starpu: not in this build (libstarpu-dev was not found), no starpu row");
+#endif
+  for (tr::Policy p : baselines) {
     say("replaying with " + std::string(tr::to_string(p)) + "...");
     Row row;
     row.name = std::string(tr::to_string(p));
-    fill_measured(row, replay(trace, nullptr, p, o));
+    try {
+      fill_measured(row, replay(trace, nullptr, p, o));
+    } catch (const Error& e) {
+      row.failure = e.what();
+      say("  replay failed: " + row.failure);
+    }
     rows.push_back(row);
   }
   const std::string report_path = o.out_dir + "/report.html";
@@ -222,15 +233,15 @@ void run_demo(const DemoOptions& o) {
   std::printf("\n%s: %d steps, %llu tasks/step, parallelism %.1f, %u threads (replay: medians of %u passes)\n\n",
               o.scene.c_str(), o.steps, static_cast<unsigned long long>(m0.tasks), m0.parallelism, o.threads,
               o.repeat);
-  std::printf("%-11s %10s %9s %12s %9s %10s %11s %11s %8s %6s\n", "method", "part. ms", "imbalance",
+  std::printf("%-13s %10s %9s %12s %9s %10s %11s %11s %8s %6s\n", "method", "part. ms", "imbalance",
               "cut bytes", "migrated", "predicted", "replay ms", "seq. ms", "speedup", "eff.");
   for (const Row& r : rows) {
     if (r.partitioned)
-      std::printf("%-11s %10.2f %9.3f %12llu %9llu %9.2fx", r.name.c_str(), r.partition_ms, r.imbalance,
+      std::printf("%-13s %10.2f %9.3f %12llu %9llu %9.2fx", r.name.c_str(), r.partition_ms, r.imbalance,
                   static_cast<unsigned long long>(r.cut_bytes), static_cast<unsigned long long>(r.migrated_tasks),
                   r.predicted_speedup);
     else
-      std::printf("%-11s %10s %9s %12s %9s %10s", r.name.c_str(), "-", "-", "-", "-", "-");
+      std::printf("%-13s %10s %9s %12s %9s %10s", r.name.c_str(), "-", "-", "-", "-", "-");
     if (!r.failure.empty())
       std::printf("  replay failed: %s\n", r.failure.c_str());
     else

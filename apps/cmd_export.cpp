@@ -3,11 +3,11 @@
 // interchange format (METIS: gpmetis input; Scotch: scotch_gpart source graph);
 // `tgraph export R.json --format chrome`: a replay timeline as Chrome/Perfetto trace events.
 #include <iostream>
-#include <sstream>
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/graph/undirected.hpp"
+#include "tgraph/graph/step_json.hpp"
+#include "tgraph/partition/export.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::app {
@@ -19,74 +19,6 @@ struct ExportOptions {
   std::string out;
   std::size_t step = 0;
 };
-
-// METIS and Scotch index with 32-bit integers here: keep every total below 2^30.
-constexpr std::int64_t kMaxTotalWeight = std::int64_t{1} << 30;
-
-std::string to_metis(const UndirectedGraph& u) {
-  std::ostringstream s;
-  s << u.vertices() << ' ' << u.edges() << " 011\n";
-  for (std::uint32_t v = 0; v < u.vertices(); ++v) {
-    s << u.vwgt[v];
-    for (auto i = u.xadj[v]; i < u.xadj[v + 1]; ++i) s << ' ' << u.adjncy[i] + 1 << ' ' << u.adjwgt[i];
-    s << '\n';
-  }
-  return s.str();
-}
-
-std::string to_scotch(const UndirectedGraph& u) {
-  std::ostringstream s;
-  // Version, vertex and arc counts, base 0, flags 011 = edge loads and vertex loads.
-  s << "0\n" << u.vertices() << ' ' << u.adjncy.size() << "\n0 011\n";
-  for (std::uint32_t v = 0; v < u.vertices(); ++v) {
-    s << u.vwgt[v] << ' ' << (u.xadj[v + 1] - u.xadj[v]);
-    for (auto i = u.xadj[v]; i < u.xadj[v + 1]; ++i) s << ' ' << u.adjwgt[i] << ' ' << u.adjncy[i];
-    s << '\n';
-  }
-  return s.str();
-}
-
-nlohmann::json edges_json(const StepGraph& g, const std::vector<Edge>& edges) {
-  nlohmann::json a = nlohmann::json::array();
-  for (const Edge& e : edges)
-    a.push_back({{"from", e.from}, {"to", e.to}, {"datum", e.datum}, {"kind", to_string(e.kind)},
-                 {"bytes", g.data[e.datum].bytes}});
-  return a;
-}
-
-std::string to_json(const StepGraph& g, std::size_t step) {
-  nlohmann::json tasks = nlohmann::json::array();
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    const Task& task = g.tasks[t];
-    nlohmann::json acc = nlohmann::json::array();
-    for (const Access& a : g.accesses_of(t)) acc.push_back({{"datum", a.datum}, {"mode", to_string(a.mode)}});
-    tasks.push_back({{"id", t},
-                     {"kind", g.kinds[task.kind]},
-                     {"object", task.object == kNoObject ? nlohmann::json(nullptr) : nlohmann::json(task.object)},
-                     {"cost_ns", task.cost_ns},
-                     {"loop", task.loop == kNoLoop ? nlohmann::json(nullptr) : nlohmann::json(task.loop)},
-                     {"key", task.key},
-                     {"accesses", acc}});
-  }
-  nlohmann::json data = nlohmann::json::array();
-  for (const Datum& d : g.data)
-    data.push_back({{"name", d.name},
-                    {"object", d.object == kNoObject ? nlohmann::json(nullptr) : nlohmann::json(d.object)},
-                    {"bytes", d.bytes}});
-  nlohmann::json objects = nlohmann::json::array();
-  for (const ObjectInfo& o : g.objects) objects.push_back(o.name);
-  nlohmann::json loops = nlohmann::json::array();
-  for (const Loop& l : g.loops)
-    loops.push_back({{"condition", l.condition}, {"first", l.first}, {"last", l.last},
-                     {"iterations", l.iterations}, {"max_iterations", l.max_iterations}});
-  nlohmann::json contacts = nlohmann::json::array();
-  for (const Contact& c : g.contacts) contacts.push_back({c.a, c.b});
-  const nlohmann::json j = {{"step", step},       {"objects", objects}, {"data", data},
-                            {"tasks", tasks},     {"loops", loops},     {"edges", edges_json(g, g.edges)},
-                            {"carried_edges", edges_json(g, g.carried_edges)},
-                            {"contacts", contacts}, {"groups", g.groups}};
-  return j.dump(1) + "\n";
-}
 
 void write_output(const ExportOptions& o, const std::string& text) {
   if (o.out.empty() || o.out == "-") {
@@ -111,11 +43,11 @@ void run_export(const ExportOptions& o) {
   const StepGraph& g = trace.steps[o.step];
   std::string text;
   if (o.format == "json") {
-    text = to_json(g, o.step);
+    text = step_graph_json(g, o.step);
   } else if (o.format == "metis") {
-    text = to_metis(make_undirected(g, kMaxTotalWeight, kMaxTotalWeight));
+    text = partition::metis_graph_file(g);
   } else {
-    text = to_scotch(make_undirected(g, kMaxTotalWeight, kMaxTotalWeight));
+    text = partition::scotch_graph_file(g);
   }
   write_output(o, text);
 }

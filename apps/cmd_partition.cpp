@@ -5,14 +5,14 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
-#include <sstream>
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/stg.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
-#include "tgraph/partition/stg.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
@@ -31,6 +31,7 @@ struct StrategyFlags {
   double threshold = 1.20;
   double migration_cost = 1.0;
   std::string rebalance = "greedy";
+  std::string sticky_fallback = "fresh";
 
   void add(CLI::App* cmd) {
     cmd->add_option("--imbalance", imbalance, "Tolerated max/mean load for METIS and Scotch (default 1.03)");
@@ -45,6 +46,10 @@ struct StrategyFlags {
     cmd->add_option("--threshold", threshold, "sticky: rebalance when imbalance exceeds this x the last partition's (default 1.20)");
     cmd->add_option("--rebalance", rebalance, "sticky: greedy (move whole objects) or scotch (graphRepart)")
         ->check(CLI::IsMember({"greedy", "scotch"}));
+    cmd->add_option("--sticky-fallback", sticky_fallback,
+                    "sticky, when solver loops merge or split: fresh (base method + relabel) or "
+                    "repartition (Scotch graphRepart from the incremental placement)")
+        ->check(CLI::IsMember({"fresh", "repartition"}));
     cmd->add_option("--migration-cost", migration_cost,
                     "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
   }
@@ -59,6 +64,7 @@ struct StrategyFlags {
     o.sticky_threshold = threshold;
     o.migration_cost = migration_cost;
     o.rebalance = tp::parse_rebalance(rebalance);
+    o.sticky_fallback = tp::parse_sticky_fallback(sticky_fallback);
     o.model = model;
     return o;
   }
@@ -78,12 +84,6 @@ struct ModelFlags {
   tp::CostModel load() const { return tp::select_cost_model(model, calibration); }
 };
 
-std::vector<std::uint64_t> structure_hashes(const Trace& trace) {
-  std::vector<std::uint64_t> h;
-  for (const StepGraph& g : trace.steps) h.push_back(g.structural_hash());
-  return h;
-}
-
 // ---- partition ----------------------------------------------------------------------
 
 struct PartitionCmd {
@@ -98,88 +98,25 @@ void run_partition(const PartitionCmd& c) {
   const Trace trace = load_trace(c.trace);
   if (c.k == 0) throw UsageError("-k: expected at least 1");
   const tp::TracePartition tp = tp::partition_trace(trace, c.method, c.k, c.flags.options(c.model.load()));
-  if (!c.out.empty()) tp::write_assignment(c.out, tp.assignment, structure_hashes(trace));
-
-  double ms = 0;
-  std::uint64_t moved = 0, reused = 0, rebalanced = 0;
-  std::optional<std::int64_t> cut;
-  nlohmann::json per_step = nlohmann::json::array();
-  for (std::size_t s = 0; s < tp.stats.size(); ++s) {
-    const tp::Stats& st = tp.stats[s];
-    ms += st.partition_ms;
-    moved += st.moved_tasks;
-    reused += st.reused ? 1 : 0;
-    rebalanced += st.rebalanced ? 1 : 0;
-    if (st.edgecut) cut = cut.value_or(0) + *st.edgecut;
-    nlohmann::json j = {{"step", s},
-                        {"partition_ms", st.partition_ms},
-                        {"moved_tasks", st.moved_tasks},
-                        {"reused", st.reused},
-                        {"rebalanced", st.rebalanced}};
-    if (st.edgecut) j["edgecut"] = *st.edgecut;
-    per_step.push_back(j);
-  }
+  if (!c.out.empty()) tp::write_assignment(c.out, tp.assignment, trace);
   if (c.json) {
-    nlohmann::json j = {{"method", c.method},   {"k", c.k},           {"steps", trace.steps.size()},
-                        {"partition_ms", ms},   {"moved_tasks", moved}, {"reused_steps", reused},
-                        {"rebalanced_steps", rebalanced}, {"output", c.out}, {"per_step", per_step}};
-    if (cut) j["edgecut"] = *cut;
-    print_json(j);
+    std::cout << tp::partition_json(tp, c.out) << std::endl;
     return;
   }
-  std::printf("method %s, k = %u, %zu steps: %.3f ms partitioning", c.method.c_str(), c.k,
-              trace.steps.size(), ms);
-  if (cut) std::printf(", edgecut %lld", static_cast<long long>(*cut));
-  std::printf(", %llu tasks moved", static_cast<unsigned long long>(moved));
+  const tp::PartitionSummary s = tp::summarize(tp.stats);
+  std::printf("method %s, k = %u, %zu steps: %.3f ms partitioning", c.method.c_str(), c.k, s.steps,
+              s.partition_ms);
+  if (s.edgecut) std::printf(", edgecut %lld", static_cast<long long>(*s.edgecut));
+  std::printf(", %llu tasks moved", static_cast<unsigned long long>(s.moved_tasks));
   if (c.method == "sticky")
-    std::printf(" (%llu steps reused, %llu rebalanced)", static_cast<unsigned long long>(reused),
-                static_cast<unsigned long long>(rebalanced));
+    std::printf(" (steps: %llu reused, %llu fallback to a fresh partition + relabel, %llu rebalanced)",
+                static_cast<unsigned long long>(s.reused_steps), static_cast<unsigned long long>(s.fallback_steps),
+                static_cast<unsigned long long>(s.rebalanced_steps));
   std::printf("\n");
   if (!c.out.empty()) std::printf("wrote %s\n", c.out.c_str());
 }
 
 // ---- evaluate -----------------------------------------------------------------------
-
-nlohmann::json step_json(const tp::StepReport& r) {
-  return {{"tasks", r.tasks},
-          {"cut_edges", r.cut_edges},
-          {"cut_bytes", r.cut_bytes},
-          {"signals", r.signals},
-          {"waits", r.waits},
-          {"reducers", r.reducers},
-          {"transfer_bytes", r.transfer_bytes},
-          {"imbalance", r.imbalance},
-          {"max_load_ns", r.max_load_ns},
-          {"work_ns", r.work_ns},
-          {"span_ns", r.span_ns},
-          {"lower_bound_ns", r.lower_bound_ns},
-          {"predicted_makespan_ns", r.makespan_ns},
-          {"predicted_speedup", r.speedup},
-          {"migrated_tasks", r.migrated_tasks},
-          {"migrated_bytes", r.migrated_bytes},
-          {"partition_ms", r.partition_ms},
-          {"quotient_acyclic", r.quotient_acyclic},
-          {"ping_pong_pairs", r.ping_pong_pairs}};
-}
-
-nlohmann::json report_json(const tp::Report& rep) {
-  nlohmann::json j = step_json(rep.total);
-  j["method"] = rep.method;
-  j["k"] = rep.k;
-  j["model"] = rep.model;
-  j["steps"] = rep.steps.size();
-  j["imbalance_max"] = rep.imbalance_max;
-  j["cyclic_steps"] = rep.cyclic_steps;
-  j["predicted_speedup_with_partitioning"] = rep.speedup_with_partitioning;
-  nlohmann::json per = nlohmann::json::array();
-  for (std::size_t s = 0; s < rep.steps.size(); ++s) {
-    nlohmann::json sj = step_json(rep.steps[s]);
-    sj["step"] = s;
-    per.push_back(sj);
-  }
-  j["per_step"] = per;
-  return j;
-}
 
 struct EvaluateCmd {
   std::string trace, assignment;
@@ -189,44 +126,21 @@ struct EvaluateCmd {
 
 void run_evaluate(const EvaluateCmd& c) {
   const Trace trace = load_trace(c.trace);
-  std::vector<std::uint64_t> hashes;
-  const TraceAssignment a = tp::read_assignment(c.assignment, &hashes);
-  tp::check_fits(trace, a, c.assignment);
-  for (std::size_t s = 0; s < hashes.size() && s < trace.steps.size(); ++s)
-    if (hashes[s] != 0 && hashes[s] != trace.steps[s].structural_hash())
-      throw InputError(c.assignment, std::nullopt,
-                       "step " + std::to_string(s) + " was partitioned for a graph of another structure than " +
-                           c.trace + "'s");
+  const TraceAssignment a = tp::load_assignment(c.assignment, trace, c.trace);
   const tp::Report rep = tp::evaluate(trace, a, c.model.load(), c.assignment);
-  if (c.json) {
-    print_json(report_json(rep));
-    return;
-  }
-  const tp::StepReport& t = rep.total;
-  std::printf("method %s, k = %u, %zu steps, cost model: %s\n", rep.method.c_str(), rep.k, rep.steps.size(),
-              rep.model.c_str());
-  std::printf("  cut: %llu edges, %llu bytes; %llu signals, %llu waits, %llu reducers, %llu bytes moved\n",
-              static_cast<unsigned long long>(t.cut_edges), static_cast<unsigned long long>(t.cut_bytes),
-              static_cast<unsigned long long>(t.signals), static_cast<unsigned long long>(t.waits),
-              static_cast<unsigned long long>(t.reducers), static_cast<unsigned long long>(t.transfer_bytes));
-  std::printf("  imbalance %.3f (worst step %.3f); migrations: %llu tasks, %llu bytes\n", t.imbalance,
-              rep.imbalance_max, static_cast<unsigned long long>(t.migrated_tasks),
-              static_cast<unsigned long long>(t.migrated_bytes));
-  std::printf("  predicted makespan %.3f ms, lower bound %.3f ms, work %.3f ms: speed-up %.2f "
-              "(%.2f with %.3f ms partitioning)\n",
-              static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
-              static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning, t.partition_ms);
-  std::printf("  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
-              t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),
-              static_cast<unsigned long long>(t.ping_pong_pairs));
+  if (c.json)
+    std::cout << tp::report_json(rep) << std::endl;
+  else
+    std::fputs(tp::report_text(rep).c_str(), stdout);
 }
 
 // ---- compare ------------------------------------------------------------------------
 
 struct CompareCmd {
   std::string trace, csv;
-  std::vector<std::string> methods = {"owner", "metis", "scotch", "sticky", "list", "roundrobin"};
+  std::vector<std::string> methods = {"owner", "metis", "metis-relabel", "scotch", "sticky", "list", "roundrobin"};
   std::vector<std::uint32_t> ks = {2, 4, 8, 16};
+  std::vector<double> migration_costs;
   bool json = false;
   StrategyFlags flags;
   ModelFlags model;
@@ -234,40 +148,13 @@ struct CompareCmd {
 
 void run_compare(const CompareCmd& c) {
   const Trace trace = load_trace(c.trace);
-  const tp::CostModel model = c.model.load();
-  const tp::Options options = c.flags.options(model);
-  for (const std::string& m : c.methods) (void)tp::make_strategy(m);  // reject unknown names early
-  for (std::uint32_t k : c.ks)
-    if (k == 0) throw UsageError("-k: expected values >= 1");
-  nlohmann::json rows = nlohmann::json::array();
-  std::ostringstream csv;
-  csv << "method,k,partition_ms,cut_edges,cut_bytes,signals,reducers,imbalance,migrated_tasks,"
-         "predicted_makespan_ns,lower_bound_ns,predicted_speedup,quotient_acyclic\n";
-  if (!c.json)
-    std::printf("%-11s %4s %12s %10s %12s %9s %9s %9s %14s %8s %8s\n", "method", "k", "partition_ms", "cut_edges",
-                "cut_bytes", "signals", "imbalance", "migrated", "makespan_ms", "speedup", "bound");
-  for (const std::string& m : c.methods)
-    for (std::uint32_t k : c.ks) {
-      const tp::TracePartition tp = tp::partition_trace(trace, m, k, options);
-      const tp::Report rep = tp::evaluate(trace, tp.assignment, model);
-      const tp::StepReport& t = rep.total;
-      const double bound_speedup =
-          t.lower_bound_ns == 0 ? 1.0 : static_cast<double>(t.work_ns) / static_cast<double>(t.lower_bound_ns);
-      nlohmann::json row = report_json(rep);
-      row.erase("per_step");
-      rows.push_back(row);
-      csv << m << ',' << k << ',' << t.partition_ms << ',' << t.cut_edges << ',' << t.cut_bytes << ','
-          << t.signals << ',' << t.reducers << ',' << t.imbalance << ',' << t.migrated_tasks << ',' << t.makespan_ns << ','
-          << t.lower_bound_ns << ',' << t.speedup << ',' << (t.quotient_acyclic ? 1 : 0) << '\n';
-      if (!c.json)
-        std::printf("%-11s %4u %12.3f %10llu %12llu %9llu %9.3f %9llu %14.3f %8.2f %8.2f\n", m.c_str(), k,
-                    t.partition_ms, static_cast<unsigned long long>(t.cut_edges),
-                    static_cast<unsigned long long>(t.cut_bytes), static_cast<unsigned long long>(t.signals),
-                    t.imbalance, static_cast<unsigned long long>(t.migrated_tasks),
-                    static_cast<double>(t.makespan_ns) / 1e6, t.speedup, bound_speedup);
-    }
-  if (!c.csv.empty()) write_file_atomic(c.csv, csv.str());
-  if (c.json) print_json({{"trace", c.trace}, {"model", model.source}, {"rows", rows}});
+  const tp::Comparison cmp =
+      tp::compare(trace, c.methods, c.ks, c.flags.options(c.model.load()), c.migration_costs);
+  if (!c.csv.empty()) write_file_atomic(c.csv, tp::comparison_csv(cmp));
+  if (c.json)
+    std::cout << tp::comparison_json(cmp, c.trace) << std::endl;
+  else
+    std::fputs(tp::comparison_table(cmp).c_str(), stdout);
 }
 
 // ---- import -------------------------------------------------------------------------
@@ -279,7 +166,7 @@ struct ImportCmd {
 };
 
 void run_import(const ImportCmd& c) {
-  const tp::StgGraph stg = tp::read_stg(c.input, c.unit_ns, c.edge_bytes);
+  const StgGraph stg = read_stg(c.input, c.unit_ns, c.edge_bytes);
   write_trace(c.out, stg.trace);
   const StepGraph& g = stg.trace.steps[0];
   if (c.json) {
@@ -361,6 +248,10 @@ void add_partition_verbs(CLI::App& app) {
     cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
     cmd->add_option("--methods", c->methods, "Comma-separated methods")->delimiter(',');
     cmd->add_option("-k", c->ks, "Comma-separated processor counts (default 2,4,8,16)")->delimiter(',');
+    cmd->add_option("--sticky-migration-cost", c->migration_costs,
+                    "Also run sticky with --sticky-fallback repartition at each of these migration "
+                    "costs (comma-separated) and mark the Pareto points")
+        ->delimiter(',');
     cmd->add_option("--csv", c->csv, "Also write the table as CSV");
     cmd->add_flag("--json", c->json, "Print one JSON object");
     c->flags.add(cmd);

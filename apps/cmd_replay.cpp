@@ -22,6 +22,7 @@
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/live.hpp"
 #include "tgraph/replay/measure.hpp"
+#include "tgraph/samples/live_engine.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::app {
@@ -34,7 +35,7 @@ tr::Policy policy_from(const std::string& name, const char* flag) {
   const auto p = tr::parse_policy(name);
   if (!p)
     throw UsageError(std::string(flag) + " " + name +
-                     ": expected partition, worksteal, barrier or sequential");
+                     ": expected partition, worksteal, barrier, starpu or sequential");
   return *p;
 }
 
@@ -42,7 +43,7 @@ tr::Policy policy_from(const std::string& name, const char* flag) {
 
 struct ReplayCmd {
   std::string trace, assignment, policy = "partition", method = "owner", timeline, chrome;
-  std::string cw, model = "calibrated", calibration;
+  std::string cw, model = "calibrated", calibration, starpu_sched = "lws";
   std::uint32_t threads = default_threads();
   std::uint32_t steps = 0, first_step = 0, repeat = 3;
   std::int64_t spin_ns = tr::kDefaultSpinNs;
@@ -57,6 +58,7 @@ void run_replay(const ReplayCmd& c) {
   o.exec.threads = c.threads;
   o.exec.pin = !c.no_pin;
   o.exec.spin_ns = c.spin_ns;
+  o.exec.starpu_sched = c.starpu_sched;
   if (c.cw == "reduce") o.exec.cw = tr::CwMode::kReduce;
   if (c.cw == "serialize") o.exec.cw = tr::CwMode::kSerialize;
   o.synthetic.cost_scale = c.scale;
@@ -105,9 +107,10 @@ void run_replay(const ReplayCmd& c) {
   }
   const auto pred = r.predicted_makespan_ns();
   std::int64_t measured_nobuild = 0;
-  for (const auto& m : r.steps) measured_nobuild += m.wall_ns - m.build_ns;
-  std::printf("replay %s: %zu steps, policy %s, %u threads\n", c.trace.c_str(), r.steps.size(),
-              std::string(tr::to_string(r.policy)).c_str(), r.threads);
+  for (const auto& m : r.steps) measured_nobuild += m.run_ns;
+  std::printf("replay %s: %zu steps, policy %s, %u threads, cw %s\n", c.trace.c_str(),
+              r.steps.size(), std::string(tr::to_string(r.policy)).c_str(), r.threads,
+              std::string(tr::to_string(r.cw)).c_str());
   std::printf("  wall            %10.3f ms (median of %u passes)\n",
               static_cast<double>(r.wall_ns) / 1e6, c.repeat);
   if (r.sequential_wall_ns > 0)
@@ -134,52 +137,14 @@ void run_replay(const ReplayCmd& c) {
 // ---- run (live) -------------------------------------------------------------------------
 
 struct RunCmd {
-  std::string scene, method = "owner", policy;
+  std::string scene, method = "owner", policy, cw, starpu_sched = "lws";
   std::uint32_t threads = default_threads();
   std::optional<int> steps;
+  std::uint32_t repeat = 1, cost_stride = 8;
   std::int64_t spin_ns = tr::kDefaultSpinNs;
-  bool check = false, no_pin = false, json = false;
+  bool check = false, no_pin = false, no_observe = false, json = false;
+  bool no_reuse = false, repartition_every_step = false, no_elide_waits = false;
 };
-
-/// Mean measured duration of each original task in the last step (feeds the next step's
-/// costs, which deferred recording leaves at zero, to the partitioner).
-class CostObserver : public tr::Observer {
- public:
-  void on_step_begin(const tr::ExecGraph& exec, std::uint32_t threads, std::int64_t) override {
-    exec_ = &exec;
-    begin_.assign(threads * 8, 0);
-    sum_.assign(exec.graph.tasks.size(), 0);
-    runs_.assign(exec.graph.tasks.size(), 0);
-  }
-  void on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t) override {
-    begin_[thread * 8] = t;
-  }
-  void on_end(std::uint32_t thread, TaskId task, std::uint32_t, std::int64_t t) override {
-    sum_[task] += static_cast<std::uint64_t>(t - begin_[thread * 8]);  // one writer per task
-    ++runs_[task];
-  }
-  /// Stable key -> mean cost of the last step.
-  std::unordered_map<StableKey, std::uint64_t> costs(const StepGraph& g) const {
-    std::unordered_map<StableKey, std::uint64_t> m;
-    for (TaskId t = 0; t < sum_.size(); ++t) {
-      const TaskId o = exec_->origin[t];
-      if (o != kNoTask && runs_[t] > 0) m[g.tasks[o].key] = sum_[t] / runs_[t];
-    }
-    return m;
-  }
-
- private:
-  const tr::ExecGraph* exec_ = nullptr;
-  std::vector<std::int64_t> begin_;
-  std::vector<std::uint64_t> sum_, runs_;
-};
-
-std::vector<tr::StateRegion> regions(const capture::Recorder& rec, const StepGraph& g) {
-  std::vector<tr::StateRegion> r;
-  for (DatumId d = 0; d < g.data.size(); ++d)
-    if (rec.datum_ptr(d)) r.push_back({g.data[d].name, rec.datum_ptr(d), g.data[d].bytes});
-  return r;
-}
 
 void run_live(const RunCmd& c) {
   if (c.threads == 0) throw UsageError("--threads must be at least 1");
@@ -191,118 +156,60 @@ void run_live(const RunCmd& c) {
     policy = *p;
   } else if (c.method == "partition") {
     method = "owner";
-  } else {
-    (void)tp::make_strategy(method);  // UsageError for an unknown name
   }
   if (!c.policy.empty()) policy = policy_from(c.policy, "--policy");
-  const std::uint32_t threads = policy == tr::Policy::kSequential ? 1 : c.threads;
+  std::shared_ptr<tp::Strategy> strategy;
+  if (policy == tr::Policy::kPartition) strategy = tp::make_strategy(method);  // UsageError if unknown
+  const int scene_steps = samples::make_scene(c.scene)->default_steps();  // InputError if unknown
 
-  std::uint64_t fallbacks = 0;
-  auto run_scene = [&](tr::Policy pol, std::uint32_t k, bool observe_costs,
-                       std::vector<double>* step_ms, tr::StateSnapshot* final_state,
-                       std::uint64_t* signals, std::uint32_t* cg) {
-    std::unique_ptr<samples::Scene> scene = samples::make_scene(c.scene);
-    const int steps = c.steps.value_or(scene->default_steps());
-    capture::Recorder rec(capture::Mode::kDeferred);
-    tr::ExecOptions eo;
-    eo.threads = k;
-    eo.pin = !c.no_pin;
-    eo.spin_ns = c.spin_ns;
-    eo.cw = tr::CwMode::kSerialize;  // the engine's bodies write through their own pointers
-    auto ex = tr::make_executor(pol, eo);
-    CostObserver costs;
-    if (observe_costs) ex->add_observer(costs);
-    std::unique_ptr<tp::Strategy> strategy =
-        pol == tr::Policy::kPartition ? tp::make_strategy(method) : nullptr;
-    StepGraph prev_graph;
-    Assignment prev_assignment;
-    bool have_prev = false;
-    std::unordered_map<StableKey, std::uint64_t> last_costs;
-    StepGraph last_graph;
-    for (int s = 0; s < steps; ++s) {
-      scene->step(rec);
-      capture::StepProgram prog = rec.end_step_program();
-      if (rec.errors() != 0)
-        throw Failure("the recorder counted " + std::to_string(rec.errors()) + " API misuses");
-      for (Task& t : prog.graph.tasks) {
-        auto it = last_costs.find(t.key);
-        t.cost_ns = it != last_costs.end() ? std::max<std::uint64_t>(1, it->second) : 1;
-      }
-      tr::ProgramWorkload w(prog.bodies, prog.conditions);
-      Assignment a;
-      if (strategy) {
-        tp::Previous prev;
-        if (have_prev) prev = {&prev_graph, &prev_assignment};
-        a = strategy->partition(prog.graph, k, prev, tp::Options{}).assignment;
-      }
-      const tr::StepStats st = ex->run_step(prog.graph, strategy ? &a : nullptr, w);
-      if (step_ms) step_ms->push_back(static_cast<double>(st.wall_ns) / 1e6);
-      if (signals) *signals += st.signals();
-      if (cg && !st.loop_iterations.empty()) *cg += st.loop_iterations[0];
-      if (observe_costs) last_costs = costs.costs(prog.graph);
-      if (strategy) {
-        prev_graph = prog.graph;
-        prev_assignment = a;
-        have_prev = true;
-      }
-      last_graph = std::move(prog.graph);
-    }
-    if (final_state) *final_state = tr::snapshot(regions(rec, last_graph));
-    fallbacks += ex->order_fallbacks();
+  tr::LiveOptions o;
+  o.policy = policy;
+  o.exec.threads = policy == tr::Policy::kSequential ? 1 : c.threads;
+  o.exec.pin = !c.no_pin;
+  o.exec.spin_ns = c.spin_ns;
+  o.exec.starpu_sched = c.starpu_sched;
+  if (c.cw == "serialize") o.exec.cw = tr::CwMode::kSerialize;
+  o.steps = static_cast<std::uint32_t>(c.steps.value_or(scene_steps));
+  o.repeat = c.repeat;
+  o.observe = !c.no_observe;
+  o.check = c.check;
+  o.reuse_structure = !c.no_reuse;
+  o.repartition_every_step = c.repartition_every_step;
+  o.cost_stride = c.cost_stride;
+  o.exec.elide_waits = !c.no_elide_waits;
+  const std::string scene = c.scene;
+  const tr::EngineFactory make = [scene] { return samples::make_live_engine(scene); };
+  tr::LivePartitioner partitioner = [strategy](const StepGraph& g, std::uint32_t k,
+                                               const StepGraph* prev_g, const Assignment* prev) {
+    return strategy->partition(g, k, tp::Previous{prev_g, prev}, tp::Options{}).assignment;
   };
-
-  std::vector<double> step_ms;
-  tr::StateSnapshot state;
-  std::uint64_t signals = 0;
-  std::uint32_t cg = 0;
-  run_scene(policy, threads, policy == tr::Policy::kPartition, &step_ms, c.check ? &state : nullptr,
-            &signals, &cg);
-  double total = 0;
-  for (double ms : step_ms) total += ms;
-  nlohmann::json j = {
-      {"scene", c.scene},
-      {"policy", std::string(tr::to_string(policy))},
-      {"method", policy == tr::Policy::kPartition ? method : std::string(tr::to_string(policy))},
-      {"threads", threads},
-      {"steps", step_ms.size()},
-      {"wall_ns", static_cast<std::int64_t>(total * 1e6)},
-      {"signals", signals},
-      {"first_loop_iterations", cg},
-      {"order_fallbacks", fallbacks}};
-  nlohmann::json per_step = nlohmann::json::array();
-  for (double ms : step_ms) per_step.push_back({{"wall_ns", static_cast<std::int64_t>(ms * 1e6)}});
-  j["per_step"] = per_step;
-  std::optional<tr::StateDifference> diff;
-  if (c.check) {
-    tr::StateSnapshot reference;
-    std::vector<double> seq_ms;
-    run_scene(tr::Policy::kSequential, 1, false, &seq_ms, &reference, nullptr, nullptr);
-    diff = tr::compare(reference, state);
-    double seq_total = 0;
-    for (double ms : seq_ms) seq_total += ms;
-    j["sequential_wall_ns"] = static_cast<std::int64_t>(seq_total * 1e6);
-    j["check"] = diff ? "differs" : "identical";
-    j["data_compared"] = reference.names.size();
-    if (diff)
-      j["first_difference"] = {{"datum", diff->datum},
-                               {"offset", diff->offset},
-                               {"differing_bytes", diff->differing_bytes}};
-  }
+  const tr::LiveResult r = tr::run_live(make, strategy ? &partitioner : nullptr, o);
+  auto j = nlohmann::json::parse(tr::to_json(r));
+  j["scene"] = c.scene;
+  j["method"] = policy == tr::Policy::kPartition ? method : std::string(tr::to_string(policy));
   if (c.json) {
     print_json(j);
   } else {
-    std::printf("run %s: %zu steps, %s (%s), %u threads: %.3f ms\n", c.scene.c_str(),
-                step_ms.size(), std::string(tr::to_string(policy)).c_str(),
-                j["method"].get<std::string>().c_str(), threads, total);
+    std::printf("run %s: %zu steps, %s (%s), %u threads, cw %s: %.3f ms (median of %u)\n",
+                c.scene.c_str(), r.steps.size(), std::string(tr::to_string(policy)).c_str(),
+                j["method"].get<std::string>().c_str(), r.threads,
+                std::string(tr::to_string(r.cw)).c_str(), static_cast<double>(r.wall_ns) / 1e6,
+                c.repeat);
+    if (r.baseline_wall_ns > 0)
+      std::printf("  uninstrumented engine %.3f ms   speed-up %.2f\n",
+                  static_cast<double>(r.baseline_wall_ns) / 1e6, r.speedup);
+    const auto& b = j["breakdown"];
+    std::printf("  record %.3f ms, partition %.3f ms, plans %.3f ms, execute %.3f ms\n",
+                b["record_ns"].get<double>() / 1e6, b["partition_ns"].get<double>() / 1e6,
+                b["prepare_ns"].get<double>() / 1e6, b["execute_ns"].get<double>() / 1e6);
     if (c.check)
-      std::printf("  check against sequential: %s (%zu data compared)\n",
-                  diff ? "DIFFERS" : "identical bit for bit",
-                  static_cast<std::size_t>(j["data_compared"]));
+      std::printf("  check against %s: %s (%zu data compared)\n", r.check_reference.c_str(),
+                  r.difference ? "DIFFERS" : "identical bit for bit", r.data_compared);
   }
-  if (diff)
-    throw Failure("state differs from the sequential run: first differing datum " + diff->datum +
-                  " (byte " + std::to_string(diff->offset) + ", " +
-                  std::to_string(diff->differing_bytes) + " bytes differ)");
+  if (r.difference)
+    throw Failure("state differs from the sequential run: first differing datum " +
+                  r.difference->datum + " (byte " + std::to_string(r.difference->offset) + ", " +
+                  std::to_string(r.difference->differing_bytes) + " bytes differ)");
 }
 
 }  // namespace
@@ -316,7 +223,8 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_option("assignment", c->assignment,
                     "Assignment file (.tga; partition policy; default: --method)");
     cmd->add_option("--threads,-k", c->threads, "Threads (processors)");
-    cmd->add_option("--policy", c->policy, "partition (default), worksteal, barrier or sequential");
+    cmd->add_option("--policy", c->policy,
+                    "partition (default), worksteal, barrier, starpu or sequential");
     cmd->add_option("--method", c->method,
                     "Strategy used when no assignment file is given (default owner)");
     cmd->add_option("--steps", c->steps, "Steps to replay (default: all)");
@@ -333,6 +241,8 @@ void add_replay_verbs(CLI::App& app) {
                     "Cost model of the prediction: calibrated (default) or ideal")
         ->check(CLI::IsMember({"ideal", "calibrated"}));
     cmd->add_option("--calibration", c->calibration, "Calibration file for the prediction");
+    cmd->add_option("--starpu-sched", c->starpu_sched,
+                    "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
     cmd->add_flag("--no-touch", c->no_touch, "Synthetic bodies only spin (no data buffers)");
     cmd->add_flag("--no-baseline", c->no_baseline, "Do not time sequential passes");
@@ -347,12 +257,29 @@ void add_replay_verbs(CLI::App& app) {
     cmd->add_option(
         "--method", c->method,
         "Partitioning strategy (owner, metis, scotch, sticky, list, roundrobin) or a baseline "
-        "(worksteal, barrier, sequential)");
+        "(worksteal, barrier, starpu, sequential)");
     cmd->add_option("--policy", c->policy, "Override the policy");
     cmd->add_option("--steps", c->steps, "Steps (default: the scene's)");
     cmd->add_option("--spin-ns", c->spin_ns, "Spin this long before parking a waiting thread");
+    cmd->add_option("--repeat", c->repeat, "Timed passes (medians reported; default 1)");
+    cmd->add_option("--cw", c->cw, "CW writes across threads: reduce (default) or serialize")
+        ->check(CLI::IsMember({"reduce", "serialize"}));
+    cmd->add_flag("--no-reuse", c->no_reuse,
+                  "Record every step (default: rerun the last program while the structure repeats)");
+    cmd->add_flag("--repartition-every-step", c->repartition_every_step,
+                  "Call the partitioner at every step (default: on change or imbalance)");
+    cmd->add_flag("--no-elide-waits", c->no_elide_waits,
+                  "One wait per cross-processor producer (default: waits implied by program "
+                  "order dropped)");
+    cmd->add_option("--cost-stride", c->cost_stride,
+                    "Cost feedback times loop iterations 0, 1 and every N-th (default 8)");
+    cmd->add_flag("--no-observe", c->no_observe,
+                  "Skip the observed passes (per-thread and per-kind figures)");
     cmd->add_flag("--check", c->check,
-                  "Compare the final state with a sequential run, bit for bit");
+                  "Compare the final state with a sequential run using the same reduction "
+                  "order, bit for bit");
+    cmd->add_option("--starpu-sched", c->starpu_sched,
+                    "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
     cmd->add_flag("--no-pin", c->no_pin, "Do not bind threads to cores");
     cmd->add_flag("--json", c->json, "Print one JSON object");
     cmd->callback([c] { run_live(*c); });

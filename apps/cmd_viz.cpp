@@ -31,19 +31,7 @@ void run_viz(const VizCmd& c) {
   o.max_nodes = c.max_nodes;
   o.title = std::filesystem::path(c.trace).filename().string() + ", step " + std::to_string(c.step);
   if (!c.assignment.empty()) {
-    std::vector<std::uint64_t> hashes;
-    assignment = partition::read_assignment(c.assignment, &hashes);
-    if (c.step >= assignment.steps.size())
-      throw UsageError("--assign " + c.assignment + ": covers " + std::to_string(assignment.steps.size()) +
-                       " steps, --step is " + std::to_string(c.step));
-    const StepGraph& g = trace.steps[c.step];
-    if (c.step < hashes.size() && hashes[c.step] != 0 && hashes[c.step] != g.structural_hash())
-      throw UsageError("--assign " + c.assignment + ": step " + std::to_string(c.step) +
-                       " was partitioned for a graph of another structure than " + c.trace + "'s");
-    if (assignment.steps[c.step].proc.size() != g.tasks.size())
-      throw UsageError("--assign " + c.assignment + ": step " + std::to_string(c.step) + " assigns " +
-                       std::to_string(assignment.steps[c.step].proc.size()) + " tasks, the trace's step has " +
-                       std::to_string(g.tasks.size()));
+    assignment = partition::load_assignment(c.assignment, trace, c.trace);
     o.assignment = &assignment.steps[c.step];
     o.title += ", " + assignment.method + " on " + std::to_string(assignment.k) + " processors";
   }

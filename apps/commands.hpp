@@ -38,10 +38,12 @@ TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed);
 // Registration of each verb (one function per cmd_*.cpp).
 void add_info(CLI::App& app);
 void add_export(CLI::App& app);
+void add_diff(CLI::App& app);
 void add_capture(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
 void add_replay_verbs(CLI::App& app);     // replay, run
+void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)
 void add_viz_verbs(CLI::App& app);        // viz, timeline, report
 
 }  // namespace tgraph::app

@@ -46,8 +46,10 @@ int main(int argc, char** argv) {
   add_capture(app);
   add_info(app);
   add_export(app);
+  add_diff(app);
   add_partition_verbs(app);
   add_replay_verbs(app);
+  add_validate(app);
   add_viz_verbs(app);
   try {
     app.parse(argc, argv);

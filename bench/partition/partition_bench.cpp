@@ -10,7 +10,7 @@
 
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/partition/simulator.hpp"
-#include "tgraph/partition/stg.hpp"
+#include "tgraph/graph/stg.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace {

@@ -6,11 +6,15 @@
 //    wait, the waiter parks (futex) and the hand-off costs microseconds: the switch point.
 //  * Policy/<policy>/<threads>: a synthetic bars64-like step (64 bars, a CG loop of 25
 //    iterations with per-bar matrix products and global dot products) under each policy.
+//  * TaskOverhead/<policy>/<threads>: the same step with empty bodies (no spin, no data):
+//    what each executor costs per task instance (ns_per_task), StarPU included.
 #include <benchmark/benchmark.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
@@ -154,6 +158,41 @@ BENCHMARK(BM_Policy)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->MinTime(1.0);
+
+void BM_TaskOverhead(benchmark::State& state) {
+  const auto policy = static_cast<Policy>(state.range(0));
+  const auto k = static_cast<std::uint32_t>(state.range(1));
+  const StepGraph g = bars_like(64, 25);
+  const Assignment a = owner_like(g, k, 64);
+  ExecOptions o;
+  o.threads = k;
+  std::unique_ptr<Executor> ex;
+  try {
+    ex = make_executor(policy, o);
+  } catch (const Error& e) {
+    state.SkipWithError(e.what());  // e.g. built without StarPU
+    return;
+  }
+  SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
+  w.set_step(g);
+  const StepStats first = ex->run_step(g, &a, w);
+  std::uint64_t instances = 0;
+  for (const ThreadCounters& c : first.threads) instances += c.tasks;
+  for (auto _ : state) ex->run_step(g, &a, w);
+  state.SetLabel(std::string(to_string(policy)));
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * instances));
+  state.counters["ns_per_task"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * instances),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_TaskOverhead)
+    ->ArgNames({"policy", "threads"})
+    ->ArgsProduct({{static_cast<int>(Policy::kPartition), static_cast<int>(Policy::kWorksteal),
+                    static_cast<int>(Policy::kStarpu)},
+                   {2}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(0.5);
 
 }  // namespace
 }  // namespace tgraph::replay

@@ -32,6 +32,15 @@ DatumId Recorder::datum(std::string_view name, ObjectId owner, std::uint64_t byt
   return static_cast<DatumId>(data_.size() - 1);
 }
 
+void Recorder::accumulator(DatumId d, Accumulator a) {
+  if (d >= data_.size()) {
+    ++errors_;
+    return;
+  }
+  if (accumulators_.size() < data_.size()) accumulators_.resize(data_.size());
+  accumulators_[d] = std::make_unique<Accumulator>(std::move(a));
+}
+
 KindId Recorder::kind(std::string_view name) {
   for (std::size_t i = 0; i < kinds_.size(); ++i)
     if (kinds_[i] == name) return static_cast<KindId>(i);
@@ -200,6 +209,9 @@ StepProgram Recorder::end_step_program() {
   p.graph = finish_step();
   p.bodies = std::move(bodies_);
   p.conditions = std::move(conditions_);
+  p.accumulators.assign(p.graph.data.size(), nullptr);
+  for (std::size_t d = 0; d < accumulators_.size() && d < p.accumulators.size(); ++d)
+    p.accumulators[d] = accumulators_[d].get();
   bodies_.clear();
   conditions_.clear();
   return p;

@@ -14,32 +14,13 @@
 #include <string_view>
 #include <unordered_map>
 
+#include "tgraph/graph/byte_codec.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
 namespace tgraph {
 
 namespace {
-
-// CRC-32 as in zlib, PNG and Ethernet (reflected polynomial 0xEDB88320), table-driven.
-constexpr std::array<std::uint32_t, 256> make_crc32_table() {
-  std::array<std::uint32_t, 256> table{};
-  for (std::uint32_t i = 0; i < 256; ++i) {
-    std::uint32_t c = i;
-    for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
-    table[i] = c;
-  }
-  return table;
-}
-
-constexpr std::array<std::uint32_t, 256> kCrc32Table = make_crc32_table();
-
-// Continues a CRC-32 over `bytes` (start with crc = 0).
-std::uint32_t crc32(const std::uint8_t* bytes, std::size_t n, std::uint32_t crc = 0) {
-  crc = ~crc;
-  for (std::size_t i = 0; i < n; ++i) crc = kCrc32Table[(crc ^ bytes[i]) & 0xFFu] ^ (crc >> 8);
-  return ~crc;
-}
 
 constexpr std::array<std::uint8_t, 4> kMagic = {'T', 'G', 'T', 'R'};
 constexpr std::uint32_t kFormatVersion = 1;
@@ -68,35 +49,6 @@ constexpr std::uint64_t kDecodedPerByte = 128;
 // ---------------------------------------------------------------------------------------
 // Encoding
 
-class ByteWriter {
- public:
-  explicit ByteWriter(std::vector<std::uint8_t>& out) : out_(out) {}
-  void u8(std::uint8_t v) { out_.push_back(v); }
-  void u32(std::uint32_t v) {
-    for (int i = 0; i < 4; ++i) out_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void u64(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) out_.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
-  }
-  void count(std::size_t n, const char* what) {
-    if (n > std::numeric_limits<std::uint32_t>::max())
-      throw UsageError(std::string("cannot write trace: more than 2^32-1 ") + what);
-    u32(static_cast<std::uint32_t>(n));
-  }
-  void str(const std::string& s) {
-    count(s.size(), "bytes in a string");
-    out_.insert(out_.end(), s.begin(), s.end());
-  }
-
- private:
-  std::vector<std::uint8_t>& out_;
-};
-
-void put_u32_at(std::vector<std::uint8_t>& out, std::size_t at, std::uint32_t v) {
-  for (int i = 0; i < 4; ++i)
-    out[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
-}
-
 // Reserves a frame header at the end of `out`; finish_frame() fills it once the payload
 // has been appended.
 std::size_t begin_frame(std::vector<std::uint8_t>& out) {
@@ -109,12 +61,13 @@ void finish_frame(std::vector<std::uint8_t>& out, std::size_t at, FrameType type
   const std::size_t length = out.size() - at - kFrameHeaderSize;
   if (length > std::numeric_limits<std::uint32_t>::max())
     throw UsageError("cannot write trace: a step encodes to more than 4 GiB");
-  put_u32_at(out, at, static_cast<std::uint32_t>(type));
-  put_u32_at(out, at + 4, static_cast<std::uint32_t>(length));
+  ByteWriter w(out);
+  w.u32_at(at, static_cast<std::uint32_t>(type));
+  w.u32_at(at + 4, static_cast<std::uint32_t>(length));
   // The checksum covers type, length and payload.
-  std::uint32_t crc = crc32(out.data() + at, 8);
-  crc = crc32(out.data() + at + kFrameHeaderSize, length, crc);
-  put_u32_at(out, at + 8, crc);
+  const std::uint32_t crc = crc32(std::span(out).subspan(at + kFrameHeaderSize, length),
+                                  crc32(std::span(out).subspan(at, 8)));
+  w.u32_at(at + 8, crc);
 }
 
 void encode_file_header(std::vector<std::uint8_t>& out, const TraceHeader& header) {
@@ -280,54 +233,6 @@ std::uint64_t structure_memory(const StepGraph& g) {
   return m;
 }
 
-class TraceDecoder;
-
-// Reads the payload of one frame; every read is bounds-checked and failures name the
-// absolute file offset of the field.
-class Payload {
- public:
-  Payload(const TraceDecoder& dec, const std::uint8_t* file, std::size_t begin, std::size_t end)
-      : dec_(dec), file_(file), pos_(begin), end_(end) {}
-
-  std::size_t pos() const { return pos_; }
-  std::uint64_t left() const { return end_ - pos_; }
-
-  std::uint8_t u8(const char* what) {
-    need(1, what);
-    return file_[pos_++];
-  }
-  std::uint32_t u32(const char* what) {
-    need(4, what);
-    std::uint32_t v = 0;
-    for (int i = 0; i < 4; ++i)
-      v |= std::uint32_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
-    pos_ += 4;
-    return v;
-  }
-  std::uint64_t u64(const char* what) {
-    need(8, what);
-    std::uint64_t v = 0;
-    for (int i = 0; i < 8; ++i)
-      v |= std::uint64_t{file_[pos_ + static_cast<std::size_t>(i)]} << (8 * i);
-    pos_ += 8;
-    return v;
-  }
-  // A list length whose elements take at least `min_size` bytes each: checked against
-  // the bytes left in the frame before the caller allocates anything.
-  std::uint32_t count(const char* what, std::uint64_t min_size);
-  std::string str(const char* what);
-  // The frame must be consumed exactly.
-  void expect_end();
-
- private:
-  void need(std::size_t n, const char* what);
-
-  const TraceDecoder& dec_;
-  const std::uint8_t* file_;
-  std::size_t pos_;
-  std::size_t end_;
-};
-
 class TraceDecoder {
  public:
   TraceDecoder(std::span<const std::uint8_t> bytes, const std::string& name,
@@ -373,13 +278,12 @@ class TraceDecoder {
       }
       const std::size_t begin = pos + kFrameHeaderSize;
       const std::size_t end = begin + length;
-      std::uint32_t crc = crc32(bytes_.data() + pos, 8);
-      crc = crc32(bytes_.data() + begin, length, crc);
+      const std::uint32_t crc = crc32(bytes_.subspan(begin, length), crc32(bytes_.subspan(pos, 8)));
       if (crc != stored_crc) {
         fail(pos, "checksum mismatch: expected CRC-32 " + hex32(stored_crc) +
                       " (stored in the frame), computed " + hex32(crc));
       }
-      Payload p(*this, bytes_.data(), begin, end);
+      ByteReader p(bytes_, begin, end, name_, "the frame");
       const auto frame_type = static_cast<FrameType>(type);
       if (!have_header_ && frame_type != FrameType::Header)
         fail(pos,
@@ -398,7 +302,7 @@ class TraceDecoder {
           break;
         case FrameType::End: {
           const std::uint32_t n = p.u32("u32 step count of the end frame");
-          p.expect_end();
+          p.expect_end("the frame payload");
           if (n != trace_.steps.size())
             fail(pos, "end frame count mismatch: expected " + std::to_string(trace_.steps.size()) +
                           " steps (frames read), the end frame says " + std::to_string(n));
@@ -445,20 +349,20 @@ class TraceDecoder {
                   "; capture interrupted?) — read with --recover");
   }
 
-  void read_header(Payload& p) {
+  void read_header(ByteReader& p) {
     trace_.header.scene = p.str("scene string");
     trace_.header.engine = p.str("engine string");
     trace_.header.machine = p.str("machine string");
     trace_.header.tgraph_version = p.str("tgraph version string");
-    p.expect_end();
+    p.expect_end("the frame payload");
   }
 
-  void read_full_step(Payload& p, std::size_t frame) {
+  void read_full_step(ByteReader& p, std::size_t frame) {
     check_step_count(frame);
     StepGraph g;
     read_structure(p, g);
     read_step_values(p, g);
-    p.expect_end();
+    p.expect_end("the frame payload");
     check_valid(g, frame);
     const std::uint64_t left = budget_ > decoded_ ? budget_ - decoded_ : 0;
     if (!g.derive_edges(static_cast<std::size_t>(left / sizeof(Edge))))
@@ -470,7 +374,7 @@ class TraceDecoder {
     trace_.steps.push_back(std::move(g));
   }
 
-  void read_reference_step(Payload& p, std::size_t frame) {
+  void read_reference_step(ByteReader& p, std::size_t frame) {
     check_step_count(frame);
     const std::size_t ref_at = p.pos();
     const std::uint32_t ref = p.u32("u32 referenced step index");
@@ -491,7 +395,7 @@ class TraceDecoder {
     g.edges = src.edges;
     g.carried_edges = src.carried_edges;
     read_step_values(p, g);
-    p.expect_end();
+    p.expect_end("the frame payload");
     check_valid(g, frame);
     charge(values_memory(g), frame);
     shape_memory_.push_back(shape_memory_[ref]);
@@ -535,7 +439,7 @@ class TraceDecoder {
                    ", found " + std::to_string(id));
   }
 
-  void read_structure(Payload& p, StepGraph& g) {
+  void read_structure(ByteReader& p, StepGraph& g) {
     const std::uint32_t n_kinds = p.count("kinds", kStringMin);
     g.kinds.reserve(n_kinds);
     for (std::uint32_t i = 0; i < n_kinds; ++i) g.kinds.push_back(p.str("kind name"));
@@ -636,7 +540,7 @@ class TraceDecoder {
                                      std::to_string(l));
   }
 
-  void read_step_values(Payload& p, StepGraph& g) {
+  void read_step_values(ByteReader& p, StepGraph& g) {
     std::size_t at = p.pos();
     const std::uint32_t n_costs = p.count("task costs", kCostSize);
     if (n_costs != g.tasks.size())
@@ -681,41 +585,6 @@ class TraceDecoder {
   std::uint64_t budget_ = 0;
 };
 
-void Payload::need(std::size_t n, const char* what) {
-  if (end_ - pos_ < n)
-    dec_.fail(pos_, std::string("truncated payload: expected ") + what + " (" + std::to_string(n) +
-                        " bytes), the frame has " + std::to_string(end_ - pos_) + " left");
-}
-
-std::uint32_t Payload::count(const char* what, std::uint64_t min_size) {
-  const std::size_t at = pos_;
-  const std::uint32_t n = u32("u32 count");
-  const std::uint64_t fits = left() / min_size;
-  if (n > fits)
-    dec_.fail(at, std::string("absurd count: expected at most ") + std::to_string(fits) + " " +
-                      what + " in the " + std::to_string(left()) +
-                      " bytes left in the frame, found " + std::to_string(n));
-  return n;
-}
-
-std::string Payload::str(const char* what) {
-  const std::size_t at = pos_;
-  const std::uint32_t n = u32("u32 string length");
-  if (n > left())
-    dec_.fail(at, std::string("absurd count: expected a ") + what + " of at most " +
-                      std::to_string(left()) + " bytes (left in the frame), found length " +
-                      std::to_string(n));
-  std::string s(reinterpret_cast<const char*>(file_ + pos_), n);
-  pos_ += n;
-  return s;
-}
-
-void Payload::expect_end() {
-  if (pos_ != end_)
-    dec_.fail(pos_, "expected the frame payload to end here, found " + std::to_string(end_ - pos_) +
-                        " unread bytes");
-}
-
 // Writes all of `bytes` with write(2): one call unless the kernel writes less.
 void write_all(int fd, const std::vector<std::uint8_t>& bytes, const std::string& path) {
   std::size_t done = 0;
@@ -735,7 +604,8 @@ void write_all(int fd, const std::vector<std::uint8_t>& bytes, const std::string
 // TraceWriter
 
 struct TraceWriter::Impl {
-  std::string path;
+  std::string path;     // where close() puts the finished trace
+  std::string partial;  // what is written until then
   int fd = -1;
   StepEncoder encoder;
   std::vector<std::uint8_t> buffer;  // reused frame buffer
@@ -743,12 +613,16 @@ struct TraceWriter::Impl {
 
   std::string closed_because;  // why appends are refused once fd is closed
 
-  // Writes the buffered frame. After a failed write the file may end in a partial frame:
-  // the writer closes it and refuses further frames, so the partial frame stays the last.
+  // Writes the buffered frame. After a failed write (disk full, file size limit) the writer
+  // cuts the file back to the end of the last complete frame, closes it and refuses further
+  // frames, so the partial file holds exactly the frames written before.
   void flush_buffer() {
     try {
-      write_all(fd, buffer, path);
+      write_all(fd, buffer, partial);
     } catch (...) {
+      if (::ftruncate(fd, static_cast<::off_t>(written)) != 0) {
+        // Nothing more to do: the reader with --recover skips a partial last frame.
+      }
       ::close(fd);
       fd = -1;
       closed_because = "a failed write";
@@ -762,19 +636,22 @@ struct TraceWriter::Impl {
 TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header)
     : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
-  impl_->fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (impl_->fd < 0) throw Error(path + ": cannot create: " + std::strerror(errno));
+  impl_->partial = path + ".partial";
+  impl_->fd = ::open(impl_->partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (impl_->fd < 0) throw Error(impl_->partial + ": cannot create: " + std::strerror(errno));
   encode_file_header(impl_->buffer, header);
   impl_->flush_buffer();
 }
 
-// Without close() no end frame is written: the trace then reads as interrupted.
+// Without close() no end frame is written and nothing is renamed: the partial file reads
+// as an interrupted trace (with ReadOptions::recover).
 TraceWriter::~TraceWriter() {
   if (impl_ && impl_->fd >= 0) ::close(impl_->fd);
 }
 
 void TraceWriter::append(const StepGraph& step) {
-  if (impl_->fd < 0) throw UsageError(impl_->path + ": append() after " + impl_->closed_because);
+  if (impl_->fd < 0)
+    throw UsageError(impl_->partial + ": append() after " + impl_->closed_because);
   impl_->buffer.clear();
   impl_->encoder.encode(step, impl_->buffer);
   impl_->flush_buffer();
@@ -788,8 +665,21 @@ void TraceWriter::close() {
   const int fd = impl_->fd;
   impl_->fd = -1;
   impl_->closed_because = "close()";
-  if (::close(fd) != 0) throw Error(impl_->path + ": cannot close: " + std::strerror(errno));
+  // The data reach the disk before the rename makes them the trace (as write_file_atomic).
+  if (::fsync(fd) != 0 && errno != EINVAL) {
+    const int err = errno;
+    ::close(fd);
+    throw Error(impl_->partial + ": cannot sync: " + std::strerror(err));
+  }
+  if (::close(fd) != 0) throw Error(impl_->partial + ": cannot close: " + std::strerror(errno));
+  if (::rename(impl_->partial.c_str(), impl_->path.c_str()) != 0)
+    throw Error(impl_->path + ": cannot rename " + impl_->partial + " into place: " +
+                std::strerror(errno));
 }
+
+const std::string& TraceWriter::partial_path() const { return impl_->partial; }
+
+std::uint32_t TraceWriter::steps_written() const { return impl_->encoder.steps(); }
 
 std::uint64_t TraceWriter::bytes_written() const { return impl_->written; }
 

@@ -14,8 +14,8 @@ namespace tgraph::partition {
 
 CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal"}; }
 
-// Defaults: the middle of the cross-core spin handoff measured on this machine kind
-// (../shared/notes/machine.md: 70-150 ns) and 0.05 ns/byte (20 GB/s cross-core).
+// Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
+// servers (`tgraph calibrate` measures it) and 0.05 ns/byte (20 GB/s cross-core).
 CostModel CostModel::defaults() { return CostModel{100.0, 0.05, "default"}; }
 
 std::string default_calibration_path() {
@@ -37,25 +37,48 @@ CostModel select_cost_model(const std::string& model, const std::string& calibra
 
 CostModel load_calibration(const std::string& path) {
   const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+  CostModel m = parse_calibration(
+      std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), path);
+  m.source = path;
+  return m;
+}
+
+CostModel parse_calibration(std::string_view text, const std::string& name) {
+  // A calibration file is a few hundred bytes: anything far larger or deeper is not one.
+  constexpr std::size_t kMaxBytes = std::size_t{1} << 20;
+  constexpr int kMaxDepth = 64;
+  if (text.size() > kMaxBytes)
+    throw InputError(name, kMaxBytes,
+                     "expected a calibration file of at most 1 MiB, found " +
+                         std::to_string(text.size()) + " bytes");
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(bytes.begin(), bytes.end());
+    j = nlohmann::json::parse(
+        text.begin(), text.end(), [&](int depth, nlohmann::json::parse_event_t, nlohmann::json&) {
+          if (depth > kMaxDepth)
+            throw InputError(name, std::nullopt,
+                             "expected a JSON calibration object, found values nested more than " +
+                                 std::to_string(kMaxDepth) + " deep");
+          return true;
+        });
   } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
-                     "expected a JSON calibration object");
+    // e.byte is the 1-based position of the offending byte.
+    throw InputError(name, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
+                     "expected a JSON calibration object (malformed JSON)");
   }
   auto number = [&](const char* key) {
     if (!j.is_object() || !j.contains(key) || !j[key].is_number())
-      throw InputError(path, std::nullopt, std::string("expected a number under \"") + key + "\"");
+      throw InputError(name, std::nullopt, std::string("expected a number under \"") + key + "\"");
     const double v = j[key].get<double>();
     if (!std::isfinite(v) || v < 0 || v > 1e9)
-      throw InputError(path, std::nullopt, std::string("\"") + key + "\" out of range [0, 1e9]");
+      throw InputError(name, std::nullopt,
+                       std::string("expected \"") + key + "\" in [0, 1e9], found " + j[key].dump());
     return v;
   };
   CostModel m;
   m.sync_latency_ns = number("sync_latency_ns");
   m.per_byte_ns = number("per_byte_ns");
-  m.source = path;
+  m.source = name;
   return m;
 }
 

@@ -130,20 +130,9 @@ void check_fits(const Trace& trace, const TraceAssignment& a, const std::string&
     throw InputError(a_name, std::nullopt,
                      "has " + std::to_string(a.steps.size()) + " steps, the trace has " +
                          std::to_string(trace.steps.size()));
-  for (std::size_t s = 0; s < a.steps.size(); ++s) {
-    const Assignment& as = a.steps[s];
-    const std::string where = "step " + std::to_string(s) + ": ";
-    if (as.k == 0 || as.k != a.k)
-      throw InputError(a_name, std::nullopt, where + "k = " + std::to_string(as.k) + ", expected " +
-                                                 std::to_string(a.k));
-    if (as.proc.size() != trace.steps[s].tasks.size())
-      throw InputError(a_name, std::nullopt,
-                       where + "assigns " + std::to_string(as.proc.size()) + " tasks, the trace has " +
-                           std::to_string(trace.steps[s].tasks.size()));
-    for (ProcId p : as.proc)
-      if (p >= as.k)
-        throw InputError(a_name, std::nullopt, where + "processor " + std::to_string(p) + " >= k");
-  }
+  for (std::size_t s = 0; s < a.steps.size(); ++s)
+    if (std::string why = validate(trace.steps[s], a.steps[s], a.k); !why.empty())
+      throw InputError(a_name, std::nullopt, "step " + std::to_string(s) + ": " + why);
 }
 
 Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,

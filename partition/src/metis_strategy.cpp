@@ -95,6 +95,22 @@ std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std:
 
 namespace {
 
+// METIS k-way on the task graph; optional multi-constraint mode balancing each phase.
+Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& options) {
+  if (auto trivial = library_trivial_case(g, k)) return *trivial;
+  Result r;
+  r.assignment.k = k;
+  const UndirectedGraph pg = library_graph(g);
+  std::vector<std::uint32_t> phase;
+  std::uint32_t used = 1;
+  if (options.phases > 1) phase = task_phases(g, options.phases, used);
+  const LibraryWeights w = library_weights(pg, phase, used);
+  std::vector<std::uint32_t> part;
+  r.stats.edgecut = metis_kway(pg, w, k, options, part);
+  r.assignment.proc.assign(part.begin(), part.end());
+  return r;
+}
+
 /// METIS k-way on the task graph; optional multi-constraint mode balancing each phase.
 class Metis final : public Strategy {
  public:
@@ -103,17 +119,23 @@ class Metis final : public Strategy {
  private:
   Result do_partition(const StepGraph& g, std::uint32_t k, const Previous&,
                       const Options& options) override {
-    if (auto trivial = library_trivial_case(g, k)) return *trivial;
-    Result r;
+    return metis_partition(g, k, options);
+  }
+};
+
+/// METIS from scratch every step (the same call as `metis`), then its K part labels renamed
+/// so that as many tasks as possible (matched by stable key, counted once each) keep the
+/// previous step's processor: the migration baseline that relabelling alone achieves.
+class MetisRelabel final : public Strategy {
+ public:
+  std::string_view name() const override { return "metis-relabel"; }
+
+ private:
+  Result do_partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
+                      const Options& options) override {
+    Result r = metis_partition(g, k, options);
     r.assignment.k = k;
-    const UndirectedGraph pg = library_graph(g);
-    std::vector<std::uint32_t> phase;
-    std::uint32_t used = 1;
-    if (options.phases > 1) phase = task_phases(g, options.phases, used);
-    const LibraryWeights w = library_weights(pg, phase, used);
-    std::vector<std::uint32_t> part;
-    r.stats.edgecut = metis_kway(pg, w, k, options, part);
-    r.assignment.proc.assign(part.begin(), part.end());
+    relabel_to_previous(g, prev, r.assignment);
     return r;
   }
 };
@@ -121,5 +143,6 @@ class Metis final : public Strategy {
 }  // namespace
 
 std::unique_ptr<Strategy> make_metis() { return std::make_unique<Metis>(); }
+std::unique_ptr<Strategy> make_metis_relabel() { return std::make_unique<MetisRelabel>(); }
 
 }  // namespace tgraph::partition::detail

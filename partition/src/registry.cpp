@@ -20,6 +20,7 @@ const std::map<std::string, Factory, std::less<>>& registry() {
       {"random", detail::make_random},
       {"owner", detail::make_owner},
       {"metis", detail::make_metis},
+      {"metis-relabel", detail::make_metis_relabel},
       {"scotch", detail::make_scotch},
       {"sticky", detail::make_sticky},
       {"list", detail::make_list},

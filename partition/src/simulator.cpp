@@ -43,29 +43,7 @@ struct SyncKeyHash {
 };
 
 void check_assignment(const StepGraph& g, const Assignment& a) {
-  if (a.k == 0) throw Error("assignment: k must be at least 1");
-  if (a.proc.size() != g.tasks.size())
-    throw Error("assignment has " + std::to_string(a.proc.size()) + " tasks, step has " +
-                std::to_string(g.tasks.size()));
-  for (TaskId t = 0; t < a.proc.size(); ++t)
-    if (a.proc[t] >= a.k)
-      throw Error("assignment: task " + std::to_string(t) + " on processor " +
-                  std::to_string(a.proc[t]) + " >= k = " + std::to_string(a.k));
-  if (a.order.empty()) return;
-  if (a.order.size() != a.k)
-    throw Error("assignment: order has " + std::to_string(a.order.size()) + " processors, k = " +
-                std::to_string(a.k));
-  std::vector<bool> seen(g.tasks.size(), false);
-  std::size_t count = 0;
-  for (ProcId p = 0; p < a.k; ++p)
-    for (TaskId t : a.order[p]) {
-      if (t >= g.tasks.size() || a.proc[t] != p || seen[t])
-        throw Error("assignment: order of processor " + std::to_string(p) + " lists task " +
-                    std::to_string(t) + " that is not its own or listed twice");
-      seen[t] = true;
-      ++count;
-    }
-  if (count != g.tasks.size()) throw Error("assignment: order misses some tasks");
+  if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
 }
 
 class Simulator {

@@ -141,28 +141,6 @@ void scotch_rebalance(const StepGraph& g, std::uint32_t k, const Options& option
   proc.assign(part.begin(), part.end());
 }
 
-// Renames the parts of a fresh partition so that as many tasks (by work) as possible keep
-// their previous processor: greedy maximum-weight matching on the K x K overlap.
-void relabel_to_previous(const std::vector<TaskId>& match, const std::vector<ProcId>& old,
-                         const std::vector<std::uint64_t>& work, std::uint32_t k,
-                         std::vector<ProcId>& proc) {
-  std::vector<std::uint64_t> overlap(static_cast<std::size_t>(k) * k, 0);
-  for (TaskId t = 0; t < proc.size(); ++t)
-    if (match[t] != kNoTask) overlap[static_cast<std::size_t>(proc[t]) * k + old[match[t]]] += work[t] + 1;
-  std::vector<std::size_t> cells(overlap.size());
-  for (std::size_t i = 0; i < cells.size(); ++i) cells[i] = i;
-  std::stable_sort(cells.begin(), cells.end(), [&](std::size_t a, std::size_t b) { return overlap[a] > overlap[b]; });
-  std::vector<ProcId> rename(k, k);
-  std::vector<bool> taken(k, false);
-  for (std::size_t c : cells) {
-    const auto from = static_cast<ProcId>(c / k), to = static_cast<ProcId>(c % k);
-    if (rename[from] != k || taken[to]) continue;
-    rename[from] = to;
-    taken[to] = true;
-  }
-  for (ProcId& p : proc) p = rename[p];
-}
-
 /// Reuses the previous step's assignment while the structure is unchanged; otherwise keeps
 /// every task found again (by stable key) on its processor, places new tasks by affinity to
 /// the data they touch, and only when imbalance exceeds `threshold` times the imbalance the
@@ -215,15 +193,17 @@ class Sticky final : public Strategy {
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);
     std::size_t matched = 0;
     for (TaskId m : match) matched += m != kNoTask ? 1 : 0;
-    if (g.loops.size() != prev.graph->loops.size() || 4 * matched < 3 * static_cast<std::size_t>(n)) {
+    const bool reshaped =
+        g.loops.size() != prev.graph->loops.size() || 4 * matched < 3 * static_cast<std::size_t>(n);
+    if (reshaped && options.sticky_fallback == StickyFallback::kFresh) {
       // The shape changed too much to patch (solver loops merged or split, or over a quarter
       // of the tasks are new): partition afresh, then rename the parts so that as many
-      // tasks as possible stay where they were.
+      // tasks as possible stay where they were (as `metis-relabel` does every step).
       const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
       r = make_strategy(base)->partition(g, k, {}, options);
       r.assignment.order.clear();
-      relabel_to_previous(match, prev.assignment->proc, work, k, r.assignment.proc);
-      r.stats.rebalanced = true;
+      relabel_to_previous(g, prev, r.assignment);
+      r.stats.fallback = true;
       remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
       return r;
     }
@@ -240,6 +220,14 @@ class Sticky final : public Strategy {
     // New tasks, in program order: the processor holding most bytes of their data.
     place_by_affinity(g, work, k, placed, proc, load);
 
+    if (reshaped) {
+      // Repartition with the incremental placement as the old partition: Scotch trades the
+      // cut against migrated load (emraval x bytes each task touches).
+      if (k > 1 && n > k) scotch_rebalance(g, k, options, match, proc);
+      r.stats.fallback = true;
+      remember(proc, imbalance(loads(work, proc, k)));
+      return r;
+    }
     if (imbalance(load) <= trigger || k == 1 || n <= k) {
       remember(proc, baseline);
       return r;

@@ -17,6 +17,7 @@ std::unique_ptr<Strategy> make_roundrobin();
 std::unique_ptr<Strategy> make_random();
 std::unique_ptr<Strategy> make_owner();
 std::unique_ptr<Strategy> make_metis();
+std::unique_ptr<Strategy> make_metis_relabel();
 std::unique_ptr<Strategy> make_scotch();
 std::unique_ptr<Strategy> make_sticky();
 std::unique_ptr<Strategy> make_list();
@@ -44,6 +45,11 @@ Assignment one_task_per_processor(const StepGraph& g, std::uint32_t k);
 /// returns incomplete partitions, an empty graph): everything on processor 0, or one task
 /// per processor, with its edge cut. Empty when the library can be called.
 std::optional<Result> library_trivial_case(const StepGraph& g, std::uint32_t k);
+
+/// Maximum-weight perfect matching of a k x k matrix (row-major): row i -> column to[i]
+/// maximising the sum of weight[i][to[i]] (Hungarian algorithm, O(k^3)).
+std::vector<std::uint32_t> max_weight_assignment(const std::vector<std::int64_t>& weight,
+                                                 std::uint32_t k);
 
 /// METIS k-way (serialised behind a process-wide mutex). `part` gets n entries; returns
 /// METIS's objval. Requires 2 <= k < n.

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "strategies.hpp"
+#include "tgraph/graph/diff.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::partition {
@@ -66,20 +67,24 @@ Rebalance parse_rebalance(std::string_view s) {
   throw UsageError("--rebalance: expected greedy or scotch, got '" + std::string(s) + "'");
 }
 
-std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
-  std::unordered_map<StableKey, std::vector<TaskId>> by_key;
-  by_key.reserve(prev.tasks.size());
-  for (TaskId t = 0; t < prev.tasks.size(); ++t) by_key[prev.tasks[t].key].push_back(t);
-  std::unordered_map<StableKey, std::size_t> seen;
-  std::vector<TaskId> match(g.tasks.size(), kNoTask);
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    auto it = by_key.find(g.tasks[t].key);
-    if (it == by_key.end()) continue;
-    std::size_t& i = seen[g.tasks[t].key];
-    if (i < it->second.size()) match[t] = it->second[i];
-    ++i;
+std::string_view to_string(StickyFallback f) {
+  switch (f) {
+    case StickyFallback::kFresh:
+      return "fresh";
+    case StickyFallback::kRepartition:
+      return "repartition";
   }
-  return match;
+  return "?";
+}
+
+StickyFallback parse_sticky_fallback(std::string_view s) {
+  if (s == "fresh") return StickyFallback::kFresh;
+  if (s == "repartition") return StickyFallback::kRepartition;
+  throw UsageError("--sticky-fallback: expected fresh or repartition, got '" + std::string(s) + "'");
+}
+
+std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
+  return match_tasks_by_key(g, prev);
 }
 
 Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
@@ -87,9 +92,9 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
   if (k == 0) throw UsageError("k must be at least 1");
   if ((prev.graph == nullptr) != (prev.assignment == nullptr))
     throw UsageError("previous step: graph and assignment must be given together");
-  if (prev.graph != nullptr && prev.assignment->proc.size() != prev.graph->tasks.size())
-    throw UsageError("previous step: assignment has " + std::to_string(prev.assignment->proc.size()) +
-                     " tasks, graph has " + std::to_string(prev.graph->tasks.size()));
+  if (prev.graph != nullptr)
+    if (std::string why = validate(*prev.graph, *prev.assignment, prev.assignment->k); !why.empty())
+      throw UsageError("previous step: " + why);
   if (!(options.imbalance >= 1.0)) throw UsageError("imbalance tolerance must be >= 1");
   if (const std::string why = g.validate(); !why.empty())
     throw UsageError("invalid step graph: " + why);
@@ -101,13 +106,8 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
 
   Assignment& a = r.assignment;
   a.k = k;
-  if (a.proc.size() != g.tasks.size())
-    throw std::logic_error("strategy " + std::string(name()) + " assigned " +
-                           std::to_string(a.proc.size()) + " of " + std::to_string(g.tasks.size()) +
-                           " tasks");
-  for (ProcId p : a.proc)
-    if (p >= k) throw std::logic_error("strategy " + std::string(name()) + " used processor " +
-                                       std::to_string(p) + " >= k");
+  if (std::string why = validate(g, a, k); !why.empty())
+    throw std::logic_error("strategy " + std::string(name()) + ": " + why);
 
   if (prev.graph != nullptr) {
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);

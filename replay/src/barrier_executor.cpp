@@ -2,10 +2,12 @@
 // Barrier baseline (the paper's first attempt): one parallel loop per operation, i.e. per
 // run of consecutive tasks of the same kind in program order, with a barrier after each
 // (OpenMP `omp for`). A run is also cut where a task depends on a task of the same run, so
-// that the barrier is always what orders dependent tasks.
+// that the barrier is always what orders dependent tasks. CW groups run as one parallel
+// phase (per-writer temporaries) followed by a reduction phase.
 #include <omp.h>
 
 #include <array>
+#include <cstdint>
 #include <atomic>
 #include <exception>
 #include <memory>
@@ -44,43 +46,70 @@ class BarrierExecutor final : public Executor {
     ThreadCounters c;
   };
 
+  // Phases: runs of consecutive tasks of one kind in program order, cut where a task depends
+  // on a task of the current phase. Reducers (CW groups lowered per writer) do not cut the
+  // run they follow: they gather in a reduction phase that runs right after it, as an
+  // OpenMP user writes a parallel loop with a reduction (the loop, then the combine).
   std::shared_ptr<void> build(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
     auto plan = std::make_shared<BarrierPlan>();
     const auto n = static_cast<TaskId>(g.tasks.size());
     const detail::Csr pred = detail::build_csr(n, g.edges, true);
-    std::vector<std::uint32_t> phase_of(n, 0);
+    constexpr std::uint32_t kNone = UINT32_MAX, kPending = UINT32_MAX - 1;
+    std::vector<std::uint32_t> phase_of(n, kNone);
     auto& phases = plan->phases;
+    Phase reducers;  // pending reduction phase, emitted after the current phase
     LoopId region = kNoLoop;
     std::uint32_t body_first_phase = 0;
     bool open = false;
+    auto flush_reducers = [&] {
+      if (reducers.tasks.empty()) return;
+      for (TaskId r : reducers.tasks) phase_of[r] = static_cast<std::uint32_t>(phases.size());
+      phases.push_back(std::move(reducers));
+      reducers = Phase{};
+    };
+    auto close = [&] {
+      open = false;
+      flush_reducers();
+    };
+    auto depends_on = [&](TaskId t, std::uint32_t phase) {
+      for (auto i = pred.begin[t]; i < pred.begin[t + 1]; ++i)
+        if (phase_of[pred.ids[i]] == phase) return true;
+      return false;
+    };
     for (TaskId t = 0; t < n; ++t) {
       const Task& task = g.tasks[t];
       const bool region_change =
           task.loop != region || (task.loop != kNoLoop && g.loops[task.loop].first == t);
       if (region_change) {
-        open = false;
+        close();
         region = task.loop;
         if (region != kNoLoop) body_first_phase = static_cast<std::uint32_t>(phases.size());
       }
-      bool cut = !open || g.tasks[phases.back().tasks.front()].kind != task.kind;
-      if (!cut) {
-        const auto current = static_cast<std::uint32_t>(phases.size() - 1);
-        for (auto i = pred.begin[t]; i < pred.begin[t + 1] && !cut; ++i)
-          cut = phase_of[pred.ids[i]] == current;
+      const bool is_break = task.loop != kNoLoop && t + 1 == g.loops[task.loop].last;
+      if (x.origin[t] == kNoTask && !is_break) {
+        if (depends_on(t, kPending)) close();  // after the reducers it needs
+        reducers.tasks.push_back(t);
+        phase_of[t] = kPending;
+        continue;
       }
+      bool cut = !open || is_break || g.tasks[phases.back().tasks.front()].kind != task.kind ||
+                 depends_on(t, kPending);
+      if (!cut) cut = depends_on(t, static_cast<std::uint32_t>(phases.size() - 1));
       if (cut) {
+        close();
         phases.emplace_back();
         open = true;
       }
       phases.back().tasks.push_back(t);
       phase_of[t] = static_cast<std::uint32_t>(phases.size() - 1);
-      if (task.loop != kNoLoop && t + 1 == g.loops[task.loop].last) {
+      if (is_break) {
         phases.back().loop_end = task.loop;
         phases.back().jump = body_first_phase;
         open = false;
       }
     }
+    close();
     return plan;
   }
 
@@ -103,6 +132,7 @@ class BarrierExecutor final : public Executor {
     std::exception_ptr error;
     std::mutex error_mutex;
     const bool observe = !observers_.empty();
+    const std::uint32_t stride = observe_stride_;
     const bool pin = options_.pin;
     std::vector<std::uint8_t> is_break(g.tasks.size(), 0);
     for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
@@ -135,9 +165,9 @@ class BarrierExecutor final : public Executor {
           const bool aborted = abort.load(std::memory_order_relaxed);
           if (!aborted) {
             try {
-              if (observe) detail::notify_begin(observers_, thread, t, iter);
+              if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers_, thread, t, iter);
               w.run(TaskRun{&x, t, x.origin[t], iter, thread});
-              if (observe) detail::notify_end(observers_, thread, t, iter);
+              if (observe && detail::sampled(iter, stride)) detail::notify_end(observers_, thread, t, iter);
               ++tc.tasks;
             } catch (...) {
               std::lock_guard<std::mutex> lock(error_mutex);

@@ -21,6 +21,10 @@ inline bool leave_loop(const ExecGraph& x, LoopId l, std::uint32_t i, Workload& 
          i + 1 >= kIterationCap;
 }
 
+/// Whether observers see loop iteration `it` under Executor::set_observe_stride(stride):
+/// iterations 0 and 1 and every stride-th one (every instance outside loops).
+inline bool sampled(std::uint32_t it, std::uint32_t stride) { return it < 2 || it % stride == 0; }
+
 /// Calls every observer's on_begin.
 inline void notify_begin(const std::vector<Observer*>& obs, std::uint32_t thread, TaskId t,
                          std::uint32_t it) {

@@ -88,6 +88,7 @@ struct Executor::CacheEntry {
   StepGraph shape;
   Assignment assignment;
   bool has_assignment = false;
+  std::vector<bool> reducible;  // Workload::reducible() the plan was lowered with
   ExecGraph exec;
   std::shared_ptr<void> plan;
   std::uint64_t bound = 0;  // Workload::instance() holding this plan's buffers
@@ -96,9 +97,21 @@ struct Executor::CacheEntry {
 Executor::Executor(Policy policy, ExecOptions options) : options_(options), policy_(policy) {}
 Executor::~Executor() = default;
 
-CwMode Executor::cw_mode() const {
-  if (options_.cw) return *options_.cw;
-  return policy_ == Policy::kPartition ? CwMode::kReduce : CwMode::kSerialize;
+CwMode Executor::cw_mode() const { return options_.cw.value_or(CwMode::kReduce); }
+
+ReduceScope Executor::reduce_scope() const {
+  if (options_.reduce_scope) return *options_.reduce_scope;
+  switch (policy_) {
+    case Policy::kSequential:
+      return ReduceScope::kNone;
+    case Policy::kPartition:
+      return ReduceScope::kPerProcessor;
+    case Policy::kWorksteal:
+    case Policy::kBarrier:
+    case Policy::kStarpu:
+      return ReduceScope::kPerWriter;
+  }
+  return ReduceScope::kNone;
 }
 
 namespace {
@@ -147,12 +160,18 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
   const std::int64_t t0 = now_ns();
   const bool use_assignment = policy_ == Policy::kPartition;
   if (use_assignment && a == nullptr) throw UsageError("the partition policy needs an assignment");
-  std::uint64_t key = g.structural_hash() * 31 + static_cast<std::uint64_t>(cw_mode());
+  const CwMode mode = cw_mode();
+  const ReduceScope scope = reduce_scope();
+  const std::vector<bool>* reducible = w.reducible();
+  std::uint64_t key = g.structural_hash() * 31 + static_cast<std::uint64_t>(mode) * 7 +
+                      static_cast<std::uint64_t>(scope);
   if (use_assignment) key ^= hash_assignment(*a) * 0x9e3779b97f4a7c15ull;
+  if (reducible != nullptr) key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;
 
   std::shared_ptr<CacheEntry> entry;
   for (auto& e : cache_) {
-    if (e->key == key && e->shape.same_structure(g) &&
+    if (e->key == key && (reducible ? e->reducible == *reducible : e->reducible.empty()) &&
+        e->shape.same_structure(g) &&
         (!use_assignment || (e->has_assignment && e->assignment == *a))) {
       entry = e;
       break;
@@ -162,6 +181,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
     if (use_assignment) validate_assignment(g, *a, options_.threads);
     entry = std::make_shared<CacheEntry>();
     entry->key = key;
+    if (reducible) entry->reducible = *reducible;
     entry->shape = g;
     entry->shape.edges.clear();
     entry->shape.carried_edges.clear();
@@ -169,7 +189,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
       entry->assignment = *a;
       entry->has_assignment = true;
     }
-    entry->exec = lower(g, use_assignment ? a : nullptr, cw_mode());
+    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible);
     entry->plan = build(entry->exec);
     ++plans_built_;
     stats.rebuilt = true;
@@ -184,6 +204,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
   }
   const std::int64_t t_built = now_ns();
   if (stats.rebuilt) stats.build_ns = t_built - t0;
+  stats.prepare_ns = t_built - t0;
   last_exec_ = &entry->exec;
   for (Observer* o : observers_) o->on_step_begin(entry->exec, options_.threads, t_built);
   try {
@@ -218,10 +239,11 @@ class SequentialExecutor final : public Executor {
     stats.loop_iterations.assign(g.loops.size(), 0);
     ThreadCounters& c = stats.threads[0];
     const bool observe = !observers_.empty();
+    const std::uint32_t stride = observe_stride_;
     auto run = [&](TaskId t, std::uint32_t it) {
-      if (observe) detail::notify_begin(observers_, 0, t, it);
+      if (observe && detail::sampled(it, stride)) detail::notify_begin(observers_, 0, t, it);
       w.run(TaskRun{&x, t, x.origin[t], it, 0});
-      if (observe) detail::notify_end(observers_, 0, t, it);
+      if (observe && detail::sampled(it, stride)) detail::notify_end(observers_, 0, t, it);
       ++c.tasks;
     };
     const auto n = static_cast<TaskId>(g.tasks.size());
@@ -250,6 +272,7 @@ class SequentialExecutor final : public Executor {
 std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
   if (options.threads == 0) throw UsageError("--threads must be at least 1");
@@ -266,6 +289,8 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
       return make_worksteal_executor(options);
     case Policy::kBarrier:
       return make_barrier_executor(options);
+    case Policy::kStarpu:
+      return make_starpu_executor(options);
   }
   throw UsageError("unknown policy");
 }

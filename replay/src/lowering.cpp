@@ -16,8 +16,8 @@ struct Segment {
 
 struct PendingReducer {
   DatumId target = 0;
-  ProcId home = 0;
-  std::vector<ProcId> procs;  // other processors, increasing
+  ProcId home = 0;            // processor that runs the reducer (the first writer's)
+  std::vector<ProcId> slots;  // temporaries to add, increasing (processors or writer ranks)
 };
 
 std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
@@ -27,14 +27,23 @@ std::uint64_t pair_key(std::uint32_t a, std::uint32_t b) {
 }  // namespace
 
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
+  return lower(g, a, mode, a != nullptr ? ReduceScope::kPerProcessor : ReduceScope::kNone);
+}
+
+ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
+                const std::vector<bool>* reducible) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   auto proc = [&](TaskId t) -> ProcId { return a ? a->proc[t] : 0; };
+  const bool per_writer = scope == ReduceScope::kPerWriter;
 
   // 1. Find the CW groups that span processors (split at loop-region boundaries).
   std::unordered_map<std::uint64_t, ProcId> redirect;     // (task, datum) -> processor temp
   std::unordered_map<std::uint64_t, bool> serialize_acc;  // (task, datum) -> CW becomes RW
   std::vector<std::vector<PendingReducer>> after(n);      // reducers emitted after task t
-  if (mode == CwMode::kReduce && a != nullptr && a->k > 1) {
+  const bool lower_groups =
+      mode == CwMode::kReduce &&
+      (per_writer || (scope == ReduceScope::kPerProcessor && a != nullptr && a->k > 1));
+  if (lower_groups) {
     // A CW group of derive_edges() can run on across a loop boundary (into the body, out of
     // it, or from the end of one iteration into the next): its members there have no edge
     // between them. A segment cut by such a boundary is therefore kept pending until the
@@ -46,26 +55,36 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
       for (TaskId m : s.members) serialize_acc[pair_key(m, d)] = true;
       s.members.clear();
     };
+    // Temporary slot of the i-th member of a segment: its processor, or (per writer) its
+    // rank in the group; slot of the first member = the home, which needs no temporary.
+    auto slot = [&](const Segment& s, std::size_t i) -> ProcId {
+      return per_writer ? static_cast<ProcId>(i) : proc(s.members[i]);
+    };
     auto lower_segment = [&](Segment& s, DatumId d) {
       if (s.members.empty()) return;
-      std::vector<ProcId> procs;
-      for (TaskId m : s.members) procs.push_back(proc(m));
-      std::sort(procs.begin(), procs.end());
-      procs.erase(std::unique(procs.begin(), procs.end()), procs.end());
-      if (procs.size() > 1) {
+      std::vector<ProcId> slots;
+      for (std::size_t i = 0; i < s.members.size(); ++i) slots.push_back(slot(s, i));
+      std::sort(slots.begin(), slots.end());
+      slots.erase(std::unique(slots.begin(), slots.end()), slots.end());
+      if (slots.size() > 1) {
         const TaskId last = s.members.back();
         const LoopId l = g.tasks[last].loop;
         if (l != kNoLoop && last + 1 == g.loops[l].last) {
           serialize(s, d);  // a break task with a CW access: no room for a reducer after it
           return;
         }
+        if (reducible != nullptr && d < reducible->size() && !(*reducible)[d]) {
+          serialize(s, d);  // the writers cannot be redirected to temporaries
+          return;
+        }
         PendingReducer r;
         r.target = d;
         r.home = proc(s.members.front());
-        for (ProcId p : procs)
-          if (p != r.home) r.procs.push_back(p);
-        for (TaskId m : s.members)
-          if (proc(m) != r.home) redirect[pair_key(m, d)] = proc(m);
+        const ProcId home_slot = slot(s, 0);
+        for (ProcId p : slots)
+          if (p != home_slot) r.slots.push_back(p);
+        for (std::size_t i = 0; i < s.members.size(); ++i)
+          if (slot(s, i) != home_slot) redirect[pair_key(s.members[i], d)] = slot(s, i);
         after[last].push_back(std::move(r));
       }
       s.members.clear();
@@ -121,6 +140,8 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
 
   // 2. Emit the exec graph.
   ExecGraph x;
+  x.cw = mode;
+  x.scope = lower_groups ? scope : ReduceScope::kNone;
   StepGraph& out = x.graph;
   out.kinds = g.kinds;
   out.objects = g.objects;
@@ -175,12 +196,16 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
       Reduction red;
       red.target = r.target;
       acc_buf.clear();
-      for (ProcId p : r.procs) {
+      for (ProcId p : r.slots) {
         const DatumId tmp = temp(r.target, p);
         red.temps.push_back(tmp);
         acc_buf.push_back({tmp, AccessMode::RW});
       }
-      acc_buf.push_back({r.target, AccessMode::CW});
+      // Per processor, the reducer and the home writers share a processor: CW leaves the
+      // reducer free to go before them in an explicit order. Per writer, the first writer
+      // may run on any thread: RW orders the reducer after it (consecutive CW accesses of
+      // one datum have no edge between them).
+      acc_buf.push_back({r.target, per_writer ? AccessMode::RW : AccessMode::CW});
       const TaskId rid = out.add_task(reduce_kind, g.data[r.target].object, acc_buf, 0,
                                       task.key * 1099511628211ull + r.target + 1);
       out.tasks[rid].loop = task.loop;

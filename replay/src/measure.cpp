@@ -135,7 +135,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
 
   const std::uint32_t n = last - o.first_step;
   r.steps.resize(n);
-  std::vector<std::vector<std::int64_t>> walls(n), seq_walls(n);
+  std::vector<std::vector<std::int64_t>> walls(n), seq_walls(n), runs(n);
   for (std::uint32_t i = 0; i < n; ++i) {
     const StepGraph& g = trace.steps[o.first_step + i];
     StepMeasure& m = r.steps[i];
@@ -168,6 +168,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       w.set_step(g);
       const StepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
       walls[i].push_back(s.wall_ns);
+      runs[i].push_back(s.wall_ns - s.build_ns);
       total += s.wall_ns;
       if (pass == 0) {
         StepMeasure& m = r.steps[i];
@@ -183,11 +184,14 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   }
   for (std::uint32_t i = 0; i < n; ++i) {
     r.steps[i].wall_ns = median(walls[i]);
+    r.steps[i].run_ns = median(runs[i]);
     r.steps[i].sequential_wall_ns = median(seq_walls[i]);
   }
   r.wall_ns = median(r.pass_wall_ns);
   r.sequential_wall_ns = median(r.sequential_pass_wall_ns);
   r.plans_built = ex->plans_built();
+  r.cw = ex->cw();
+  r.scope = ex->scope();
   r.order_fallbacks = ex->order_fallbacks();
   if (misses.available()) {
     r.cache_misses = misses.read() - misses0;
@@ -234,6 +238,7 @@ std::string to_json(const ReplayResult& r) {
               {"wall_ns", m.wall_ns},
               {"sequential_wall_ns", m.sequential_wall_ns},
               {"build_ns", m.build_ns},
+              {"run_ns", m.run_ns},
               {"signals", m.signals},
               {"waits", m.waits},
               {"blocked_waits", m.blocked_waits},
@@ -250,6 +255,8 @@ std::string to_json(const ReplayResult& r) {
   }
   json j = {{"policy", std::string(to_string(r.policy))},
             {"threads", r.threads},
+            {"cw", std::string(to_string(r.cw))},
+            {"reduce_scope", std::string(to_string(r.scope))},
             {"steps", r.steps.size()},
             {"wall_ns", r.wall_ns},
             {"sequential_wall_ns", r.sequential_wall_ns},
@@ -277,10 +284,11 @@ std::string to_json(const ReplayResult& r) {
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
   const auto pred = r.predicted_makespan_ns();
   j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
-  // Ratio of measured to predicted, both without build: sum of per-step walls minus builds.
+  // Ratio of measured to predicted, both without plan builds: the sum over steps of the
+  // median over passes of (wall - that pass's build).
   if (pred && *pred > 0) {
     std::int64_t measured = 0;
-    for (const auto& m : r.steps) measured += m.wall_ns - m.build_ns;
+    for (const auto& m : r.steps) measured += m.run_ns;
     j["measured_over_predicted"] = static_cast<double>(measured) / static_cast<double>(*pred);
   } else {
     j["measured_over_predicted"] = nullptr;

@@ -12,6 +12,7 @@
 // runs the loop control itself; the processor of the break task publishes, per iteration,
 // loop[l] = (epoch << 32) | (iterations << 1) | stop, and the others read it before starting
 // the next iteration. Calling thread = processor 0.
+#include <algorithm>
 #include <atomic>
 #include <exception>
 #include <memory>
@@ -99,7 +100,7 @@ std::vector<TaskId> local_topological(const ExecGraph& x, const std::vector<Task
 }
 
 /// Builds the per-processor programs.
-Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
+Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide) {
   const StepGraph& g = x.graph;
   const auto n = static_cast<TaskId>(g.tasks.size());
   const Assignment& a = x.assignment;
@@ -108,7 +109,7 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
   plan.tasks = n;
   plan.loops = g.loops.size();
   plan.procs.resize(k);
-  std::vector<std::uint32_t> pos(n, 0);
+  std::vector<std::int64_t> pos(n, 0);  // position of each task in its processor's ops
   std::vector<bool> signal(n, false);
 
   // 1. Ops per processor: its tasks in order, each loop's body tasks gathered in one block.
@@ -128,7 +129,7 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
     for (TaskId t : seq) {
       const LoopId l = g.tasks[t].loop;
       if (l == kNoLoop) {
-        pos[t] = static_cast<std::uint32_t>(ops.size());
+        pos[t] = static_cast<std::int64_t>(ops.size());
         ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0});
         continue;
       }
@@ -137,30 +138,47 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
       ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0});
       const auto body = static_cast<std::uint32_t>(ops.size());
       for (TaskId u : in_loop[l]) {
-        pos[u] = static_cast<std::uint32_t>(ops.size());
+        pos[u] = static_cast<std::int64_t>(ops.size());
         ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0});
       }
       ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body});
     }
   }
 
-  // 2. Wait points, deduplicated along each processor's program.
+  // 2. Wait points, reduced along each processor's program. Processor q runs its ops in
+  // order, so a wait on the task at position i of q implies every wait on q's earlier
+  // positions in the same context: outside loops (kOnce, kAfterLoop: q finished what comes
+  // before), in the same iteration of a loop (kSameIter), and in the previous iteration
+  // (kPrevIter, also implied by any kSameIter wait on q: q finished iteration i - 1 before
+  // starting i). Per op the candidates are taken latest first, and across ops the latest
+  // position waited for on each processor is remembered (reset at each loop begin for
+  // the loop contexts), so that a reducer waits for the last of another processor's CW
+  // writers, not for each of them, and only the tasks still waited for signal.
   const detail::Csr intra = detail::build_csr(n, g.edges, true);
   const detail::Csr carried = detail::build_csr(n, g.carried_edges, true);
+  constexpr std::int64_t kNever = -1;
+  struct Candidate {
+    WaitPoint w;
+    std::uint32_t proc = 0;
+    std::int64_t at = 0;  // position of the producer in its processor's ops
+  };
+  std::vector<Candidate> cands;
   for (ProcId p = 0; p < k; ++p) {
     ProcPlan& pp = plan.procs[p];
-    std::vector<std::uint8_t> seen_once(n, 0), seen_iter(n, 0), seen_prev(n, 0);
-    std::vector<TaskId> iter_marks, prev_marks;
+    std::vector<std::int64_t> done_outside(k, kNever), done_iter(k, kNever), done_prev(k, kNever);
+    std::vector<std::uint8_t> seen_once, seen_iter, seen_prev;  // without elision only
+    std::vector<TaskId> marks;
+    if (!elide) seen_once.assign(n, 0), seen_iter.assign(n, 0), seen_prev.assign(n, 0);
     for (Op& op : pp.ops) {
       if (op.kind == OpKind::kLoopBegin) {
-        for (TaskId u : iter_marks) seen_iter[u] = 0;
-        for (TaskId u : prev_marks) seen_prev[u] = 0;
-        iter_marks.clear();
-        prev_marks.clear();
+        std::fill(done_iter.begin(), done_iter.end(), kNever);
+        std::fill(done_prev.begin(), done_prev.end(), kNever);
+        for (TaskId u : marks) seen_iter[u] = seen_prev[u] = 0;
+        marks.clear();
       }
       if (op.kind != OpKind::kTask) continue;
       const TaskId v = op.task;
-      op.wait_begin = static_cast<std::uint32_t>(pp.waits.size());
+      cands.clear();
       for (auto i = intra.begin[v]; i < intra.begin[v + 1]; ++i) {
         const TaskId u = intra.ids[i];
         if (a.proc[u] == p && pos[u] < pos[v]) continue;  // program order on p guarantees it
@@ -173,25 +191,53 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order) {
         } else {
           w.kind = WaitKind::kAfterLoop;
         }
-        if (w.kind == WaitKind::kSameIter) {
-          if (seen_iter[u]) continue;
-          seen_iter[u] = 1;
-          iter_marks.push_back(u);
-        } else {
-          if (seen_once[u]) continue;
-          seen_once[u] = 1;
-        }
-        signal[u] = true;
-        pp.waits.push_back(w);
+        cands.push_back({w, a.proc[u], pos[u]});
       }
       for (auto i = carried.begin[v]; i < carried.begin[v + 1]; ++i) {
         const TaskId u = carried.ids[i];
         if (a.proc[u] == p) continue;  // p finishes iteration i before starting i + 1
-        if (seen_prev[u]) continue;
-        seen_prev[u] = 1;
-        prev_marks.push_back(u);
-        signal[u] = true;
-        pp.waits.push_back({u, g.tasks[u].loop, WaitKind::kPrevIter});
+        cands.push_back({{u, g.tasks[u].loop, WaitKind::kPrevIter}, a.proc[u], pos[u]});
+      }
+      // kSameIter first (they imply kPrevIter), then the latest position first.
+      std::sort(cands.begin(), cands.end(), [](const Candidate& x, const Candidate& y) {
+        const bool xs = x.w.kind == WaitKind::kSameIter, ys = y.w.kind == WaitKind::kSameIter;
+        if (xs != ys) return xs;
+        return x.at > y.at;
+      });
+      op.wait_begin = static_cast<std::uint32_t>(pp.waits.size());
+      for (const Candidate& c : cands) {
+        std::int64_t* done = nullptr;
+        bool implied = false;
+        switch (c.w.kind) {
+          case WaitKind::kOnce:
+          case WaitKind::kAfterLoop:
+            done = &done_outside[c.proc];
+            implied = c.at <= *done;
+            break;
+          case WaitKind::kSameIter:
+            done = &done_iter[c.proc];
+            implied = c.at <= *done;
+            break;
+          case WaitKind::kPrevIter:
+            done = &done_prev[c.proc];
+            implied = c.at <= *done || done_iter[c.proc] != kNever;
+            break;
+        }
+        if (!elide) {
+          // Only one wait per producer and context along the program (the dedupe every plan
+          // needs), as before the reduction.
+          std::vector<std::uint8_t>& seen = c.w.kind == WaitKind::kSameIter   ? seen_iter
+                                            : c.w.kind == WaitKind::kPrevIter ? seen_prev
+                                                                              : seen_once;
+          implied = seen[c.w.producer] != 0;
+          if (!implied && c.w.kind != WaitKind::kOnce && c.w.kind != WaitKind::kAfterLoop)
+            marks.push_back(c.w.producer);
+          seen[c.w.producer] = 1;
+        }
+        if (implied) continue;
+        *done = c.at;
+        signal[c.w.producer] = true;
+        pp.waits.push_back(c.w);
       }
       op.wait_end = static_cast<std::uint32_t>(pp.waits.size());
     }
@@ -343,14 +389,17 @@ class PartitionExecutor final : public Executor {
   };
 
   std::shared_ptr<void> build(const ExecGraph& x) override {
-    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true));
+    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits));
+    // Program order on every processor never deadlocks (every wait names an earlier task in
+    // program order); only an explicit order needs the check.
+    if (plan->program_order) return plan;
     try {
       run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
     } catch (const UsageError&) {
       if (plan->program_order || !x.added_edges) throw;  // the order itself is invalid
       // The explicit order cannot be kept with the lowered graph's extra edges (serialised
       // CW writers): fall back to program order on each processor, which never deadlocks.
-      plan = std::make_shared<Plan>(build_plan(x, options_.threads, false));
+      plan = std::make_shared<Plan>(build_plan(x, options_.threads, false, options_.elide_waits));
       ++order_fallbacks_;
     }
     return plan;
@@ -483,6 +532,7 @@ class PartitionExecutor final : public Executor {
     const ProcPlan& pp = plan.procs[p];
     const std::uint64_t E = epoch_;
     const bool observe = !observers_.empty();
+    const std::uint32_t stride = observe_stride_;
     try {
       if (fresh_) {
         for (DatumId d : pp.owned)
@@ -555,9 +605,9 @@ class PartitionExecutor final : public Executor {
                       op.task, tc, v))
                 goto out;
             }
-            if (observe) detail::notify_begin(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers_, p, op.task, iter);
             w.run(TaskRun{&x, op.task, x.origin[op.task], iter, p});
-            if (observe) detail::notify_end(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride)) detail::notify_end(observers_, p, op.task, iter);
             ++tc.tasks;
             if (op.signal) {
               parking_.signal(done_[op.task].v, E + iter + 1);

@@ -13,12 +13,15 @@ std::string_view to_string(Policy policy) {
       return "worksteal";
     case Policy::kBarrier:
       return "barrier";
+    case Policy::kStarpu:
+      return "starpu";
   }
   return "?";
 }
 
 std::optional<Policy> parse_policy(std::string_view name) {
-  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier,
+                   Policy::kStarpu})
     if (to_string(p) == name) return p;
   return std::nullopt;
 }
@@ -29,6 +32,18 @@ std::string_view to_string(CwMode mode) {
       return "reduce";
     case CwMode::kSerialize:
       return "serialize";
+  }
+  return "?";
+}
+
+std::string_view to_string(ReduceScope scope) {
+  switch (scope) {
+    case ReduceScope::kNone:
+      return "none";
+    case ReduceScope::kPerProcessor:
+      return "per-processor";
+    case ReduceScope::kPerWriter:
+      return "per-writer";
   }
   return "?";
 }

@@ -202,6 +202,11 @@ bool SyntheticWorkload::stop_after(LoopId loop, std::uint32_t iteration) {
   return step_ == nullptr || iteration + 1 >= step_->loops[loop].iterations;
 }
 
+std::optional<std::uint32_t> SyntheticWorkload::known_iterations(LoopId loop) const {
+  if (step_ == nullptr) return std::nullopt;
+  return std::max<std::uint32_t>(1, step_->loops[loop].iterations);
+}
+
 std::span<const std::uint64_t> SyntheticWorkload::words(DatumId d) const {
   if (d >= buffers_.size() || !buffers_[d]) return {};
   return {buffers_[d]->w.get(), buffers_[d]->words};

@@ -160,9 +160,10 @@ class WorkstealExecutor final : public Executor {
     const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options_.threads;
     ThreadCounters& tc = counters_[thread].c;
     const ExecGraph& x = *exec_;
-    if (!observers_.empty()) detail::notify_begin(observers_, thread, t, it);
+    const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
+    if (observe) detail::notify_begin(observers_, thread, t, it);
     workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
-    if (!observers_.empty()) detail::notify_end(observers_, thread, t, it);
+    if (observe) detail::notify_end(observers_, thread, t, it);
     ++tc.tasks;
     const LoopId l = x.graph.tasks[t].loop;
     const WsPlan& p = *plan_;

@@ -89,6 +89,7 @@ class Stepper {
       StateVec& v = bd.vec(id);
       d = rec_.datum(bd.name() + "." + std::string(to_string(id)), object_of(body),
                      static_cast<std::uint64_t>(v.size()) * sizeof(double), v.data());
+      rec_.accumulator(d, make_accumulator(v));  // force fields add through Body::vec
     }
     return d;
   }
@@ -128,6 +129,9 @@ class Stepper {
     s.d_rho = scalar("rho", &s.rho, sizeof(double));
     s.d_rho_new = scalar("rho_new", &s.rho_new, sizeof(double));
     s.d_den = scalar("den", &s.den, sizeof(double));
+    rec_.accumulator(s.d_rho, make_accumulator(s.rho));  // the dot products' partial sums
+    rec_.accumulator(s.d_rho_new, make_accumulator(s.rho_new));
+    rec_.accumulator(s.d_den, make_accumulator(s.den));
     s.d_beta = scalar("beta", &s.beta, sizeof(double));
     s.d_b2 = scalar("b2", &s.b2, sizeof(double));
     s.d_cond = scalar("converged", &s.converged, sizeof(bool));
@@ -253,7 +257,7 @@ class Stepper {
     for (int i : g.bodies) {
       Body* bd = body(i);
       rec_.task(b_.dot, object_of(i), {{vec(i, VecId::kR), R}, {s->d_rho, CW}},
-                [bd, s] { s->rho += dot(bd->vec(VecId::kR), bd->vec(VecId::kR)); });
+                [bd, s] { accumulate(s->rho) += dot(bd->vec(VecId::kR), bd->vec(VecId::kR)); });
     }
     rec_.task(b_.cg_start, s->object, {{s->d_rho, R}, {s->d_b2, W}, {s->d_cond, W}}, [s] {
       s->b2 = s->rho;
@@ -286,7 +290,7 @@ class Stepper {
         Body* bd = body(i);
         rec_.task(b_.dot, object_of(i),
                   {{vec(i, VecId::kP), R}, {vec(i, VecId::kQ), R}, {s->d_den, CW}},
-                  [bd, s] { s->den += dot(bd->vec(VecId::kP), bd->vec(VecId::kQ)); });
+                  [bd, s] { accumulate(s->den) += dot(bd->vec(VecId::kP), bd->vec(VecId::kQ)); });
       }
       for (int i : g.bodies) {
         Body* bd = body(i);
@@ -298,7 +302,7 @@ class Stepper {
                     bd->vec(VecId::kDv).noalias() += alpha * bd->vec(VecId::kP);
                     StateVec& r = bd->vec(VecId::kR);
                     r.noalias() -= alpha * bd->vec(VecId::kQ);
-                    s->rho_new += dot(r, r);
+                    accumulate(s->rho_new) += dot(r, r);
                   });
       }
       rec_.task(b_.cg_scalars, s->object,
@@ -404,8 +408,13 @@ void Scene::finalize() {
   }
 }
 
-void Scene::step(Recorder& rec) {
+void Scene::step(Recorder& rec) { advance(rec, false); }
+
+bool Scene::step_if_changed(Recorder& rec) { return advance(rec, true); }
+
+bool Scene::advance(Recorder& rec, bool allow_reuse) {
   finalize();
+  detail::check_divergence(*this, *impl_);  // what the last step left (deferred: ran since)
   Impl& m = *impl_;
   Binding& b = m.bind;
   const std::size_t n = bodies_.size();
@@ -484,6 +493,22 @@ void Scene::step(Recorder& rec) {
     g.solver = slot.get();
   }
 
+  // The shape of this step: every interaction field, then each body's group.
+  std::vector<const void*> shape(interactions.begin(), interactions.end());
+  shape.push_back(nullptr);
+  for (std::size_t i = 0; i < n; ++i)
+    shape.push_back(m.groups[static_cast<std::size_t>(m.body_group[i])].solver);
+  const bool reuse = allow_reuse && b.rec == &rec && shape == m.recorded_shape;
+  if (!reuse) m.recorded_shape = std::move(shape);
+  stats_ = StepStats{};
+  stats_.groups = static_cast<std::uint32_t>(m.groups.size());
+  stats_.interactions = static_cast<std::uint32_t>(interactions.size());
+  stats_.contact_fields = static_cast<std::uint32_t>(m.contacts.size());
+  for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
+  time_ += solver_.dt;
+  ++steps_run_;
+  if (reuse) return false;
+
   rec.begin_step();
   Stepper stepper(*this, m, rec);
   // Declare everything this step touches before the contact set names the objects.
@@ -512,14 +537,8 @@ void Scene::step(Recorder& rec) {
       case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;
     }
   }
-
-  stats_ = StepStats{};
-  stats_.groups = static_cast<std::uint32_t>(m.groups.size());
-  stats_.interactions = static_cast<std::uint32_t>(interactions.size());
-  stats_.contact_fields = static_cast<std::uint32_t>(m.contacts.size());
-  for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
-  time_ += solver_.dt;
-  ++steps_run_;
+  if (rec.mode() != capture::Mode::kDeferred) detail::check_divergence(*this, m);
+  return true;
 }
 
 StepStats Scene::last_stats() const {

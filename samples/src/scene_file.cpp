@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -32,6 +33,9 @@ namespace {
 using detail::HexMesh;
 using detail::Shape;
 
+// Up to this many particles, the contact radius comes from the exact closest pair.
+constexpr Index kExactSpacingPoints = 2048;
+
 // Deterministic uniform numbers in [-1, 1) from the scene seed (independent of the
 // standard library's distribution implementations).
 class Jitter {
@@ -54,6 +58,7 @@ class Directive {
       : file_(std::move(file)), line_(line), keyword_(std::move(keyword)), attrs_(std::move(attrs)) {}
 
   const std::string& keyword() const { return keyword_; }
+  int line() const { return line_; }
 
   [[noreturn]] void fail(const std::string& what) const {
     throw InputError(file_ + ":" + std::to_string(line_), std::nullopt, what);
@@ -174,6 +179,71 @@ class Directive {
   std::set<std::string> used_;
 };
 
+// Upper bound on the highest natural frequency of the scene, omega_max^2 = lambda_max(M^-1 K),
+// by Gershgorin's theorem on each node's row: omega^2 <= (sum over the node's row of |K_ij|)
+// / m_i. A spring of stiffness k adds k to the diagonal and -k (projected) off it, so 2 k
+// per node it touches; an FEM element adds the largest absolute row sum of its 24 x 24
+// stiffness matrix; a contact or floor point adds its penalty stiffness (twice the stiffness:
+// one pair, both ends). The stiffest node names the object in the messages.
+class FrequencyBound {
+ public:
+  // One node: `row` = sum of |K_ij| over its row, `mass` its mass.
+  void node(const std::string& object, double row, double mass) {
+    if (!(mass > 0.0) || !std::isfinite(omega2_)) return;  // keep the first overflow found
+    const double w2 = row / mass;
+    if (!(w2 <= omega2_)) {  // also takes a NaN or infinity, reported as such
+      omega2_ = w2;
+      object_ = object;
+      object_line_ = line_;
+      row_ = row;
+      mass_ = mass;
+    }
+  }
+  // Springs between nodes of `a` (and `b`, or `a` again when null).
+  void springs(const std::string& object, const std::vector<Spring>& springs, const Body& a,
+               const Body* b) {
+    std::vector<double> ra(static_cast<std::size_t>(a.num_points()), 0.0);
+    std::vector<double> rb(b != nullptr ? static_cast<std::size_t>(b->num_points()) : 0, 0.0);
+    std::vector<double>& rj = b != nullptr ? rb : ra;
+    for (const Spring& sp : springs) {
+      ra[static_cast<std::size_t>(sp.i)] += 2.0 * sp.stiffness;
+      rj[static_cast<std::size_t>(sp.j)] += 2.0 * sp.stiffness;
+    }
+    body_rows(object, ra, a);
+    if (b != nullptr) body_rows(object, rb, *b);
+  }
+  void body_rows(const std::string& object, const std::vector<double>& rows, const Body& body) {
+    for (std::size_t i = 0; i < rows.size(); ++i)
+      if (rows[i] != 0.0) node(object, rows[i], point_mass(body, static_cast<Index>(i)));
+  }
+  // Mass a force at point i moves: the node's mass, or a rigid body's whole mass.
+  static double point_mass(const Body& body, Index i) {
+    if (const auto* p = dynamic_cast<const ParticleBody*>(&body)) return p->mass(i);
+    return body.total_mass();
+  }
+  // Line of the directive being built (named in messages).
+  void set_line(int line) { line_ = line; }
+  int object_line() const { return object_line_; }
+  double omega2() const { return omega2_; }
+  const std::string& object() const { return object_; }
+  double row() const { return row_; }
+  double mass() const { return mass_; }
+
+ private:
+  double omega2_ = 0.0;
+  std::string object_;
+  int line_ = 0;
+  int object_line_ = 0;
+  double row_ = 0.0;
+  double mass_ = 0.0;
+};
+
+std::string short_num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 class SceneBuilder {
  public:
   SceneBuilder(std::string file, const SceneOptions& options)
@@ -212,11 +282,9 @@ class SceneBuilder {
         continue;
       }
       if (!positional.empty()) d.fail("'" + positional[0] + "' is not a key=value attribute");
+      bound_.set_line(number);
       directive(d);
       d.finish();
-      std::uint64_t nodes = 0;
-      for (const auto& b : scene_->bodies()) nodes += static_cast<std::uint64_t>(b->columns());
-      if (nodes > (1u << 24)) d.fail("the scene exceeds 16777216 nodes");
     }
     if (!header) Directive(file_, number, "", {}).fail("empty scene file (the first line must be 'tgraph-scene 1')");
     if (!scene_) Directive(file_, number, "", {}).fail("no 'scene name=...' line");
@@ -226,6 +294,7 @@ class SceneBuilder {
       scene_->solver().dt = *options_.dt;
     }
     if (options_.coupling) scene_->solver().coupling = *options_.coupling;
+    check_stability(number);
     return std::move(scene_);
   }
 
@@ -264,6 +333,11 @@ class SceneBuilder {
     s.dt = d.positive("dt", 0.01);
     s.tolerance = d.positive("tolerance", 1e-5);
     s.max_iterations = static_cast<std::uint32_t>(d.integer("max_iterations", 100, 1, 100000));
+    s.cg_stall_steps = static_cast<std::uint32_t>(d.integer("cg_stall_steps", 10, 0, 1000000));
+    s.energy_factor = d.non_negative("energy_factor", 10.0);
+    if (s.energy_factor > 0.0 && s.energy_factor < 1.0)
+      d.fail("energy_factor must be 0 (off) or >= 1 (got " + d.text("energy_factor") + ")");
+    dt_line_ = d.line();
   }
 
   void collision(Directive& d) {
@@ -286,6 +360,67 @@ class SceneBuilder {
     Body* b = scene_->find_body(name);
     if (b == nullptr) d.fail(key + ": no object named '" + name + "' (objects must be declared first)");
     return b;
+  }
+
+  // Settings the integrator cannot handle: a stiffness that overflows is refused; a time step
+  // above the explicit stability limit, or one that leaves CG too few iterations, is a
+  // warning (the divergence checks of Scene::step stop a run that does blow up).
+  void check_stability(int last_line) {
+    const CollisionSettings& c = scene_->collision();
+    if (c.enabled) {
+      for (const auto& b : scene_->bodies()) {
+        if (b->surface.empty()) continue;
+        double m = 1e300;
+        for (Index i : b->surface) m = std::min(m, FrequencyBound::point_mass(*b, i));
+        bound_.node(b->name() + " (contact)", 2.0 * c.stiffness, m);
+        if (c.floor) bound_.node(b->name() + " (floor contact)", c.floor_stiffness, m);
+      }
+    }
+    const SolverSettings& s = scene_->solver();
+    const std::string where =
+        options_.dt ? file_ + " with --dt" : file_ + ":" + std::to_string(dt_line_ > 0 ? dt_line_ : last_line);
+    const double w2 = bound_.omega2();
+    if (w2 == 0.0) return;
+    if (!std::isfinite(w2) || w2 > 1e200)
+      throw InputError(file_ + ":" + std::to_string(bound_.object_line()), std::nullopt,
+                       "object '" + bound_.object() + "': " +
+                           (std::isfinite(bound_.row())
+                                ? "stiffness " + short_num(bound_.row()) + " N/m over a node mass of " +
+                                      short_num(bound_.mass()) + " kg gives omega_max^2 = " + short_num(w2) + " 1/s^2"
+                                : std::string("the stiffness overflows double arithmetic")) +
+                           ": expected omega_max^2 = stiffness/mass <= 1e200 1/s^2, which the integrators can "
+                           "handle (check young=, stiffness= and density=)");
+    const double omega = std::sqrt(w2);
+    const double h = s.dt;
+    const std::string source = "omega_max <= " + short_num(omega) + " rad/s, from object '" +
+                               bound_.object() + "': stiffness " + short_num(bound_.row()) +
+                               " N/m on a node of " + short_num(bound_.mass()) + " kg";
+    if (s.integrator == Integrator::kExplicitEuler) {
+      if (h * omega >= 2.0)
+        scene_->add_warning(where + ": dt=" + short_num(h) +
+                            " s may be unstable for explicit Euler, stable for dt < 2/omega_max = " +
+                            short_num(2.0 / omega) + " s (" + source + ")");
+      return;
+    }
+    // Implicit Euler is stable for any dt, but CG on M - h^2 K needs about
+    // sqrt(cond)/2 ln(2/tolerance) iterations, cond <= 1 + h^2 omega_max^2.
+    const double cond = 1.0 + h * h * w2;
+    const double needed = 0.5 * std::sqrt(cond) * std::log(2.0 / s.tolerance);
+    if (!(needed <= s.max_iterations))
+      scene_->add_warning(
+          where + ": dt=" + short_num(h) + " s makes the implicit system stiff (condition number up to " +
+          short_num(cond) + ", " + source + "): CG may need about " + short_num(needed) +
+          " iterations, more than max_iterations=" + std::to_string(s.max_iterations));
+  }
+
+  // Counts `n` more points (nodes, particles, rigid surface points) against
+  // SceneOptions::max_nodes before they are built.
+  void add_points(Directive& d, std::uint64_t n) {
+    if (n > options_.max_nodes || points_ > options_.max_nodes - n)
+      d.fail("expected at most " + std::to_string(options_.max_nodes) +
+             " points (nodes, particles and rigid surface points) in the scene, this line brings "
+             "it to " + std::to_string(points_ + std::min<std::uint64_t>(n, UINT64_MAX - points_)));
+    points_ += n;
   }
 
   void check_new_name(Directive& d, const std::string& name) {
@@ -380,6 +515,7 @@ class SceneBuilder {
       const std::size_t semi = spec.find(';', start);
       const auto v = d.numbers("points", 3, spec.substr(start, semi == std::string::npos ? std::string::npos : semi - start));
       pts.emplace_back(v[0], v[1], v[2]);
+      add_points(d, 1);
       if (semi == std::string::npos) break;
       start = semi + 1;
     }
@@ -390,10 +526,14 @@ class SceneBuilder {
     for (Index i = 0; i < x.cols(); ++i) body->surface.push_back(i);
     Body& b = scene_->add_body(std::move(body));
     double spacing = 0.1;
-    if (x.cols() > 1) {
+    if (x.cols() > 1 && x.cols() <= kExactSpacingPoints) {
       spacing = 1e300;
       for (Index i = 0; i < x.cols(); ++i)
         for (Index j = i + 1; j < x.cols(); ++j) spacing = std::min(spacing, (x.col(i) - x.col(j)).norm());
+    } else if (x.cols() > kExactSpacingPoints) {
+      // The closest pair costs n^2/2 distances: estimate from the bounding box instead.
+      const Vec3 extent = x.rowwise().maxCoeff() - x.rowwise().minCoeff();
+      spacing = extent.norm() / std::cbrt(static_cast<double>(x.cols()));
     }
     common(d, b, spacing);
     add_gravity(b);
@@ -429,6 +569,7 @@ class SceneBuilder {
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
+    bound_.springs(name, springs, *a, b);
     scene_->add_force_field(std::make_unique<SpringForceField>(name, a, b, std::move(springs)));
   }
 
@@ -437,8 +578,10 @@ class SceneBuilder {
     const bool fem = d.keyword() == "fem";
     const std::string name = d.text("name");
     const auto nodes = d.int3("nodes", std::nullopt, 2, 512);
-    if (static_cast<long long>(nodes[0]) * nodes[1] * nodes[2] > (1LL << 22))
-      d.fail("nodes: at most 4194304 nodes per object");
+    const std::uint64_t grid_nodes = static_cast<std::uint64_t>(nodes[0]) * nodes[1] * nodes[2];
+    if (grid_nodes > (1u << 22)) d.fail("nodes: at most 4194304 nodes per object");
+    const auto copies = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+    add_points(d, grid_nodes * static_cast<std::uint64_t>(copies[0]) * copies[1] * copies[2]);
     const Vec3 size = d.vec3("size");
     if ((size.array() <= 0.0).any()) d.fail("size: every extent must be > 0");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -458,6 +601,20 @@ class SceneBuilder {
     const HexMesh proto = detail::make_hex_grid(nodes, size, Vec3::Zero(), shape);
     if (proto.elements.empty()) d.fail("the shape contains no element (use more nodes)");
     const std::vector<Spring> springs = fem ? std::vector<Spring>{} : detail::grid_springs(proto, k);
+    // Gershgorin rows of one instance (all instances are copies of the prototype).
+    std::vector<double> rows(proto.node_volume.size(), 0.0);
+    if (fem) {
+      Eigen::Matrix<double, 3, 8> corners;
+      for (int i = 0; i < 8; ++i) corners.col(i) = proto.nodes.col(proto.elements[0][static_cast<std::size_t>(i)]);
+      const double row = HexFemForceField::element_stiffness(corners, mat).cwiseAbs().rowwise().sum().maxCoeff();
+      for (const auto& e : proto.elements)
+        for (Index n : e) rows[static_cast<std::size_t>(n)] += row;
+    } else {
+      for (const Spring& sp : springs) {
+        rows[static_cast<std::size_t>(sp.i)] += 2.0 * sp.stiffness;
+        rows[static_cast<std::size_t>(sp.j)] += 2.0 * sp.stiffness;
+      }
+    }
     bool first = true;
     for (const auto& [inst, c] : instances(d, name, center)) {
       check_new_name(d, inst);
@@ -467,6 +624,7 @@ class SceneBuilder {
       for (std::size_t i = 0; i < masses.size(); ++i) masses[i] = density * proto.node_volume[i];
       auto body = std::make_unique<ParticleBody>(inst, x, std::move(masses));
       ParticleBody* pb = body.get();
+      if (first) bound_.body_rows(inst, rows, *pb);
       pb->surface = proto.surface;
       pb->triangles = proto.triangles;
       scene_->add_body(std::move(body));
@@ -516,6 +674,10 @@ class SceneBuilder {
       surf = detail::sphere_surface(r, res);
       mass = density * 4.0 / 3.0 * M_PI * r * r * r;
       inertia = Mat3::Identity() * (0.4 * mass * r * r);
+    }
+    {
+      const auto copies = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+      add_points(d, static_cast<std::uint64_t>(surf.points.cols()) * copies[0] * copies[1] * copies[2]);
     }
     Eigen::Quaterniond q = Eigen::Quaterniond::Identity();
     if (d.has("rotation")) {
@@ -567,6 +729,7 @@ class SceneBuilder {
     const std::string name = d.text("name");
     check_new_name(d, name);
     const int n = d.integer("nodes", std::nullopt, 3, 1000000);
+    add_points(d, static_cast<std::uint64_t>(n));
     const int rows = d.integer("rows", 1, 1, n);
     const double seg = d.positive("segment");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -592,6 +755,7 @@ class SceneBuilder {
     if (kb > 0.0)
       for (Index i = 0; i + 2 < n; ++i) springs.push_back({i, i + 2, (x.col(i + 2) - x.col(i)).norm(), kb});
     add_gravity(b);
+    bound_.springs(name, springs, b, nullptr);
     scene_->add_force_field(std::make_unique<SpringForceField>(name + ".springs", &b, nullptr, std::move(springs)));
     add_fix(b, fixed_nodes(d, x, d.text("fix", "none")));
   }
@@ -609,6 +773,7 @@ class SceneBuilder {
       split = s;
     }
     if (split > n) d.fail("split must not exceed nodes");
+    add_points(d, static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(n));
     const double size = d.positive("size");
     const Vec3 center = d.vec3("center", Vec3::Zero());
     const double k = d.positive("stiffness");
@@ -650,10 +815,13 @@ class SceneBuilder {
     // Springs, sorted into internal fields and interaction fields by the blocks they join.
     std::vector<std::vector<Spring>> internal(bodies.size());
     std::map<std::pair<int, int>, std::vector<Spring>> ties;
+    std::vector<double> rows(block.size(), 0.0);
     auto add = [&](int i0, int j0, int i1, int j1, double stiffness) {
       if (stiffness <= 0.0 || i1 < 0 || i1 >= n || j1 >= n) return;
       const std::size_t a = static_cast<std::size_t>(i0) + static_cast<std::size_t>(n) * static_cast<std::size_t>(j0);
       const std::size_t b = static_cast<std::size_t>(i1) + static_cast<std::size_t>(n) * static_cast<std::size_t>(j1);
+      rows[a] += 2.0 * stiffness;
+      rows[b] += 2.0 * stiffness;
       const double rest = h * std::hypot(i1 - i0, j1 - j0);
       if (block[a] == block[b]) {
         internal[static_cast<std::size_t>(block[a])].push_back({local[a], local[b], rest, stiffness});
@@ -672,6 +840,7 @@ class SceneBuilder {
         add(i, j, i + 2, j, kb);
         add(i, j, i, j + 2, kb);
       }
+    for (const double row : rows) bound_.node(name, row, node_mass);
     for (std::size_t b = 0; b < bodies.size(); ++b)
       scene_->add_force_field(
           std::make_unique<SpringForceField>(bodies[b]->name() + ".springs", bodies[b], nullptr, std::move(internal[b])));
@@ -696,6 +865,9 @@ class SceneBuilder {
   Jitter jitter_;
   std::unique_ptr<Scene> scene_;
   std::set<std::string> names_;
+  std::uint64_t points_ = 0;  // counted by add_points()
+  FrequencyBound bound_;      // of the objects built so far
+  int dt_line_ = 0;           // line of the solver directive, 0 if none
   // Attributes shared by the instances of an array (parsed on the first one).
   double damping_ = 0.0;
   Vec3 velocity_ = Vec3::Zero();

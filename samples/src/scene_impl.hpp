@@ -22,15 +22,17 @@ inline constexpr DatumId kNoDatum = std::numeric_limits<DatumId>::max();
 struct GroupSolver {
   std::string name;
   int first_body = 0;  // body whose group this solver serves
-  // CG scalars (each a shared datum of the graph).
-  double rho = 0.0;      // r.r of the previous iteration
-  double rho_new = 0.0;  // r.r of this iteration (partial sums CW)
-  double den = 0.0;      // p.q (partial sums CW)
-  double beta = 0.0;     // rho_new / rho
+  // CG scalars (each a shared datum of the graph). The two that CW writers add into while
+  // other threads read the rest have cache lines of their own (no false sharing).
+  double rho = 0.0;                   // r.r of the previous iteration
+  alignas(64) double rho_new = 0.0;   // r.r of this iteration (partial sums CW)
+  alignas(64) double den = 0.0;       // p.q (partial sums CW)
+  alignas(64) double beta = 0.0;      // rho_new / rho
   double b2 = 0.0;       // |b|^2 (tolerance reference)
   bool converged = false;  // the loop's condition datum
   std::uint32_t iterations = 0;
   double residual = 0.0;  // |r| / |b| reached
+  std::uint32_t stalled_steps = 0;  // consecutive steps ended at max_iterations unconverged
   // Recorder ids (valid for Binding::generation == generation).
   std::uint64_t generation = 0;
   ObjectId object = kNoObject;
@@ -72,10 +74,22 @@ struct Group {
 
 }  // namespace tgraph::samples::detail
 
+namespace tgraph::samples::detail {
+/// Reference values of the divergence checks (samples/src/divergence.cpp).
+struct DivergenceState {
+  bool have_baseline = false;
+  double kinetic0 = 0.0;    // kinetic energy at the first step
+  double internal0 = 0.0;   // potential energy of the fields other than gravity, then
+  double gravity0 = 0.0;    // gravity potential energy, then
+  std::uint64_t checked = 0;  // steps_run() when last checked
+};
+}  // namespace tgraph::samples::detail
+
 namespace tgraph::samples {
 
 struct Scene::Impl {
   bool finalized = false;
+  detail::DivergenceState divergence;
   std::unordered_map<const Body*, int> body_index;
   std::vector<std::vector<ForceField*>> body_fields;  // internal fields per body, floor included
   std::vector<std::vector<FixedConstraint*>> body_constraints;
@@ -88,11 +102,17 @@ struct Scene::Impl {
   std::vector<int> body_group;
   detail::Binding bind;
   std::uint64_t next_generation = 1;
+  // What the step last recorded into `bind.rec` interacted and how bodies were grouped
+  // (Scene::step_if_changed reuses that recording while it repeats).
+  std::vector<const void*> recorded_shape;
 };
 
 namespace detail {
 /// Collision detection: updates the floor points and creates/removes contact fields.
 void detect_collisions(Scene& scene, Scene::Impl& impl);
+/// Divergence checks of the state the last executed step left (samples/src/divergence.cpp):
+/// throws DivergenceError; the first call records the reference energies.
+void check_divergence(const Scene& scene, Scene::Impl& impl);
 }  // namespace detail
 
 }  // namespace tgraph::samples

@@ -369,18 +369,23 @@ TEST(TraceWriter, DedupeMakesTheFileSmallerThanFullFrames) {
 TEST(TraceWriter, CompleteFramesReadBackBeforeClose) {
   const Trace trace = make_trace({0, 1, 0});
   const fs::path p = temp_path("open.tgt");
+  fs::remove(p);
   TraceWriter w(p.string(), trace.header);
   for (const auto& s : trace.steps) w.append(s);
-  const Bytes open_bytes = slurp(p);
+  EXPECT_EQ(w.partial_path(), p.string() + ".partial");
+  EXPECT_EQ(w.steps_written(), 3u);
+  EXPECT_FALSE(fs::exists(p));  // only the partial file exists until close()
+  const Bytes open_bytes = slurp(w.partial_path());
   EXPECT_EQ(open_bytes.size(), w.bytes_written());
   EXPECT_READ_ERROR(
       open_bytes,
       "trace not closed (3 complete steps; capture interrupted?) — read with --recover");
   ReadOptions recover;
   recover.recover = true;
-  EXPECT_EQ(read_trace(p.string(), recover), trace);
+  EXPECT_EQ(read_trace(w.partial_path(), recover), trace);
   w.close();
   EXPECT_EQ(read_trace(p.string()), trace);
+  EXPECT_FALSE(fs::exists(p.string() + ".partial"));
   EXPECT_THROW(w.append(trace.steps[0]), UsageError);
 }
 
@@ -397,14 +402,16 @@ TEST(TraceWriter, CaptureKilledBySigkillLeavesItsCompleteStepsReadable) {
   }
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
   std::error_code ec;
-  while ((!fs::exists(p, ec) || fs::file_size(p, ec) < 200000) &&
+  const fs::path partial = p.string() + ".partial";
+  while ((!fs::exists(partial, ec) || fs::file_size(partial, ec) < 200000) &&
          std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   kill(child, SIGKILL);
   int status = 0;
   waitpid(child, &status, 0);
   ASSERT_TRUE(WIFSIGNALED(status));
-  const Bytes bytes = slurp(p);
+  const Bytes bytes = slurp(p.string() + ".partial");
+  EXPECT_FALSE(fs::exists(p));
   EXPECT_READ_ERROR(bytes, "capture interrupted?) — read with --recover");
   ReadOptions recover;
   recover.recover = true;
@@ -421,11 +428,13 @@ TEST(TraceWriter, CaptureKilledBySigkillLeavesItsCompleteStepsReadable) {
 TEST(TraceWriter, DestroyedWithoutCloseLeavesAnUnclosedTrace) {
   const Trace trace = make_trace({0});
   const fs::path p = temp_path("unclosed.tgt");
+  fs::remove(p);
   {
     TraceWriter w(p.string(), trace.header);
     w.append(trace.steps[0]);
   }
-  EXPECT_READ_ERROR(slurp(p), "trace not closed (1 complete step;");
+  EXPECT_FALSE(fs::exists(p));
+  EXPECT_READ_ERROR(slurp(p.string() + ".partial"), "trace not closed (1 complete step;");
 }
 
 TEST(TraceWriter, RejectsAnInvalidStep) {
@@ -442,14 +451,67 @@ TEST(TraceWriter, RejectsAnInvalidStep) {
 TEST(TraceWriter, ReportsAnUnwritablePath) {
   EXPECT_THROW(TraceWriter("/nonexistent-folder/x.tgt", {}), Error);
   EXPECT_THROW(write_trace("/nonexistent-folder/x.tgt", Trace{}), Error);
-  if (fs::exists("/dev/full")) {  // every write fails with ENOSPC
+}
+
+TEST(TraceWriter, ClosingReplacesAnExistingFileOnlyWithTheCompleteTrace) {
+  const Trace old_trace = make_trace({0});
+  const Trace new_trace = make_trace({1, 2});
+  const fs::path p = temp_path("replace.tgt");
+  write_trace(p.string(), old_trace);
+  TraceWriter w(p.string(), new_trace.header);
+  w.append(new_trace.steps[0]);
+  EXPECT_EQ(read_trace(p.string()), old_trace);  // untouched while the new one streams
+  w.append(new_trace.steps[1]);
+  w.close();
+  EXPECT_EQ(read_trace(p.string()), new_trace);
+}
+
+// A write that fails (here: the file size limit, as a full disk would) leaves the partial
+// file cut back to its complete frames; the writer refuses further steps.
+TEST(TraceWriter, AFailedWriteLeavesTheCompleteFramesReadable) {
+  const fs::path p = temp_path("fsize.tgt");
+  fs::remove(p);
+  fs::remove(p.string() + ".partial");
+  const TraceHeader header{"fsize", "test", "here", "0.1.0"};
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::signal(SIGXFSZ, SIG_IGN);  // write() then fails with EFBIG instead of killing
+    rlimit limit{20000, 20000};
+    if (::setrlimit(RLIMIT_FSIZE, &limit) != 0) std::_Exit(3);
+    TraceWriter w(p.string(), header);
     try {
-      TraceWriter w("/dev/full", {});
-      ADD_FAILURE() << "no error";
+      for (int i = 0; i < 100000; ++i) w.append(make_step(i % 3, i));
+      std::_Exit(4);  // never ran out of room
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("/dev/full: cannot write"), std::string::npos)
-          << e.what();
+      const std::string msg = e.what();
+      if (msg.find(".partial: cannot write: File too large") == std::string::npos) std::_Exit(5);
     }
+    try {
+      w.append(make_step(0, 0));
+      std::_Exit(6);
+    } catch (const UsageError&) {
+    }
+    std::_Exit(0);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  ASSERT_EQ(WEXITSTATUS(status), 0);
+  EXPECT_FALSE(fs::exists(p));
+  const Bytes bytes = slurp(p.string() + ".partial");
+  EXPECT_LE(bytes.size(), 20000u);
+  // Cut back to a frame boundary: the reader sees a clean end without an end frame.
+  EXPECT_READ_ERROR(bytes, "trace not closed (");
+  ReadOptions recover;
+  recover.recover = true;
+  const Trace back = read_trace_bytes(bytes, "fsize", recover);
+  EXPECT_EQ(back.header, header);
+  ASSERT_GT(back.steps.size(), 5u);
+  for (std::size_t i = 0; i < back.steps.size(); ++i) {
+    StepGraph expected = make_step(static_cast<int>(i % 3), static_cast<int>(i));
+    expected.derive_edges();
+    ASSERT_EQ(back.steps[i], expected) << "step " << i;
   }
 }
 
@@ -698,7 +760,7 @@ TEST(TraceReader, RejectsFramesOutOfPlace) {
   EXPECT_READ_ERROR(extra_payload, "expected the frame payload to end here, found 1 unread bytes");
   const Bytes short_payload = trace_of({frame(2, s.structure())}, 1);
   EXPECT_READ_ERROR(short_payload,
-                    "truncated payload: expected u32 count (4 bytes), the frame has 0 left");
+                    "truncated: expected u32 count (4 bytes), the frame has 0 left");
 }
 
 TEST(TraceReader, RejectsInconsistentLists) {

@@ -7,6 +7,8 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/strategy.hpp"
+#include "test_graphs.hpp"
 
 namespace tgraph::partition {
 namespace {
@@ -127,6 +129,27 @@ TEST(AssignmentFile, RejectsAbsurdCountsWithoutAllocating) {
   std::memset(b.data() + 32, 0xFF, 4);
   reseal(b);
   EXPECT_NE(message_of(b).find("exceeds the file"), std::string::npos);
+}
+
+TEST(AssignmentFile, LoadsOnlyForTheTraceItWasMadeFor) {
+  Trace trace, other;
+  trace.steps = {testing::objects_scene(6, {}), testing::objects_scene(6, {{1, 2}})};
+  // Same task counts, another structure at step 1 (another contact).
+  other.steps = {testing::objects_scene(6, {}), testing::objects_scene(6, {{3, 4}})};
+  const TracePartition tp = partition_trace(trace, "owner", 2);
+  const std::string path = (std::filesystem::temp_directory_path() / "tgraph_load_assignment.tga").string();
+  write_assignment(path, tp.assignment, trace);
+  EXPECT_EQ(load_assignment(path, trace, "t.tgt"), tp.assignment);
+  try {
+    load_assignment(path, other, "o.tgt");
+    ADD_FAILURE() << "accepted an assignment made for another structure";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": step 1 was partitioned for a graph of another structure than o.tgt's");
+  }
+  Trace shorter;
+  shorter.steps = {trace.steps[0]};
+  EXPECT_THROW(load_assignment(path, shorter, "s.tgt"), InputError);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

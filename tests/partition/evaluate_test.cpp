@@ -2,6 +2,8 @@
 // Evaluation numbers on hand-made traces.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "test_graphs.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/evaluate.hpp"
@@ -56,6 +58,37 @@ TEST(Evaluate, CountsCutSignalsReducersAndImbalance) {
   EXPECT_EQ(r.model, "ideal");
 }
 
+TEST(Evaluate, ReportJsonAndTextCarryTheTotals) {
+  Builder b;
+  const DatumId x = b.datum("x", 100), f = b.datum("f", 40);
+  b.task({{x, M::W}}, 10);
+  b.task({{x, M::R}, {f, M::CW}}, 10);
+  b.task({{x, M::R}, {f, M::CW}}, 10);
+  b.task({{f, M::R}}, 10);
+  Trace tr;
+  tr.steps = {b.done()};
+  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), CostModel::ideal());
+  const nlohmann::json j = nlohmann::json::parse(report_json(r));
+  EXPECT_EQ(j["method"], "hand");
+  EXPECT_EQ(j["k"], 2);
+  EXPECT_EQ(j["model"], "ideal");
+  EXPECT_EQ(j["cut_bytes"], 140);
+  EXPECT_EQ(j["predicted_makespan_ns"], 30);
+  EXPECT_EQ(j["quotient_acyclic"], false);
+  ASSERT_EQ(j["per_step"].size(), 1u);
+  EXPECT_EQ(j["per_step"][0]["reducers"], 1);
+  EXPECT_FALSE(nlohmann::json::parse(report_json(r, false)).contains("per_step"));
+  EXPECT_EQ(report_text(r),
+            "method hand, k = 2, 1 steps, cost model: ideal\n"
+            "  cut: 2 edges, 140 bytes; 2 signals, 2 waits, 1 reducers, " +
+                std::to_string(r.total.transfer_bytes) +
+                " bytes moved\n"
+                "  imbalance 1.500 (worst step 1.500); migrations: 0 tasks, 0 bytes\n"
+                "  predicted makespan 0.000 ms, lower bound 0.000 ms, work 0.000 ms: speed-up 1.33 "
+                "(0.00 with 2.500 ms partitioning)\n"
+                "  quotient graph: cyclic (1 steps with cycles, 1 ping-pong pairs)\n");
+}
+
 TEST(Evaluate, ReportsPingPongBetweenProcessorsAsACycle) {
   Builder b;
   const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
@@ -107,7 +140,7 @@ TEST(Evaluate, RejectsAnAssignmentThatDoesNotFitTheTrace) {
     evaluate(tr, one_step(2, {0, 1, 0, 1, 0}), CostModel::ideal(), "a.tga");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assigns 5 tasks, the trace has 6"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assignment covers 5 tasks, the step has 6"), std::string::npos)
         << e.what();
   }
   TraceAssignment two = one_step(2, {0, 1, 0, 1, 0, 1});

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <future>
+#include <random>
 #include <set>
 #include <thread>
 
@@ -18,6 +19,7 @@ namespace {
 
 using testing::Builder;
 using testing::M;
+using testing::objects_scene;
 
 std::vector<std::uint64_t> loads_of(const StepGraph& g, const Assignment& a) {
   std::vector<std::uint64_t> l(a.k, 0);
@@ -27,7 +29,8 @@ std::vector<std::uint64_t> loads_of(const StepGraph& g, const Assignment& a) {
 
 TEST(Registry, KnowsEveryStrategyAndRejectsUnknownNames) {
   const std::vector<std::string> names = strategy_names();
-  for (const char* n : {"single", "roundrobin", "random", "owner", "metis", "scotch", "sticky", "list"})
+  for (const char* n :
+       {"single", "roundrobin", "random", "owner", "metis", "metis-relabel", "scotch", "sticky", "list"})
     EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
   EXPECT_THROW(make_strategy("nope"), UsageError);
   for (const std::string& n : names) EXPECT_EQ(make_strategy(n)->name(), n);
@@ -80,8 +83,8 @@ TEST_P(EveryStrategy, GivesValidAssignmentsOnRandomGraphs) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Strategies, EveryStrategy,
-                         ::testing::Values("single", "roundrobin", "random", "owner", "metis", "scotch",
-                                           "sticky", "list"));
+                         ::testing::Values("single", "roundrobin", "random", "owner", "metis",
+                                           "metis-relabel", "scotch", "sticky", "list"));
 
 class GraphPartitioner : public ::testing::TestWithParam<std::string> {};
 
@@ -99,7 +102,8 @@ TEST_P(GraphPartitioner, CutsNothingBetweenTwoDisconnectedHalves) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Partitioners, GraphPartitioner, ::testing::Values("owner", "metis", "scotch", "sticky"));
+INSTANTIATE_TEST_SUITE_P(Partitioners, GraphPartitioner,
+                         ::testing::Values("owner", "metis", "metis-relabel", "scotch", "sticky"));
 
 TEST(Owner, KeepsEachObjectsTasksTogetherAndInteractionsWithTheWrittenObject) {
   Builder b;
@@ -215,39 +219,6 @@ TEST(Random, IsReproducibleForOneSeed) {
             make_strategy("random")->partition(g, 8, {}, b).assignment.proc);
 }
 
-// A scene of objects each with a few tasks; contacts add interaction tasks.
-StepGraph objects_scene(int objects, const std::vector<std::pair<int, int>>& contacts,
-                        int heavy_on_zero = 0) {
-  Builder b;
-  std::vector<DatumId> x, f;
-  for (int i = 0; i < objects; ++i) {
-    const ObjectId o = b.object(testing::name("obj", i));
-    x.push_back(b.datum(testing::name("x", i), 1024, o));
-    f.push_back(b.datum(testing::name("f", i), 1024, o));
-  }
-  for (int i = 0; i < objects; ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{f[u], M::W}, {x[u], M::R}}, 100,
-                 static_cast<StableKey>(10 * i + 1));
-  }
-  for (const auto& [a, c] : contacts) {
-    const auto ua = static_cast<std::size_t>(a), uc = static_cast<std::size_t>(c);
-    b.g.add_task(0, kNoObject,
-                 std::vector<Access>{{f[ua], M::CW}, {f[uc], M::CW}, {x[ua], M::R}, {x[uc], M::R}}, 20,
-                 static_cast<StableKey>(100000 + 1000 * a + c));
-    b.g.contacts.push_back({static_cast<ObjectId>(a), static_cast<ObjectId>(c)});
-  }
-  for (int j = 0; j < heavy_on_zero; ++j)
-    b.g.add_task(0, kNoObject, std::vector<Access>{{f[0], M::CW}, {x[0], M::R}}, 400,
-                 static_cast<StableKey>(200000 + j));
-  for (int i = 0; i < objects; ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{x[u], M::RW}, {f[u], M::R}}, 100,
-                 static_cast<StableKey>(10 * i + 2));
-  }
-  return b.done();
-}
-
 TEST(Owner, KeepsObjectsOnTheirProcessorAcrossStepsWhileBalanced) {
   const StepGraph g0 = objects_scene(12, {});
   StepGraph g1 = objects_scene(12, {{1, 2}});
@@ -310,24 +281,100 @@ TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
   EXPECT_LE(r1.stats.moved_tasks, 8u);
 }
 
-TEST(Sticky, RebalancesWithScotchRepartitioningWithoutCrashing) {
-  const StepGraph g0 = objects_scene(16, {});
-  const StepGraph g1 = objects_scene(16, {}, 8);
+TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTasksThanMetisRelabel) {
+  StepGraph g0 = objects_scene(16, {});
+  StepGraph g1 = objects_scene(16, {}, 8);
+  for (Task& t : g0.tasks) t.cost_ns *= 1000;
+  for (Task& t : g1.tasks) t.cost_ns *= 1000;
   Options o;
   o.sticky_threshold = 1.2;
   o.rebalance = Rebalance::kScotch;
   auto s = make_strategy("sticky");
   const Result r0 = s->partition(g0, 4, {}, o);
+  const Result fresh = make_strategy("metis-relabel")->partition(g1, 4, {&g0, &r0.assignment}, o);
   // Scotch quantises the migration cost ratio to 0.01; with new vertices marked -1 in the
   // old partition, Scotch 7.0.3 read uninitialised memory and crashed at 0.01.
   for (double emraval : {0.001, 0.01, 1.0, 10.0}) {
     o.migration_cost = emraval;
     const Result r = s->partition(g1, 4, {&g0, &r0.assignment}, o);
-    EXPECT_TRUE(r.stats.rebalanced);
-    for (ProcId p : r.assignment.proc) EXPECT_LT(p, 4u);
+    EXPECT_TRUE(r.stats.rebalanced) << emraval;
+    EXPECT_FALSE(r.stats.fallback) << emraval;
+    ASSERT_EQ(r.assignment.proc.size(), g1.tasks.size());
+    for (ProcId p : r.assignment.proc) ASSERT_LT(p, 4u);
+    const auto l = loads_of(g1, r.assignment);
+    const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
+    const double imbalance = static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total);
+    EXPECT_LE(imbalance, 1.2) << emraval;
+    EXPECT_EQ(r.stats.matched_tasks, g0.tasks.size());
+    EXPECT_LT(r.stats.moved_tasks, fresh.stats.moved_tasks) << emraval;
   }
   EXPECT_EQ(parse_rebalance("scotch"), Rebalance::kScotch);
   EXPECT_THROW(parse_rebalance("magic"), UsageError);
+}
+
+TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
+  using testing::grouped_scene;
+  const StepGraph apart = grouped_scene(8, {{0, 1, 2, 3}, {4, 5, 6, 7}});
+  const StepGraph merged = grouped_scene(8, {{0, 1, 2, 3, 4, 5, 6, 7}});
+  ASSERT_EQ(apart.loops.size(), 2u);
+  ASSERT_EQ(merged.loops.size(), 1u);
+  for (std::uint32_t k : {2u, 3u, 4u}) {
+    auto s = make_strategy("sticky");
+    const Result r0 = s->partition(apart, k, {}, {});
+    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, {});
+    EXPECT_TRUE(r1.stats.fallback) << k;
+    EXPECT_FALSE(r1.stats.rebalanced);
+    EXPECT_FALSE(r1.stats.reused);
+    // What metis-relabel gives from the same previous step: METIS afresh, optimally renamed.
+    const Result m1 = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, {});
+    EXPECT_EQ(r1.assignment.proc, m1.assignment.proc) << k;
+    EXPECT_EQ(r1.stats.moved_tasks, m1.stats.moved_tasks);
+    EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
+    EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
+    // Every processor gets work: a real partition, not everything kept in place.
+    std::set<ProcId> used(r1.assignment.proc.begin(), r1.assignment.proc.end());
+    EXPECT_EQ(used.size(), k);
+    // The groups split again: another fallback.
+    const Result r2 = s->partition(apart, k, {&merged, &r1.assignment}, {});
+    EXPECT_TRUE(r2.stats.fallback) << k;
+    EXPECT_EQ(r2.stats.matched_tasks, apart.tasks.size() - 2) << "all but the second group's own tasks";
+    EXPECT_NO_THROW(simulate(apart, r2.assignment, CostModel::defaults()));
+  }
+  // Over a trace: apart, apart, merged, merged, apart = reused, fallback, reused, fallback.
+  Trace trace;
+  trace.steps = {apart, apart, merged, merged, apart};
+  const TracePartition tp = partition_trace(trace, "sticky", 4);
+  std::vector<int> kind;
+  for (const Stats& st : tp.stats) kind.push_back(st.reused ? 1 : st.fallback ? 2 : st.rebalanced ? 3 : 0);
+  EXPECT_EQ(kind, (std::vector<int>{0, 1, 2, 1, 2}));
+}
+
+TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
+  using testing::grouped_scene;
+  const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
+  const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
+  Options o;
+  o.sticky_fallback = StickyFallback::kRepartition;
+  for (std::uint32_t k : {2u, 3u, 4u}) {
+    auto s = make_strategy("sticky");
+    const Result r0 = s->partition(apart, k, {}, o);
+    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, o);
+    EXPECT_TRUE(r1.stats.fallback) << k;
+    EXPECT_FALSE(r1.stats.rebalanced);
+    EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
+    // Balanced within the tolerance METIS gets, with fewer moves than a fresh partition
+    // relabelled: the previous placement is the starting point.
+    const auto l = loads_of(merged, r1.assignment);
+    std::uint64_t total = 0;
+    for (std::uint64_t x : l) total += x;
+    EXPECT_LE(static_cast<double>(*std::max_element(l.begin(), l.end())) * k / static_cast<double>(total), 1.1)
+        << k;
+    const Result fresh = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, o);
+    EXPECT_LE(r1.stats.moved_tasks, fresh.stats.moved_tasks) << k;
+  }
+  EXPECT_EQ(parse_sticky_fallback("repartition"), StickyFallback::kRepartition);
+  EXPECT_EQ(to_string(StickyFallback::kFresh), "fresh");
+  EXPECT_THROW(parse_sticky_fallback("magic"), UsageError);
 }
 
 TEST(Sticky, StartsFromItsBaseMethodAndWhenKChanges) {
@@ -386,6 +433,85 @@ TEST(Strategy, CountsMovedTasksByStableKey) {
   for (ProcId p : r.assignment.proc) moved += p != 0 ? 1 : 0;
   EXPECT_EQ(r.stats.moved_tasks, moved);
   EXPECT_EQ(r.stats.matched_tasks, g.tasks.size());
+}
+
+// Fewest moved tasks over every renaming of the K labels of `a`, by brute force.
+std::uint64_t fewest_moves_by_renaming(const Assignment& a, const Assignment& prev) {
+  std::vector<ProcId> perm(a.k);
+  for (ProcId p = 0; p < a.k; ++p) perm[p] = p;
+  std::uint64_t best = UINT64_MAX;
+  do {
+    std::uint64_t moved = 0;
+    for (TaskId t = 0; t < a.proc.size(); ++t) moved += perm[a.proc[t]] != prev.proc[t] ? 1 : 0;
+    best = std::min(best, moved);
+  } while (std::next_permutation(perm.begin(), perm.end()));
+  return best;
+}
+
+TEST(Relabel, RenamesPartsOptimallyAgainstBruteForce) {
+  std::mt19937_64 rng(5);
+  const StepGraph g = objects_scene(30, {});  // 60 tasks, distinct keys
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto k = static_cast<std::uint32_t>(2 + trial % 6);
+    Assignment prev, a;
+    prev.k = a.k = k;
+    for (TaskId t = 0; t < g.tasks.size(); ++t) {
+      prev.proc.push_back(static_cast<ProcId>(rng() % k));
+      // Mostly a renamed copy of prev with noise, so that the best renaming is not obvious.
+      a.proc.push_back(rng() % 3 == 0 ? static_cast<ProcId>(rng() % k) : (prev.proc.back() + 1) % k);
+    }
+    const std::uint64_t best = fewest_moves_by_renaming(a, prev);
+    Assignment r = a;
+    const std::uint64_t kept = relabel_to_previous(g, {&g, &prev}, r);
+    std::uint64_t moved = 0;
+    for (TaskId t = 0; t < g.tasks.size(); ++t) moved += r.proc[t] != prev.proc[t] ? 1 : 0;
+    ASSERT_EQ(moved, best) << "trial " << trial << " k " << k;
+    EXPECT_EQ(kept + moved, g.tasks.size());
+    // A renaming: tasks together in `a` stay together, apart stay apart.
+    for (TaskId t = 1; t < g.tasks.size(); ++t)
+      EXPECT_EQ(r.proc[t] == r.proc[0], a.proc[t] == a.proc[0]);
+  }
+}
+
+TEST(MetisRelabel, EqualsMetisUpToARenamingThatMovesFewestTasks) {
+  // Three steps of a scene whose contacts change: METIS from scratch every step.
+  const std::vector<StepGraph> steps = {objects_scene(24, {}), objects_scene(24, {{1, 2}, {7, 9}}),
+                                        objects_scene(24, {{1, 2}, {3, 20}, {11, 12}})};
+  for (std::uint32_t k : {2u, 3u, 4u}) {
+    auto metis = make_strategy("metis");
+    auto relabel = make_strategy("metis-relabel");
+    Assignment prev;
+    for (std::size_t s = 0; s < steps.size(); ++s) {
+      const Previous p = s == 0 ? Previous{} : Previous{&steps[s - 1], &prev};
+      const Result m = metis->partition(steps[s], k, {}, {});
+      const Result r = relabel->partition(steps[s], k, p, {});
+      ASSERT_EQ(r.assignment.proc.size(), m.assignment.proc.size());
+      EXPECT_EQ(r.stats.edgecut, m.stats.edgecut);
+      // Same parts, other names.
+      std::vector<ProcId> rename(k, k);
+      for (TaskId t = 0; t < m.assignment.proc.size(); ++t) {
+        ProcId& to = rename[m.assignment.proc[t]];
+        if (to == k) to = r.assignment.proc[t];
+        EXPECT_EQ(to, r.assignment.proc[t]);
+      }
+      if (s == 0) {
+        EXPECT_EQ(r.assignment.proc, m.assignment.proc);  // first step: plain METIS
+      } else {
+        const std::vector<TaskId> match = match_by_key(steps[s], steps[s - 1]);
+        std::uint64_t best = UINT64_MAX;
+        std::vector<ProcId> perm(k);
+        for (ProcId q = 0; q < k; ++q) perm[q] = q;
+        do {
+          std::uint64_t moved = 0;
+          for (TaskId t = 0; t < match.size(); ++t)
+            if (match[t] != kNoTask) moved += perm[m.assignment.proc[t]] != prev.proc[match[t]] ? 1 : 0;
+          best = std::min(best, moved);
+        } while (std::next_permutation(perm.begin(), perm.end()));
+        EXPECT_EQ(r.stats.moved_tasks, best) << "k " << k << " step " << s;
+      }
+      prev = r.assignment;
+    }
+  }
 }
 
 TEST(Strategy, RejectsAPreviousAssignmentOfTheWrongSize) {

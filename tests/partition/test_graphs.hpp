@@ -112,4 +112,81 @@ inline StepGraph random_graph(std::uint64_t seed, int tasks, int data, bool with
   return b.done();
 }
 
+/// A scene of objects each with a few tasks (keys 10 i + 1, 10 i + 2); each contact (a, c)
+/// adds an interaction task (key 100000 + 1000 a + c); `heavy_on_zero` heavy tasks on object
+/// 0's data only.
+inline StepGraph objects_scene(int objects, const std::vector<std::pair<int, int>>& contacts,
+                        int heavy_on_zero = 0) {
+  Builder b;
+  std::vector<DatumId> x, f;
+  for (int i = 0; i < objects; ++i) {
+    const ObjectId o = b.object(testing::name("obj", i));
+    x.push_back(b.datum(testing::name("x", i), 1024, o));
+    f.push_back(b.datum(testing::name("f", i), 1024, o));
+  }
+  for (int i = 0; i < objects; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{f[u], M::W}, {x[u], M::R}}, 100,
+                 static_cast<StableKey>(10 * i + 1));
+  }
+  for (const auto& [a, c] : contacts) {
+    const auto ua = static_cast<std::size_t>(a), uc = static_cast<std::size_t>(c);
+    b.g.add_task(0, kNoObject,
+                 std::vector<Access>{{f[ua], M::CW}, {f[uc], M::CW}, {x[ua], M::R}, {x[uc], M::R}}, 20,
+                 static_cast<StableKey>(100000 + 1000 * a + c));
+    b.g.contacts.push_back({static_cast<ObjectId>(a), static_cast<ObjectId>(c)});
+  }
+  for (int j = 0; j < heavy_on_zero; ++j)
+    b.g.add_task(0, kNoObject, std::vector<Access>{{f[0], M::CW}, {x[0], M::R}}, 400,
+                 static_cast<StableKey>(200000 + j));
+  for (int i = 0; i < objects; ++i) {
+    const auto u = static_cast<std::size_t>(i);
+    b.g.add_task(0, static_cast<ObjectId>(i), std::vector<Access>{{x[u], M::RW}, {f[u], M::R}}, 100,
+                 static_cast<StableKey>(10 * i + 2));
+  }
+  return b.done();
+}
+
+/// Objects in collision groups, each group solved by its own CG-like loop (as the engine
+/// does): per object a force task, then per group a loop of `iterations` whose body holds
+/// per object a product task, one dot product (CW into the group's scalar) per object, per
+/// object an update, and the break; then per object an integration task. Per-object tasks
+/// keep their stable key whatever group the object is in; group tasks are keyed by the
+/// group's first object. `groups` partitions 0..objects-1.
+inline StepGraph grouped_scene(int objects, const std::vector<std::vector<int>>& groups,
+                               std::uint32_t iterations = 5) {
+  Builder b;
+  std::vector<DatumId> x, p, q;
+  for (int i = 0; i < objects; ++i) {
+    const ObjectId o = b.object(name("obj", i));
+    x.push_back(b.datum(name("x", i), 4096, o));
+    p.push_back(b.datum(name("p", i), 4096, o));
+    q.push_back(b.datum(name("q", i), 4096, o));
+  }
+  auto ob = [](int i) { return static_cast<ObjectId>(i); };
+  auto ui = [](int i) { return static_cast<std::size_t>(i); };
+  auto key = [](int i, int what) { return static_cast<StableKey>(100 * i + what); };
+  for (int i = 0; i < objects; ++i)
+    b.g.add_task(0, ob(i), std::vector<Access>{{p[ui(i)], M::W}, {x[ui(i)], M::R}}, 200, key(i, 1));
+  for (const std::vector<int>& group : groups) {
+    const int first = group.front();
+    const DatumId alpha = b.datum(name("alpha", first), 8), cond = b.datum(name("cond", first), 1);
+    const TaskId begin = static_cast<TaskId>(b.g.tasks.size());
+    for (int i : group)
+      b.g.add_task(0, ob(i), std::vector<Access>{{q[ui(i)], M::W}, {p[ui(i)], M::R}}, 300, key(i, 2));
+    for (int i : group)
+      b.g.add_task(0, ob(i), std::vector<Access>{{alpha, M::CW}, {p[ui(i)], M::R}, {q[ui(i)], M::R}}, 50,
+                   key(i, 3));
+    for (int i : group)
+      b.g.add_task(0, ob(i), std::vector<Access>{{p[ui(i)], M::RW}, {q[ui(i)], M::R}, {alpha, M::R}}, 100,
+                   key(i, 4));
+    b.g.add_task(0, kNoObject, std::vector<Access>{{cond, M::W}, {alpha, M::R}}, 10, key(first, 5));
+    b.g.add_task(0, kNoObject, std::vector<Access>{{cond, M::R}}, 1, key(first, 6));
+    b.loop(cond, begin, static_cast<TaskId>(b.g.tasks.size()), iterations);
+  }
+  for (int i = 0; i < objects; ++i)
+    b.g.add_task(0, ob(i), std::vector<Access>{{x[ui(i)], M::RW}, {p[ui(i)], M::R}}, 100, key(i, 7));
+  return b.done();
+}
+
 }  // namespace tgraph::partition::testing

@@ -6,7 +6,8 @@
 namespace tgraph::replay {
 
 TEST(Policy, NamesRoundTrip) {
-  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier,
+                   Policy::kStarpu})
     EXPECT_EQ(parse_policy(to_string(p)), p);
   EXPECT_FALSE(parse_policy("magic").has_value());
   EXPECT_EQ(to_string(CwMode::kReduce), "reduce");

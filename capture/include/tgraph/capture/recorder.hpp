@@ -6,12 +6,14 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <initializer_list>
 #include <string>
 #include <string_view>
 #include <unordered_map>
 #include <vector>
 
+#include "tgraph/graph/cumulative.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -52,6 +54,9 @@ struct StepProgram {
   StepGraph graph;
   std::vector<std::function<void()>> bodies;
   std::vector<std::function<bool()>> conditions;
+  /// By datum: how its CW writers can be redirected to temporaries (Recorder::accumulator),
+  /// or nullptr. Owned by the recorder.
+  std::vector<const Accumulator*> accumulators;
 };
 
 /// Records the tasks of each step. Cheap on the hot path: no allocation per task once
@@ -104,8 +109,14 @@ class Recorder {
   /// Interns a task kind (method name).
   KindId kind(std::string_view name);
 
+  /// Every datum declared so far (persistent across steps).
+  const std::vector<Datum>& data() const { return data_; }
   /// Storage pointer given for datum `d` (nullptr if none).
   void* datum_ptr(DatumId d) const { return ptrs_[d]; }
+  /// Declares that the CW writers of datum `d` add into `a.target` through
+  /// tgraph::accumulate(), so that a live executor can give them temporaries and reduce
+  /// (paper section 3.2). Data without one keep their CW writers in program order live.
+  void accumulator(DatumId d, Accumulator a);
 
   /// Starts recording a step.
   void begin_step();
@@ -226,6 +237,7 @@ class Recorder {
   std::vector<ObjectInfo> objects_;
   std::vector<Datum> data_;
   std::vector<void*> ptrs_;
+  std::vector<std::unique_ptr<Accumulator>> accumulators_;  // by datum (stable addresses)
   std::unordered_map<std::string, ObjectId> object_ids_;
   std::vector<std::uint64_t> cost_sum_;  // per task, ticks summed over iterations
   std::vector<std::uint64_t> cost_max_;  // per task, the longest iteration

@@ -30,6 +30,13 @@ struct TraceAssignment {
   friend bool operator==(const TraceAssignment&, const TraceAssignment&) = default;
 };
 
+/// Why `a` cannot run `g` on `k` processors, or empty when it can: a.k == k >= 1, one
+/// processor in [0, k) per task, and an order (when given) that lists each processor's own
+/// tasks, every task exactly once. Callers turn the reason into their error type.
+///
+///   if (std::string why = validate(g, a, 4); !why.empty()) throw UsageError(why);
+std::string validate(const StepGraph& g, const Assignment& a, std::uint32_t k);
+
 /// Tasks of processor `p` in execution order (program order unless `a.order` says otherwise).
 std::vector<TaskId> tasks_of(const Assignment& a, ProcId p);
 

@@ -20,27 +20,36 @@ struct ReadOptions {
   bool recover = false;
 };
 
-/// Streams steps to a .tgt file, one self-delimiting frame per step, each written and
-/// flushed before append() returns, so a capture killed at any moment leaves a file whose
-/// complete steps read back (with ReadOptions::recover). Steps whose structure equals an
-/// earlier step's are stored as a reference plus costs, loop counts and contacts.
+/// Streams steps to a .tgt file, one self-delimiting frame per step, each written with
+/// write(2) before append() returns. The frames go to `<path>.partial`; close() writes the
+/// end frame, syncs and renames it to `path`, so an existing file at `path` is replaced only
+/// by a complete trace. A capture killed at any moment (or stopped by a failed write or a
+/// diverging simulation) leaves `<path>.partial`, whose complete steps read back with
+/// ReadOptions::recover (`tgraph info X.partial --recover`). Steps whose structure equals
+/// an earlier step's are stored as a reference plus costs, loop counts and contacts.
 ///
-///   TraceWriter w("run.tgt", header);
+///   TraceWriter w("run.tgt", header);   // writes run.tgt.partial
 ///   for (...) w.append(step);
-///   w.close();
+///   w.close();                          // renames it to run.tgt
 class TraceWriter {
  public:
-  /// Opens (truncates) `path` and writes the header frame. Throws tgraph::Error.
+  /// Creates (truncates) `<path>.partial` and writes the header frame. Throws tgraph::Error.
   TraceWriter(const std::string& path, const TraceHeader& header);
   ~TraceWriter();
   TraceWriter(const TraceWriter&) = delete;
   TraceWriter& operator=(const TraceWriter&) = delete;
-  /// Appends one step (edges need not be derived; they are not stored).
+  /// Appends one step (edges need not be derived; they are not stored). After a failed
+  /// write (tgraph::Error) the partial file ends at the last complete frame and further
+  /// appends throw UsageError.
   void append(const StepGraph& step);
-  /// Writes the end frame and closes the file.
+  /// Writes the end frame, syncs and renames the partial file to the path.
   void close();
   /// Bytes written so far.
   std::uint64_t bytes_written() const;
+  /// `<path>.partial`: where the frames are until close().
+  const std::string& partial_path() const;
+  /// Steps appended so far (complete frames in the partial file).
+  std::uint32_t steps_written() const;
 
  private:
   struct Impl;

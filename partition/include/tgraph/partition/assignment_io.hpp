@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
 
 namespace tgraph::partition {
 
@@ -28,5 +29,14 @@ void write_assignment(const std::string& path, const TraceAssignment& a,
 /// Reads a .tga file.
 TraceAssignment read_assignment(const std::string& path,
                                 std::vector<std::uint64_t>* hashes = nullptr);
+
+/// Writes the assignment of `trace`'s steps with their structural hashes (what `tgraph
+/// partition -o` writes), so that load_assignment can tell a file made for another trace.
+void write_assignment(const std::string& path, const TraceAssignment& a, const Trace& trace);
+/// Reads the .tga file `path` and checks that it fits `trace` (named `trace_name` in
+/// errors): check_fits (step and task counts, processors, orders) and, where the file stored
+/// one, each step's structural hash. Throws InputError naming `path`.
+TraceAssignment load_assignment(const std::string& path, const Trace& trace,
+                                const std::string& trace_name);
 
 }  // namespace tgraph::partition

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <string_view>
 
 namespace tgraph::partition {
 
@@ -32,6 +33,9 @@ std::string default_calibration_path();
 /// Reads a calibration file written by `tgraph calibrate`; throws InputError naming the
 /// file for unreadable or malformed content.
 CostModel load_calibration(const std::string& path);
+/// Parses a calibration file's text (at most 1 MiB, JSON nested at most 64 deep); `name`
+/// names it in errors.
+CostModel parse_calibration(std::string_view text, const std::string& name);
 /// The model the command line uses: `model` "ideal" -> CostModel::ideal(); else the file
 /// `calibration` if given, else the default calibration file if present, else defaults().
 CostModel select_cost_model(const std::string& model, const std::string& calibration);

@@ -52,6 +52,14 @@ struct Report {
 Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
                 const std::string& a_name = "<assignment>");
 
+/// `tgraph evaluate --json`: the totals' keys, method, k, model, steps, imbalance_max,
+/// cyclic_steps, predicted_speedup_with_partitioning and (when `per_step`) one object per step.
+std::string report_json(const Report& report, bool per_step = true);
+
+/// `tgraph evaluate`'s text: method, k, cut, synchronisation, balance, migrations, predicted
+/// makespan and the quotient graph, five lines.
+std::string report_text(const Report& report);
+
 /// Checks that `a` fits `trace`; throws InputError naming `a_name` otherwise.
 void check_fits(const Trace& trace, const TraceAssignment& a, const std::string& a_name);
 

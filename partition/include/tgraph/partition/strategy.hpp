@@ -40,6 +40,17 @@ std::string_view to_string(Rebalance r);
 /// Parses a rebalance name; throws UsageError.
 Rebalance parse_rebalance(std::string_view s);
 
+/// What `sticky` does when a step's shape changed too much to patch (solver loops merged or
+/// split, or over a quarter of the tasks new).
+enum class StickyFallback : std::uint8_t {
+  kFresh = 0,        ///< the base method afresh, parts relabelled to the previous step's
+  kRepartition = 1,  ///< SCOTCH_graphRepart from the incremental placement, migration cost per task
+};
+/// "fresh" or "repartition".
+std::string_view to_string(StickyFallback f);
+/// Parses a fallback name; throws UsageError.
+StickyFallback parse_sticky_fallback(std::string_view s);
+
 /// Knobs of the strategies; each strategy reads the ones it understands.
 struct Options {
   double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
@@ -50,7 +61,10 @@ struct Options {
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
   Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
-  double migration_cost = 1.0;      ///< sticky + scotch rebalance: emraval (quantised to 0.01)
+  StickyFallback sticky_fallback = StickyFallback::kFresh;  ///< sticky: when the shape changed
+  /// sticky, Scotch repartitioning (rebalance or fallback): emraval, the weight of migrated
+  /// load against the cut (quantised to 0.01 by Scotch)
+  double migration_cost = 1.0;
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
 };
 
@@ -66,8 +80,9 @@ struct Stats {
   std::optional<std::int64_t> edgecut;  ///< library objective (METIS objval, Scotch cut), library units
   std::uint64_t matched_tasks = 0;      ///< tasks found in the previous step by stable key
   std::uint64_t moved_tasks = 0;        ///< matched tasks whose processor changed
-  bool reused = false;                  ///< sticky: previous assignment reused as is
-  bool rebalanced = false;              ///< sticky: repartitioned with a migration cost
+  bool reused = false;    ///< sticky: previous assignment reused as is
+  bool fallback = false;  ///< sticky: partitioned afresh and relabelled (shape changed too much)
+  bool rebalanced = false;  ///< sticky: kept the assignment, then moved tasks to fix imbalance
 };
 
 /// An assignment and its statistics.
@@ -112,6 +127,13 @@ struct TracePartition {
 /// step and its assignment (what `sticky` needs).
 TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
                                const Options& options = {});
+
+/// Renames the K part labels of `a` (a partition of `g`) so that as many tasks as possible,
+/// matched in `prev` by stable key and counted once each, keep their previous processor: an
+/// optimal assignment of labels (Hungarian algorithm on the K x K overlap), so no other
+/// renaming moves fewer tasks. Returns the matched tasks that kept their processor; does
+/// nothing (returns 0) without a previous step or when its K differs.
+std::uint64_t relabel_to_previous(const StepGraph& g, const Previous& prev, Assignment& a);
 
 /// Tasks of `g` matched in `prev` by stable key (the i-th task with a key matches the
 /// i-th task with the same key); match[t] = task in prev or kNoTask.

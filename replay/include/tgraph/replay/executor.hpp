@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
@@ -25,10 +26,20 @@ struct ExecOptions {
   std::uint32_t threads = 1;  ///< threads (processors); partition: must equal Assignment::k
   bool pin = true;            ///< bind thread p to a core with hwloc (partition, barrier)
   std::int64_t spin_ns = kDefaultSpinNs;  ///< spin this long before parking (0: park at once)
-  std::optional<CwMode> cw;               ///< default: kReduce for partition, kSerialize otherwise
+  std::optional<CwMode> cw;               ///< default: kReduce for every policy
+  /// Temporaries of kReduce; default: kPerProcessor for partition, kPerWriter for the
+  /// dynamic policies (worksteal, barrier, starpu), kNone for sequential. A sequential run
+  /// given the scope of another policy reproduces that policy's reduction order.
+  std::optional<ReduceScope> reduce_scope;
+  /// Partition only: drop the waits that program order on the producing processor already
+  /// implies (a reducer waits for the last of another processor's writers). Off: one wait
+  /// per cross-processor producer (for measuring what the reduction saves).
+  bool elide_waits = true;
   /// Partition only: run the per-processor programs interleaved on the calling thread
   /// (deterministic, same plans and waits; the serial twin of the threaded executor).
   bool serial = false;
+  /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
+  std::string starpu_sched = "lws";
 };
 
 /// Counters of one thread in one step, kept by the executor itself.
@@ -45,6 +56,7 @@ struct ThreadCounters {
 struct StepStats {
   std::int64_t wall_ns = 0;   ///< whole step, structure build included
   std::int64_t build_ns = 0;  ///< lowering + plan build (0 when the plan was reused)
+  std::int64_t prepare_ns = 0;  ///< plan lookup + build_ns + binding the workload
   bool rebuilt = false;       ///< a new plan was built for this step
   std::vector<ThreadCounters> threads;
   std::vector<std::uint32_t> loop_iterations;  ///< iterations each loop ran
@@ -79,10 +91,18 @@ class Executor {
   std::uint32_t threads() const { return options_.threads; }
   /// Options in force.
   const ExecOptions& options() const { return options_; }
+  /// How CW groups are lowered ("reduce" or "serialize" in reports).
+  CwMode cw() const { return cw_mode(); }
+  /// Where kReduce puts its temporaries.
+  ReduceScope scope() const { return reduce_scope(); }
   /// Adds an observer (not owned; must outlive the executor's use).
   void add_observer(Observer& observer) { observers_.push_back(&observer); }
   /// Removes every observer.
   void clear_observers() { observers_.clear(); }
+  /// Observers see loop iterations 0, 1 and every `stride`-th one only (default 1: all).
+  /// For observers that sample (cost feedback): a clock read per task instance costs a few
+  /// percent of a fine-grained step.
+  void set_observe_stride(std::uint32_t stride) { observe_stride_ = stride == 0 ? 1 : stride; }
 
   /// Runs one step of `g` (edges derived). `a` is required by Policy::kPartition
   /// (a->k == threads()) and ignored by the others. Throws UsageError on a bad assignment.
@@ -105,8 +125,11 @@ class Executor {
                        StepStats& stats) = 0;
   /// The CW mode this executor uses.
   CwMode cw_mode() const;
+  /// The reduction scope this executor uses with CwMode::kReduce.
+  ReduceScope reduce_scope() const;
 
   std::vector<Observer*> observers_;
+  std::uint32_t observe_stride_ = 1;
   ExecOptions options_;
 
  private:

@@ -25,9 +25,13 @@ struct Reduction {
 ///
 /// Paper section 3.2: "cumulative writes by tasks on different processors go to temporary
 /// copies, and a reduction task is added". Lowering with CwMode::kReduce does exactly that
-/// for every group of consecutive CW writers of one datum that spans several processors:
-/// writers off the group's home processor (the first writer's) write a per-processor
-/// temporary, and a `reduce` task on the home processor adds them in processor order.
+/// for every group of consecutive CW writers of one datum whose writers may run on
+/// different threads. ReduceScope::kPerProcessor (partition): writers off the group's home
+/// processor (the first writer's) write a per-processor temporary, and a `reduce` task on
+/// the home processor adds them in processor order. ReduceScope::kPerWriter (work stealing,
+/// barrier, StarPU: any writer may run on any thread): the first writer adds into the
+/// datum itself, every later writer into a temporary of its own, and the `reduce` task adds
+/// the temporaries in program order, so the result does not depend on the threads.
 /// CwMode::kSerialize turns every CW into RW instead (writers in program order).
 struct ExecGraph {
   StepGraph graph;                       ///< edges derived
@@ -37,12 +41,20 @@ struct ExecGraph {
   std::vector<DatumId> datum_origin;  ///< exec datum -> original datum (a temp: its target)
   std::vector<TaskId> exec_of;        ///< original task -> exec task
   Assignment assignment;              ///< the assignment on exec tasks (k = 1 when none)
+  CwMode cw = CwMode::kReduce;        ///< how CW groups were lowered
+  ReduceScope scope = ReduceScope::kNone;  ///< temporaries used by kReduce
   /// Lowering added dependencies the original graph did not have (a CW writer made RW).
   bool added_edges = false;
 };
 
 /// Lowers `g` (edges derived) for assignment `a` (nullptr: everything on processor 0).
-/// With kReduce, reducers are only needed where a CW group spans processors.
+/// With kReduce and kPerProcessor, reducers are only needed where a CW group spans
+/// processors; with kPerWriter, wherever a group has two writers or more. `reducible`
+/// (optional, by original datum) marks the data whose CW groups may use temporaries; the
+/// groups of other data are serialised (live bodies that cannot be redirected).
+ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
+                const std::vector<bool>* reducible = nullptr);
+/// Same with the scope implied by `a`: kPerProcessor with an assignment, else kNone.
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode);
 
 }  // namespace tgraph::replay

@@ -54,6 +54,8 @@ struct StepMeasure {
   std::int64_t wall_ns = 0;
   std::int64_t sequential_wall_ns = 0;
   std::int64_t build_ns = 0;  ///< plan build in the first pass (0: reused)
+  /// Median over passes of each pass's wall time minus that pass's own plan build.
+  std::int64_t run_ns = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
   std::int64_t wait_ns = 0;
   std::uint64_t remote_bytes = 0, migrated_bytes = 0;  ///< from the observed pass
@@ -66,6 +68,8 @@ struct StepMeasure {
 struct ReplayResult {
   Policy policy = Policy::kPartition;
   std::uint32_t threads = 1;
+  CwMode cw = CwMode::kReduce;              ///< how CW groups ran
+  ReduceScope scope = ReduceScope::kNone;   ///< where their temporaries lived
   std::vector<StepMeasure> steps;
   std::int64_t wall_ns = 0;             ///< median over passes of the pass total
   std::int64_t sequential_wall_ns = 0;  ///< same for sequential

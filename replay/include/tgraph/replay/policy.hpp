@@ -13,9 +13,10 @@ enum class Policy : unsigned char {
   kPartition = 1,   ///< one pinned thread per processor of an Assignment, signal/wait
   kWorksteal = 2,   ///< oneTBB, dependency counting over the dataflow graph, no affinity
   kBarrier = 3,     ///< a parallel loop per operation, barrier after each (OpenMP)
+  kStarpu = 4,      ///< StarPU tasks with one data handle per datum (implicit dependencies)
 };
 
-/// "sequential", "partition", "worksteal" or "barrier".
+/// "sequential", "partition", "worksteal", "barrier" or "starpu".
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);
@@ -28,5 +29,18 @@ enum class CwMode : unsigned char {
 
 /// "reduce" or "serialize".
 std::string_view to_string(CwMode mode);
+
+/// Where the temporaries of a CW group whose writers may run on different threads live
+/// (CwMode::kReduce).
+enum class ReduceScope : unsigned char {
+  kNone = 0,          ///< no temporaries: the writers run on one thread (sequential)
+  kPerProcessor = 1,  ///< one temporary per processor off the group's home (partition)
+  /// One temporary per writer after the group's first, added in program order (the dynamic
+  /// policies: any writer may run on any thread, the combine stays deterministic).
+  kPerWriter = 2,
+};
+
+/// "none", "per-processor" or "per-writer".
+std::string_view to_string(ReduceScope scope);
 
 }  // namespace tgraph::replay

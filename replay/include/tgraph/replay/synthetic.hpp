@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -52,6 +53,8 @@ class SyntheticWorkload : public Workload {
   void first_touch(DatumId d) override;
   void run(const TaskRun& r) override;
   bool stop_after(LoopId loop, std::uint32_t iteration) override;
+  /// The recorded iterations of the step set by set_step (nullopt before set_step).
+  std::optional<std::uint32_t> known_iterations(LoopId loop) const override;
 
   /// Words of exec datum `d` (empty before first touch).
   std::span<const std::uint64_t> words(DatumId d) const;

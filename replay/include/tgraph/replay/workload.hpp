@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
+#include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
 
@@ -41,10 +43,20 @@ class Workload {
     (void)d;
     return false;
   }
+  /// By original datum: whether CW writers of it can write a temporary instead (nullptr:
+  /// all can). Executors serialise the CW groups of the others.
+  virtual const std::vector<bool>* reducible() const { return nullptr; }
   /// Runs one task.
   virtual void run(const TaskRun& r) = 0;
   /// After iteration `iteration` (0-based) of loop `loop`: true = leave the loop.
   virtual bool stop_after(LoopId loop, std::uint32_t iteration) = 0;
+  /// The number of iterations loop `loop` will run this step when the workload knows it
+  /// before the loop starts (a replay of recorded counts), else nullopt (a live condition).
+  /// When known, stop_after must agree with it; executors may then unroll the loop.
+  virtual std::optional<std::uint32_t> known_iterations(LoopId loop) const {
+    (void)loop;
+    return std::nullopt;
+  }
 
  private:
   static std::uint64_t next_instance() {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/cumulative.hpp"
 #include "tgraph/samples/state.hpp"
 
 namespace tgraph::samples {
@@ -27,8 +28,9 @@ class Body {
   const std::string& name() const { return name_; }
   /// Columns of every state vector.
   Index columns() const { return columns_; }
-  /// State vector `id`.
-  StateVec& vec(VecId id) { return vecs_[static_cast<int>(id)]; }
+  /// State vector `id` (for a cumulative write, the temporary a live executor redirected it
+  /// to: see tgraph/graph/cumulative.hpp).
+  StateVec& vec(VecId id) { return accumulate(vecs_[static_cast<int>(id)]); }
   const StateVec& vec(VecId id) const { return vecs_[static_cast<int>(id)]; }
 
   /// out += factor * M * in.

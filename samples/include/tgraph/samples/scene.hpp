@@ -41,6 +41,9 @@ struct SceneOptions {
   std::uint64_t seed = 1;            ///< random placement jitter (scenes that use it)
   std::optional<int> subobjects;     ///< cloth scenes: number of sub-objects (a square)
   std::optional<Coupling> coupling;  ///< solver sharing
+  /// Ceiling on the points of a scene file (nodes, particles, rigid surface points), checked
+  /// before each object is built.
+  std::uint64_t max_nodes = std::uint64_t{1} << 24;
 };
 
 /// What the last step did (known after the step in capture and off modes).
@@ -95,6 +98,12 @@ class Scene {
   /// Runs one time step: collision detection (sequential, unrecorded), then
   /// rec.begin_step(), the contact set, and every solver's tasks. The step is left open.
   void step(capture::Recorder& rec);
+  /// For live runs that keep the program of the last step recorded into `rec` (deferred
+  /// mode): runs collision detection; when the step's interactions and collision groups
+  /// are those of that step, advances without recording and returns false (its bodies
+  /// point at the same state, so the caller runs the kept program again, as the paper
+  /// re-executes an unchanged graph); otherwise records like step() and returns true.
+  bool step_if_changed(capture::Recorder& rec);
 
   /// Scene name.
   const std::string& name() const { return name_; }
@@ -120,12 +129,19 @@ class Scene {
   StepStats last_stats() const;
   /// Total surface triangles of the bodies.
   std::uint64_t surface_triangles() const;
+  /// Settings the integrator may not handle well, found when the scene was built (a time
+  /// step above the explicit stability limit, a CG that cannot converge in max_iterations);
+  /// see samples/scenes/README.md. The command line prints them.
+  const std::vector<std::string>& warnings() const { return warnings_; }
+  /// Adds a warning.
+  void add_warning(std::string warning) { warnings_.push_back(std::move(warning)); }
 
   /// Private state (defined in the library).
   struct Impl;
 
  private:
   void finalize();
+  bool advance(capture::Recorder& rec, bool allow_reuse);
   std::string name_;
   std::vector<std::unique_ptr<Body>> bodies_;
   std::vector<std::unique_ptr<ForceField>> fields_;
@@ -137,6 +153,7 @@ class Scene {
   double time_ = 0.0;
   std::uint64_t steps_run_ = 0;
   StepStats stats_;
+  std::vector<std::string> warnings_;
   std::unique_ptr<Impl> impl_;
 };
 

@@ -30,6 +30,12 @@ struct SolverSettings {
   double dt = 0.01;                    ///< time step (s)
   double tolerance = 1e-5;             ///< CG stops when |r| <= tolerance |b|
   std::uint32_t max_iterations = 100;  ///< CG iteration cap
+  /// Divergence check: a CG solve ending at max_iterations without converging on this many
+  /// consecutive steps stops the run (0: never).
+  std::uint32_t cg_stall_steps = 10;
+  /// Divergence check: kinetic energy above energy_factor x (initial kinetic + initial
+  /// internal potential energy + work done by gravity since) stops the run (0: never).
+  double energy_factor = 10.0;
 };
 
 }  // namespace tgraph::samples

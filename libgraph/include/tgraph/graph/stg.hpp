@@ -9,7 +9,7 @@
 
 #include "tgraph/graph/trace.hpp"
 
-namespace tgraph::partition {
+namespace tgraph {
 
 /// An STG file read into a trace.
 struct StgGraph {
@@ -27,4 +27,4 @@ StgGraph parse_stg(std::string_view text, const std::string& name, std::uint64_t
 StgGraph read_stg(const std::string& path, std::uint64_t unit_ns = 1000,
                   std::uint64_t edge_bytes = 8);
 
-}  // namespace tgraph::partition
+}  // namespace tgraph

@@ -1,0 +1,154 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/graph/summary.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "tgraph/graph/diff.hpp"
+#include "tgraph/graph/metrics.hpp"
+
+namespace tgraph {
+
+TraceSummary summarize_trace(const Trace& trace) {
+  TraceSummary s;
+  s.header = trace.header;
+  s.steps = trace.steps.size();
+  s.tasks_min = trace.steps.empty() ? 0 : UINT64_MAX;
+  std::set<std::uint64_t> shapes;
+  for (std::size_t i = 0; i < trace.steps.size(); ++i) {
+    const StepGraph& g = trace.steps[i];
+    const Metrics m = compute_metrics(g);
+    StepSummary st;
+    st.tasks = m.tasks;
+    st.edges = m.edges;
+    st.data = m.data;
+    st.loops = m.loops;
+    for (const Loop& l : g.loops) st.loop_iterations.push_back(l.iterations);
+    st.work_ns = m.work_ns;
+    st.span_ns = m.span_ns;
+    st.parallelism = m.parallelism;
+    st.contacts = g.contacts.size();
+    const std::set<std::uint32_t> groups(g.groups.begin(), g.groups.end());
+    st.collision_groups = g.groups.empty() ? (g.objects.empty() ? 0 : 1) : groups.size();
+    st.contacts_changed = contacts_changed(trace, i);
+    st.structure = g.structural_hash();
+    if (i > 0 && !g.same_structure(trace.steps[i - 1])) {
+      st.structure_changed = true;
+      st.change = step_diff_summary(diff_steps(trace.steps[i - 1], g));
+    }
+
+    s.tasks += st.tasks;
+    s.tasks_min = std::min(s.tasks_min, st.tasks);
+    s.tasks_max = std::max(s.tasks_max, st.tasks);
+    s.edges += st.edges;
+    s.data_max = std::max(s.data_max, st.data);
+    s.loops += st.loops;
+    s.loop_iterations += m.loop_iterations;
+    for (std::uint32_t it : st.loop_iterations)
+      s.max_loop_iterations = std::max(s.max_loop_iterations, it);
+    s.work_ns += st.work_ns;
+    s.span_ns += st.span_ns;
+    shapes.insert(st.structure);
+    s.contact_changes += st.contacts_changed ? 1 : 0;
+    s.last_step_collision_groups = st.collision_groups;
+    s.per_step.push_back(std::move(st));
+  }
+  s.distinct_structures = shapes.size();
+  s.tasks_mean = s.steps == 0 ? 0.0 : static_cast<double>(s.tasks) / static_cast<double>(s.steps);
+  s.parallelism =
+      s.span_ns == 0 ? 0.0 : static_cast<double>(s.work_ns) / static_cast<double>(s.span_ns);
+  return s;
+}
+
+std::string trace_summary_json(const TraceSummary& s, const std::string& trace_name) {
+  using nlohmann::json;
+  json per_step = json::array(), changes = json::array();
+  for (std::size_t i = 0; i < s.per_step.size(); ++i) {
+    const StepSummary& st = s.per_step[i];
+    per_step.push_back({{"step", i},
+                        {"tasks", st.tasks},
+                        {"edges", st.edges},
+                        {"data", st.data},
+                        {"loops", st.loops},
+                        {"loop_iterations", st.loop_iterations},
+                        {"work_ns", st.work_ns},
+                        {"span_ns", st.span_ns},
+                        {"parallelism", st.parallelism},
+                        {"contacts", st.contacts},
+                        {"collision_groups", st.collision_groups},
+                        {"contacts_changed", st.contacts_changed},
+                        {"structure", st.structure},
+                        {"structure_changed", st.structure_changed}});
+    if (st.structure_changed) changes.push_back({{"step", i}, {"summary", st.change}});
+  }
+  const json j = {
+      {"trace", trace_name},
+      {"scene", s.header.scene},
+      {"engine", s.header.engine},
+      {"machine", s.header.machine},
+      {"tgraph_version", s.header.tgraph_version},
+      {"steps", s.steps},
+      {"tasks", s.tasks},
+      {"tasks_per_step", {{"min", s.tasks_min}, {"mean", s.tasks_mean}, {"max", s.tasks_max}}},
+      {"edges", s.edges},
+      {"data", s.data_max},
+      {"loops", s.loops},
+      {"loop_iterations", s.loop_iterations},
+      {"max_loop_iterations", s.max_loop_iterations},
+      {"work_ns", s.work_ns},
+      {"span_ns", s.span_ns},
+      {"parallelism", s.parallelism},
+      {"distinct_structures", s.distinct_structures},
+      {"contact_changes", s.contact_changes},
+      {"last_step_collision_groups", s.last_step_collision_groups},
+      {"structure_changes", changes},
+      {"per_step", per_step},
+  };
+  return j.dump();
+}
+
+std::string trace_summary_text(const TraceSummary& s, const std::string& trace_name) {
+  std::string out;
+  char line[1024];
+  auto add = [&](int n) { out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 1023))); };
+  add(std::snprintf(line, sizeof line, "trace          %s (scene %s, engine %s)\n",
+                    trace_name.c_str(), s.header.scene.c_str(), s.header.engine.c_str()));
+  add(std::snprintf(line, sizeof line, "steps          %llu\n",
+                    static_cast<unsigned long long>(s.steps)));
+  add(std::snprintf(
+      line, sizeof line, "tasks          %llu (per step min %llu, mean %.1f, max %llu)\n",
+      static_cast<unsigned long long>(s.tasks), static_cast<unsigned long long>(s.tasks_min),
+      s.tasks_mean, static_cast<unsigned long long>(s.tasks_max)));
+  add(std::snprintf(line, sizeof line, "data           %llu (largest step)\n",
+                    static_cast<unsigned long long>(s.data_max)));
+  add(std::snprintf(line, sizeof line, "edges          %llu\n",
+                    static_cast<unsigned long long>(s.edges)));
+  add(std::snprintf(line, sizeof line,
+                    "loops          %llu, %llu iterations (max %u in one loop)\n",
+                    static_cast<unsigned long long>(s.loops),
+                    static_cast<unsigned long long>(s.loop_iterations), s.max_loop_iterations));
+  add(std::snprintf(line, sizeof line, "work           %.3f ms\n",
+                    static_cast<double>(s.work_ns) / 1e6));
+  add(std::snprintf(line, sizeof line, "span           %.3f ms\n",
+                    static_cast<double>(s.span_ns) / 1e6));
+  add(std::snprintf(line, sizeof line, "parallelism    %.2f\n", s.parallelism));
+  add(std::snprintf(line, sizeof line, "structures     %llu distinct\n",
+                    static_cast<unsigned long long>(s.distinct_structures)));
+  add(std::snprintf(
+      line, sizeof line,
+      "contacts       %llu steps whose contact set changed; last step %llu collision group(s)\n",
+      static_cast<unsigned long long>(s.contact_changes),
+      static_cast<unsigned long long>(s.last_step_collision_groups)));
+  std::size_t changed = 0;
+  for (const StepSummary& st : s.per_step) changed += st.structure_changed ? 1 : 0;
+  if (changed > 0)
+    out += "changes        " + std::to_string(changed) + " steps whose structure changed:\n";
+  for (std::size_t i = 0; i < s.per_step.size(); ++i)
+    if (s.per_step[i].structure_changed)
+      out += "  step " + std::to_string(i) + ": " + s.per_step[i].change + "\n";
+  return out;
+}
+
+}  // namespace tgraph

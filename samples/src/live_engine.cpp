@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/samples/live_engine.hpp"
+
+#include <utility>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::samples {
+namespace {
+
+class SceneEngine final : public replay::LiveEngine {
+ public:
+  explicit SceneEngine(std::unique_ptr<Scene> scene)
+      : scene_(std::move(scene)), rec_(capture::Mode::kDeferred), plain_(capture::Mode::kOff) {}
+
+  replay::LiveStep record_step(bool allow_reuse) override {
+    if (!allow_reuse) {
+      scene_->step(rec_);
+    } else if (!scene_->step_if_changed(rec_)) {
+      replay::LiveStep same;
+      same.reuse_previous = true;
+      return same;
+    }
+    capture::StepProgram p = rec_.end_step_program();
+    if (rec_.errors() != 0)
+      throw UsageError("scene " + scene_->name() + ": the recorder counted " +
+                       std::to_string(rec_.errors()) + " API misuses");
+    replay::LiveStep step;
+    step.graph = std::move(p.graph);
+    step.bodies = std::move(p.bodies);
+    step.conditions = std::move(p.conditions);
+    step.accumulators = std::move(p.accumulators);
+    return step;
+  }
+
+  void plain_step() override {
+    scene_->step(plain_);
+    plain_.end_step();
+    used_ = &plain_;
+  }
+
+  std::vector<replay::StateRegion> state() const override {
+    std::vector<replay::StateRegion> r;
+    const std::vector<Datum>& data = used_->data();
+    for (DatumId d = 0; d < data.size(); ++d)
+      if (used_->datum_ptr(d) != nullptr)
+        r.push_back({data[d].name, used_->datum_ptr(d), data[d].bytes});
+    return r;
+  }
+
+ private:
+  std::unique_ptr<Scene> scene_;
+  capture::Recorder rec_;
+  capture::Recorder plain_;
+  const capture::Recorder* used_ = &rec_;  // the recorder whose ids name the state
+};
+
+}  // namespace
+
+std::unique_ptr<replay::LiveEngine> make_live_engine(const std::string& scene,
+                                                     const SceneOptions& options) {
+  return std::make_unique<SceneEngine>(make_scene(scene, options));
+}
+
+}  // namespace tgraph::samples

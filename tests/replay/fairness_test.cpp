@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+// Fair baselines: every policy reduces CW groups in parallel by default, and says so.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/observer.hpp"
+#include "tgraph/replay/synthetic.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+/// x is written, then `writers` tasks add into y (CW) reading x, then one task reads y.
+StepGraph cw_group(int writers, std::uint64_t cost_ns) {
+  StepGraph g;
+  const KindId init = g.intern_kind("init"), add = g.intern_kind("add"),
+               use = g.intern_kind("use");
+  for (int i = 0; i < writers; ++i) g.objects.push_back({"o" + std::to_string(i)});
+  g.data = {{"x", kNoObject, 4096}, {"y", kNoObject, 4096}, {"z", kNoObject, 64}};
+  g.add_task(init, 0, std::vector<Access>{{0, AccessMode::W}}, 1000, 1);
+  for (int i = 0; i < writers; ++i)
+    g.add_task(add, static_cast<ObjectId>(i),
+               std::vector<Access>{{0, AccessMode::R}, {1, AccessMode::CW}}, cost_ns,
+               static_cast<StableKey>(i + 2));
+  g.add_task(use, 0, std::vector<Access>{{1, AccessMode::R}, {2, AccessMode::W}}, 1000, 999);
+  g.derive_edges();
+  return g;
+}
+
+class DynamicBaseline : public ::testing::TestWithParam<Policy> {};
+
+// The fairness bug this guards against: baselines that turned every CW into RW ran the
+// writers of one datum one after the other.
+TEST_P(DynamicBaseline, RunsCwWritersOfOneDatumOnTwoThreadsAtOnce) {
+  const StepGraph g = cw_group(8, 4'000'000);
+  ExecOptions o;
+  o.threads = 2;
+  auto ex = make_executor(GetParam(), o);
+  EXPECT_EQ(ex->cw(), CwMode::kReduce);
+  EXPECT_EQ(ex->scope(), ReduceScope::kPerWriter);
+  TimelineObserver timeline;
+  ex->add_observer(timeline);
+  SyntheticWorkload w;
+  w.set_step(g);
+  ex->run_step(g, nullptr, w);
+  const ExecGraph& x = *ex->last_exec();
+  ASSERT_EQ(x.reductions.size(), 1u);
+  EXPECT_EQ(x.reductions[0].temps.size(), 7u);  // the first writer adds into y itself
+  std::vector<TimelineEvent> writers;
+  for (const TimelineEvent& e : timeline.events())
+    if (e.origin != kNoTask && g.kind_name(e.origin) == "add") writers.push_back(e);
+  ASSERT_EQ(writers.size(), 8u);
+  bool overlap = false;
+  for (const auto& a : writers)
+    for (const auto& b : writers)
+      if (a.thread != b.thread && a.start_ns < b.end_ns && b.start_ns < a.end_ns) overlap = true;
+  EXPECT_TRUE(overlap) << "no two CW writers of y ran at the same time on two threads";
+  // The reader ran after every writer and after the reducer.
+  std::int64_t last_writer_end = 0, reducer_end = 0, reader_start = 0;
+  for (const TimelineEvent& e : timeline.events()) {
+    if (e.origin == kNoTask) reducer_end = e.end_ns;
+    else if (g.kind_name(e.origin) == "add") last_writer_end = std::max(last_writer_end, e.end_ns);
+    else if (g.kind_name(e.origin) == "use") reader_start = e.start_ns;
+  }
+  EXPECT_GE(reader_start, reducer_end);
+  EXPECT_GE(reducer_end, last_writer_end);
+}
+
+TEST_P(DynamicBaseline, SerializeIsStillAvailableAndOrdersTheWriters) {
+  const StepGraph g = cw_group(4, 1000);
+  ExecOptions o;
+  o.threads = 2;
+  o.cw = CwMode::kSerialize;
+  auto ex = make_executor(GetParam(), o);
+  EXPECT_EQ(ex->cw(), CwMode::kSerialize);
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  ex->run_step(g, nullptr, w);
+  EXPECT_TRUE(ex->last_exec()->reductions.empty());
+  EXPECT_TRUE(ex->last_exec()->added_edges);
+}
+
+INSTANTIATE_TEST_SUITE_P(Policies, DynamicBaseline,
+                         ::testing::Values(Policy::kWorksteal, Policy::kBarrier),
+                         [](const auto& p) { return std::string(to_string(p.param)); });
+
+// Sum of the synthetic CW bodies is exact integer arithmetic: every policy and scope must
+// reach the sequential result, and the per-writer reducer must add each temporary once.
+TEST(FairReduction, EveryPolicyReachesTheSequentialSums) {
+  const StepGraph g = cw_group(6, 0);
+  auto run = [&](Policy p, std::uint32_t k) {
+    ExecOptions o;
+    o.threads = k;
+    auto ex = make_executor(p, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    Assignment a;
+    a.k = k;
+    for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % k);
+    for (int s = 0; s < 3; ++s) ex->run_step(g, p == Policy::kPartition ? &a : nullptr, w);
+    auto y = w.words(1);
+    return std::vector<std::uint64_t>(y.begin(), y.end());
+  };
+  const auto want = run(Policy::kSequential, 1);
+  for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+    for (std::uint32_t k : {2u, 3u}) EXPECT_EQ(run(p, k), want) << to_string(p) << " k=" << k;
+}
+
+// The barrier baseline: a CW group is one parallel phase (plus one reduction phase), not a
+// phase per writer.
+TEST(FairReduction, BarrierRunsACwGroupAsOnePhase) {
+  const StepGraph g = cw_group(16, 0);
+  ExecOptions o;
+  o.threads = 2;
+  auto ex = make_executor(Policy::kBarrier, o);
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  const StepStats s = ex->run_step(g, nullptr, w);
+  // init | 16 writers | reducer | reader: 4 phases, one barrier each per thread.
+  for (const ThreadCounters& t : s.threads) EXPECT_EQ(t.waits, 4u);
+}
+
+}  // namespace
+}  // namespace tgraph::replay
