@@ -13,7 +13,7 @@ namespace {
 struct VizCmd {
   std::string trace, assignment, out, collapse = "none";
   std::size_t step = 0;
-  std::size_t max_nodes = 2000;
+  std::size_t max_nodes = 2000, max_edges = 4000;
   bool critical_path = false;
 };
 
@@ -29,6 +29,7 @@ void run_viz(const VizCmd& c) {
   o.collapse = collapse;
   o.critical_path = c.critical_path;
   o.max_nodes = c.max_nodes;
+  o.max_edges = c.max_edges;
   o.title = std::filesystem::path(c.trace).filename().string() + ", step " + std::to_string(c.step);
   if (!c.assignment.empty()) {
     assignment = partition::load_assignment(c.assignment, trace, c.trace);
@@ -55,8 +56,11 @@ void add_viz_verbs(CLI::App& app) {
   cmd->add_option("--collapse", c->collapse, "none (default), object, kind, processor or loop");
   cmd->add_flag("--critical-path", c->critical_path, "Highlight the critical path (loops unrolled)");
   cmd->add_option("--max-nodes", c->max_nodes, "Refuse pictures with more nodes (default 2000; 0: no limit)");
+  cmd->add_option("--max-edges", c->max_edges, "Refuse pictures with more edges (default 4000; 0: no limit)");
   cmd->add_option("-o,--output", c->out, "Output file: .dot, .svg, .png or .pdf")->required();
   cmd->callback([c] { run_viz(*c); });
+  add_timeline(app);
+  add_report(app);
 }
 
 }  // namespace tgraph::app

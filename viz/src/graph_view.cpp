@@ -587,13 +587,13 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   }
   if (o.collapse == Collapse::kProcessor && !a)
     throw UsageError("--collapse processor needs an assignment (--assign A.tga)");
-  auto too_many = [&](std::size_t nodes) {
-    return UsageError("the picture would have " + std::to_string(nodes) + " nodes, more than --max-nodes " +
-                      std::to_string(o.max_nodes) +
-                      ": aggregate with --collapse object, kind, processor or loop (or raise --max-nodes)");
+  auto too_many = [&](std::size_t count, const char* what, std::size_t limit) {
+    return UsageError("the picture would have " + std::to_string(count) + " " + what + ", more than --max-" +
+                      what + " " + std::to_string(limit) +
+                      ": aggregate with --collapse object, kind, processor or loop (or raise --max-" + what + ")");
   };
   if (o.collapse == Collapse::kNone && o.max_nodes != 0 && g.tasks.size() > o.max_nodes)
-    throw too_many(g.tasks.size());
+    throw too_many(g.tasks.size(), "nodes", o.max_nodes);
 
   GraphView v;
   v.processors = a ? a->k : 0;
@@ -607,7 +607,8 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   } else {
     build_groups(g, o, cpp, v);
   }
-  if (o.max_nodes != 0 && v.nodes.size() > o.max_nodes) throw too_many(v.nodes.size());
+  if (o.max_nodes != 0 && v.nodes.size() > o.max_nodes) throw too_many(v.nodes.size(), "nodes", o.max_nodes);
+  if (o.max_edges != 0 && v.edges.size() > o.max_edges) throw too_many(v.edges.size(), "edges", o.max_edges);
 
   for (LoopId l = 0; l < g.loops.size(); ++l) {
     const bool used = std::any_of(v.nodes.begin(), v.nodes.end(), [l](const ViewNode& n) { return n.loop == l; });

@@ -92,6 +92,9 @@ struct ViewOptions {
   bool critical_path = false;
   /// Refuse (UsageError) when the picture would have more nodes than this (0: no limit).
   std::size_t max_nodes = 2000;
+  /// Likewise for edges (0: no limit): dot's layout time grows with the edges (bars64's
+  /// 11,206 task-level edges take minutes), so large pictures are refused before layout.
+  std::size_t max_edges = 4000;
   std::string title;  ///< first line of the graph label
 };
 
@@ -114,7 +117,7 @@ struct GraphView {
 
 /// Builds the picture of `g` (edges derived). Throws UsageError when the assignment does
 /// not fit the step, when --collapse processor has no assignment, and when the result has
-/// more than `max_nodes` nodes (the message suggests --collapse).
+/// more than `max_nodes` nodes or `max_edges` edges (the message suggests --collapse).
 GraphView make_graph_view(const StepGraph& g, const ViewOptions& options);
 
 /// "96 B", "1.5 KiB", "2.25 MiB".
