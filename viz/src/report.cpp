@@ -250,6 +250,7 @@ json timeline_spec(const Timeline& t, std::string* caption) {
                     {"encoding", {{"x", {{"field", "start"}, {"type", "quantitative"}}}}}});
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 900},
+          {"height", {{"step", 34}}},
           {"title", {{"text", "Replay timeline"},
                      {"subtitle", "one row per thread; dark thin bars: blocking waits; black rules: step starts"}}},
           {"layer", layers}};
