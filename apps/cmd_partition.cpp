@@ -19,8 +19,7 @@ namespace tp = tgraph::partition;
 using Named = std::shared_ptr<tp::NamedOptions>;
 
 void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
-  cmd->add_option("--model", n.model,
-                  "Cost model: calibrated (default) or ideal (no sync/transfer cost)")
+  cmd->add_option("--model", n.model, "Cost model: calibrated (default) or ideal (free syncs)")
       ->check(CLI::IsMember({"ideal", "calibrated"}));
   cmd->add_option("--calibration", n.calibration,
                   "Calibration file (default: " + tp::default_calibration_path() + " if present)");
@@ -28,23 +27,17 @@ void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
 
 void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   tp::Options& o = n.values;
-  cmd->add_option("--imbalance", o.imbalance,
-                  "Tolerated max/mean load for METIS and Scotch (default 1.03)");
-  cmd->add_option("--seed", o.seed,
-                  "Seed of METIS, Scotch and random (default 0: METIS's own, as gpmetis)");
+  cmd->add_option("--imbalance", o.imbalance, "METIS/Scotch max/mean load allowed (1.03)");
+  cmd->add_option("--seed", o.seed, "METIS/Scotch/random seed (0: METIS's own, as gpmetis)");
   cmd->add_option("--objective", n.objective, "METIS objective: cut or vol")
       ->check(CLI::IsMember({"cut", "vol"}));
-  cmd->add_option("--phases", o.phases,
-                  "METIS multi-constraint mode: balance each of N graph phases (0 = off)");
+  cmd->add_option("--phases", o.phases, "METIS: balance each of N graph phases (0 = off)");
   cmd->add_option("--scotch-strategy", n.scotch, "Scotch flavour: default, quality, speed, balance")
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
-  cmd->add_option("--sticky-base", o.sticky_base,
-                  "sticky: method for the first step (default metis)");
-  cmd->add_option(
-      "--threshold", o.sticky_threshold,
-      "sticky: rebalance when imbalance exceeds this x the last partition's (default 1.20)");
-  cmd->add_option("--rebalance", n.rebalance,
-                  "sticky: greedy (move whole objects) or scotch (graphRepart)")
+  cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");
+  cmd->add_option("--threshold", o.sticky_threshold,
+                  "sticky: rebalance when imbalance exceeds this x the last partition's (1.20)");
+  cmd->add_option("--rebalance", n.rebalance, "sticky: greedy (whole objects) or scotch")
       ->check(CLI::IsMember({"greedy", "scotch"}));
   cmd->add_option("--sticky-fallback", n.sticky_fallback,
                   "sticky, when solver loops merge or split: fresh (base method + relabel) or "

@@ -93,7 +93,7 @@ struct LiveStep {
 };
 
 /// The engine side of a live run (the physics engine behind a small interface; see the
-/// adapter over samples::Scene in apps/live_scene.cpp).
+/// adapter over samples::Scene in samples/src/live_engine.cpp).
 class LiveEngine {
  public:
   virtual ~LiveEngine() = default;
