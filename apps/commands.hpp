@@ -4,18 +4,18 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
-
-namespace tgraph::samples {
-class Scene;
-}
+#include "tgraph/samples/capture_run.hpp"
 
 namespace tgraph::app {
 
@@ -23,6 +23,20 @@ namespace tgraph::app {
 class Failure : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+};
+
+/// Values of a verb's flags that no module's option struct holds (each verb owns one; module
+/// options such as partition::NamedOptions or replay::LiveOptions hold the rest).
+struct Args {
+  std::string input, second, output, method, policy, format, cw, timeline, chrome, csv;
+  std::vector<std::string> names;
+  std::vector<std::uint32_t> counts;
+  std::vector<double> values;
+  std::optional<int> steps;
+  std::uint32_t k = 0;
+  std::uint64_t unit_ns = 1000, edge_bytes = 8;
+  bool json = false, recover = false, no_pin = false, no_touch = false, no_baseline = false;
+  bool no_observe = false, no_reuse = false, no_elide_waits = false;
 };
 
 /// Prints a JSON object on stdout (one line, as `--json` promises).
@@ -34,12 +48,12 @@ inline std::string read_file_text(const std::string& path) {
   const std::vector<std::uint8_t> bytes = read_file_bytes(path);
   return std::string(bytes.begin(), bytes.end());
 }
-/// "<cpu model>, N hardware threads", for trace headers.
-std::string machine_description();
+/// "<cpu model>, N hardware threads", for trace headers (libgraph).
+using tgraph::machine_description;
 /// Threads a verb uses by default: all hardware threads (at least 1).
 std::uint32_t default_threads();
-/// Header of a trace captured from `scene` (engine, integrator, dt, seed, machine).
-TraceHeader scene_header(const samples::Scene& scene, std::uint64_t seed);
+/// Header of a trace captured from a scene (samples).
+using samples::scene_header;
 
 // Registration of each verb (one function per cmd_*.cpp).
 void add_info(CLI::App& app);

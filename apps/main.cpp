@@ -3,10 +3,9 @@
 // work, 2 bad usage or bad input (one line on stderr naming the file or flag).
 #include <algorithm>
 #include <cstdio>
-#include <fstream>
-#include <thread>
 #include <exception>
 #include <iostream>
+#include <thread>
 
 #include "commands.hpp"
 
@@ -18,19 +17,6 @@ Trace load_trace(const std::string& path, bool recover) {
   ReadOptions options;
   options.recover = recover;
   return read_trace(path, options);
-}
-
-std::string machine_description() {
-  std::string model;
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) {
-      if (auto colon = line.find(':'); colon != std::string::npos) model = line.substr(colon + 2);
-      break;
-    }
-  }
-  if (model.empty()) model = "unknown cpu";
-  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
 }
 
 std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }

@@ -28,6 +28,15 @@ add_library(tgraph_scotch INTERFACE)
 add_library(tgraph::scotch ALIAS tgraph_scotch)
 target_link_libraries(tgraph_scotch INTERFACE ${SCOTCH_LIBRARY} ${SCOTCHERR_LIBRARY} Threads::Threads)
 
+if(TGRAPH_PYTHON)
+  # Debian python3-dev, pybind11-dev (python3-pybind11), python3-pytest: they belong to
+  # Debian's interpreter, preferred over another python3 earlier on PATH (pyenv, venv).
+  if(NOT DEFINED Python3_EXECUTABLE AND EXISTS /usr/bin/python3)
+    set(Python3_EXECUTABLE /usr/bin/python3)
+  endif()
+  find_package(Python3 3.9 REQUIRED COMPONENTS Interpreter Development.Module)
+  find_package(pybind11 2.10 REQUIRED CONFIG)
+endif()
 if(TGRAPH_BUILD_TESTS)
   find_package(GTest REQUIRED CONFIG)
   include(GoogleTest)

@@ -3,6 +3,7 @@
 #include "tgraph/graph/stg.hpp"
 
 #include <charconv>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
@@ -142,6 +143,26 @@ StgGraph read_stg(const std::string& path, std::uint64_t unit_ns, std::uint64_t 
   const std::vector<std::uint8_t> bytes = read_file_bytes(path);
   return parse_stg(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), path,
                    unit_ns, edge_bytes);
+}
+
+std::string stg_import_report(const StgGraph& stg, const std::string& input,
+                              const std::string& output, std::uint64_t unit_ns, bool json) {
+  const StepGraph& g = stg.trace.steps.at(0);
+  if (json) {
+    nlohmann::json j = {{"input", input},
+                        {"output", output},
+                        {"tasks", g.tasks.size()},
+                        {"edges", g.edges.size()},
+                        {"unit_ns", unit_ns}};
+    j["cp_length"] = stg.cp_length ? nlohmann::json(*stg.cp_length) : nlohmann::json(nullptr);
+    return j.dump() + "\n";
+  }
+  std::string out = "imported " + input + ": " + std::to_string(g.tasks.size()) + " tasks, " +
+                    std::to_string(g.edges.size()) + " edges";
+  if (stg.cp_length)
+    out += ", stated critical path " + std::to_string(*stg.cp_length) +
+           " units = " + std::to_string(*stg.cp_length * unit_ns) + " ns";
+  return out + "\nwrote " + output + "\n";
 }
 
 }  // namespace tgraph

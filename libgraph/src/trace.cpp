@@ -2,11 +2,26 @@
 // Trace and assignment helpers.
 #include "tgraph/graph/trace.hpp"
 
+#include <fstream>
 #include <numeric>
+#include <thread>
 
 #include "tgraph/graph/assignment.hpp"
 
 namespace tgraph {
+
+std::string machine_description() {
+  std::string model;
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0) {
+      if (auto colon = line.find(':'); colon != std::string::npos) model = line.substr(colon + 2);
+      break;
+    }
+  }
+  if (model.empty()) model = "unknown cpu";
+  return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
 
 bool contacts_changed(const Trace& trace, std::size_t i) {
   if (i == 0 || i >= trace.steps.size()) return false;

@@ -11,6 +11,7 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/partition/evaluate.hpp"
+#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {
 
@@ -189,6 +190,17 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
                        "step " + std::to_string(s) +
                            " was partitioned for a graph of another structure than " + trace_name +
                            "'s");
+  return a;
+}
+
+TraceAssignment load_or_partition(const Trace& trace, const std::string& path,
+                                  const std::string& method, std::uint32_t k) {
+  if (path.empty()) return partition_trace(trace, method, k, Options{}).assignment;
+  TraceAssignment a = read_assignment(path);
+  check_fits(trace, a, path);
+  if (a.k != k)
+    throw UsageError(path + ": assignment has k = " + std::to_string(a.k) + " but --threads is " +
+                     std::to_string(k));
   return a;
 }
 

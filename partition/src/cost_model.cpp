@@ -2,6 +2,7 @@
 #include "tgraph/partition/cost_model.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -91,6 +92,30 @@ std::string calibration_json(const Calibration& c) {
   j["buffer_bytes"] = c.buffer_bytes;
   j["tgraph_version"] = TGRAPH_VERSION;
   return j.dump(2) + "\n";
+}
+
+std::string save_calibration(const Calibration& c, const std::string& path) {
+  const std::string out = path.empty() ? default_calibration_path() : path;
+  const std::filesystem::path parent = std::filesystem::path(out).parent_path();
+  std::error_code ec;  // a failure shows in the write below, naming the file
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  write_file_atomic(out, calibration_json(c));
+  return out;
+}
+
+std::string calibration_report(const Calibration& c, const std::string& path, bool json) {
+  if (json) {
+    const nlohmann::json j = {{"sync_latency_ns", c.sync_latency_ns},
+                              {"per_byte_ns", c.per_byte_ns},
+                              {"cpus", {c.cpu_a, c.cpu_b}},
+                              {"output", path}};
+    return j.dump() + "\n";
+  }
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "signal/wait latency %.1f ns, transfer %.4f ns/byte (CPUs %d and %d)\n",
+                c.sync_latency_ns, c.per_byte_ns, c.cpu_a, c.cpu_b);
+  return line + ("wrote " + path + "\n");
 }
 
 }  // namespace tgraph::partition

@@ -141,6 +141,23 @@ std::string partition_json(const TracePartition& tp, const std::string& output) 
   return j.dump();
 }
 
+std::string partition_text(const TracePartition& tp, const std::string& output) {
+  const PartitionSummary s = summarize(tp.stats);
+  char line[512];
+  std::snprintf(line, sizeof line, "method %s, k = %u, %zu steps: %.3f ms partitioning",
+                tp.assignment.method.c_str(), tp.assignment.k, s.steps, s.partition_ms);
+  std::string out = line;
+  if (s.edgecut) out += ", edgecut " + std::to_string(*s.edgecut);
+  out += ", " + std::to_string(s.moved_tasks) + " tasks moved";
+  if (tp.assignment.method == "sticky")
+    out += " (steps: " + std::to_string(s.reused_steps) + " reused, " +
+           std::to_string(s.fallback_steps) + " fallback to a fresh partition + relabel, " +
+           std::to_string(s.rebalanced_steps) + " rebalanced)";
+  out += "\n";
+  if (!output.empty()) out += "wrote " + output + "\n";
+  return out;
+}
+
 std::string comparison_json(const Comparison& c, const std::string& trace_name) {
   json rows = json::array();
   for (const CompareRow& r : c.rows) {

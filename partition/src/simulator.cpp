@@ -231,4 +231,12 @@ Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& mode
   return Simulator(g, a, model).run();
 }
 
+std::vector<std::uint64_t> predicted_makespans(const Trace& trace, const TraceAssignment& a,
+                                               const CostModel& model) {
+  std::vector<std::uint64_t> out;
+  for (std::size_t s = 0; s < trace.steps.size() && s < a.steps.size(); ++s)
+    out.push_back(simulate(trace.steps[s], a.steps[s], model).makespan_ns);
+  return out;
+}
+
 }  // namespace tgraph::partition

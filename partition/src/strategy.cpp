@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -138,6 +139,26 @@ TracePartition partition_trace(const Trace& trace, std::string_view method, std:
     out.stats.push_back(r.stats);
   }
   return out;
+}
+
+CostModel NamedOptions::cost_model() const { return select_cost_model(model, calibration); }
+
+Options NamedOptions::options() const {
+  Options o = values;
+  o.objective = parse_objective(objective);
+  o.scotch = parse_scotch_flavour(scotch);
+  o.rebalance = parse_rebalance(rebalance);
+  o.sticky_fallback = parse_sticky_fallback(sticky_fallback);
+  o.model = cost_model();
+  return o;
+}
+
+StepPartitioner step_partitioner(std::string_view method, const Options& options) {
+  std::shared_ptr<Strategy> strategy = make_strategy(method);
+  return [strategy, options](const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
+                             const Assignment* prev) {
+    return strategy->partition(g, k, Previous{prev_graph, prev}, options).assignment;
+  };
 }
 
 namespace detail {

@@ -3,13 +3,14 @@
 #include "tgraph/replay/live.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <unordered_map>
 
-#include "tgraph/graph/error.hpp"
 #include "sync.hpp"
+#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
@@ -602,6 +603,40 @@ std::string to_json(const LiveResult& r) {
                                {"differing_bytes", r.difference->differing_bytes}};
   }
   return j.dump();
+}
+
+std::string to_json(const LiveResult& r, const std::string& scene, const std::string& method) {
+  auto j = nlohmann::json::parse(to_json(r));
+  j["scene"] = scene;
+  j["method"] = method;
+  return j.dump();
+}
+
+std::string to_text(const LiveResult& r, const std::string& scene, const std::string& method,
+                    std::uint32_t repeat) {
+  std::string out;
+  char line[512];
+  const auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 511)));
+  };
+  const auto ms = [](auto ns) { return static_cast<double>(ns) / 1e6; };
+  add(std::snprintf(
+      line, sizeof line, "run %s: %zu steps, %s (%s), %u threads, cw %s: %.3f ms (median of %u)\n",
+      scene.c_str(), r.steps.size(), std::string(to_string(r.policy)).c_str(), method.c_str(),
+      r.threads, std::string(to_string(r.cw)).c_str(), ms(r.wall_ns), repeat));
+  if (r.baseline_wall_ns > 0)
+    add(std::snprintf(line, sizeof line, "  uninstrumented engine %.3f ms   speed-up %.2f\n",
+                      ms(r.baseline_wall_ns), r.speedup));
+  const auto b = nlohmann::json::parse(to_json(r))["breakdown"];
+  add(std::snprintf(line, sizeof line,
+                    "  record %.3f ms, partition %.3f ms, plans %.3f ms, execute %.3f ms\n",
+                    b["record_ns"].get<double>() / 1e6, b["partition_ns"].get<double>() / 1e6,
+                    b["prepare_ns"].get<double>() / 1e6, b["execute_ns"].get<double>() / 1e6));
+  if (!r.check.empty())
+    add(std::snprintf(line, sizeof line, "  check against %s: %s (%zu data compared)\n",
+                      r.check_reference.c_str(), r.difference ? "DIFFERS" : "identical bit for bit",
+                      r.data_compared));
+  return out;
 }
 
 }  // namespace tgraph::replay

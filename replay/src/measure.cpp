@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
@@ -294,6 +295,54 @@ std::string to_json(const ReplayResult& r) {
     j["measured_over_predicted"] = nullptr;
   }
   return j.dump();
+}
+
+std::string to_json(const ReplayResult& r, const std::string& trace_name,
+                    const std::string& assignment) {
+  auto j = nlohmann::json::parse(to_json(r));
+  j["trace"] = trace_name;
+  j["assignment"] = assignment;
+  return j.dump();
+}
+
+std::string to_text(const ReplayResult& r, const std::string& trace_name, std::uint32_t repeat) {
+  std::string out;
+  char line[512];
+  const auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 511)));
+  };
+  const auto ms = [](auto ns) { return static_cast<double>(ns) / 1e6; };
+  const auto pred = r.predicted_makespan_ns();
+  std::int64_t measured_nobuild = 0;
+  for (const auto& m : r.steps) measured_nobuild += m.run_ns;
+  add(std::snprintf(line, sizeof line, "replay %s: %zu steps, policy %s, %u threads, cw %s\n",
+                    trace_name.c_str(), r.steps.size(), std::string(to_string(r.policy)).c_str(),
+                    r.threads, std::string(to_string(r.cw)).c_str()));
+  add(std::snprintf(line, sizeof line, "  wall            %10.3f ms (median of %u passes)\n",
+                    ms(r.wall_ns), repeat));
+  if (r.sequential_wall_ns > 0)
+    add(std::snprintf(
+        line, sizeof line,
+        "  sequential      %10.3f ms   speed-up %.2f   efficiency %.2f (bound %.2f)\n",
+        ms(r.sequential_wall_ns), r.speedup, r.efficiency, r.bound));
+  add(std::snprintf(line, sizeof line, "  work / span     %10.3f / %.3f ms\n", ms(r.work_ns),
+                    ms(r.span_ns)));
+  add(std::snprintf(line, sizeof line,
+                    "  signals %llu, waits %llu, wait time %.3f ms, plan builds %llu (%.3f ms)\n",
+                    static_cast<unsigned long long>(r.signals()),
+                    static_cast<unsigned long long>(r.waits()), ms(r.wait_ns()),
+                    static_cast<unsigned long long>(r.plans_built), ms(r.build_ns())));
+  add(std::snprintf(line, sizeof line, "  remote bytes %llu, migrated bytes %llu\n",
+                    static_cast<unsigned long long>(r.remote_bytes()),
+                    static_cast<unsigned long long>(r.migrated_bytes())));
+  if (pred)
+    add(std::snprintf(
+        line, sizeof line, "  predicted       %10.3f ms   measured/predicted %.3f\n", ms(*pred),
+        *pred ? static_cast<double>(measured_nobuild) / static_cast<double>(*pred) : 0.0));
+  add(std::snprintf(
+      line, sizeof line, "  cache misses    %s\n",
+      r.cache_misses ? std::to_string(*r.cache_misses).c_str() : r.cache_misses_note.c_str()));
+  return out;
 }
 
 }  // namespace tgraph::replay

@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "tgraph/replay/policy.hpp"
 
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+
 namespace tgraph::replay {
 
 std::string_view to_string(Policy policy) {
@@ -24,6 +28,22 @@ std::optional<Policy> parse_policy(std::string_view name) {
                    Policy::kStarpu})
     if (to_string(p) == name) return p;
   return std::nullopt;
+}
+
+Policy policy_flag(std::string_view name, std::string_view flag) {
+  if (const auto p = parse_policy(name)) return *p;
+  throw UsageError(std::string(flag) + " " + std::string(name) +
+                   ": expected partition, worksteal, barrier, starpu or sequential");
+}
+
+MethodChoice choose_method(std::string_view method, std::string_view policy) {
+  MethodChoice c{Policy::kPartition, std::string(method)};
+  if (const auto p = parse_policy(method); p && *p != Policy::kPartition)
+    c.policy = *p;
+  else if (method == "partition")
+    c.method = "owner";
+  if (!policy.empty()) c.policy = policy_flag(policy, "--policy");
+  return c;
 }
 
 std::string_view to_string(CwMode mode) {

@@ -1,8 +1,13 @@
 // SPDX-License-Identifier: MIT
 // The capture API: tasks, loops, stable keys, deferred mode.
+#include "tgraph/capture/recorder.hpp"
+
 #include <gtest/gtest.h>
 
-#include "tgraph/capture/recorder.hpp"
+#include <array>
+#include <ranges>
+#include <span>
+#include <vector>
 
 namespace tgraph::capture {
 namespace {
@@ -68,6 +73,49 @@ TEST(Recorder, CapturesTasksLoopsAndIterations) {
   // force -> integrate (f, RAW); x read by force then rewritten by integrate (WAR).
   EXPECT_NE(std::find(g.edges.begin(), g.edges.end(), Edge{0, 3, s.df, EdgeKind::RAW}), g.edges.end());
   EXPECT_NE(std::find(g.edges.begin(), g.edges.end(), Edge{0, 3, s.dx, EdgeKind::WAR}), g.edges.end());
+}
+
+TEST(Recorder, AccessesGivenAsAnyRangeRecordTheSameGraphAsAnInitializerList) {
+  // The same three tasks issued with an initializer list, then with a vector, an array, a
+  // span and a transformed view (non-contiguous: copied by the recorder).
+  const auto run = [](int form) {
+    Recorder rec(Mode::kCapture);
+    const ObjectId o = rec.object("o");
+    const DatumId a = rec.datum("a", o, 8), b = rec.datum("b", o, 8), c = rec.datum("c", o, 8);
+    const KindId k = rec.kind("k");
+    int ran = 0;
+    rec.begin_step();
+    const std::vector<Access> first = {{a, M::W}};
+    const std::array<Access, 2> second = {Access{a, M::R}, Access{b, M::CW}};
+    const std::vector<DatumId> readers = {a, b};
+    switch (form) {
+      case 0:
+        rec.task(k, o, {{a, M::W}}, [&] { ++ran; });
+        rec.task(k, o, {{a, M::R}, {b, M::CW}}, [&] { ++ran; });
+        rec.task(k, o, {{a, M::R}, {b, M::R}}, [&] { ++ran; });
+        break;
+      default:
+        rec.task(k, o, first, [&] { ++ran; });
+        rec.task(k, o, std::span<const Access>(second), [&] { ++ran; });
+        rec.task(k, o, readers | std::views::transform([](DatumId d) {
+                         return Access{d, M::R};
+                       }),
+                 [&] { ++ran; });
+        break;
+    }
+    rec.task(k, o, std::vector<Access>{{c, M::W}, {a, M::R}}, [&] { ++ran; });
+    StepGraph g = rec.end_step();
+    EXPECT_EQ(ran, 4);
+    EXPECT_EQ(rec.errors(), 0u);
+    for (Task& t : g.tasks) t.cost_ns = 0;  // measured times differ between the runs
+    return g;
+  };
+  const StepGraph listed = run(0), ranged = run(1);
+  ASSERT_EQ(listed.tasks.size(), 4u);
+  EXPECT_EQ(ranged.accesses, listed.accesses);
+  EXPECT_EQ(ranged.edges, listed.edges);
+  EXPECT_TRUE(ranged.same_structure(listed));
+  EXPECT_EQ(ranged.accesses_of(2)[1], (Access{1, M::R}));
 }
 
 TEST(Recorder, StableKeysRepeatAcrossStepsAndStructureIsEqual) {
@@ -197,7 +245,7 @@ TEST(Recorder, TaskCostsAreInNanoseconds) {
   });
   const StepGraph g = rec.end_step();
   EXPECT_GE(g.tasks[0].cost_ns, 4'900'000u);
-  EXPECT_LT(g.tasks[0].cost_ns, 50'000'000u);
+  EXPECT_LT(g.tasks[0].cost_ns, 2'000'000'000u);  // not µs, not ps: a loaded machine may stretch it
 }
 
 }  // namespace

@@ -6,8 +6,9 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
-#include <memory>
 #include <initializer_list>
+#include <memory>
+#include <ranges>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -130,24 +131,26 @@ class Recorder {
   /// Issues one task: runs (and in capture mode times) `body` now, or keeps it (deferred).
   template <class F>
   void task(KindId kind, ObjectId obj, std::initializer_list<Access> acc, F&& body) {
-    switch (mode_) {
-      case Mode::kOff:
-        body();
-        return;
-      case Mode::kCapture: {
-        if (!time_task_) {  // an untimed loop iteration (see kTimeEvery)
-          body();
-          record(kind, obj, acc.begin(), acc.size(), 0);
-          return;
-        }
-        const std::uint64_t t0 = detail::ticks();
-        body();
-        record(kind, obj, acc.begin(), acc.size(), detail::ticks() - t0);
-        return;
-      }
-      case Mode::kDeferred:
-        if (record(kind, obj, acc.begin(), acc.size(), 0)) bodies_.emplace_back(std::forward<F>(body));
-        return;
+    issue(kind, obj, acc.begin(), acc.size(), std::forward<F>(body));
+  }
+  /// Same, with the accesses in any range of Access: a std::vector or std::array built at
+  /// run time, a std::span, or a view yielding Access (copied into a buffer kept by the
+  /// recorder, so no allocation once it has grown).
+  ///
+  ///   std::vector<Access> acc = {{x, AccessMode::R}};
+  ///   for (DatumId f : touched) acc.push_back({f, AccessMode::CW});
+  ///   rec.task(add_force, obj, acc, [&] { ff.add_force(); });
+  template <std::ranges::input_range R, class F>
+  requires std::convertible_to<std::ranges::range_reference_t<R>, Access>
+  void task(KindId kind, ObjectId obj, R&& acc, F&& body) {
+    if constexpr (std::ranges::contiguous_range<R> && std::ranges::sized_range<R> &&
+                  std::same_as<std::ranges::range_value_t<R>, Access>) {
+      issue(kind, obj, std::ranges::data(acc), std::ranges::size(acc), std::forward<F>(body));
+    } else {
+      range_buffer_.clear();
+      if (mode_ != Mode::kOff)
+        for (auto&& a : acc) range_buffer_.push_back(static_cast<Access>(a));
+      issue(kind, obj, range_buffer_.data(), range_buffer_.size(), std::forward<F>(body));
     }
   }
 
@@ -208,6 +211,28 @@ class Recorder {
   std::uint64_t errors() const { return errors_; }
 
  private:
+  template <class F>
+  void issue(KindId kind, ObjectId obj, const Access* acc, std::size_t n, F&& body) {
+    switch (mode_) {
+      case Mode::kOff:
+        body();
+        return;
+      case Mode::kCapture: {
+        if (!time_task_) {  // an untimed loop iteration (see kTimeEvery)
+          body();
+          record(kind, obj, acc, n, 0);
+          return;
+        }
+        const std::uint64_t t0 = detail::ticks();
+        body();
+        record(kind, obj, acc, n, detail::ticks() - t0);
+        return;
+      }
+      case Mode::kDeferred:
+        if (record(kind, obj, acc, n, 0)) bodies_.emplace_back(std::forward<F>(body));
+        return;
+    }
+  }
   // `ticks` are detail::ticks() units. Returns true when a new task was appended (false for
   // later loop iterations, whose costs add to the task recorded in the first one).
   bool record(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ticks) {
@@ -246,6 +271,7 @@ class Recorder {
   std::uint64_t step_ticks_ = 0;
   std::vector<std::function<void()>> bodies_;
   std::vector<std::function<bool()>> conditions_;
+  std::vector<Access> range_buffer_;  // accesses of task() given as a non-contiguous range
   LoopId open_loop_ = kNoLoop;
   std::uint32_t iteration_ = 0;          // current iteration of the open loop (0-based)
   std::uint32_t replay_pos_ = 0;         // next body task to match in iterations > 0

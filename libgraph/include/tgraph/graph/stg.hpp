@@ -27,4 +27,9 @@ StgGraph parse_stg(std::string_view text, const std::string& name, std::uint64_t
 StgGraph read_stg(const std::string& path, std::uint64_t unit_ns = 1000,
                   std::uint64_t edge_bytes = 8);
 
+/// `tgraph import`'s report on `g` read from `input` and written to `output`: one JSON object
+/// (input, output, tasks, edges, unit_ns, cp_length) or a text line and "wrote ...".
+std::string stg_import_report(const StgGraph& g, const std::string& input,
+                              const std::string& output, std::uint64_t unit_ns, bool json);
+
 }  // namespace tgraph

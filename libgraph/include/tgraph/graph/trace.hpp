@@ -25,6 +25,9 @@ struct Trace {
   friend bool operator==(const Trace&, const Trace&) = default;
 };
 
+/// This machine for trace headers: "<cpu model>, N hardware threads".
+std::string machine_description();
+
 /// True when the contact set of step `i` differs from step `i - 1` (false for step 0).
 bool contacts_changed(const Trace& trace, std::size_t i);
 

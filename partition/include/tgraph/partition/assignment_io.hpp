@@ -39,4 +39,10 @@ void write_assignment(const std::string& path, const TraceAssignment& a, const T
 TraceAssignment load_assignment(const std::string& path, const Trace& trace,
                                 const std::string& trace_name);
 
+/// The assignment `tgraph replay` runs on `k` threads: the .tga file `path` (checked against
+/// `trace`, and its K against `k`: UsageError) or, when `path` is empty, `method` applied to
+/// every step.
+TraceAssignment load_or_partition(const Trace& trace, const std::string& path,
+                                  const std::string& method, std::uint32_t k);
+
 }  // namespace tgraph::partition

@@ -29,6 +29,9 @@ PartitionSummary summarize(const std::vector<Stats>& stats);
 
 /// `tgraph partition --json`: method, k, the summary, `output` and one object per step.
 std::string partition_json(const TracePartition& tp, const std::string& output);
+/// `tgraph partition`'s text: method, K, time, edgecut, moves (sticky: reused, fallback,
+/// rebalanced steps), and the file written when `output` is not empty.
+std::string partition_text(const TracePartition& tp, const std::string& output);
 
 /// One cell of the grid: a method at one K, partitioned and evaluated.
 struct CompareRow {

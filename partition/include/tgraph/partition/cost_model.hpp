@@ -61,5 +61,10 @@ struct CalibrateOptions {
 Calibration measure_calibration(const CalibrateOptions& options = {});
 /// The calibration file's JSON text.
 std::string calibration_json(const Calibration& c);
+/// Writes calibration_json(c) to `path` atomically (default_calibration_path() when empty),
+/// creating its folder; returns the path written.
+std::string save_calibration(const Calibration& c, const std::string& path = "");
+/// `tgraph calibrate`'s report of a saved calibration: one JSON object, or two lines.
+std::string calibration_report(const Calibration& c, const std::string& path, bool json);
 
 }  // namespace tgraph::partition

@@ -7,6 +7,7 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
 #include "tgraph/partition/cost_model.hpp"
 
 namespace tgraph::partition {
@@ -40,5 +41,10 @@ struct Schedule {
 ///
 /// Throws tgraph::Error when `a` does not fit `g` or its order deadlocks.
 Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model);
+
+/// The simulated makespan of every step of `trace` under `a` (one per step), what `tgraph
+/// replay` reports as predicted.
+std::vector<std::uint64_t> predicted_makespans(const Trace& trace, const TraceAssignment& a,
+                                               const CostModel& model);
 
 }  // namespace tgraph::partition

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -68,6 +69,23 @@ struct Options {
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
 };
 
+/// Options with their enumerations and cost model by name, as the command line and scripts
+/// give them; options() checks the names (UsageError) and loads the model.
+struct NamedOptions {
+  Options values;                         ///< numbers and the sticky base method
+  std::string objective = "cut";          ///< cut, vol
+  std::string scotch = "quality";         ///< default, quality, speed, balance
+  std::string rebalance = "greedy";       ///< greedy, scotch
+  std::string sticky_fallback = "fresh";  ///< fresh, repartition
+  std::string model = "calibrated";       ///< calibrated, ideal (select_cost_model)
+  std::string calibration;                ///< calibration file ("": the default one if present)
+
+  /// The cost model named by `model` and `calibration`.
+  CostModel cost_model() const;
+  /// `values` with the named enumerations and the cost model filled in.
+  Options options() const;
+};
+
 /// The previous step, for incremental strategies (both null for the first step).
 struct Previous {
   const StepGraph* graph = nullptr;
@@ -127,6 +145,13 @@ struct TracePartition {
 /// step and its assignment (what `sticky` needs).
 TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
                                const Options& options = {});
+
+/// Partitions one step given the previous one (null at the first step): the callback a live
+/// run calls at each step (the same type as replay::LivePartitioner).
+using StepPartitioner = std::function<Assignment(
+    const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph, const Assignment* prev)>;
+/// Strategy `method` as a StepPartitioner (UsageError for an unknown name).
+StepPartitioner step_partitioner(std::string_view method, const Options& options = {});
 
 /// Renames the K part labels of `a` (a partition of `g`) so that as many tasks as possible,
 /// matched in `prev` by stable key and counted once each, keep their previous processor: an

@@ -93,7 +93,7 @@ struct LiveStep {
 };
 
 /// The engine side of a live run (the physics engine behind a small interface; see the
-/// adapter over samples::Scene in apps/live_scene.cpp).
+/// adapter over samples::Scene in samples/src/live_engine.cpp).
 class LiveEngine {
  public:
   virtual ~LiveEngine() = default;
@@ -205,5 +205,11 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
 
 /// The result as one JSON object (keys as `tgraph replay --json` where they mean the same).
 std::string to_json(const LiveResult& r);
+/// `tgraph run --json`: to_json(r) plus the scene and the method (strategy or policy).
+std::string to_json(const LiveResult& r, const std::string& scene, const std::string& method);
+/// `tgraph run`'s text report of `r`: a run of `scene` with `method` (strategy or policy),
+/// `repeat` timed passes; the check line when one was made.
+std::string to_text(const LiveResult& r, const std::string& scene, const std::string& method,
+                    std::uint32_t repeat);
 
 }  // namespace tgraph::replay

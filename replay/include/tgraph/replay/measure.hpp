@@ -107,5 +107,11 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
 /// The result as one JSON object (keys: policy, threads, steps, wall_ns, per_step, speedup,
 /// efficiency, signals, wait_ns, remote_bytes, migrated_bytes, predicted_makespan_ns, ...).
 std::string to_json(const ReplayResult& r);
+/// `tgraph replay --json`: to_json(r) plus the trace's name and how its assignment was
+/// obtained (a .tga path, "<method> (computed)", or "" for the other policies).
+std::string to_json(const ReplayResult& r, const std::string& trace_name,
+                    const std::string& assignment);
+/// `tgraph replay`'s text report of `r`, a replay of `trace_name` with `repeat` passes.
+std::string to_text(const ReplayResult& r, const std::string& trace_name, std::uint32_t repeat);
 
 }  // namespace tgraph::replay

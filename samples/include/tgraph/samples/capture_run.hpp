@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+// Driving the engine for `tgraph capture`: a scene stepped N times through a Recorder, every
+// step streamed to a .tgt trace, with per-step figures; and the trace header of a scene.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/samples/scene.hpp"
+
+namespace tgraph::samples {
+
+/// What to capture (the flags of `tgraph capture`).
+struct CaptureOptions {
+  std::string scene;           ///< built-in scene name or scene file
+  std::optional<int> steps;    ///< default: the scene's
+  std::string output;          ///< .tgt to write; required unless `no_capture`
+  SceneOptions scene_options;  ///< dt, seed, sub-objects, coupling
+  bool no_capture = false;     ///< run uninstrumented (Mode::kOff), write nothing
+  bool progress = false;       ///< a progress line on stderr
+  /// Called with each of the scene's warnings (unstable dt...) before the first step.
+  std::function<void(const std::string&)> warn;
+};
+
+/// What a capture did.
+struct CaptureRun {
+  std::string scene;
+  std::string mode;  ///< "capture" or "off"
+  int steps = 0;
+  double seconds = 0.0;     ///< engine time (steps, recording included)
+  std::uint64_t tasks = 0;  ///< over all steps
+  std::uint64_t file_bytes = 0;
+  double dt = 0.0;
+  std::size_t bodies = 0;
+  std::vector<double> step_ms;
+  std::vector<std::uint32_t> cg_iterations;
+  std::vector<std::uint32_t> groups;  ///< collision groups after each step
+};
+
+/// The work of a capture failed (a diverging simulation, a failed write, API misuse): the
+/// message says what and where the complete steps before it are (exit status 1).
+class CaptureFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Runs the capture. Bad options or scene: tgraph::Error; failure of the run: CaptureFailure
+/// (the steps written before stay in `<output>.partial`, readable with --recover).
+///
+///   CaptureRun r = capture_scene({.scene = "bars64", .steps = 20, .output = "b.tgt"});
+CaptureRun capture_scene(const CaptureOptions& options);
+
+/// `tgraph capture --json`: one JSON object.
+std::string capture_json(const CaptureRun& run, const CaptureOptions& options);
+/// `tgraph capture`'s line.
+std::string capture_text(const CaptureRun& run, const CaptureOptions& options);
+
+/// Header of a trace captured from `scene` (engine, integrator, dt, seed, this machine).
+TraceHeader scene_header(const Scene& scene, std::uint64_t seed);
+
+}  // namespace tgraph::samples
