@@ -44,7 +44,8 @@ Trace capture_scene(const DemoOptions& o) {
     scene->step(rec);
     trace.steps.push_back(rec.end_step());
   }
-  if (rec.errors() != 0) throw Failure("demo: the capture API reported " + std::to_string(rec.errors()) + " misuses");
+  if (rec.errors() != 0)
+    throw Failure("demo: the capture API reported " + std::to_string(rec.errors()) + " misuses");
   return trace;
 }
 
@@ -66,7 +67,8 @@ void fill_measured(viz::MethodRow& row, const tr::ReplayResult& r) {
 }
 
 // Replays the chosen method once more on its first steps, observed, for the report's timeline.
-viz::Timeline observed_timeline(const Trace& trace, const TraceAssignment& a, const DemoOptions& o) {
+viz::Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
+                                const DemoOptions& o) {
   tr::ReplayOptions ro;
   ro.exec.threads = o.threads;
   ro.repeat = 1;
@@ -99,7 +101,8 @@ void run_demo(const DemoOptions& o) {
   ks.push_back(o.threads);
   for (const std::string& method : tp::strategy_names()) {
     if (method == "single") continue;  // the null strategy: everything on processor 0
-    say("partitioning with " + method + " and replaying on " + std::to_string(o.threads) + " threads...");
+    say("partitioning with " + method + " and replaying on " + std::to_string(o.threads) +
+        " threads...");
     for (std::uint32_t k : ks) {
       const tp::TracePartition part = tp::partition_trace(trace, method, k);
       const tp::Report ev = tp::evaluate(trace, part.assignment, model, method);
@@ -154,54 +157,66 @@ void run_demo(const DemoOptions& o) {
   for (std::size_t i = 0; i < assignments.size(); ++i)
     if (rows[i].speedup.value_or(0) > rows[best].speedup.value_or(0)) best = i;
   const std::size_t graph_step = trace.steps.size() > 1 ? 1 : 0;
-  viz::ReportContent c = viz::report_content(trace, trace_path, &assignments[best].steps[graph_step], graph_step,
-                                             rows[best].method);
-  c.title = "tgraph demo: " + o.scene + ", " + std::to_string(o.steps) + " steps, " + std::to_string(o.threads) +
-            " threads";
-  c.notes = {"Wall times are medians of " + std::to_string(o.repeat) +
-             " passes; speed-up is against sequential replay timed in the same run. Predicted speed-ups "
-             "come from the calibrated cost model (tgraph evaluate)."};
+  viz::ReportContent c = viz::report_content(
+      trace, trace_path, &assignments[best].steps[graph_step], graph_step, rows[best].method);
+  c.title = "tgraph demo: " + o.scene + ", " + std::to_string(o.steps) + " steps, " +
+            std::to_string(o.threads) + " threads";
+  c.notes = {
+      "Wall times are medians of " + std::to_string(o.repeat) +
+      " passes; speed-up is against sequential replay timed in the same run. Predicted speed-ups "
+      "come from the calibrated cost model (tgraph evaluate)."};
   c.rows = rows;
   c.rows.insert(c.rows.end(), predictions.begin(), predictions.end());
   c.series = series;
   say("observing " + rows[best].method + " for the timeline...");
   c.timeline = observed_timeline(trace, assignments[best], o);
-  c.timeline_caption = rows[best].method + " on " + std::to_string(o.threads) + " threads, observed pass.";
+  c.timeline_caption =
+      rows[best].method + " on " + std::to_string(o.threads) + " threads, observed pass.";
   const std::string report_path = o.out_dir + "/report.html";
   write_file_atomic(report_path, viz::report_html(c));
 
   if (o.json) {
-    nlohmann::json j = {{"scene", o.scene}, {"steps", o.steps}, {"threads", o.threads},
-                        {"trace", trace_path}, {"report", report_path}, {"rows", nlohmann::json::array()}};
+    nlohmann::json j = {{"scene", o.scene},      {"steps", o.steps},
+                        {"threads", o.threads},  {"trace", trace_path},
+                        {"report", report_path}, {"rows", nlohmann::json::array()}};
     for (const viz::MethodRow& r : rows)
-      j["rows"].push_back({{"method", r.method}, {"partitioned", r.partitioned}, {"partition_ms", r.partition_ms},
-                           {"imbalance", r.imbalance}, {"cut_bytes", r.cut_bytes},
-                           {"migrated_tasks", r.migrated_tasks}, {"predicted_speedup", r.predicted_speedup.value_or(0)},
+      j["rows"].push_back({{"method", r.method},
+                           {"partitioned", r.partitioned},
+                           {"partition_ms", r.partition_ms},
+                           {"imbalance", r.imbalance},
+                           {"cut_bytes", r.cut_bytes},
+                           {"migrated_tasks", r.migrated_tasks},
+                           {"predicted_speedup", r.predicted_speedup.value_or(0)},
                            {"wall_ns", r.measured_ms.value_or(0) * 1e6},
                            {"sequential_wall_ns", r.sequential_ms.value_or(0) * 1e6},
-                           {"speedup", r.speedup.value_or(0)}, {"efficiency", r.efficiency.value_or(0)},
+                           {"speedup", r.speedup.value_or(0)},
+                           {"efficiency", r.efficiency.value_or(0)},
                            {"signals", r.signals.value_or(0)},
-                           {"replay_failure", r.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.failure)}});
+                           {"replay_failure", r.failure.empty() ? nlohmann::json(nullptr)
+                                                                : nlohmann::json(r.failure)}});
     print_json(j);
     return;
   }
-  std::printf("\n%s: %d steps, %llu tasks/step, parallelism %.1f, %u threads (replay: medians of %u passes)\n\n",
-              o.scene.c_str(), o.steps, static_cast<unsigned long long>(m0.tasks), m0.parallelism, o.threads,
-              o.repeat);
+  std::printf(
+      "\n%s: %d steps, %llu tasks/step, parallelism %.1f, %u threads (replay: medians of %u "
+      "passes)\n\n",
+      o.scene.c_str(), o.steps, static_cast<unsigned long long>(m0.tasks), m0.parallelism,
+      o.threads, o.repeat);
   std::printf("%-13s %10s %9s %12s %9s %10s %11s %11s %8s %6s\n", "method", "part. ms", "imbalance",
               "cut bytes", "migrated", "predicted", "replay ms", "seq. ms", "speedup", "eff.");
   for (const viz::MethodRow& r : rows) {
     if (r.partitioned)
-      std::printf("%-13s %10.2f %9.3f %12llu %9llu %9.2fx", r.method.c_str(), r.partition_ms, r.imbalance,
-                  static_cast<unsigned long long>(r.cut_bytes), static_cast<unsigned long long>(r.migrated_tasks),
+      std::printf("%-13s %10.2f %9.3f %12llu %9llu %9.2fx", r.method.c_str(), r.partition_ms,
+                  r.imbalance, static_cast<unsigned long long>(r.cut_bytes),
+                  static_cast<unsigned long long>(r.migrated_tasks),
                   r.predicted_speedup.value_or(0));
     else
       std::printf("%-13s %10s %9s %12s %9s %10s", r.method.c_str(), "-", "-", "-", "-", "-");
     if (!r.failure.empty())
       std::printf("  replay failed: %s\n", r.failure.c_str());
     else
-      std::printf(" %11.2f %11.2f %7.2fx %6.2f\n", r.measured_ms.value_or(0), r.sequential_ms.value_or(0),
-                  r.speedup.value_or(0), r.efficiency.value_or(0));
+      std::printf(" %11.2f %11.2f %7.2fx %6.2f\n", r.measured_ms.value_or(0),
+                  r.sequential_ms.value_or(0), r.speedup.value_or(0), r.efficiency.value_or(0));
   }
   std::printf("\ntrace: %s\nreport: %s\n", trace_path.c_str(), report_path.c_str());
 }
@@ -210,7 +225,8 @@ void run_demo(const DemoOptions& o) {
 
 void add_demo(CLI::App& app) {
   auto o = std::make_shared<DemoOptions>();
-  auto* cmd = app.add_subcommand("demo", "Default job: capture, partition with every strategy, replay, compare");
+  auto* cmd = app.add_subcommand(
+      "demo", "Default job: capture, partition with every strategy, replay, compare");
   cmd->add_option("--scene", o->scene, "Built-in scene or scene file");
   cmd->add_option("--steps", o->steps, "Steps to capture");
   cmd->add_option("--threads", o->threads, "Replay threads (default: all hardware threads)");

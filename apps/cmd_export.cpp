@@ -56,10 +56,12 @@ void run_export(const ExportOptions& o) {
 void add_export(CLI::App& app) {
   auto o = std::make_shared<ExportOptions>();
   auto* cmd = app.add_subcommand("export", "Write one step's graph in an interchange format");
-  cmd->add_option("input", o->trace, "Trace file (.tgt); for chrome, a replay timeline (R.json)")->required();
+  cmd->add_option("input", o->trace, "Trace file (.tgt); for chrome, a replay timeline (R.json)")
+      ->required();
   cmd->add_option("--step", o->step, "Step index (0-based)");
   cmd->add_option("--format", o->format,
-                  "json, metis (gpmetis input), scotch (scotch_gpart input), chrome (timeline -> trace-event JSON)")
+                  "json, metis (gpmetis input), scotch (scotch_gpart input), chrome (timeline -> "
+                  "trace-event JSON)")
       ->check(CLI::IsMember({"json", "metis", "scotch", "chrome"}));
   cmd->add_option("-o,--output", o->out, "Output file (default: standard output)");
   cmd->callback([o] { run_export(*o); });

@@ -13,8 +13,10 @@ void add_timeline(CLI::App& app) {
     std::string input, out, steps;
   };
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("timeline", "Draw a replay timeline (tgraph replay --timeline) as a Gantt chart");
-  cmd->add_option("timeline", o->input, "Timeline file (JSON from tgraph replay --timeline)")->required();
+  auto* cmd = app.add_subcommand(
+      "timeline", "Draw a replay timeline (tgraph replay --timeline) as a Gantt chart");
+  cmd->add_option("timeline", o->input, "Timeline file (JSON from tgraph replay --timeline)")
+      ->required();
   cmd->add_option("--steps", o->steps, "Step range a:b, a: or a (default: all)");
   cmd->add_option("-o,--output", o->out, "Output file: .svg or .png")->required();
   cmd->callback([o] {
@@ -25,8 +27,9 @@ void add_timeline(CLI::App& app) {
       t = viz::select_steps(t, a, b);
     }
     const std::string title = std::filesystem::path(o->input).filename().string() + ": " +
-                              std::to_string(t.threads) + " threads, " + std::to_string(t.tasks.size()) +
-                              " task instances, " + std::to_string(t.waits.size()) + " blocking waits";
+                              std::to_string(t.threads) + " threads, " +
+                              std::to_string(t.tasks.size()) + " task instances, " +
+                              std::to_string(t.waits.size()) + " blocking waits";
     write_file_atomic(o->out, viz::render_timeline(t, format, title));
   });
 }

@@ -49,14 +49,19 @@ void run_viz(const VizCmd& c) {
 
 void add_viz_verbs(CLI::App& app) {
   auto c = std::make_shared<VizCmd>();
-  auto* cmd = app.add_subcommand("viz", "Draw one step's dataflow graph (DOT, SVG, PNG or PDF by extension)");
+  auto* cmd = app.add_subcommand(
+      "viz", "Draw one step's dataflow graph (DOT, SVG, PNG or PDF by extension)");
   cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
   cmd->add_option("--step", c->step, "Step index (0-based; default 0)");
-  cmd->add_option("--assign", c->assignment, "Assignment (.tga): colours by processor, signal/wait/reducer nodes");
+  cmd->add_option("--assign", c->assignment,
+                  "Assignment (.tga): colours by processor, signal/wait/reducer nodes");
   cmd->add_option("--collapse", c->collapse, "none (default), object, kind, processor or loop");
-  cmd->add_flag("--critical-path", c->critical_path, "Highlight the critical path (loops unrolled)");
-  cmd->add_option("--max-nodes", c->max_nodes, "Refuse pictures with more nodes (default 2000; 0: no limit)");
-  cmd->add_option("--max-edges", c->max_edges, "Refuse pictures with more edges (default 4000; 0: no limit)");
+  cmd->add_flag("--critical-path", c->critical_path,
+                "Highlight the critical path (loops unrolled)");
+  cmd->add_option("--max-nodes", c->max_nodes,
+                  "Refuse pictures with more nodes (default 2000; 0: no limit)");
+  cmd->add_option("--max-edges", c->max_edges,
+                  "Refuse pictures with more edges (default 4000; 0: no limit)");
   cmd->add_option("-o,--output", c->out, "Output file: .dot, .svg, .png or .pdf")->required();
   cmd->callback([c] { run_viz(*c); });
   add_timeline(app);

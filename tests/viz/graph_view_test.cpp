@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Step graph pictures: golden DOT text, dot's acceptance, collapsed totals, refusals, the
 // critical path.
+#include "tgraph/viz/graph_view.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -17,7 +19,6 @@
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/critical_path.hpp"
-#include "tgraph/viz/graph_view.hpp"
 #include "tgraph/viz/graphviz.hpp"
 
 namespace tgraph::viz {
@@ -96,17 +97,20 @@ std::string read_text(const std::string& path) {
 void expect_golden(const std::string& name, const std::string& dot) {
   const std::string path = std::string(TGRAPH_VIZ_GOLDEN) + "/" + name + ".dot";
   if (std::getenv("TGRAPH_UPDATE_GOLDEN")) write_file_atomic(path, dot);
-  ASSERT_TRUE(std::filesystem::exists(path)) << path << " missing (TGRAPH_UPDATE_GOLDEN=1 writes it)";
+  ASSERT_TRUE(std::filesystem::exists(path))
+      << path << " missing (TGRAPH_UPDATE_GOLDEN=1 writes it)";
   EXPECT_EQ(dot, read_text(path)) << "DOT differs from " << path;
 }
 
 // `dot -Tsvg` accepts the text and writes an SVG document.
 void expect_dot_accepts(const std::string& dot, const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("tgraph_viz_test_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("tgraph_viz_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string in = (dir / (name + ".dot")).string(), out = (dir / (name + ".svg")).string();
   write_file_atomic(in, dot);
-  const std::string cmd = std::string(TGRAPH_DOT) + " -Tsvg '" + in + "' -o '" + out + "' 2>/dev/null";
+  const std::string cmd =
+      std::string(TGRAPH_DOT) + " -Tsvg '" + in + "' -o '" + out + "' 2>/dev/null";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << name;
   EXPECT_NE(read_text(out).find("<svg"), std::string::npos) << name;
   std::filesystem::remove_all(dir);
@@ -187,7 +191,8 @@ TEST(GraphView, CollapsedBars64HasOneNodePerObjectAndLoopWithSummedWork) {
   std::uint64_t total = 0;
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     const Task& task = g.tasks[t];
-    const std::string key = task.object == kNoObject ? "k" + std::to_string(task.kind) : "o" + std::to_string(task.object);
+    const std::string key = task.object == kNoObject ? "k" + std::to_string(task.kind)
+                                                     : "o" + std::to_string(task.object);
     expected[{key, task.loop}] += task.cost_ns * g.runs(t);
     total += task.cost_ns * g.runs(t);
   }
@@ -277,7 +282,8 @@ TEST(GraphView, RejectsAnAssignmentThatDoesNotFit) {
 
 TEST(CriticalPath, LengthIsTheSpanOnRandomGraphsWithLoops) {
   for (std::uint64_t seed = 1; seed <= 200; ++seed) {
-    const StepGraph g = partition::testing::random_graph(seed, 6 + static_cast<int>(seed % 20), 5, seed % 2 == 0);
+    const StepGraph g =
+        partition::testing::random_graph(seed, 6 + static_cast<int>(seed % 20), 5, seed % 2 == 0);
     const CriticalPath cp = critical_path(g);
     EXPECT_EQ(cp.length_ns, compute_metrics(g).span_ns) << "seed " << seed;
     std::uint64_t sum = 0;

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Timelines (parsing, Gantt rendering, Chrome flows) and the HTML report.
+#include "tgraph/viz/timeline.hpp"
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -8,7 +10,6 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/report.hpp"
-#include "tgraph/viz/timeline.hpp"
 
 namespace tgraph::viz {
 namespace {
@@ -31,10 +32,11 @@ TEST(Timeline, ParsesAndLaysStepsEndToEnd) {
 }
 
 TEST(Timeline, RejectsMalformedInputNamingTheFile) {
-  for (const char* bad : {"", "[]", R"({"tasks":3})", R"({"tasks":[{"step":0}]})",
-                          R"({"threads":1,"tasks":[{"step":0,"thread":3,"task":0,"start_ns":0,"end_ns":1}]})",
-                          R"({"tasks":[{"step":0,"thread":0,"task":0,"start_ns":5,"end_ns":1}]})",
-                          R"({"tasks":[{"step":-1,"thread":0,"task":0,"start_ns":0,"end_ns":1}]})"}) {
+  for (const char* bad :
+       {"", "[]", R"({"tasks":3})", R"({"tasks":[{"step":0}]})",
+        R"({"threads":1,"tasks":[{"step":0,"thread":3,"task":0,"start_ns":0,"end_ns":1}]})",
+        R"({"tasks":[{"step":0,"thread":0,"task":0,"start_ns":5,"end_ns":1}]})",
+        R"({"tasks":[{"step":-1,"thread":0,"task":0,"start_ns":0,"end_ns":1}]})"}) {
     try {
       parse_timeline(bad, "bad.json");
       ADD_FAILURE() << "accepted: " << bad;
@@ -112,7 +114,8 @@ TEST(Report, PageIsSelfContainedWithOneContainerPerChart) {
   c.series.push_back({"metis", 2, {0.1, 0.2, 0.3}, {0, 1, 0}});
   c.timeline = parse_timeline(kTimeline, "t.json");
   const std::string html = report_html(c);
-  for (const char* id : {"chart-speedup", "chart-methods", "chart-partition-time", "chart-migrations", "chart-timeline"})
+  for (const char* id : {"chart-speedup", "chart-methods", "chart-partition-time",
+                         "chart-migrations", "chart-timeline"})
     EXPECT_NE(html.find(std::string("id=\"") + id + "\""), std::string::npos) << id;
   EXPECT_EQ(html.find("<script src"), std::string::npos);
   EXPECT_EQ(html.find("cdn"), std::string::npos);

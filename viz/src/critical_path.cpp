@@ -39,10 +39,14 @@ struct Origin {
 
 const char* to_string(PathLink link) {
   switch (link) {
-    case PathLink::kStart: return "start";
-    case PathLink::kEdge: return "edge";
-    case PathLink::kCarried: return "carried";
-    case PathLink::kLoopGate: return "loop gate";
+    case PathLink::kStart:
+      return "start";
+    case PathLink::kEdge:
+      return "edge";
+    case PathLink::kCarried:
+      return "carried";
+    case PathLink::kLoopGate:
+      return "loop gate";
   }
   return "?";
 }

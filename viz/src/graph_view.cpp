@@ -68,7 +68,9 @@ class TaskViewBuilder {
   }
 
  private:
-  static EdgeStyle style_of(EdgeKind k) { return k == EdgeKind::RAW ? EdgeStyle::kData : EdgeStyle::kOrder; }
+  static EdgeStyle style_of(EdgeKind k) {
+    return k == EdgeKind::RAW ? EdgeStyle::kData : EdgeStyle::kOrder;
+  }
 
   ProcId proc_of(std::uint32_t node) const { return v_.nodes[node].procs.front().proc; }
 
@@ -175,9 +177,9 @@ class TaskViewBuilder {
     for (std::uint32_t i = 0; i < groups.size(); ++i) {
       const Group& gr = groups[i];
       if (!gr.spans) continue;
-      reducer[i] = add_sync_node(NodeKind::kReducer, "r", gr.home, gr.loop,
-                                 {"reduce", g_.data[gr.datum].name,
-                                  std::to_string(gr.writers.size()) + " writers"});
+      reducer[i] = add_sync_node(
+          NodeKind::kReducer, "r", gr.home, gr.loop,
+          {"reduce", g_.data[gr.datum].name, std::to_string(gr.writers.size()) + " writers"});
       v_.nodes[reducer[i]].procs.front().proc = gr.home;
     }
     auto group_at = [&](std::uint32_t task, DatumId d) {
@@ -194,7 +196,8 @@ class TaskViewBuilder {
         continue;
       }
       writer_critical[{d.from, gi}] += d.critical;
-      const auto key = std::make_tuple(reducer[gi], d.to, d.datum, static_cast<int>(d.kind), d.carried);
+      const auto key =
+          std::make_tuple(reducer[gi], d.to, d.datum, static_cast<int>(d.kind), d.carried);
       auto [it, fresh] = merged.try_emplace(key, out.size());
       if (fresh) {
         Dep r = d;
@@ -335,7 +338,7 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
       shares.emplace_back();
       body.push_back(single ? kNoLoop : task.loop);
       names.push_back(single && task.object != kNoObject ? name + "\n" + g.objects[task.object].name
-                                                          : name);
+                                                         : name);
     }
     const std::uint32_t k = it->second;
     node_of[t] = k;
@@ -369,14 +372,16 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
       n.lines.back() = "p" + std::to_string(n.procs.front().proc) + " \xC2\xB7 " + n.lines.back();
     } else if (n.procs.size() > 1) {
       std::vector<ProcessorShare> by_work = n.procs;
-      std::stable_sort(by_work.begin(), by_work.end(),
-                       [](const ProcessorShare& x, const ProcessorShare& y) { return x.work_ns > y.work_ns; });
+      std::stable_sort(
+          by_work.begin(), by_work.end(),
+          [](const ProcessorShare& x, const ProcessorShare& y) { return x.work_ns > y.work_ns; });
       std::string mix;
       for (std::size_t i = 0; i < by_work.size() && i < 3; ++i) {
         const double pct = n.work_ns == 0 ? 0.0
                                           : 100.0 * static_cast<double>(by_work[i].work_ns) /
                                                 static_cast<double>(n.work_ns);
-        mix += (i ? " \xC2\xB7 " : "") + ("p" + std::to_string(by_work[i].proc)) + " " + sig3(pct) + "%";
+        mix += (i ? " \xC2\xB7 " : "") + ("p" + std::to_string(by_work[i].proc)) + " " + sig3(pct) +
+               "%";
       }
       if (by_work.size() > 3) mix += " \xC2\xB7 +" + std::to_string(by_work.size() - 3);
       n.lines.push_back(mix);
@@ -425,11 +430,11 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
     n.kind = NodeKind::kDatum;
     n.loop = loop;
     const char* verb = static_cast<EdgeKind>(kind) == EdgeKind::RAW ? " read by " : " before ";
-    n.lines = {g.data[datum].name,
-               std::to_string(src.size()) + (carried ? " (previous it.)" : "") + verb +
-                   std::to_string(targets.size())};
+    n.lines = {g.data[datum].name, std::to_string(src.size()) + (carried ? " (previous it.)" : "") +
+                                       verb + std::to_string(targets.size())};
     v.nodes.push_back(std::move(n));
-    for (TaskId t : targets) hub_of[{datum, kind, carried, t}] = static_cast<std::uint32_t>(v.nodes.size() - 1);
+    for (TaskId t : targets)
+      hub_of[{datum, kind, carried, t}] = static_cast<std::uint32_t>(v.nodes.size() - 1);
   }
 
   struct Agg {
@@ -462,7 +467,8 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
       agg.data_flow = true;
     }
     if (cross) ++ve.cross_deps;
-    if (agg.data.size() < 2 && std::find(agg.data.begin(), agg.data.end(), e.datum) == agg.data.end())
+    if (agg.data.size() < 2 &&
+        std::find(agg.data.begin(), agg.data.end(), e.datum) == agg.data.end())
       agg.data.push_back(e.datum);
   };
   // (source task, hub) -> whether one of its dependencies through the hub crosses processors.
@@ -496,11 +502,14 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
   }
   for (const auto& [key, agg] : aggs) {
     ViewEdge& ve = v.edges[agg.edge];
-    ve.style = std::get<2>(key) ? EdgeStyle::kCarried : agg.data_flow ? EdgeStyle::kData : EdgeStyle::kOrder;
-    std::string first = agg.data.size() == 1 ? g.data[agg.data.front()].name
-                                             : std::to_string(ve.deps) + " deps";
+    ve.style = std::get<2>(key) ? EdgeStyle::kCarried
+               : agg.data_flow  ? EdgeStyle::kData
+                                : EdgeStyle::kOrder;
+    std::string first =
+        agg.data.size() == 1 ? g.data[agg.data.front()].name : std::to_string(ve.deps) + " deps";
     if (agg.data.size() == 1 && ve.deps > 1) first += " (" + std::to_string(ve.deps) + " deps)";
-    ve.lines = {first, agg.data_flow ? format_bytes(ve.bytes) + "/step" : std::string("order only")};
+    ve.lines = {first,
+                agg.data_flow ? format_bytes(ve.bytes) + "/step" : std::string("order only")};
     if (ve.cross_deps > 0) ve.lines.push_back(std::to_string(ve.cross_deps) + " cross");
   }
 }
@@ -526,30 +535,42 @@ std::string loop_summary(const StepGraph& g, const CriticalPath& cp) {
 
 std::string_view to_string(Collapse c) {
   switch (c) {
-    case Collapse::kNone: return "none";
-    case Collapse::kObject: return "object";
-    case Collapse::kKind: return "kind";
-    case Collapse::kProcessor: return "processor";
-    case Collapse::kLoop: return "loop";
+    case Collapse::kNone:
+      return "none";
+    case Collapse::kObject:
+      return "object";
+    case Collapse::kKind:
+      return "kind";
+    case Collapse::kProcessor:
+      return "processor";
+    case Collapse::kLoop:
+      return "loop";
   }
   return "?";
 }
 
 Collapse parse_collapse(std::string_view s) {
-  for (Collapse c : {Collapse::kNone, Collapse::kObject, Collapse::kKind, Collapse::kProcessor,
-                     Collapse::kLoop})
+  for (Collapse c :
+       {Collapse::kNone, Collapse::kObject, Collapse::kKind, Collapse::kProcessor, Collapse::kLoop})
     if (to_string(c) == s) return c;
-  throw UsageError("--collapse " + std::string(s) + ": expected none, object, kind, processor or loop");
+  throw UsageError("--collapse " + std::string(s) +
+                   ": expected none, object, kind, processor or loop");
 }
 
 std::string_view to_string(NodeKind k) {
   switch (k) {
-    case NodeKind::kTask: return "task";
-    case NodeKind::kSignal: return "signal";
-    case NodeKind::kWait: return "wait";
-    case NodeKind::kReducer: return "reducer";
-    case NodeKind::kGroup: return "group";
-    case NodeKind::kDatum: return "datum";
+    case NodeKind::kTask:
+      return "task";
+    case NodeKind::kSignal:
+      return "signal";
+    case NodeKind::kWait:
+      return "wait";
+    case NodeKind::kReducer:
+      return "reducer";
+    case NodeKind::kGroup:
+      return "group";
+    case NodeKind::kDatum:
+      return "datum";
   }
   return "?";
 }
@@ -582,15 +603,17 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
     if (a->k == 0) throw UsageError("--assign: the assignment has k = 0");
     for (ProcId p : a->proc)
       if (p >= a->k)
-        throw UsageError("--assign: processor " + std::to_string(p) + " out of range (k = " +
-                         std::to_string(a->k) + ")");
+        throw UsageError("--assign: processor " + std::to_string(p) +
+                         " out of range (k = " + std::to_string(a->k) + ")");
   }
   if (o.collapse == Collapse::kProcessor && !a)
     throw UsageError("--collapse processor needs an assignment (--assign A.tga)");
   auto too_many = [&](std::size_t count, const char* what, std::size_t limit) {
-    return UsageError("the picture would have " + std::to_string(count) + " " + what + ", more than --max-" +
-                      what + " " + std::to_string(limit) +
-                      ": aggregate with --collapse object, kind, processor or loop (or raise --max-" + what + ")");
+    return UsageError(
+        "the picture would have " + std::to_string(count) + " " + what + ", more than --max-" +
+        what + " " + std::to_string(limit) +
+        ": aggregate with --collapse object, kind, processor or loop (or raise --max-" + what +
+        ")");
   };
   if (o.collapse == Collapse::kNone && o.max_nodes != 0 && g.tasks.size() > o.max_nodes)
     throw too_many(g.tasks.size(), "nodes", o.max_nodes);
@@ -607,11 +630,14 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   } else {
     build_groups(g, o, cpp, v);
   }
-  if (o.max_nodes != 0 && v.nodes.size() > o.max_nodes) throw too_many(v.nodes.size(), "nodes", o.max_nodes);
-  if (o.max_edges != 0 && v.edges.size() > o.max_edges) throw too_many(v.edges.size(), "edges", o.max_edges);
+  if (o.max_nodes != 0 && v.nodes.size() > o.max_nodes)
+    throw too_many(v.nodes.size(), "nodes", o.max_nodes);
+  if (o.max_edges != 0 && v.edges.size() > o.max_edges)
+    throw too_many(v.edges.size(), "edges", o.max_edges);
 
   for (LoopId l = 0; l < g.loops.size(); ++l) {
-    const bool used = std::any_of(v.nodes.begin(), v.nodes.end(), [l](const ViewNode& n) { return n.loop == l; });
+    const bool used =
+        std::any_of(v.nodes.begin(), v.nodes.end(), [l](const ViewNode& n) { return n.loop == l; });
     if (!used) continue;
     const Loop& loop = g.loops[l];
     std::string label = "loop " + std::to_string(l) + ": " + std::to_string(loop.iterations) +
@@ -637,9 +663,9 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
     v.title.push_back("collapsed by " + std::string(to_string(o.collapse)) +
                       ": work = cost \xC3\x97 runs, edge bytes per step");
   if (o.critical_path)
-    v.title.push_back("critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
-                      " over " + std::to_string(cp.instances.size()) + " task instances" +
-                      loop_summary(g, cp));
+    v.title.push_back(
+        "critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
+        " over " + std::to_string(cp.instances.size()) + " task instances" + loop_summary(g, cp));
   return v;
 }
 

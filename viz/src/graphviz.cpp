@@ -130,7 +130,8 @@ class Builder {
     set(an, "label", label_text(n.lines));
     const std::string fill = node_fill(n);
     switch (n.kind) {
-      case NodeKind::kTask: break;
+      case NodeKind::kTask:
+        break;
       case NodeKind::kGroup:
         set(an, "style", "filled");
         break;
@@ -163,8 +164,9 @@ class Builder {
       // Several processors: stripes as wide as each one's share of the work.
       std::string list;
       for (const ProcessorShare& s : n.procs) {
-        const double f = n.work_ns == 0 ? 1.0 / static_cast<double>(n.procs.size())
-                                        : static_cast<double>(s.work_ns) / static_cast<double>(n.work_ns);
+        const double f = n.work_ns == 0
+                             ? 1.0 / static_cast<double>(n.procs.size())
+                             : static_cast<double>(s.work_ns) / static_cast<double>(n.work_ns);
         char frac[16];
         std::snprintf(frac, sizeof frac, "%.3f", std::max(f, 0.001));
         if (!list.empty()) list += ':';
@@ -184,13 +186,18 @@ class Builder {
   void style_edge(Agedge_t* ae, const ViewEdge& e) {
     if (!e.lines.empty()) set(ae, "label", label_text(e.lines));
     switch (e.style) {
-      case EdgeStyle::kData: break;
-      case EdgeStyle::kOrder: set(ae, "style", "dashed"); break;
+      case EdgeStyle::kData:
+        break;
+      case EdgeStyle::kOrder:
+        set(ae, "style", "dashed");
+        break;
       case EdgeStyle::kCarried:
         set(ae, "style", "dotted");
         set(ae, "constraint", "false");
         break;
-      case EdgeStyle::kInternal: set(ae, "arrowsize", "0.4"); break;
+      case EdgeStyle::kInternal:
+        set(ae, "arrowsize", "0.4");
+        break;
     }
     const bool cross = e.cross_deps > 0;
     const bool critical = e.critical_hits > 0;
@@ -238,11 +245,13 @@ class Builder {
              kNeutralFill, nullptr);
     if (v_.processors == 0) sample("no assignment", kNeutralFill, nullptr);
     auto has = [&](NodeKind k) {
-      return std::any_of(v_.nodes.begin(), v_.nodes.end(), [k](const ViewNode& n) { return n.kind == k; });
+      return std::any_of(v_.nodes.begin(), v_.nodes.end(),
+                         [k](const ViewNode& n) { return n.kind == k; });
     };
     if (has(NodeKind::kSignal)) set(sample("signal", kNeutralFill, "cds"), "style", "filled");
     if (has(NodeKind::kWait)) set(sample("wait", kNeutralFill, "octagon"), "style", "filled");
-    if (has(NodeKind::kReducer)) set(sample("reducer", kNeutralFill, "invtrapezium"), "style", "filled");
+    if (has(NodeKind::kReducer))
+      set(sample("reducer", kNeutralFill, "invtrapezium"), "style", "filled");
     if (has(NodeKind::kDatum)) set(sample("shared datum", "", "ellipse"), "style", "solid");
     if (v_.critical_path) {
       Agnode_t* n = sample("on the critical path", "", nullptr);
@@ -284,10 +293,14 @@ class Builder {
 
 std::string_view to_string(GraphFormat f) {
   switch (f) {
-    case GraphFormat::kDot: return "dot";
-    case GraphFormat::kSvg: return "svg";
-    case GraphFormat::kPng: return "png";
-    case GraphFormat::kPdf: return "pdf";
+    case GraphFormat::kDot:
+      return "dot";
+    case GraphFormat::kSvg:
+      return "svg";
+    case GraphFormat::kPng:
+      return "png";
+    case GraphFormat::kPdf:
+      return "pdf";
   }
   return "?";
 }
@@ -295,7 +308,8 @@ std::string_view to_string(GraphFormat f) {
 GraphFormat graph_format_of(const std::string& path) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? std::string() : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (GraphFormat f : {GraphFormat::kDot, GraphFormat::kSvg, GraphFormat::kPng, GraphFormat::kPdf})
     if (to_string(f) == ext) return f;
   throw UsageError("-o " + path + ": expected a .dot, .svg, .png or .pdf file name");
@@ -324,7 +338,8 @@ std::string render_graph(const GraphView& view, GraphFormat format) {
   GraphPtr g = b.build();
   if (gvLayout(gvc.get(), g.get(), "dot") != 0) {
     const char* why = aglasterr();
-    throw std::runtime_error(std::string("Graphviz dot layout failed") + (why ? ": " + std::string(why) : ""));
+    throw std::runtime_error(std::string("Graphviz dot layout failed") +
+                             (why ? ": " + std::string(why) : ""));
   }
   char* data = nullptr;
   unsigned int length = 0;

@@ -28,9 +28,9 @@ std::string format(Rgb c) {
 constexpr std::array<const char*, 6> kProcessors = {"#E69F00", "#56B4E9", "#009E73",
                                                     "#F0E442", "#0072B2", "#CC79A7"};
 // Paul Tol, "muted" qualitative scheme (2021).
-constexpr std::array<const char*, kKindColours> kKinds = {
-    "#CC6677", "#332288", "#DDCC77", "#117733", "#88CCEE",
-    "#882255", "#44AA99", "#999933", "#AA4499"};
+constexpr std::array<const char*, kKindColours> kKinds = {"#CC6677", "#332288", "#DDCC77",
+                                                          "#117733", "#88CCEE", "#882255",
+                                                          "#44AA99", "#999933", "#AA4499"};
 
 }  // namespace
 

@@ -30,11 +30,20 @@ std::string escape(std::string_view s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '&':
+        out += "&amp;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -86,10 +95,14 @@ json speedup_spec(const ReportContent& c) {
   std::set<std::string> methods;
   for (const MethodRow& r : c.rows) {
     if (r.predicted_speedup)
-      values.push_back({{"method", r.method}, {"threads", r.k}, {"speedup", *r.predicted_speedup},
+      values.push_back({{"method", r.method},
+                        {"threads", r.k},
+                        {"speedup", *r.predicted_speedup},
                         {"series", "predicted (simulated)"}});
     if (r.speedup)
-      values.push_back({{"method", r.method}, {"threads", r.k}, {"speedup", *r.speedup},
+      values.push_back({{"method", r.method},
+                        {"threads", r.k},
+                        {"speedup", *r.speedup},
                         {"series", "measured (replay)"}});
     if (r.predicted_speedup || r.speedup) {
       ks.insert(r.k);
@@ -100,40 +113,69 @@ json speedup_spec(const ReportContent& c) {
   json refs = json::array();
   const std::uint32_t kmax = *ks.rbegin();
   for (std::uint32_t k = 1;; k = std::min(kmax, k * 2)) {
-    refs.push_back({{"threads", k}, {"speedup", static_cast<double>(k)}, {"line", "ideal (= threads)"}});
+    refs.push_back(
+        {{"threads", k}, {"speedup", static_cast<double>(k)}, {"line", "ideal (= threads)"}});
     if (c.parallelism > 0)
       refs.push_back({{"threads", k},
                       {"speedup", std::min(static_cast<double>(k), c.parallelism)},
                       {"line", "bound min(threads, work/span)"}});
     if (k == kmax) break;
   }
-  const json x = {{"field", "threads"}, {"type", "quantitative"}, {"title", "threads / processors (K)"},
-                  {"scale", {{"type", "log"}, {"base", 2}}}, {"axis", {{"values", ks}, {"format", "d"}}}};
-  const json y = {{"field", "speedup"}, {"type", "quantitative"}, {"title", "speed-up over sequential (×)"}};
-  const json colour = {{"field", "method"}, {"type", "nominal"}, {"title", "method"},
-                       {"scale", {{"range", colour_range(std::max<std::size_t>(methods.size(), 1))}}}};
+  const json x = {{"field", "threads"},
+                  {"type", "quantitative"},
+                  {"title", "threads / processors (K)"},
+                  {"scale", {{"type", "log"}, {"base", 2}}},
+                  {"axis", {{"values", ks}, {"format", "d"}}}};
+  const json y = {
+      {"field", "speedup"}, {"type", "quantitative"}, {"title", "speed-up over sequential (×)"}};
+  const json colour = {
+      {"field", "method"},
+      {"type", "nominal"},
+      {"title", "method"},
+      {"scale", {{"range", colour_range(std::max<std::size_t>(methods.size(), 1))}}}};
   json layers = json::array();
   layers.push_back({{"data", {{"values", refs}}},
                     {"mark", {{"type", "line"}, {"color", "#000000"}, {"strokeWidth", 1}}},
                     {"encoding",
-                     {{"x", x}, {"y", y},
-                      {"strokeDash", {{"field", "line"}, {"type", "nominal"}, {"title", "reference"},
-                                      {"scale", {{"range", {{2, 2}, {6, 3}}}}}}}}}});
-  layers.push_back({{"transform", {{{"filter", "datum.series === 'predicted (simulated)'"}}}},
-                    {"mark", {{"type", "line"}, {"point", {{"filled", false}, {"size", 60}}}, {"strokeDash", {4, 2}}}},
-                    {"encoding", {{"x", x}, {"y", y}, {"color", colour},
-                                  {"tooltip", {{{"field", "method"}}, {{"field", "threads"}},
-                                               {{"field", "speedup"}, {"format", ".2f"}}, {{"field", "series"}}}}}}});
-  layers.push_back({{"transform", {{{"filter", "datum.series === 'measured (replay)'"}}}},
-                    {"mark", {{"type", "point"}, {"filled", true}, {"size", 110}, {"shape", "diamond"}}},
-                    {"encoding", {{"x", x}, {"y", y}, {"color", colour},
-                                  {"tooltip", {{{"field", "method"}}, {{"field", "threads"}},
-                                               {{"field", "speedup"}, {"format", ".2f"}}, {{"field", "series"}}}}}}});
+                     {{"x", x},
+                      {"y", y},
+                      {"strokeDash",
+                       {{"field", "line"},
+                        {"type", "nominal"},
+                        {"title", "reference"},
+                        {"scale", {{"range", {{2, 2}, {6, 3}}}}}}}}}});
+  layers.push_back(
+      {{"transform", {{{"filter", "datum.series === 'predicted (simulated)'"}}}},
+       {"mark",
+        {{"type", "line"}, {"point", {{"filled", false}, {"size", 60}}}, {"strokeDash", {4, 2}}}},
+       {"encoding",
+        {{"x", x},
+         {"y", y},
+         {"color", colour},
+         {"tooltip",
+          {{{"field", "method"}},
+           {{"field", "threads"}},
+           {{"field", "speedup"}, {"format", ".2f"}},
+           {{"field", "series"}}}}}}});
+  layers.push_back(
+      {{"transform", {{{"filter", "datum.series === 'measured (replay)'"}}}},
+       {"mark", {{"type", "point"}, {"filled", true}, {"size", 110}, {"shape", "diamond"}}},
+       {"encoding",
+        {{"x", x},
+         {"y", y},
+         {"color", colour},
+         {"tooltip",
+          {{{"field", "method"}},
+           {{"field", "threads"}},
+           {{"field", "speedup"}, {"format", ".2f"}},
+           {{"field", "series"}}}}}}});
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 520},
           {"height", 320},
-          {"title", {{"text", "Speed-up against threads"},
-                     {"subtitle", "diamonds: measured; open circles, dashed: predicted; black: ideal and bound"}}},
+          {"title",
+           {{"text", "Speed-up against threads"},
+            {"subtitle",
+             "diamonds: measured; open circles, dashed: predicted; black: ideal and bound"}}},
           {"data", {{"values", values}}},
           {"layer", layers}};
 }
@@ -143,9 +185,11 @@ json methods_spec(const ReportContent& c) {
   json values = json::array();
   for (const MethodRow& r : c.rows) {
     const std::string label = r.method + " (K=" + std::to_string(r.k) + ")";
-    if (r.speedup) values.push_back({{"row", label}, {"speedup", *r.speedup}, {"series", "measured"}});
+    if (r.speedup)
+      values.push_back({{"row", label}, {"speedup", *r.speedup}, {"series", "measured"}});
     if (r.predicted_speedup)
-      values.push_back({{"row", label}, {"speedup", *r.predicted_speedup}, {"series", "predicted"}});
+      values.push_back(
+          {{"row", label}, {"speedup", *r.predicted_speedup}, {"series", "predicted"}});
   }
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 420},
@@ -155,9 +199,16 @@ json methods_spec(const ReportContent& c) {
           {"encoding",
            {{"y", {{"field", "row"}, {"type", "nominal"}, {"title", nullptr}, {"sort", nullptr}}},
             {"yOffset", {{"field", "series"}}},
-            {"x", {{"field", "speedup"}, {"type", "quantitative"}, {"title", "speed-up over sequential (×)"}}},
-            {"color", {{"field", "series"}, {"type", "nominal"}, {"title", nullptr},
-                       {"scale", {{"domain", {"measured", "predicted"}}, {"range", {"#0072B2", "#E69F00"}}}}}}}}};
+            {"x",
+             {{"field", "speedup"},
+              {"type", "quantitative"},
+              {"title", "speed-up over sequential (×)"}}},
+            {"color",
+             {{"field", "series"},
+              {"type", "nominal"},
+              {"title", nullptr},
+              {"scale",
+               {{"domain", {"measured", "predicted"}}, {"range", {"#0072B2", "#E69F00"}}}}}}}}};
 }
 
 // Per-step partition time or migrations, one line per method, contact changes as rules.
@@ -167,20 +218,33 @@ json series_spec(const ReportContent& c, bool migrations) {
     const std::string label = s.method + " (K=" + std::to_string(s.k) + ")";
     const std::size_t n = migrations ? s.migrated_tasks.size() : s.partition_ms.size();
     for (std::size_t i = 0; i < n; ++i)
-      values.push_back({{"method", label}, {"step", i},
-                        {"value", migrations ? static_cast<double>(s.migrated_tasks[i]) : s.partition_ms[i]}});
+      values.push_back(
+          {{"method", label},
+           {"step", i},
+           {"value", migrations ? static_cast<double>(s.migrated_tasks[i]) : s.partition_ms[i]}});
   }
   json rules = json::array();
   for (std::uint32_t s : c.contact_changes) rules.push_back({{"step", s}});
   const char* title = migrations ? "migrated tasks" : "partition time (ms)";
   json layers = json::array();
-  layers.push_back({{"mark", {{"type", "line"}, {"point", true}}},
-                    {"encoding",
-                     {{"x", {{"field", "step"}, {"type", "quantitative"}, {"title", "step"}, {"axis", {{"format", "d"}}}}},
-                      {"y", {{"field", "value"}, {"type", "quantitative"}, {"title", title}}},
-                      {"color", {{"field", "method"}, {"type", "nominal"}, {"title", "method"},
-                                 {"scale", {{"range", colour_range(std::max<std::size_t>(c.series.size(), 1))}}}}},
-                      {"tooltip", {{{"field", "method"}}, {{"field", "step"}}, {{"field", "value"}, {"format", ".3~f"}}}}}}});
+  layers.push_back(
+      {{"mark", {{"type", "line"}, {"point", true}}},
+       {"encoding",
+        {{"x",
+          {{"field", "step"},
+           {"type", "quantitative"},
+           {"title", "step"},
+           {"axis", {{"format", "d"}}}}},
+         {"y", {{"field", "value"}, {"type", "quantitative"}, {"title", title}}},
+         {"color",
+          {{"field", "method"},
+           {"type", "nominal"},
+           {"title", "method"},
+           {"scale", {{"range", colour_range(std::max<std::size_t>(c.series.size(), 1))}}}}},
+         {"tooltip",
+          {{{"field", "method"}},
+           {{"field", "step"}},
+           {{"field", "value"}, {"format", ".3~f"}}}}}}});
   if (!rules.empty())
     layers.push_back({{"data", {{"values", rules}}},
                       {"mark", {{"type", "rule"}, {"color", "#D55E00"}, {"strokeDash", {3, 3}}}},
@@ -188,8 +252,9 @@ json series_spec(const ReportContent& c, bool migrations) {
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 420},
           {"height", 220},
-          {"title", {{"text", migrations ? "Migrations per step" : "Partition time per step"},
-                     {"subtitle", rules.empty() ? "" : "vermillion rules: steps whose contacts changed"}}},
+          {"title",
+           {{"text", migrations ? "Migrations per step" : "Partition time per step"},
+            {"subtitle", rules.empty() ? "" : "vermillion rules: steps whose contacts changed"}}},
           {"data", {{"values", values}}},
           {"layer", layers}};
 }
@@ -219,40 +284,61 @@ json timeline_spec(const Timeline& t, std::string* caption) {
                        {"kind", "blocking wait"}});
   json steps = json::array();
   for (std::uint32_t s = 0; s <= last_step && s < offsets.size(); ++s)
-    steps.push_back({{"start", static_cast<double>(offsets[s]) / 1e6}, {"label", "step " + std::to_string(s)}});
+    steps.push_back(
+        {{"start", static_cast<double>(offsets[s]) / 1e6}, {"label", "step " + std::to_string(s)}});
   if (shown < t.tasks.size())
-    *caption += " Steps 0 to " + std::to_string(last_step) + " shown (" + with_commas(shown) + " of " +
-                with_commas(t.tasks.size()) + " task instances); `tgraph timeline --steps` draws any range.";
+    *caption += " Steps 0 to " + std::to_string(last_step) + " shown (" + with_commas(shown) +
+                " of " + with_commas(t.tasks.size()) +
+                " task instances); `tgraph timeline --steps` draws any range.";
   json kind_range = json::array();
   for (std::uint32_t i = 0; i < kKindColours; ++i) kind_range.push_back(kind_colour(i));
   const json x = {{"field", "start"}, {"type", "quantitative"}, {"title", "time (ms)"}};
-  const json y = {{"field", "thread"}, {"type", "nominal"}, {"title", nullptr},
+  const json y = {{"field", "thread"},
+                  {"type", "nominal"},
+                  {"title", nullptr},
                   {"sort", {{"field", "thread"}}}};
   json layers = json::array();
   layers.push_back({{"data", {{"values", tasks}}},
                     {"mark", {{"type", "bar"}, {"height", {{"band", 0.8}}}}},
                     {"encoding",
-                     {{"x", x}, {"x2", {{"field", "end"}}}, {"y", y},
-                      {"color", {{"field", "kind"}, {"type", "nominal"}, {"title", "task kind"},
-                                 {"scale", {{"range", kind_range}}}}},
-                      {"tooltip", {{{"field", "kind"}}, {{"field", "thread"}}, {{"field", "step"}},
-                                   {{"field", "iteration"}}, {{"field", "start"}, {"format", ".3f"}},
-                                   {{"field", "end"}, {"format", ".3f"}}}}}}});
+                     {{"x", x},
+                      {"x2", {{"field", "end"}}},
+                      {"y", y},
+                      {"color",
+                       {{"field", "kind"},
+                        {"type", "nominal"},
+                        {"title", "task kind"},
+                        {"scale", {{"range", kind_range}}}}},
+                      {"tooltip",
+                       {{{"field", "kind"}},
+                        {{"field", "thread"}},
+                        {{"field", "step"}},
+                        {{"field", "iteration"}},
+                        {{"field", "start"}, {"format", ".3f"}},
+                        {{"field", "end"}, {"format", ".3f"}}}}}}});
   if (!waits.empty())
-    layers.push_back({{"data", {{"values", waits}}},
-                      {"mark", {{"type", "bar"}, {"height", {{"band", 0.35}}}, {"color", "#444444"},
-                                {"opacity", 0.7}}},
-                      {"encoding", {{"x", x}, {"x2", {{"field", "end"}}}, {"y", y},
-                                    {"tooltip", {{{"field", "kind"}}, {{"field", "start"}, {"format", ".3f"}},
-                                                 {{"field", "end"}, {"format", ".3f"}}}}}}});
+    layers.push_back(
+        {{"data", {{"values", waits}}},
+         {"mark",
+          {{"type", "bar"}, {"height", {{"band", 0.35}}}, {"color", "#444444"}, {"opacity", 0.7}}},
+         {"encoding",
+          {{"x", x},
+           {"x2", {{"field", "end"}}},
+           {"y", y},
+           {"tooltip",
+            {{{"field", "kind"}},
+             {{"field", "start"}, {"format", ".3f"}},
+             {{"field", "end"}, {"format", ".3f"}}}}}}});
   layers.push_back({{"data", {{"values", steps}}},
                     {"mark", {{"type", "rule"}, {"color", "#000000"}, {"strokeWidth", 1.5}}},
                     {"encoding", {{"x", {{"field", "start"}, {"type", "quantitative"}}}}}});
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 900},
           {"height", {{"step", 34}}},
-          {"title", {{"text", "Replay timeline"},
-                     {"subtitle", "one row per thread; dark thin bars: blocking waits; black rules: step starts"}}},
+          {"title",
+           {{"text", "Replay timeline"},
+            {"subtitle",
+             "one row per thread; dark thin bars: blocking waits; black rules: step starts"}}},
           {"layer", layers}};
 }
 
@@ -262,15 +348,18 @@ std::string number_cell(const std::optional<double>& v, int decimals) {
 
 std::string table_html(const ReportContent& c) {
   std::string h =
-      "<table><thead><tr><th>method</th><th>K</th><th>partition (ms)</th><th>imbalance (max/mean)</th>"
+      "<table><thead><tr><th>method</th><th>K</th><th>partition (ms)</th><th>imbalance "
+      "(max/mean)</th>"
       "<th>cut (KiB)</th><th>migrated tasks</th><th>predicted speed-up (&times;)</th>"
-      "<th>replay (ms)</th><th>sequential (ms)</th><th>speed-up (&times;)</th><th>efficiency (%)</th>"
+      "<th>replay (ms)</th><th>sequential (ms)</th><th>speed-up (&times;)</th><th>efficiency "
+      "(%)</th>"
       "<th>signals</th></tr></thead><tbody>";
   for (const MethodRow& r : c.rows) {
     h += "<tr><td>" + escape(r.method) + "</td><td>" + std::to_string(r.k) + "</td>";
     if (r.partitioned) {
       h += "<td>" + round3(r.partition_ms) + "</td><td>" + fixed(r.imbalance, 3) + "</td><td>" +
-           round3(static_cast<double>(r.cut_bytes) / 1024.0) + "</td><td>" + with_commas(r.migrated_tasks) + "</td>";
+           round3(static_cast<double>(r.cut_bytes) / 1024.0) + "</td><td>" +
+           with_commas(r.migrated_tasks) + "</td>";
     } else {
       h += "<td>&ndash;</td><td>&ndash;</td><td>&ndash;</td><td>&ndash;</td>";
     }
@@ -348,21 +437,24 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
   ReportContent c;
   const TraceSummary s = summarize_trace(trace);
   c.title = "tgraph report: " + (trace.header.scene.empty() ? trace_name : trace.header.scene);
-  c.facts = {{"trace", trace_name},
-             {"scene", trace.header.scene},
-             {"engine", trace.header.engine},
-             {"machine", trace.header.machine},
-             {"steps", with_commas(s.steps)},
-             {"tasks per step", with_commas(s.tasks_min) + (s.tasks_min == s.tasks_max ? "" : " to " + with_commas(s.tasks_max))},
-             {"dependencies", with_commas(s.edges) + " (all steps)"},
-             {"loops", with_commas(s.loops) + ", " + with_commas(s.loop_iterations) + " iterations"},
-             {"work, span", round3(static_cast<double>(s.work_ns) / 1e6) + " ms, " +
-                                round3(static_cast<double>(s.span_ns) / 1e6) + " ms (all steps)"},
-             {"parallelism (work/span)", round3(s.parallelism)},
-             {"contact changes", with_commas(s.contact_changes) + " steps"}};
+  c.facts = {
+      {"trace", trace_name},
+      {"scene", trace.header.scene},
+      {"engine", trace.header.engine},
+      {"machine", trace.header.machine},
+      {"steps", with_commas(s.steps)},
+      {"tasks per step", with_commas(s.tasks_min) +
+                             (s.tasks_min == s.tasks_max ? "" : " to " + with_commas(s.tasks_max))},
+      {"dependencies", with_commas(s.edges) + " (all steps)"},
+      {"loops", with_commas(s.loops) + ", " + with_commas(s.loop_iterations) + " iterations"},
+      {"work, span", round3(static_cast<double>(s.work_ns) / 1e6) + " ms, " +
+                         round3(static_cast<double>(s.span_ns) / 1e6) + " ms (all steps)"},
+      {"parallelism (work/span)", round3(s.parallelism)},
+      {"contact changes", with_commas(s.contact_changes) + " steps"}};
   c.parallelism = s.parallelism;
   for (std::size_t i = 0; i < s.per_step.size(); ++i)
-    if (s.per_step[i].contacts_changed && i > 0) c.contact_changes.push_back(static_cast<std::uint32_t>(i));
+    if (s.per_step[i].contacts_changed && i > 0)
+      c.contact_changes.push_back(static_cast<std::uint32_t>(i));
   if (step < trace.steps.size()) {
     ViewOptions o;
     o.collapse = Collapse::kObject;
@@ -371,15 +463,20 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
     o.max_nodes = 0;
     o.max_edges = 0;
     o.title = trace_name + ", step " + std::to_string(step) +
-              (assignment ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors" : "");
-    c.graph_svg = inline_svg(render_graph(make_graph_view(trace.steps[step], o), GraphFormat::kSvg));
-    c.graph_caption = "Step " + std::to_string(step) +
-                      " collapsed by object (one node per object and loop level, work = cost × runs), "
-                      "coloured by processor" +
-                      (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
-                      "; vermillion edges cross processors; thick black: the critical path. "
-                      "Same picture: tgraph viz " + trace_name + " --step " + std::to_string(step) +
-                      " --collapse object --critical-path" + (assignment ? " --assign A.tga" : "") + " -o g.svg";
+              (assignment
+                   ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors"
+                   : "");
+    c.graph_svg =
+        inline_svg(render_graph(make_graph_view(trace.steps[step], o), GraphFormat::kSvg));
+    c.graph_caption =
+        "Step " + std::to_string(step) +
+        " collapsed by object (one node per object and loop level, work = cost × runs), "
+        "coloured by processor" +
+        (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
+        "; vermillion edges cross processors; thick black: the critical path. "
+        "Same picture: tgraph viz " +
+        trace_name + " --step " + std::to_string(step) + " --collapse object --critical-path" +
+        (assignment ? " --assign A.tga" : "") + " -o g.svg";
   }
   return c;
 }
@@ -387,12 +484,14 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
 void add_compare_json(ReportContent& c, std::string_view text, const std::string& name) {
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object() || !j.contains("rows") || !j["rows"].is_array())
-    throw InputError(name, std::nullopt, "not a comparison (expected tgraph compare --json output with \"rows\")");
+    throw InputError(name, std::nullopt,
+                     "not a comparison (expected tgraph compare --json output with \"rows\")");
   std::size_t i = 0;
   try {
     for (const json& r : j["rows"]) {
       MethodRow row;
-      row.method = r.contains("label") ? r.at("label").get<std::string>() : r.at("method").get<std::string>();
+      row.method = r.contains("label") ? r.at("label").get<std::string>()
+                                       : r.at("method").get<std::string>();
       row.k = r.at("k").get<std::uint32_t>();
       row.partitioned = true;
       row.partition_ms = r.at("partition_ms").get<double>();
@@ -422,7 +521,8 @@ void add_replay_json(ReportContent& c, std::string_view text, const std::string&
   }
   if (j.is_discarded() || !j.is_object() || !j.contains("policy") || !j.contains("speedup"))
     throw InputError(name, std::nullopt,
-                     "expected a replay timeline (tgraph replay --timeline) or a measurement (tgraph replay --json)");
+                     "expected a replay timeline (tgraph replay --timeline) or a measurement "
+                     "(tgraph replay --json)");
   try {
     MethodRow row;
     const std::string policy = j.at("policy").get<std::string>();
@@ -453,31 +553,37 @@ std::string report_html(const ReportContent& c) {
   body += "</dl>";
   if (!c.rows.empty()) {
     body += "<h2>Methods</h2>" + table_html(c);
-    body += "<div class=\"charts\"><div class=\"chart\" id=\"chart-speedup\"></div>"
-            "<div class=\"chart\" id=\"chart-methods\"></div></div>";
+    body +=
+        "<div class=\"charts\"><div class=\"chart\" id=\"chart-speedup\"></div>"
+        "<div class=\"chart\" id=\"chart-methods\"></div></div>";
     specs["chart-speedup"] = speedup_spec(c);
     specs["chart-methods"] = methods_spec(c);
   }
   if (!c.series.empty()) {
-    body += "<h2>Over the run</h2><div class=\"charts\"><div class=\"chart\" id=\"chart-partition-time\"></div>"
-            "<div class=\"chart\" id=\"chart-migrations\"></div></div>";
+    body +=
+        "<h2>Over the run</h2><div class=\"charts\"><div class=\"chart\" "
+        "id=\"chart-partition-time\"></div>"
+        "<div class=\"chart\" id=\"chart-migrations\"></div></div>";
     specs["chart-partition-time"] = series_spec(c, false);
     specs["chart-migrations"] = series_spec(c, true);
   }
   if (c.timeline) {
     std::string caption = c.timeline_caption;
     specs["chart-timeline"] = timeline_spec(*c.timeline, &caption);
-    body += "<h2>Replay timeline</h2><figure><div class=\"chart\" id=\"chart-timeline\"></div><figcaption>" +
-            escape(caption) + "</figcaption></figure>";
+    body +=
+        "<h2>Replay timeline</h2><figure><div class=\"chart\" "
+        "id=\"chart-timeline\"></div><figcaption>" +
+        escape(caption) + "</figcaption></figure>";
   }
   if (!c.graph_svg.empty())
-    body += "<h2>Step graph</h2><figure><div class=\"graph\">" + c.graph_svg + "</div><figcaption>" +
-            escape(c.graph_caption) + "</figcaption></figure>";
+    body += "<h2>Step graph</h2><figure><div class=\"graph\">" + c.graph_svg +
+            "</div><figcaption>" + escape(c.graph_caption) + "</figcaption></figure>";
   body += "<p><small>Charts: " + escape(std::string(detail::web_asset_versions())) +
           " (BSD-3-Clause), inlined; the page uses no network.</small></p>";
 
-  std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(c.title) +
-                  "</title><style>" + kStyle + "</style><script>" + kErrorHook + "</script>";
+  std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
+                  escape(c.title) + "</title><style>" + kStyle + "</style><script>" + kErrorHook +
+                  "</script>";
   for (const char* lib : {"vega", "vega-lite", "vega-embed"}) {
     h += "<script>/* ";
     h += lib;

@@ -204,7 +204,8 @@ void draw(cairo_t* cr, const Timeline& t, const ChartLayout& L, const std::strin
   cairo_line_to(cr, L.left + plot_w, L.plot_bottom());
   cairo_stroke(cr);
   const double first_ms = static_cast<double>(begin_ns) / 1e6;
-  for (double v = std::ceil(first_ms / step) * step; v <= first_ms + span_ms + step * 1e-6; v += step) {
+  for (double v = std::ceil(first_ms / step) * step; v <= first_ms + span_ms + step * 1e-6;
+       v += step) {
     const double x = L.left + (v - first_ms) / span_ms * plot_w;
     cairo_move_to(cr, x, L.plot_bottom());
     cairo_line_to(cr, x, L.plot_bottom() + 4);
@@ -242,7 +243,8 @@ std::vector<std::string> rank_kinds(const Timeline& t) {
   std::map<std::string, std::int64_t> total;
   for (const TimelineTask& e : t.tasks) total[e.kind] += e.end_ns - e.start_ns;
   std::vector<std::pair<std::string, std::int64_t>> v(total.begin(), total.end());
-  std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  std::stable_sort(v.begin(), v.end(),
+                   [](const auto& a, const auto& b) { return a.second > b.second; });
   std::vector<std::string> out;
   for (const auto& [k, ns] : v) out.push_back(k);
   return out;
@@ -251,13 +253,15 @@ std::vector<std::string> rank_kinds(const Timeline& t) {
 std::uint32_t get_u32(const json& e, const char* key) {
   const json& v = e.at(key);
   if (!v.is_number_unsigned() || v.get<std::uint64_t>() > 0xffffffffu)
-    throw json::type_error::create(302, std::string("\"") + key + "\" must be an unsigned 32-bit integer", &v);
+    throw json::type_error::create(
+        302, std::string("\"") + key + "\" must be an unsigned 32-bit integer", &v);
   return v.get<std::uint32_t>();
 }
 
 std::int64_t get_i64(const json& e, const char* key) {
   const json& v = e.at(key);
-  if (!v.is_number_integer()) throw json::type_error::create(302, std::string("\"") + key + "\" must be an integer", &v);
+  if (!v.is_number_integer())
+    throw json::type_error::create(302, std::string("\"") + key + "\" must be an integer", &v);
   return v.get<std::int64_t>();
 }
 
@@ -283,7 +287,8 @@ std::vector<std::int64_t> Timeline::step_offsets() const {
 Timeline parse_timeline(std::string_view text, const std::string& name) {
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded())
-    throw InputError(name, std::nullopt, "not JSON (expected a replay timeline from tgraph replay --timeline)");
+    throw InputError(name, std::nullopt,
+                     "not JSON (expected a replay timeline from tgraph replay --timeline)");
   if (!j.is_object() || !j.contains("tasks") || !j["tasks"].is_array())
     throw InputError(name, std::nullopt,
                      "not a replay timeline (expected a JSON object with a \"tasks\" array)");
@@ -310,7 +315,8 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
     what = "waits";
     index = 0;
     if (j.contains("waits")) {
-      if (!j["waits"].is_array()) throw json::type_error::create(302, "\"waits\" must be an array", &j);
+      if (!j["waits"].is_array())
+        throw json::type_error::create(302, "\"waits\" must be an array", &j);
       for (const json& e : j["waits"]) {
         TimelineWait w;
         w.step = get_u32(e, "step");
@@ -328,23 +334,27 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
   } catch (const json::exception& e) {
     std::string why = e.what();
     if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
-    throw InputError(name, std::nullopt, std::string(what) + "[" + std::to_string(index) + "]: " + why);
+    throw InputError(name, std::nullopt,
+                     std::string(what) + "[" + std::to_string(index) + "]: " + why);
   }
   std::uint32_t seen = 0;
   for (const TimelineTask& e : t.tasks) seen = std::max(seen, e.thread + 1);
   for (const TimelineWait& w : t.waits) seen = std::max(seen, w.thread + 1);
   if (t.threads == 0) t.threads = seen;
   if (seen > t.threads)
-    throw InputError(name, std::nullopt, "thread " + std::to_string(seen - 1) + " out of range (\"threads\": " +
-                                             std::to_string(t.threads) + ")");
+    throw InputError(name, std::nullopt,
+                     "thread " + std::to_string(seen - 1) +
+                         " out of range (\"threads\": " + std::to_string(t.threads) + ")");
   if (t.threads > 4096)
-    throw InputError(name, std::nullopt, "\"threads\": " + std::to_string(t.threads) + " (expected at most 4096)");
+    throw InputError(name, std::nullopt,
+                     "\"threads\": " + std::to_string(t.threads) + " (expected at most 4096)");
   return t;
 }
 
 std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text) {
   auto bad = [&] {
-    return UsageError("--steps " + std::string(text) + ": expected a:b, a: or a (step numbers, a <= b)");
+    return UsageError("--steps " + std::string(text) +
+                      ": expected a:b, a: or a (step numbers, a <= b)");
   };
   auto number = [&](std::string_view s, std::uint32_t fallback) {
     if (s.empty()) return fallback;
@@ -376,15 +386,18 @@ Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last
     std::uint32_t hi = 0;
     for (const TimelineTask& e : t.tasks) hi = std::max(hi, e.step);
     throw UsageError("--steps " + std::to_string(first) + ":" + std::to_string(last) +
-                     ": no task in that range (the timeline has steps 0 to " + std::to_string(hi) + ")");
+                     ": no task in that range (the timeline has steps 0 to " + std::to_string(hi) +
+                     ")");
   }
   return out;
 }
 
 std::string_view to_string(TimelineFormat f) {
   switch (f) {
-    case TimelineFormat::kSvg: return "svg";
-    case TimelineFormat::kPng: return "png";
+    case TimelineFormat::kSvg:
+      return "svg";
+    case TimelineFormat::kPng:
+      return "png";
   }
   return "?";
 }
@@ -392,7 +405,8 @@ std::string_view to_string(TimelineFormat f) {
 TimelineFormat timeline_format_of(const std::string& path) {
   const auto dot = path.rfind('.');
   std::string ext = dot == std::string::npos ? std::string() : path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (TimelineFormat f : {TimelineFormat::kSvg, TimelineFormat::kPng})
     if (to_string(f) == ext) return f;
   throw UsageError("-o " + path + ": expected a .svg or .png file name");
@@ -402,24 +416,28 @@ std::string render_timeline(const Timeline& t, TimelineFormat format, const std:
   const std::vector<std::string> kinds = rank_kinds(t);
   ChartLayout L;
   L.threads = std::max<std::uint32_t>(t.threads, 1);
-  L.legend_items = std::min<std::size_t>(kinds.size(), kKindColours + 1) + (t.waits.empty() ? 0 : 1);
+  L.legend_items =
+      std::min<std::size_t>(kinds.size(), kKindColours + 1) + (t.waits.empty() ? 0 : 1);
   const double h = L.height();
   std::string out;
   cairo_surface_t* surface =
       format == TimelineFormat::kSvg
           ? cairo_svg_surface_create_for_stream(append_bytes, &out, L.width, h)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(L.width), static_cast<int>(std::ceil(h)));
+          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(L.width),
+                                       static_cast<int>(std::ceil(h)));
   cairo_t* cr = cairo_create(surface);
   draw(cr, t, L, title, kinds);
   const cairo_status_t drawn = cairo_status(cr);
   cairo_destroy(cr);
   cairo_status_t written = CAIRO_STATUS_SUCCESS;
-  if (format == TimelineFormat::kPng) written = cairo_surface_write_to_png_stream(surface, append_bytes, &out);
+  if (format == TimelineFormat::kPng)
+    written = cairo_surface_write_to_png_stream(surface, append_bytes, &out);
   cairo_surface_finish(surface);  // the SVG surface writes its document here
   const cairo_status_t finished = cairo_surface_status(surface);
   cairo_surface_destroy(surface);
   for (cairo_status_t s : {drawn, written, finished})
-    if (s != CAIRO_STATUS_SUCCESS) throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(s));
+    if (s != CAIRO_STATUS_SUCCESS)
+      throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(s));
   return out;
 }
 
@@ -428,7 +446,8 @@ std::vector<TimelineFlow> timeline_flows(const Timeline& t) {
   std::map<std::uint32_t, std::vector<std::size_t>> by_step;
   for (std::size_t i = 0; i < t.tasks.size(); ++i) by_step[t.tasks[i].step].push_back(i);
   for (auto& [s, v] : by_step)
-    std::sort(v.begin(), v.end(), [&](std::size_t a, std::size_t b) { return t.tasks[a].end_ns < t.tasks[b].end_ns; });
+    std::sort(v.begin(), v.end(),
+              [&](std::size_t a, std::size_t b) { return t.tasks[a].end_ns < t.tasks[b].end_ns; });
   std::vector<TimelineFlow> flows;
   for (std::size_t w = 0; w < t.waits.size(); ++w) {
     const TimelineWait& wait = t.waits[w];
@@ -436,8 +455,9 @@ std::vector<TimelineFlow> timeline_flows(const Timeline& t) {
     if (it == by_step.end()) continue;
     const std::vector<std::size_t>& v = it->second;
     // Last instance ending at or before the wait's end.
-    auto pos = std::upper_bound(v.begin(), v.end(), wait.end_ns,
-                                [&](std::int64_t ns, std::size_t i) { return ns < t.tasks[i].end_ns; });
+    auto pos =
+        std::upper_bound(v.begin(), v.end(), wait.end_ns,
+                         [&](std::int64_t ns, std::size_t i) { return ns < t.tasks[i].end_ns; });
     while (pos != v.begin()) {
       --pos;
       const TimelineTask& e = t.tasks[*pos];
@@ -480,16 +500,31 @@ std::string chrome_trace(const Timeline& t) {
   for (const TimelineFlow& f : timeline_flows(t)) {
     const TimelineTask& from = t.tasks[f.from_task];
     const TimelineWait& to = t.waits[f.to_wait];
-    const double from_ts = std::max(us(from.step, from.start_ns), us(from.step, from.end_ns) - 0.001);
+    const double from_ts =
+        std::max(us(from.step, from.start_ns), us(from.step, from.end_ns) - 0.001);
     const double to_ts = std::max(us(to.step, to.start_ns), us(to.step, to.end_ns) - 0.001);
-    ev.push_back({{"name", "signal"}, {"cat", "dependency"}, {"ph", "s"}, {"id", id}, {"pid", 0},
-                  {"tid", from.thread}, {"ts", from_ts}});
-    ev.push_back({{"name", "signal"}, {"cat", "dependency"}, {"ph", "f"}, {"bp", "e"}, {"id", id},
-                  {"pid", 0}, {"tid", to.thread}, {"ts", to_ts}});
+    ev.push_back({{"name", "signal"},
+                  {"cat", "dependency"},
+                  {"ph", "s"},
+                  {"id", id},
+                  {"pid", 0},
+                  {"tid", from.thread},
+                  {"ts", from_ts}});
+    ev.push_back({{"name", "signal"},
+                  {"cat", "dependency"},
+                  {"ph", "f"},
+                  {"bp", "e"},
+                  {"id", id},
+                  {"pid", 0},
+                  {"tid", to.thread},
+                  {"ts", to_ts}});
     ++id;
   }
   for (std::uint32_t th = 0; th < t.threads; ++th)
-    ev.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 0}, {"tid", th},
+    ev.push_back({{"name", "thread_name"},
+                  {"ph", "M"},
+                  {"pid", 0},
+                  {"tid", th},
                   {"args", {{"name", "thread " + std::to_string(th)}}}});
   return json{{"traceEvents", ev}, {"displayTimeUnit", "ns"}}.dump();
 }

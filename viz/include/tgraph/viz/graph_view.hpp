@@ -61,10 +61,10 @@ struct ViewNode {
 
 /// How an edge orders its ends.
 enum class EdgeStyle : std::uint8_t {
-  kData = 0,      ///< read after write (data flows)
-  kOrder = 1,     ///< write after read / write after write only (ordering, no data)
-  kCarried = 2,   ///< loop-carried: iteration i to i+1
-  kInternal = 3   ///< into or out of a signal, wait or reducer
+  kData = 0,     ///< read after write (data flows)
+  kOrder = 1,    ///< write after read / write after write only (ordering, no data)
+  kCarried = 2,  ///< loop-carried: iteration i to i+1
+  kInternal = 3  ///< into or out of a signal, wait or reducer
 };
 
 /// One edge of the picture.

@@ -51,7 +51,7 @@ struct StepSeries {
 struct ReportContent {
   std::string title;
   std::vector<std::pair<std::string, std::string>> facts;  ///< scene and machine, label -> value
-  double parallelism = 0;                       ///< work / span of the trace (speed-up bound)
+  double parallelism = 0;                      ///< work / span of the trace (speed-up bound)
   std::vector<std::uint32_t> contact_changes;  ///< steps whose contact set changed
   std::vector<MethodRow> rows;
   std::vector<StepSeries> series;

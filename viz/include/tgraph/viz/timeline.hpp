@@ -16,8 +16,8 @@ namespace tgraph::viz {
 struct TimelineTask {
   std::uint32_t step = 0;
   std::uint32_t thread = 0;
-  std::uint32_t task = 0;                 ///< executed task (reducers included)
-  std::optional<std::uint32_t> origin;    ///< task of the step graph (empty: a reducer)
+  std::uint32_t task = 0;               ///< executed task (reducers included)
+  std::optional<std::uint32_t> origin;  ///< task of the step graph (empty: a reducer)
   std::string kind;
   std::uint32_t iteration = 0;
   std::int64_t start_ns = 0;
