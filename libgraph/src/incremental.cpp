@@ -21,12 +21,21 @@ std::int64_t now_ns() {
 // StepGraph::derive_edges() finds them: loop bodies get their second pass over the same
 // accesses from the end-of-body state. Appends to `edges` / `carried`, each sorted and
 // without duplicates.
+// `state` and `second_state` are scratch (their buffers are reused from datum to datum).
 template <class Entry>
 void derive_datum(const StepGraph& g, DatumId d, const Entry* first, const Entry* last,
-                  std::vector<Edge>& edges, std::vector<Edge>& carried) {
+                  std::vector<Edge>& edges, std::vector<Edge>& carried,
+                  detail::DatumState& state, detail::DatumState& second_state) {
   const std::size_t edges_at = edges.size(), carried_at = carried.size();
   const auto n = static_cast<TaskId>(g.tasks.size());
-  detail::DatumState state;
+  auto clear = [](detail::DatumState& s) {
+    s.writers.clear();
+    s.readers.clear();
+    s.group_preds.clear();
+    s.group_kind = EdgeKind::WAW;
+    s.cw_group = false;
+  };
+  clear(state);
   detail::EdgeSink main;
   main.out = &edges;
   for (const Entry* i = first; i < last;) {
@@ -38,7 +47,11 @@ void derive_datum(const StepGraph& g, DatumId d, const Entry* first, const Entry
     const Entry* j = i;
     while (j < last && j->loop == i->loop) ++j;
     for (const Entry* k = i; k < j; ++k) detail::apply_access(state, k->task, {d, k->mode}, main);
-    detail::DatumState second_state = state;
+    second_state.writers.assign(state.writers.begin(), state.writers.end());
+    second_state.readers.assign(state.readers.begin(), state.readers.end());
+    second_state.group_preds.assign(state.group_preds.begin(), state.group_preds.end());
+    second_state.group_kind = state.group_kind;
+    second_state.cw_group = state.cw_group;
     detail::EdgeSink second;
     second.out = &carried;
     second.offset = n;
@@ -86,6 +99,33 @@ void group_edges(const std::vector<Edge>& edges, std::size_t n_data,
 
 }  // namespace
 
+bool EdgeDeriver::KeyTable::build(const StepGraph& g) {
+  std::size_t size = 16;
+  while (size < 2 * g.tasks.size()) size *= 2;
+  mask_ = size - 1;
+  keys_.assign(size, 0);
+  tasks_.assign(size, kNoTask);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    const StableKey k = g.tasks[t].key;
+    std::size_t i = (k ^ (k >> 29)) & mask_;
+    while (tasks_[i] != kNoTask) {
+      if (keys_[i] == k) return false;
+      i = (i + 1) & mask_;
+    }
+    keys_[i] = k;
+    tasks_[i] = t;
+  }
+  return true;
+}
+
+TaskId EdgeDeriver::KeyTable::find(StableKey k) const {
+  if (tasks_.empty()) return kNoTask;
+  for (std::size_t i = (k ^ (k >> 29)) & mask_;; i = (i + 1) & mask_) {
+    if (tasks_[i] == kNoTask) return kNoTask;
+    if (keys_[i] == k) return tasks_[i];
+  }
+}
+
 void EdgeDeriver::group_accesses(const StepGraph& g, ByDatum& out) {
   out.begin.assign(g.data.size() + 1, 0);
   for (const Access& a : g.accesses) ++out.begin[a.datum + 1];
@@ -98,7 +138,7 @@ void EdgeDeriver::group_accesses(const StepGraph& g, ByDatum& out) {
 
 void EdgeDeriver::reset() {
   have_previous_ = false;
-  previous_task_.clear();
+  previous_task_ = {};
   previous_names_.clear();
   previous_accesses_ = {};
   edge_begin_.clear();
@@ -107,11 +147,11 @@ void EdgeDeriver::reset() {
   carried_by_datum_.clear();
 }
 
-void EdgeDeriver::remember(const StepGraph& g, ByDatum&& accesses,
-                           std::unordered_map<StableKey, TaskId>&& keys, bool keyed) {
+// current_task_ holds g's keys (KeyTable::build) when this is called.
+void EdgeDeriver::remember(const StepGraph& g, ByDatum&& accesses, bool keyed) {
   have_previous_ = true;
   previous_keyed_ = keyed;
-  previous_task_ = std::move(keys);
+  std::swap(previous_task_, current_task_);
   previous_names_.resize(g.data.size());
   for (DatumId d = 0; d < g.data.size(); ++d)
     if (previous_names_[d] != g.data[d].name) previous_names_[d] = g.data[d].name;
@@ -121,11 +161,8 @@ void EdgeDeriver::remember(const StepGraph& g, ByDatum&& accesses,
 void EdgeDeriver::seed(const StepGraph& g) {
   ByDatum acc;
   group_accesses(g, acc);
-  std::unordered_map<StableKey, TaskId> keys;
-  bool keyed = true;
-  keys.reserve(g.tasks.size());
-  for (TaskId t = 0; t < g.tasks.size() && keyed; ++t) keyed = keys.emplace(g.tasks[t].key, t).second;
-  remember(g, std::move(acc), std::move(keys), keyed);
+  const bool keyed = current_task_.build(g);
+  remember(g, std::move(acc), keyed);
   group_edges(g.edges, g.data.size(), edge_begin_, edges_by_datum_);
   group_edges(g.carried_edges, g.data.size(), carried_begin_, carried_by_datum_);
 }
@@ -138,13 +175,10 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   // New task -> previous task, by stable key; every key must name one task in each step.
   std::vector<TaskId> old_of(n, kNoTask);
-  bool keyed = true;
-  std::unordered_map<StableKey, TaskId> keys;
-  keys.reserve(n);
-  for (TaskId t = 0; t < n && keyed; ++t) keyed = keys.emplace(g.tasks[t].key, t).second;
+  const bool keyed = current_task_.build(g);
   if (!have_previous_ || !previous_keyed_ || !keyed) {
     g.derive_edges();
-    remember(g, std::move(cur), std::move(keys), keyed);
+    remember(g, std::move(cur), keyed);
     group_edges(g.edges, g.data.size(), edge_begin_, edges_by_datum_);
     group_edges(g.carried_edges, g.data.size(), carried_begin_, carried_by_datum_);
     u.edges = g.edges.size() + g.carried_edges.size();
@@ -153,9 +187,9 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
   }
   std::size_t previous_n = 0;
   for (TaskId t = 0; t < n; ++t)
-    if (auto it = previous_task_.find(g.tasks[t].key); it != previous_task_.end()) {
-      old_of[t] = it->second;
-      previous_n = std::max<std::size_t>(previous_n, it->second + 1);
+    if (const TaskId o = previous_task_.find(g.tasks[t].key); o != kNoTask) {
+      old_of[t] = o;
+      previous_n = std::max<std::size_t>(previous_n, o + 1);
     }
   std::vector<TaskId> new_of(previous_n, kNoTask);
   for (TaskId t = 0; t < n; ++t)
@@ -198,7 +232,8 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
                           (carried_begin_[d + 1] - carried_begin_[d]);
         ++u.data_reused;
       } else {
-        derive_datum(g, d, nb, ne, edges, carried);
+        thread_local detail::DatumState state, second_state;  // buffers kept between data
+        derive_datum(g, d, nb, ne, edges, carried, state, second_state);
         ++u.data_rederived;
       }
     }
@@ -208,7 +243,7 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
   assemble(edges, n, g.edges);
   assemble(carried, n, g.carried_edges);
   u.edges = g.edges.size() + g.carried_edges.size();
-  remember(g, std::move(cur), std::move(keys), keyed);
+  remember(g, std::move(cur), keyed);
   edge_begin_ = std::move(edge_begin);
   carried_begin_ = std::move(carried_begin);
   edges_by_datum_ = std::move(edges);

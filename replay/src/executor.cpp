@@ -195,7 +195,8 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
       entry->assignment = *a;
       entry->has_assignment = true;
     }
-    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible);
+    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible,
+                        options_.incremental_plans ? &exec_edges_ : nullptr);
     const std::int64_t t_lowered = now_ns();
     if (last_entry_ && options_.incremental_plans) {
       entry->plan = rebuild(entry->exec, last_entry_->exec, last_entry_->plan.get());

@@ -21,7 +21,6 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
-#include <unordered_map>
 #include <vector>
 
 #include "common.hpp"
@@ -327,22 +326,32 @@ Plan update_plan(const ExecGraph& x, const Plan& prev, std::uint32_t k, bool use
     for (ProcId p = 0; p < k; ++p) build_waits(x, p, plan);
     plan.rebuilt_procs = k;
     finish_plan(x, plan);
-    return plan;
+    return std::move(plan);
   };
   if (plan.program_order != prev.program_order) return from_scratch();
 
-  // Tasks and loops matched by stable key (both ways; keys must be unique).
-  std::unordered_map<StableKey, TaskId> by_key;
-  by_key.reserve(prev.keys.size());
-  for (TaskId t = 0; t < prev.keys.size(); ++t)
-    if (!by_key.emplace(prev.keys[t], t).second) return from_scratch();
+  // Tasks and loops matched by stable key (both ways; keys must be unique). The keys are
+  // hashes: an open-addressing table with linear probing.
+  std::size_t size = 16;
+  while (size < 2 * prev.keys.size()) size *= 2;
+  const std::size_t mask = size - 1;
+  std::vector<TaskId> slot(size, kNoTask);
+  auto home = [mask](StableKey key) { return static_cast<std::size_t>(key ^ (key >> 29)) & mask; };
+  for (TaskId t = 0; t < prev.keys.size(); ++t) {
+    std::size_t i = home(prev.keys[t]);
+    for (; slot[i] != kNoTask; i = (i + 1) & mask)
+      if (prev.keys[slot[i]] == prev.keys[t]) return from_scratch();
+    slot[i] = t;
+  }
   std::vector<TaskId> old_of(n, kNoTask), new_of(prev.keys.size(), kNoTask);
   for (TaskId t = 0; t < n; ++t)
-    if (auto it = by_key.find(plan.keys[t]); it != by_key.end()) {
-      if (new_of[it->second] != kNoTask) return from_scratch();
-      old_of[t] = it->second;
-      new_of[it->second] = t;
-    }
+    for (std::size_t i = home(plan.keys[t]); slot[i] != kNoTask; i = (i + 1) & mask)
+      if (prev.keys[slot[i]] == plan.keys[t]) {
+        if (new_of[slot[i]] != kNoTask) return from_scratch();
+        old_of[t] = slot[i];
+        new_of[slot[i]] = t;
+        break;
+      }
   constexpr LoopId kUnmatched = kNoLoop - 1;
   std::vector<LoopId> old_loop(g.loops.size(), kUnmatched), new_loop(prev.breaks.size(), kUnmatched);
   for (LoopId l = 0; l < g.loops.size(); ++l) {

@@ -4,7 +4,6 @@
 
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -59,13 +58,25 @@ class EdgeDeriver {
     std::vector<std::uint32_t> begin;
     std::vector<Entry> entries;
   };
+  // Task by stable key: open addressing, linear probing (keys are hashes already).
+  class KeyTable {
+   public:
+    /// Fills the table; false when a key names two tasks.
+    bool build(const StepGraph& g);
+    /// The task with key `k`, or kNoTask.
+    TaskId find(StableKey k) const;
+
+   private:
+    std::vector<StableKey> keys_;
+    std::vector<TaskId> tasks_;  // kNoTask: empty slot
+    std::size_t mask_ = 0;
+  };
   static void group_accesses(const StepGraph& g, ByDatum& out);
-  void remember(const StepGraph& g, ByDatum&& accesses,
-                std::unordered_map<StableKey, TaskId>&& keys, bool keyed);
+  void remember(const StepGraph& g, ByDatum&& accesses, bool keyed);
 
   bool have_previous_ = false;
   bool previous_keyed_ = false;  // stable keys unique in the previous step
-  std::unordered_map<StableKey, TaskId> previous_task_;  // by key
+  KeyTable previous_task_, current_task_;  // by key; current_task_ is swapped in
   std::vector<std::string> previous_names_;              // by datum
   ByDatum previous_accesses_;
   std::vector<std::uint32_t> edge_begin_, carried_begin_;  // previous edges by datum (CSR)

@@ -155,6 +155,7 @@ class Executor {
   Policy policy_;
   std::vector<std::shared_ptr<CacheEntry>> cache_;
   std::shared_ptr<CacheEntry> last_entry_;  // the plan of the previous step
+  EdgeDeriver exec_edges_;                  // the last lowered graph's edges, by datum
   std::uint64_t plans_built_ = 0;
   const ExecGraph* last_exec_ = nullptr;
 };
