@@ -1,14 +1,15 @@
 // SPDX-License-Identifier: MIT
 // `tgraph export T.tgt --step S --format {json,metis,scotch} [-o F]`: one step's graph in an
 // interchange format (METIS: gpmetis input; Scotch: scotch_gpart source graph);
-// `tgraph export R.json --format chrome`: a replay timeline as Chrome/Perfetto trace events.
+// `tgraph export R.json --format chrome`: a replay timeline as Chrome/Perfetto trace events,
+// with signal -> wait flow arrows.
 #include <iostream>
 
 #include "commands.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/step_json.hpp"
 #include "tgraph/partition/export.hpp"
-#include "tgraph/replay/observer.hpp"
+#include "tgraph/viz/timeline.hpp"
 
 namespace tgraph::app {
 namespace {
@@ -31,9 +32,7 @@ void write_output(const ExportOptions& o, const std::string& text) {
 void run_export(const ExportOptions& o) {
   if (o.format == "chrome") {
     // The input is a replay timeline (tgraph replay --timeline R.json).
-    const auto bytes = read_file_bytes(o.trace);
-    write_output(o, replay::chrome_from_timeline_json(
-                        std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), o.trace));
+    write_output(o, viz::chrome_trace(viz::parse_timeline(read_file_text(o.trace), o.trace)));
     return;
   }
   const Trace trace = load_trace(o.trace);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
 
@@ -28,6 +29,11 @@ class Failure : public std::runtime_error {
 void print_json(const nlohmann::json& j);
 /// Reads a trace for a verb; malformed input throws InputError (exit 2).
 Trace load_trace(const std::string& path, bool recover = false);
+/// A whole file as text (InputError when it cannot be read).
+inline std::string read_file_text(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+  return std::string(bytes.begin(), bytes.end());
+}
 /// "<cpu model>, N hardware threads", for trace headers.
 std::string machine_description();
 /// Threads a verb uses by default: all hardware threads (at least 1).
@@ -44,5 +50,8 @@ void add_demo(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
 void add_replay_verbs(CLI::App& app);     // replay, run
 void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)
+void add_viz_verbs(CLI::App& app);        // viz, then add_timeline and add_report
+void add_timeline(CLI::App& app);
+void add_report(CLI::App& app);
 
 }  // namespace tgraph::app

@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   add_partition_verbs(app);
   add_replay_verbs(app);
   add_validate(app);
+  add_viz_verbs(app);
   try {
     app.parse(argc, argv);
     if (app.get_subcommands().empty()) {

@@ -8,13 +8,16 @@ TGRAPH_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 TGRAPH_PACKAGES=(cmake g++ ninja-build pkg-config python3
   libeigen3-dev libmetis-dev metis libscotch-dev scotch libgraphviz-dev graphviz
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libhwloc-dev libcli11-dev nlohmann-json3-dev
-  libstarpu-dev zlib1g-dev clang libclang-rt-14-dev libomp-14-dev)
+  libstarpu-dev zlib1g-dev clang libclang-rt-14-dev libomp-14-dev libcairo2-dev)
 
 tgraph_install_packages() {
   local missing=()
   for p in "${TGRAPH_PACKAGES[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
+  # npm (with node) fetches the report's charting libraries at build time (viz/web); any npm
+  # will do, so a node from elsewhere (nodesource, nvm) is kept rather than Debian's.
+  command -v npm >/dev/null 2>&1 || missing+=(nodejs npm)
   [ ${#missing[@]} -eq 0 ] && return 0
   if [ "$(id -u)" -eq 0 ]; then
     echo "tgraph: installing ${missing[*]}" >&2
@@ -41,4 +44,18 @@ tgraph_build() {
   else
     cmake --build "build/$preset" -j "$jobs"
   fi
+}
+
+# Optional: Debian's chromium for the browser test of the HTML report (tests/viz). Installed
+# when running as root; otherwise, or when apt fails, a notice says the test will be skipped.
+tgraph_install_browser() {
+  command -v chromium >/dev/null 2>&1 && return 0
+  if [ "$(id -u)" -eq 0 ] &&
+    { DEBIAN_FRONTEND=noninteractive apt-get update -qq &&
+      DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium; } >/dev/null 2>&1; then
+    echo "tgraph: installed chromium (browser test of the HTML report)" >&2
+    return 0
+  fi
+  echo "tgraph: NOTICE: chromium is not installed and could not be installed (run as root:" \
+    "apt-get install chromium); the browser test of the HTML report will be skipped" >&2
 }

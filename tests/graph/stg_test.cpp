@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Standard Task Graph Set import: critical paths, dummy tasks, round trip, malformed files.
+#include "../stg_files.hpp"
 #include "tgraph/graph/stg.hpp"
 
 #include <gtest/gtest.h>
@@ -14,17 +15,7 @@
 namespace tgraph {
 namespace {
 
-std::vector<std::string> stg_files() {
-  std::vector<std::string> files;
-  for (const char* dir : {"50", "100"}) {
-    const std::filesystem::path p = std::filesystem::path(TGRAPH_TEST_DATA) / "stg" / dir;
-    std::error_code ec;
-    for (const auto& e : std::filesystem::directory_iterator(p, ec))
-      if (e.path().extension() == ".stg") files.push_back(e.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
+using test::stg_files;
 
 TEST(Stg, ReproducesTheStatedCriticalPathOfEveryGraph) {
   const std::vector<std::string> files = stg_files();

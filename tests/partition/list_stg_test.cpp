@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "../stg_files.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/stg.hpp"
 #include "tgraph/partition/simulator.hpp"
@@ -13,17 +14,7 @@
 namespace tgraph::partition {
 namespace {
 
-std::vector<std::string> stg_files() {
-  std::vector<std::string> files;
-  for (const char* dir : {"50", "100"}) {
-    const std::filesystem::path p = std::filesystem::path(TGRAPH_TEST_DATA) / "stg" / dir;
-    std::error_code ec;
-    for (const auto& e : std::filesystem::directory_iterator(p, ec))
-      if (e.path().extension() == ".stg") files.push_back(e.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
+using test::stg_files;
 
 TEST(ListOnStg, BeatsRandomPlacementAndRespectsTheBound) {
   std::uint64_t list_total = 0, random_total = 0;

@@ -15,6 +15,9 @@
 namespace tgraph::replay {
 namespace {
 
+using test::final_state;
+using test::sequential_state;
+
 struct Variant {
   Policy policy;
   bool serial;
@@ -42,25 +45,6 @@ ExecOptions options_for(const Variant& v, std::uint32_t k) {
   o.serial = v.serial;
   o.spin_ns = 20'000;
   return o;
-}
-
-/// Final words of the original data after running `steps` steps of g.
-std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w,
-                                                    const StepGraph& g) {
-  std::vector<std::vector<std::uint64_t>> s;
-  for (DatumId d = 0; d < g.data.size(); ++d) {
-    auto words = w.words(d);
-    s.emplace_back(words.begin(), words.end());
-  }
-  return s;
-}
-
-std::vector<std::vector<std::uint64_t>> sequential_state(const StepGraph& g, int steps) {
-  auto ex = make_executor(Policy::kSequential, {});
-  SyntheticWorkload w({.cost_scale = 0.0});
-  w.set_step(g);
-  for (int s = 0; s < steps; ++s) ex->run_step(g, nullptr, w);
-  return final_state(w, g);
 }
 
 class EveryPolicy : public ::testing::TestWithParam<std::tuple<int, std::uint32_t>> {};

@@ -12,7 +12,9 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/observer.hpp"
+#include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay::test {
 
@@ -133,6 +135,26 @@ inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineEve
         EXPECT_GE(start_of(v, i), end_of(l.last - 1, i - 1)) << "gate of loop, task " << v;
         EXPECT_GE(start_of(v, i), end_of(v, i - 1)) << "task " << v << " overtook itself";
       }
+}
+
+/// Final words of the original data after the steps `w` ran.
+inline std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w,
+                                                           const StepGraph& g) {
+  std::vector<std::vector<std::uint64_t>> s;
+  for (DatumId d = 0; d < g.data.size(); ++d) {
+    auto words = w.words(d);
+    s.emplace_back(words.begin(), words.end());
+  }
+  return s;
+}
+
+/// Final words of the original data after `steps` sequential steps of g.
+inline std::vector<std::vector<std::uint64_t>> sequential_state(const StepGraph& g, int steps) {
+  auto ex = make_executor(Policy::kSequential, {});
+  SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  for (int s = 0; s < steps; ++s) ex->run_step(g, nullptr, w);
+  return final_state(w, g);
 }
 
 }  // namespace tgraph::replay::test

@@ -17,6 +17,9 @@
 namespace tgraph::replay {
 namespace {
 
+using test::final_state;
+using test::sequential_state;
+
 #if !defined(TGRAPH_HAVE_STARPU)
 #define TGRAPH_NEED_STARPU() GTEST_SKIP() << "tgraph was built without StarPU"
 #else
@@ -45,24 +48,6 @@ ExecOptions starpu_options(std::uint32_t k, Cw cw = Cw::kPerWriter) {
   if (cw == Cw::kCommute) o.reduce_scope = ReduceScope::kNone;
   if (cw == Cw::kSerialize) o.cw = CwMode::kSerialize;
   return o;
-}
-
-std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorkload& w,
-                                                    const StepGraph& g) {
-  std::vector<std::vector<std::uint64_t>> s;
-  for (DatumId d = 0; d < g.data.size(); ++d) {
-    auto words = w.words(d);
-    s.emplace_back(words.begin(), words.end());
-  }
-  return s;
-}
-
-std::vector<std::vector<std::uint64_t>> sequential_state(const StepGraph& g, int steps) {
-  auto ex = make_executor(Policy::kSequential, {});
-  SyntheticWorkload w({.cost_scale = 0.0});
-  w.set_step(g);
-  for (int s = 0; s < steps; ++s) ex->run_step(g, nullptr, w);
-  return final_state(w, g);
 }
 
 /// Synthetic bodies whose loop counts are only known when the break task decides (as in a

@@ -1,0 +1,311 @@
+// SPDX-License-Identifier: MIT
+// Step graph pictures: golden DOT text, dot's acceptance, collapsed totals, refusals, the
+// critical path.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "../partition/test_graphs.hpp"
+#include "tgraph/capture/recorder.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/metrics.hpp"
+#include "tgraph/samples/scene.hpp"
+#include "tgraph/viz/critical_path.hpp"
+#include "tgraph/viz/graph_view.hpp"
+#include "tgraph/viz/graphviz.hpp"
+
+namespace tgraph::viz {
+namespace {
+
+using partition::testing::Builder;
+using M = AccessMode;
+
+StepGraph capture_step(const std::string& scene_name, int step) {
+  auto scene = samples::make_scene(scene_name, {});
+  capture::Recorder rec(capture::Mode::kCapture);
+  StepGraph g;
+  for (int s = 0; s <= step; ++s) {
+    scene->step(rec);
+    g = rec.end_step();
+  }
+  return g;
+}
+
+// fig2's step 1 with costs replaced by 10 ns x (task + 1): captured costs are measured times,
+// the golden files compare structure, labels and styles.
+StepGraph fig2_fixed_costs() {
+  StepGraph g = capture_step("fig2", 1);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) g.tasks[t].cost_ns = 10 * (t + 1);
+  return g;
+}
+
+// fig2 on 2 processors: object A's tasks and the interaction on p0, object B's on p1.
+Assignment fig2_assignment(const StepGraph& g) {
+  Assignment a;
+  a.k = 2;
+  for (const Task& t : g.tasks) a.proc.push_back(g.objects[t.object].name == "B" ? 1 : 0);
+  return a;
+}
+
+// A hand-made graph: two bodies accumulate (CW) into a shared force, then a loop of 3
+// iterations (solve, dot product by CW into a scalar, the break reading the condition).
+StepGraph cw_loop_graph() {
+  Builder b;
+  b.g.kinds = {"force", "solve", "dot", "check", "update"};
+  const ObjectId o0 = b.object("body0"), o1 = b.object("body1");
+  const DatumId f = b.datum("f", 96), x0 = b.datum("x0", 48, o0), x1 = b.datum("x1", 48, o1);
+  const DatumId alpha = b.datum("alpha", 8), cond = b.datum("cond", 1);
+  auto task = [&](std::uint32_t kind, ObjectId o, std::vector<Access> acc, std::uint64_t cost) {
+    const auto t = static_cast<TaskId>(b.g.tasks.size());
+    return b.g.add_task(kind, o, acc, cost, 100 + t);
+  };
+  task(0, o0, {{f, M::CW}, {x0, M::R}}, 30);
+  task(0, o1, {{f, M::CW}, {x1, M::R}}, 40);
+  const TaskId first = task(1, o0, {{x0, M::RW}, {f, M::R}}, 20);
+  task(1, o1, {{x1, M::RW}, {f, M::R}}, 25);
+  task(2, o0, {{alpha, M::CW}, {x0, M::R}}, 5);
+  task(2, o1, {{alpha, M::CW}, {x1, M::R}}, 5);
+  task(3, kNoObject, {{cond, M::W}, {alpha, M::R}}, 2);
+  const TaskId brk = task(3, kNoObject, {{cond, M::R}}, 1);
+  b.loop(cond, first, brk + 1, 3);
+  task(4, o0, {{x0, M::RW}}, 10);
+  return b.done();
+}
+
+Assignment by_object(const StepGraph& g) {
+  Assignment a;
+  a.k = 2;
+  for (const Task& t : g.tasks) a.proc.push_back(t.object == 1 ? 1 : 0);
+  return a;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Compares with tests/viz/golden/<name>.dot (TGRAPH_UPDATE_GOLDEN=1 rewrites it).
+void expect_golden(const std::string& name, const std::string& dot) {
+  const std::string path = std::string(TGRAPH_VIZ_GOLDEN) + "/" + name + ".dot";
+  if (std::getenv("TGRAPH_UPDATE_GOLDEN")) write_file_atomic(path, dot);
+  ASSERT_TRUE(std::filesystem::exists(path)) << path << " missing (TGRAPH_UPDATE_GOLDEN=1 writes it)";
+  EXPECT_EQ(dot, read_text(path)) << "DOT differs from " << path;
+}
+
+// `dot -Tsvg` accepts the text and writes an SVG document.
+void expect_dot_accepts(const std::string& dot, const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("tgraph_viz_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string in = (dir / (name + ".dot")).string(), out = (dir / (name + ".svg")).string();
+  write_file_atomic(in, dot);
+  const std::string cmd = std::string(TGRAPH_DOT) + " -Tsvg '" + in + "' -o '" + out + "' 2>/dev/null";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << name;
+  EXPECT_NE(read_text(out).find("<svg"), std::string::npos) << name;
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GraphView, Fig2MatchesItsGoldenDot) {
+  const StepGraph g = fig2_fixed_costs();
+  ViewOptions o;
+  o.title = "fig2, step 1";
+  const std::string dot = to_dot(make_graph_view(g, o));
+  expect_golden("fig2", dot);
+  expect_dot_accepts(dot, "fig2");
+}
+
+TEST(GraphView, Fig2OnTwoProcessorsHasTwoFillsAndRedCrossingEdges) {
+  const StepGraph g = fig2_fixed_costs();
+  const Assignment a = fig2_assignment(g);
+  ViewOptions o;
+  o.assignment = &a;
+  o.title = "fig2, step 1, by object on 2 processors";
+  const GraphView v = make_graph_view(g, o);
+  std::set<ProcId> fills;
+  std::size_t signals = 0, waits = 0, reducers = 0, cross = 0;
+  for (const ViewNode& n : v.nodes) {
+    if (n.kind == NodeKind::kTask) fills.insert(n.procs.at(0).proc);
+    signals += n.kind == NodeKind::kSignal;
+    waits += n.kind == NodeKind::kWait;
+    reducers += n.kind == NodeKind::kReducer;
+  }
+  for (const ViewEdge& e : v.edges) cross += e.cross_deps > 0;
+  EXPECT_EQ(fills, (std::set<ProcId>{0, 1}));
+  // B.f's CW group (addForce@B on p1, addForce@AB on p0) spans both processors: one reducer.
+  EXPECT_EQ(reducers, 1u);
+  EXPECT_GT(signals, 0u);
+  EXPECT_EQ(signals, waits);
+  EXPECT_EQ(cross, waits);  // each crossing edge runs signal -> wait
+  const std::string dot = to_dot(v);
+  EXPECT_NE(dot.find("#E69F00"), std::string::npos);  // p0 fill
+  EXPECT_NE(dot.find("#56B4E9"), std::string::npos);  // p1 fill
+  EXPECT_NE(dot.find("#D55E00"), std::string::npos);  // crossing edges
+  expect_golden("fig2_k2", dot);
+  expect_dot_accepts(dot, "fig2_k2");
+}
+
+TEST(GraphView, CwLoopGraphMatchesItsGoldenDot) {
+  const StepGraph g = cw_loop_graph();
+  ASSERT_EQ(g.validate(), "");
+  const Assignment a = by_object(g);
+  ViewOptions o;
+  o.assignment = &a;
+  o.critical_path = true;
+  o.title = "cw + loop";
+  const GraphView v = make_graph_view(g, o);
+  ASSERT_EQ(v.clusters.size(), 1u);
+  EXPECT_EQ(v.clusters[0].label, "loop 0: 3 iterations (max 100)");
+  const std::string dot = to_dot(v);
+  expect_golden("cw_loop", dot);
+  expect_dot_accepts(dot, "cw_loop");
+  for (Collapse c : {Collapse::kObject, Collapse::kKind, Collapse::kProcessor, Collapse::kLoop}) {
+    o.collapse = c;
+    expect_dot_accepts(to_dot(make_graph_view(g, o)), "cw_loop_" + std::string(to_string(c)));
+  }
+}
+
+TEST(GraphView, RendersSvgThroughLibgvc) {
+  const StepGraph g = cw_loop_graph();
+  ViewOptions o;
+  const std::string svg = render_graph(make_graph_view(g, o), GraphFormat::kSvg);
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  EXPECT_NE(svg.find("loop 0: 3 iterations"), std::string::npos);
+}
+
+// Expected aggregates of --collapse object computed from the trace directly.
+TEST(GraphView, CollapsedBars64HasOneNodePerObjectAndLoopWithSummedWork) {
+  const StepGraph g = capture_step("bars64", 1);
+  ASSERT_GT(g.tasks.size(), 900u);
+  std::map<std::pair<std::string, LoopId>, std::uint64_t> expected;  // key -> work
+  std::uint64_t total = 0;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    const Task& task = g.tasks[t];
+    const std::string key = task.object == kNoObject ? "k" + std::to_string(task.kind) : "o" + std::to_string(task.object);
+    expected[{key, task.loop}] += task.cost_ns * g.runs(t);
+    total += task.cost_ns * g.runs(t);
+  }
+  ViewOptions o;
+  o.collapse = Collapse::kObject;
+  const GraphView v = make_graph_view(g, o);
+  std::size_t groups = 0;
+  std::uint64_t work = 0;
+  std::multiset<std::uint64_t> got_work, want_work;
+  for (const ViewNode& n : v.nodes) {
+    if (n.kind == NodeKind::kDatum) continue;
+    ++groups;
+    work += n.work_ns;
+    got_work.insert(n.work_ns);
+  }
+  for (const auto& [key, w] : expected) want_work.insert(w);
+  EXPECT_EQ(groups, expected.size());
+  EXPECT_EQ(got_work, want_work);
+  EXPECT_EQ(work, total);
+  EXPECT_EQ(work, compute_metrics(g).work_ns);
+  std::uint64_t tasks = 0;
+  for (const ViewNode& n : v.nodes) tasks += n.tasks;
+  EXPECT_EQ(tasks, g.tasks.size());
+}
+
+TEST(GraphView, CollapsedByKindAndProcessorSumTheWork) {
+  const StepGraph g = capture_step("bars64", 1);
+  Assignment a;
+  a.k = 4;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 4);
+  ViewOptions o;
+  o.assignment = &a;
+  const std::uint64_t total = compute_metrics(g).work_ns;
+  for (Collapse c : {Collapse::kKind, Collapse::kProcessor, Collapse::kLoop}) {
+    o.collapse = c;
+    const GraphView v = make_graph_view(g, o);
+    std::uint64_t work = 0, tasks = 0, shares = 0;
+    for (const ViewNode& n : v.nodes) {
+      work += n.work_ns;
+      tasks += n.tasks;
+      for (const ProcessorShare& s : n.procs) shares += s.work_ns;
+    }
+    EXPECT_EQ(work, total) << to_string(c);
+    EXPECT_EQ(shares, total) << to_string(c);
+    EXPECT_EQ(tasks, g.tasks.size()) << to_string(c);
+  }
+  o.collapse = Collapse::kProcessor;
+  std::set<std::pair<ProcId, LoopId>> want;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) want.insert({a.proc[t], g.tasks[t].loop});
+  std::size_t groups = 0;
+  for (const ViewNode& n : make_graph_view(g, o).nodes) groups += n.kind == NodeKind::kGroup;
+  EXPECT_EQ(groups, want.size());
+}
+
+TEST(GraphView, Bars64WithoutCollapseIsRefusedWithAHint) {
+  const StepGraph g = capture_step("bars64", 1);
+  ViewOptions o;
+  try {
+    make_graph_view(g, o);
+    FAIL() << "expected a refusal";
+  } catch (const UsageError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("--collapse"), std::string::npos) << what;
+    EXPECT_NE(what.find("--max-edges 4000"), std::string::npos) << what;
+  }
+  o.max_nodes = 100;
+  o.max_edges = 0;
+  EXPECT_THROW(make_graph_view(g, o), UsageError);
+}
+
+TEST(GraphView, RejectsAnAssignmentThatDoesNotFit) {
+  const StepGraph g = cw_loop_graph();
+  Assignment a = by_object(g);
+  a.proc.pop_back();
+  ViewOptions o;
+  o.assignment = &a;
+  EXPECT_THROW(make_graph_view(g, o), UsageError);
+  a = by_object(g);
+  a.proc[0] = 7;
+  EXPECT_THROW(make_graph_view(g, o), UsageError);
+  ViewOptions p;
+  p.collapse = Collapse::kProcessor;
+  EXPECT_THROW(make_graph_view(g, p), UsageError);
+  EXPECT_THROW(parse_collapse("objects"), UsageError);
+  EXPECT_THROW(graph_format_of("x.jpeg"), UsageError);
+}
+
+TEST(CriticalPath, LengthIsTheSpanOnRandomGraphsWithLoops) {
+  for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+    const StepGraph g = partition::testing::random_graph(seed, 6 + static_cast<int>(seed % 20), 5, seed % 2 == 0);
+    const CriticalPath cp = critical_path(g);
+    EXPECT_EQ(cp.length_ns, compute_metrics(g).span_ns) << "seed " << seed;
+    std::uint64_t sum = 0;
+    for (const TaskInstance& i : cp.instances) sum += g.tasks[i.task].cost_ns;
+    EXPECT_EQ(sum, cp.length_ns) << "seed " << seed;  // a path: its costs add up to its length
+  }
+}
+
+TEST(CriticalPath, CountsLoopIterations) {
+  const StepGraph g = cw_loop_graph();
+  const CriticalPath cp = critical_path(g);
+  EXPECT_EQ(cp.length_ns, compute_metrics(g).span_ns);
+  // Iterations 0 and 1 end with body1's solve (25) -> dot -> check -> break; the last one
+  // ends with body0's solve -> dot -> the update after the loop (20 + 5 + 10 > 25 + 5 + 2 + 1).
+  EXPECT_EQ(cp.task_hits[3], 2u);  // solve@body1
+  EXPECT_EQ(cp.task_hits[7], 2u);  // the break, gating iterations 1 and 2
+  EXPECT_EQ(cp.task_hits[2], 1u);  // solve@body0
+  ASSERT_FALSE(cp.instances.empty());
+  EXPECT_EQ(cp.instances.back().task, 8u);
+  EXPECT_EQ(cp.instances.front().task, 1u);  // the heavier force (40)
+}
+
+TEST(Format, RoundsWithUnits) {
+  EXPECT_EQ(format_bytes(96), "96 B");
+  EXPECT_EQ(format_bytes(1536), "1.5 KiB");
+  EXPECT_EQ(format_ns(850), "850 ns");
+  EXPECT_EQ(format_ns(4474820), "4.47 ms");
+}
+
+}  // namespace
+}  // namespace tgraph::viz

@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# The viz verbs end to end: the commands of issue 9's "done means", bad input (exit 2, one
+# line, no file written), and `dot -Tsvg` on every .dot written.
+# Usage: viz_cli.sh TGRAPH DOT
+set -euo pipefail
+T="$1"
+DOT="$2"
+d="$(mktemp -d)"
+trap 'rm -rf "$d"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# expect_refusal OUTPUT CMD...: exit 2, one line on stderr, OUTPUT not written.
+expect_refusal() {
+  local out="$1"; shift
+  set +e
+  "$@" >"$d/out" 2>"$d/err"
+  local rc=$?
+  set -e
+  [ "$rc" -eq 2 ] || fail "$* exited $rc, expected 2: $(cat "$d/err")"
+  [ "$(wc -l <"$d/err")" -eq 1 ] || fail "$*: expected a one-line error, got: $(cat "$d/err")"
+  [ ! -e "$out" ] || fail "$*: wrote $out"
+}
+
+"$T" capture --scene fig2 --steps 3 -o "$d/fig2.tgt" >/dev/null
+"$T" partition "$d/fig2.tgt" --method metis -k 2 -o "$d/f2.tga" >/dev/null
+"$T" viz "$d/fig2.tgt" --step 1 --assign "$d/f2.tga" -o "$d/f.svg"
+grep -qi 'fill="#e69f00"' "$d/f.svg" || fail "f.svg: no p0 fill"
+grep -qi 'fill="#56b4e9"' "$d/f.svg" || fail "f.svg: no p1 fill"
+grep -qi 'stroke="#d55e00"' "$d/f.svg" || fail "f.svg: no red crossing edge"
+for c in none object kind processor loop; do
+  "$T" viz "$d/fig2.tgt" --step 1 --assign "$d/f2.tga" --collapse "$c" --critical-path -o "$d/f_$c.dot"
+done
+"$T" viz "$d/fig2.tgt" --step 1 -o "$d/plain.dot"
+"$T" viz "$d/fig2.tgt" --step 1 --assign "$d/f2.tga" -o "$d/f.png"
+[ "$(head -c 4 "$d/f.png" | tail -c 3)" = "PNG" ] || fail "f.png is not a PNG"
+
+"$T" capture --scene bars64 --steps 2 -o "$d/b.tgt" >/dev/null
+"$T" viz "$d/b.tgt" --step 1 --collapse object -o "$d/b.svg"
+grep -q '<svg' "$d/b.svg" || fail "b.svg is not an SVG"
+"$T" viz "$d/b.tgt" --step 1 --collapse kind --critical-path -o "$d/b_kind.dot"
+expect_refusal "$d/nb.svg" "$T" viz "$d/b.tgt" --step 1 -o "$d/nb.svg"
+grep -q -- '--collapse' "$d/err" || fail "refusal does not suggest --collapse: $(cat "$d/err")"
+expect_refusal "$d/x.jpeg" "$T" viz "$d/fig2.tgt" --step 1 -o "$d/x.jpeg"
+expect_refusal "$d/x.svg" "$T" viz "$d/fig2.tgt" --step 9 -o "$d/x.svg"
+expect_refusal "$d/x.svg" "$T" viz "$d/fig2.tgt" --collapse objects -o "$d/x.svg"
+expect_refusal "$d/x.svg" "$T" viz "$d/fig2.tgt" --collapse processor -o "$d/x.svg"
+expect_refusal "$d/x.svg" "$T" viz "$d/b.tgt" --assign "$d/f2.tga" -o "$d/x.svg"
+
+for f in "$d"/*.dot; do
+  "$DOT" -Tsvg "$f" -o "$f.svg" || fail "dot -Tsvg rejects $(basename "$f")"
+done
+
+"$T" replay "$d/fig2.tgt" --threads 2 --steps 2 --repeat 1 --timeline "$d/r.json" >/dev/null
+"$T" timeline "$d/r.json" -o "$d/r.svg"
+grep -q '<svg' "$d/r.svg" || fail "r.svg is not an SVG"
+"$T" timeline "$d/r.json" --steps 1:1 -o "$d/r.png"
+[ "$(head -c 4 "$d/r.png" | tail -c 3)" = "PNG" ] || fail "r.png is not a PNG"
+"$T" export "$d/r.json" --format chrome -o "$d/chrome.json"
+python3 -c "import json,sys; e=json.load(open(sys.argv[1]))['traceEvents']; assert any(x['ph']=='X' for x in e)" "$d/chrome.json" \
+  || fail "chrome trace has no events"
+echo '{"tasks": [' >"$d/bad.json"
+expect_refusal "$d/x.svg" "$T" timeline "$d/bad.json" -o "$d/x.svg"
+expect_refusal "$d/x.svg" "$T" timeline "$d/r.json" --steps 7:9 -o "$d/x.svg"
+expect_refusal "$d/x.gif" "$T" timeline "$d/r.json" -o "$d/x.gif"
+
+"$T" compare "$d/fig2.tgt" --methods metis,owner -k 2 --json >"$d/cmp.json"
+"$T" replay "$d/fig2.tgt" --threads 2 --repeat 1 --json >"$d/rep.json"
+"$T" report "$d/fig2.tgt" --replay "$d/r.json" --replay "$d/rep.json" --compare "$d/cmp.json" \
+  --assign "$d/f2.tga" -o "$d/report.html" >/dev/null
+for id in chart-speedup chart-methods chart-timeline; do
+  grep -q "id=\"$id\"" "$d/report.html" || fail "report.html has no $id"
+done
+! grep -q '<script src' "$d/report.html" || fail "report.html loads a script from elsewhere"
+expect_refusal "$d/y.html" "$T" report "$d/fig2.tgt" --compare "$d/r.json" -o "$d/y.html"
+echo "viz command line: all checks passed"

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: MIT
+// GraphView -> Graphviz: the graph is built with libcgraph (agopen, agnode, agedge,
+// agsafeset), written as DOT by agwrite, or laid out by libgvc's dot engine and rendered.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "tgraph/viz/graph_view.hpp"
+
+namespace tgraph::viz {
+
+/// Output formats of a step graph.
+enum class GraphFormat : std::uint8_t { kDot = 0, kSvg = 1, kPng = 2, kPdf = 3 };
+/// "dot", "svg", "png" or "pdf".
+std::string_view to_string(GraphFormat f);
+/// Format from a file name's extension; throws UsageError naming the file otherwise.
+GraphFormat graph_format_of(const std::string& path);
+
+/// The picture as DOT text, without layout (what golden tests compare).
+std::string to_dot(const GraphView& view);
+/// The picture laid out by dot and rendered (kDot: same as to_dot). Graphviz is not
+/// thread-safe: calls are serialised by a lock. Throws std::runtime_error when Graphviz
+/// fails (for instance a missing cairo plugin for png and pdf).
+std::string render_graph(const GraphView& view, GraphFormat format);
+
+}  // namespace tgraph::viz

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+// The HTML report of `tgraph report` and `tgraph demo`: one self-contained page (Vega-Lite,
+// Vega and Vega-Embed inlined, no network) with the scene, the method x K table, speed-up
+// charts, per-step partition time and migrations, the replay timeline and the step graph.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/viz/timeline.hpp"
+
+namespace tgraph::viz {
+
+/// One row of the comparison: a method at K processors, or a dynamic baseline at K threads.
+struct MethodRow {
+  std::string method;
+  std::uint32_t k = 1;
+  bool partitioned = false;  ///< a graph partition (else the partition columns are empty)
+  double partition_ms = 0;   ///< over the whole trace
+  double imbalance = 0;      ///< max load / mean load
+  std::uint64_t cut_bytes = 0;
+  std::uint64_t migrated_tasks = 0;
+  std::optional<double> predicted_speedup;  ///< simulated: work / makespan
+  std::optional<double> measured_ms;        ///< replay wall time
+  std::optional<double> sequential_ms;      ///< sequential replay timed in the same run
+  std::optional<double> speedup;            ///< measured
+  std::optional<double> efficiency;         ///< speed-up / threads
+  std::optional<std::uint64_t> signals;
+  std::string failure;  ///< why the replay could not run (empty: it ran or was not asked for)
+};
+
+/// Per-step figures of one method at one K (partition time and migrations over the run).
+struct StepSeries {
+  std::string method;
+  std::uint32_t k = 1;
+  std::vector<double> partition_ms;
+  std::vector<std::uint64_t> migrated_tasks;
+};
+
+/// Everything the page shows.
+///
+///   ReportContent c = report_content(trace, "b.tgt", &assignment.steps[1], 1);
+///   c.rows.push_back(row);
+///   write_file_atomic("report.html", report_html(c));
+struct ReportContent {
+  std::string title;
+  std::vector<std::pair<std::string, std::string>> facts;  ///< scene and machine, label -> value
+  double parallelism = 0;                       ///< work / span of the trace (speed-up bound)
+  std::vector<std::uint32_t> contact_changes;  ///< steps whose contact set changed
+  std::vector<MethodRow> rows;
+  std::vector<StepSeries> series;
+  std::optional<Timeline> timeline;
+  std::string timeline_caption;
+  std::string graph_svg;  ///< the step graph (Graphviz SVG), empty: none
+  std::string graph_caption;
+  std::vector<std::string> notes;  ///< paragraphs under the title
+};
+
+/// Facts, parallelism, contact changes and the step graph of `trace` (collapsed by object,
+/// coloured by `assignment` when given, critical path highlighted) for step `step`.
+ReportContent report_content(const Trace& trace, const std::string& trace_name,
+                             const Assignment* assignment, std::size_t step,
+                             const std::string& assignment_name = {});
+
+/// Adds the rows (and per-step series) of `tgraph compare --json` text; throws InputError
+/// naming `name` when the text is not such a comparison.
+void add_compare_json(ReportContent& c, std::string_view json, const std::string& name);
+/// Adds a `--replay` file: a timeline (tgraph replay --timeline; the first one is drawn) or
+/// a measurement (tgraph replay --json, one measured row). Throws InputError otherwise.
+void add_replay_json(ReportContent& c, std::string_view json, const std::string& name);
+
+/// The page. Charts are Vega-Lite specifications rendered as SVG by the inlined libraries; a
+/// chart that fails to render shows its error in place and on the console.
+std::string report_html(const ReportContent& c);
+
+/// Three significant digits, no exponent below 1e6 ("4.47", "0.0123", "1230").
+std::string round3(double v);
+
+}  // namespace tgraph::viz

@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+// Replay timelines (`tgraph replay --timeline R.json`): reading them, drawing them as a Gantt
+// chart with cairo (SVG, PNG), and converting them to Chrome / Perfetto trace events.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace tgraph::viz {
+
+/// One task instance of a timeline (times from the start of its step).
+struct TimelineTask {
+  std::uint32_t step = 0;
+  std::uint32_t thread = 0;
+  std::uint32_t task = 0;                 ///< executed task (reducers included)
+  std::optional<std::uint32_t> origin;    ///< task of the step graph (empty: a reducer)
+  std::string kind;
+  std::uint32_t iteration = 0;
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+};
+
+/// One blocking wait of a timeline.
+struct TimelineWait {
+  std::uint32_t step = 0;
+  std::uint32_t thread = 0;
+  std::optional<std::uint32_t> task;  ///< the task that waited
+  std::int64_t start_ns = 0;
+  std::int64_t end_ns = 0;
+  bool parked = false;
+};
+
+/// A replay timeline; steps are laid end to end by step_offsets().
+///
+///   const Timeline t = parse_timeline(read_text("r.json"), "r.json");
+///   write_file_atomic("r.svg", render_timeline(t, TimelineFormat::kSvg, {}));
+struct Timeline {
+  std::uint32_t threads = 0;
+  std::vector<TimelineTask> tasks;
+  std::vector<TimelineWait> waits;
+  /// Start of each step on the common time axis (step s begins where step s-1's last
+  /// task or wait ended), indexed by step number; size = highest step + 1.
+  std::vector<std::int64_t> step_offsets() const;
+};
+
+/// Parses TimelineObserver::to_json text; throws InputError naming `name` and what is
+/// wrong (not JSON, missing field, thread out of range, end before start).
+Timeline parse_timeline(std::string_view json, const std::string& name);
+
+/// Steps [first, last] (inclusive) of `t`; throws UsageError when none is in range.
+Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last);
+/// Parses "a:b", "a:" or "a" (a step range for --steps); throws UsageError naming the flag.
+std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text);
+
+/// Output formats of a timeline picture.
+enum class TimelineFormat : std::uint8_t { kSvg = 0, kPng = 1 };
+/// "svg" or "png".
+std::string_view to_string(TimelineFormat f);
+/// Format from a file name's extension; throws UsageError naming the file otherwise.
+TimelineFormat timeline_format_of(const std::string& path);
+
+/// The Gantt chart: one row per thread, tasks coloured by kind (legend of the kinds ranked
+/// by time), waits hatched grey, step boundaries as solid lines, the start of each loop
+/// iteration as dotted lines, axis in ms. `title` is drawn above the chart.
+std::string render_timeline(const Timeline& t, TimelineFormat format, const std::string& title);
+
+/// A cross-thread dependency in a timeline: `to` (a wait) was released when `from` (a task
+/// instance on another thread) ended.
+struct TimelineFlow {
+  std::size_t from_task = 0;  ///< index in Timeline::tasks
+  std::size_t to_wait = 0;    ///< index in Timeline::waits
+};
+/// For each wait, the task instance that released it: in the same step, on another thread,
+/// the one whose end is the latest at or before the wait's end (the timeline does not record
+/// which datum was awaited; waits with no such task get no flow).
+std::vector<TimelineFlow> timeline_flows(const Timeline& t);
+
+/// Chrome / Perfetto trace-event JSON: one complete event per task instance and per wait
+/// (microseconds, steps end to end), thread names, and a flow arrow ("s" -> "f") for each
+/// timeline_flows() entry, which Perfetto and chrome://tracing draw as signal -> wait arrows.
+std::string chrome_trace(const Timeline& t);
+
+}  // namespace tgraph::viz

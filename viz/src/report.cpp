@@ -1,0 +1,494 @@
+// SPDX-License-Identifier: MIT
+// The self-contained HTML report: tables written here, charts as Vega-Lite specifications
+// rendered in the page by the inlined Vega libraries (web_assets.hpp).
+#include "tgraph/viz/report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/metrics.hpp"
+#include "tgraph/graph/summary.hpp"
+#include "tgraph/viz/graph_view.hpp"
+#include "tgraph/viz/graphviz.hpp"
+#include "tgraph/viz/palette.hpp"
+#include "web_assets.hpp"
+
+namespace tgraph::viz {
+namespace {
+
+using nlohmann::json;
+
+// Timeline events embedded in the page at most (the first steps up to this many).
+constexpr std::size_t kMaxTimelineEvents = 6000;
+
+std::string escape(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string with_commas(std::uint64_t v) {
+  std::string s = std::to_string(v), out;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (i && (s.size() - i) % 3 == 0) out += ',';
+    out += s[i];
+  }
+  return out;
+}
+
+// The Graphviz SVG without its XML prolog and doctype (inline SVG in HTML).
+std::string inline_svg(const std::string& svg) {
+  const auto at = svg.find("<svg");
+  return at == std::string::npos ? svg : svg.substr(at);
+}
+
+// JSON to embed in a <script>: "</" is written "<\/" so no text can close the element.
+std::string script_json(const json& j) {
+  std::string s = j.dump();
+  std::string out;
+  out.reserve(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    out += s[i];
+    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += '\\';
+  }
+  return out;
+}
+
+json colour_range(std::size_t n) {
+  json r = json::array();
+  for (std::size_t i = 0; i < n; ++i) r.push_back(processor_colour(static_cast<std::uint32_t>(i)));
+  return r;
+}
+
+// Speed-up against threads: measured points, predicted lines, the ideal and the bound.
+json speedup_spec(const ReportContent& c) {
+  json values = json::array();
+  std::set<std::uint32_t> ks;
+  std::set<std::string> methods;
+  for (const MethodRow& r : c.rows) {
+    if (r.predicted_speedup)
+      values.push_back({{"method", r.method}, {"threads", r.k}, {"speedup", *r.predicted_speedup},
+                        {"series", "predicted (simulated)"}});
+    if (r.speedup)
+      values.push_back({{"method", r.method}, {"threads", r.k}, {"speedup", *r.speedup},
+                        {"series", "measured (replay)"}});
+    if (r.predicted_speedup || r.speedup) {
+      ks.insert(r.k);
+      methods.insert(r.method);
+    }
+  }
+  ks.insert(1);
+  json refs = json::array();
+  const std::uint32_t kmax = *ks.rbegin();
+  for (std::uint32_t k = 1;; k = std::min(kmax, k * 2)) {
+    refs.push_back({{"threads", k}, {"speedup", static_cast<double>(k)}, {"line", "ideal (= threads)"}});
+    if (c.parallelism > 0)
+      refs.push_back({{"threads", k},
+                      {"speedup", std::min(static_cast<double>(k), c.parallelism)},
+                      {"line", "bound min(threads, work/span)"}});
+    if (k == kmax) break;
+  }
+  const json x = {{"field", "threads"}, {"type", "quantitative"}, {"title", "threads / processors (K)"},
+                  {"scale", {{"type", "log"}, {"base", 2}}}, {"axis", {{"values", ks}, {"format", "d"}}}};
+  const json y = {{"field", "speedup"}, {"type", "quantitative"}, {"title", "speed-up over sequential (×)"}};
+  const json colour = {{"field", "method"}, {"type", "nominal"}, {"title", "method"},
+                       {"scale", {{"range", colour_range(std::max<std::size_t>(methods.size(), 1))}}}};
+  json layers = json::array();
+  layers.push_back({{"data", {{"values", refs}}},
+                    {"mark", {{"type", "line"}, {"color", "#000000"}, {"strokeWidth", 1}}},
+                    {"encoding",
+                     {{"x", x}, {"y", y},
+                      {"strokeDash", {{"field", "line"}, {"type", "nominal"}, {"title", "reference"},
+                                      {"scale", {{"range", {{2, 2}, {6, 3}}}}}}}}}});
+  layers.push_back({{"transform", {{{"filter", "datum.series === 'predicted (simulated)'"}}}},
+                    {"mark", {{"type", "line"}, {"point", {{"filled", false}, {"size", 60}}}, {"strokeDash", {4, 2}}}},
+                    {"encoding", {{"x", x}, {"y", y}, {"color", colour},
+                                  {"tooltip", {{{"field", "method"}}, {{"field", "threads"}},
+                                               {{"field", "speedup"}, {"format", ".2f"}}, {{"field", "series"}}}}}}});
+  layers.push_back({{"transform", {{{"filter", "datum.series === 'measured (replay)'"}}}},
+                    {"mark", {{"type", "point"}, {"filled", true}, {"size", 110}, {"shape", "diamond"}}},
+                    {"encoding", {{"x", x}, {"y", y}, {"color", colour},
+                                  {"tooltip", {{{"field", "method"}}, {{"field", "threads"}},
+                                               {{"field", "speedup"}, {"format", ".2f"}}, {{"field", "series"}}}}}}});
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
+          {"width", 520},
+          {"height", 320},
+          {"title", {{"text", "Speed-up against threads"},
+                     {"subtitle", "diamonds: measured; open circles, dashed: predicted; black: ideal and bound"}}},
+          {"data", {{"values", values}}},
+          {"layer", layers}};
+}
+
+// Bars of measured and predicted speed-up per method at the largest K measured.
+json methods_spec(const ReportContent& c) {
+  json values = json::array();
+  for (const MethodRow& r : c.rows) {
+    const std::string label = r.method + " (K=" + std::to_string(r.k) + ")";
+    if (r.speedup) values.push_back({{"row", label}, {"speedup", *r.speedup}, {"series", "measured"}});
+    if (r.predicted_speedup)
+      values.push_back({{"row", label}, {"speedup", *r.predicted_speedup}, {"series", "predicted"}});
+  }
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
+          {"width", 420},
+          {"title", "Speed-up per method (×)"},
+          {"data", {{"values", values}}},
+          {"mark", {{"type", "bar"}, {"tooltip", true}}},
+          {"encoding",
+           {{"y", {{"field", "row"}, {"type", "nominal"}, {"title", nullptr}, {"sort", nullptr}}},
+            {"yOffset", {{"field", "series"}}},
+            {"x", {{"field", "speedup"}, {"type", "quantitative"}, {"title", "speed-up over sequential (×)"}}},
+            {"color", {{"field", "series"}, {"type", "nominal"}, {"title", nullptr},
+                       {"scale", {{"domain", {"measured", "predicted"}}, {"range", {"#0072B2", "#E69F00"}}}}}}}}};
+}
+
+// Per-step partition time or migrations, one line per method, contact changes as rules.
+json series_spec(const ReportContent& c, bool migrations) {
+  json values = json::array();
+  for (const StepSeries& s : c.series) {
+    const std::string label = s.method + " (K=" + std::to_string(s.k) + ")";
+    const std::size_t n = migrations ? s.migrated_tasks.size() : s.partition_ms.size();
+    for (std::size_t i = 0; i < n; ++i)
+      values.push_back({{"method", label}, {"step", i},
+                        {"value", migrations ? static_cast<double>(s.migrated_tasks[i]) : s.partition_ms[i]}});
+  }
+  json rules = json::array();
+  for (std::uint32_t s : c.contact_changes) rules.push_back({{"step", s}});
+  const char* title = migrations ? "migrated tasks" : "partition time (ms)";
+  json layers = json::array();
+  layers.push_back({{"mark", {{"type", "line"}, {"point", true}}},
+                    {"encoding",
+                     {{"x", {{"field", "step"}, {"type", "quantitative"}, {"title", "step"}, {"axis", {{"format", "d"}}}}},
+                      {"y", {{"field", "value"}, {"type", "quantitative"}, {"title", title}}},
+                      {"color", {{"field", "method"}, {"type", "nominal"}, {"title", "method"},
+                                 {"scale", {{"range", colour_range(std::max<std::size_t>(c.series.size(), 1))}}}}},
+                      {"tooltip", {{{"field", "method"}}, {{"field", "step"}}, {{"field", "value"}, {"format", ".3~f"}}}}}}});
+  if (!rules.empty())
+    layers.push_back({{"data", {{"values", rules}}},
+                      {"mark", {{"type", "rule"}, {"color", "#D55E00"}, {"strokeDash", {3, 3}}}},
+                      {"encoding", {{"x", {{"field", "step"}, {"type", "quantitative"}}}}}});
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
+          {"width", 420},
+          {"height", 220},
+          {"title", {{"text", migrations ? "Migrations per step" : "Partition time per step"},
+                     {"subtitle", rules.empty() ? "" : "vermillion rules: steps whose contacts changed"}}},
+          {"data", {{"values", values}}},
+          {"layer", layers}};
+}
+
+// The replay timeline as a Gantt chart (first steps, at most kMaxTimelineEvents tasks).
+json timeline_spec(const Timeline& t, std::string* caption) {
+  const std::vector<std::int64_t> offsets = t.step_offsets();
+  json tasks = json::array(), waits = json::array();
+  std::uint32_t last_step = 0;
+  std::size_t shown = 0;
+  for (const TimelineTask& e : t.tasks) {
+    if (shown >= kMaxTimelineEvents && e.step != last_step) break;
+    last_step = e.step;
+    ++shown;
+    tasks.push_back({{"thread", "thread " + std::to_string(e.thread)},
+                     {"start", static_cast<double>(offsets[e.step] + e.start_ns) / 1e6},
+                     {"end", static_cast<double>(offsets[e.step] + e.end_ns) / 1e6},
+                     {"kind", e.kind},
+                     {"step", e.step},
+                     {"iteration", e.iteration}});
+  }
+  for (const TimelineWait& w : t.waits)
+    if (w.step <= last_step)
+      waits.push_back({{"thread", "thread " + std::to_string(w.thread)},
+                       {"start", static_cast<double>(offsets[w.step] + w.start_ns) / 1e6},
+                       {"end", static_cast<double>(offsets[w.step] + w.end_ns) / 1e6},
+                       {"kind", "blocking wait"}});
+  json steps = json::array();
+  for (std::uint32_t s = 0; s <= last_step && s < offsets.size(); ++s)
+    steps.push_back({{"start", static_cast<double>(offsets[s]) / 1e6}, {"label", "step " + std::to_string(s)}});
+  if (shown < t.tasks.size())
+    *caption += " Steps 0 to " + std::to_string(last_step) + " shown (" + with_commas(shown) + " of " +
+                with_commas(t.tasks.size()) + " task instances); `tgraph timeline --steps` draws any range.";
+  json kind_range = json::array();
+  for (std::uint32_t i = 0; i < kKindColours; ++i) kind_range.push_back(kind_colour(i));
+  const json x = {{"field", "start"}, {"type", "quantitative"}, {"title", "time (ms)"}};
+  const json y = {{"field", "thread"}, {"type", "nominal"}, {"title", nullptr},
+                  {"sort", {{"field", "thread"}}}};
+  json layers = json::array();
+  layers.push_back({{"data", {{"values", tasks}}},
+                    {"mark", {{"type", "bar"}, {"height", {{"band", 0.8}}}}},
+                    {"encoding",
+                     {{"x", x}, {"x2", {{"field", "end"}}}, {"y", y},
+                      {"color", {{"field", "kind"}, {"type", "nominal"}, {"title", "task kind"},
+                                 {"scale", {{"range", kind_range}}}}},
+                      {"tooltip", {{{"field", "kind"}}, {{"field", "thread"}}, {{"field", "step"}},
+                                   {{"field", "iteration"}}, {{"field", "start"}, {"format", ".3f"}},
+                                   {{"field", "end"}, {"format", ".3f"}}}}}}});
+  if (!waits.empty())
+    layers.push_back({{"data", {{"values", waits}}},
+                      {"mark", {{"type", "bar"}, {"height", {{"band", 0.35}}}, {"color", "#444444"},
+                                {"opacity", 0.7}}},
+                      {"encoding", {{"x", x}, {"x2", {{"field", "end"}}}, {"y", y},
+                                    {"tooltip", {{{"field", "kind"}}, {{"field", "start"}, {"format", ".3f"}},
+                                                 {{"field", "end"}, {"format", ".3f"}}}}}}});
+  layers.push_back({{"data", {{"values", steps}}},
+                    {"mark", {{"type", "rule"}, {"color", "#000000"}, {"strokeWidth", 1.5}}},
+                    {"encoding", {{"x", {{"field", "start"}, {"type", "quantitative"}}}}}});
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
+          {"width", 900},
+          {"height", {{"step", 34}}},
+          {"title", {{"text", "Replay timeline"},
+                     {"subtitle", "one row per thread; dark thin bars: blocking waits; black rules: step starts"}}},
+          {"layer", layers}};
+}
+
+std::string number_cell(const std::optional<double>& v, int decimals) {
+  return v ? "<td>" + fixed(*v, decimals) + "</td>" : "<td>&ndash;</td>";
+}
+
+std::string table_html(const ReportContent& c) {
+  std::string h =
+      "<table><thead><tr><th>method</th><th>K</th><th>partition (ms)</th><th>imbalance (max/mean)</th>"
+      "<th>cut (KiB)</th><th>migrated tasks</th><th>predicted speed-up (&times;)</th>"
+      "<th>replay (ms)</th><th>sequential (ms)</th><th>speed-up (&times;)</th><th>efficiency (%)</th>"
+      "<th>signals</th></tr></thead><tbody>";
+  for (const MethodRow& r : c.rows) {
+    h += "<tr><td>" + escape(r.method) + "</td><td>" + std::to_string(r.k) + "</td>";
+    if (r.partitioned) {
+      h += "<td>" + round3(r.partition_ms) + "</td><td>" + fixed(r.imbalance, 3) + "</td><td>" +
+           round3(static_cast<double>(r.cut_bytes) / 1024.0) + "</td><td>" + with_commas(r.migrated_tasks) + "</td>";
+    } else {
+      h += "<td>&ndash;</td><td>&ndash;</td><td>&ndash;</td><td>&ndash;</td>";
+    }
+    h += number_cell(r.predicted_speedup, 2);
+    if (!r.failure.empty()) {
+      h += "<td colspan=\"5\" class=\"fail\">replay failed: " + escape(r.failure) + "</td></tr>";
+      continue;
+    }
+    h += r.measured_ms ? "<td>" + round3(*r.measured_ms) + "</td>" : "<td>&ndash;</td>";
+    h += r.sequential_ms ? "<td>" + round3(*r.sequential_ms) + "</td>" : "<td>&ndash;</td>";
+    h += number_cell(r.speedup, 2);
+    h += r.efficiency ? "<td>" + fixed(*r.efficiency * 100, 0) + "</td>" : "<td>&ndash;</td>";
+    h += r.signals ? "<td>" + with_commas(*r.signals) + "</td>" : "<td>&ndash;</td>";
+    h += "</tr>";
+  }
+  return h + "</tbody></table>";
+}
+
+const char* kStyle =
+    "body{font-family:system-ui,Helvetica,Arial,sans-serif;margin:2em;max-width:1200px;color:#222}"
+    "h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}"
+    "table{border-collapse:collapse;font-size:0.9em}td,th{border:1px solid #bbb;padding:3px 8px;"
+    "text-align:right}th{background:#eee}td:first-child{text-align:left}td.fail{color:#D55E00;"
+    "text-align:left}dl{display:grid;grid-template-columns:max-content auto;gap:2px 16px}"
+    "dt{font-weight:600}dd{margin:0}.charts{display:flex;flex-wrap:wrap;gap:24px}"
+    ".graph{overflow:auto;max-height:900px;border:1px solid #ddd}.chart-error{color:#D55E00}"
+    "figcaption{font-size:0.85em;color:#555;max-width:900px}";
+
+// First script of the page: records uncaught errors, rejected promises and console.error
+// calls on <html data-js-errors> (what the browser test reads; visible in the inspector).
+const char* kErrorHook = R"js(
+(function () {
+  var root = document.documentElement;
+  function add(m) { root.dataset.jsErrors = (root.dataset.jsErrors ? root.dataset.jsErrors + ' | ' : '') + m; }
+  window.addEventListener('error', function (e) { add(String(e.message)); });
+  window.addEventListener('unhandledrejection', function (e) { add(String(e.reason)); });
+  var original = console.error;
+  console.error = function () { add(Array.prototype.join.call(arguments, ' ')); original.apply(console, arguments); };
+})();
+)js";
+
+// Renders every chart; a failure is shown in place and logged as a console error.
+const char* kRenderScript = R"js(
+(function () {
+  const specs = JSON.parse(document.getElementById('tgraph-specs').textContent);
+  const ids = Object.keys(specs);
+  let done = 0;
+  document.body.dataset.charts = String(ids.length);
+  for (const id of ids) {
+    vegaEmbed('#' + id, specs[id], {renderer: 'svg', actions: false})
+      .then(function () { done += 1; document.body.dataset.chartsRendered = String(done); })
+      .catch(function (err) {
+        const el = document.getElementById(id);
+        el.textContent = 'chart failed: ' + err;
+        el.className += ' chart-error';
+        console.error('tgraph chart ' + id + ': ' + err);
+      });
+  }
+})();
+)js";
+
+}  // namespace
+
+std::string round3(double v) {
+  if (!std::isfinite(v)) return "&ndash;";
+  if (v == 0) return "0";
+  const int magnitude = static_cast<int>(std::floor(std::log10(std::fabs(v))));
+  if (magnitude >= 2) return fixed(v, 0);
+  return fixed(v, 2 - magnitude);
+}
+
+ReportContent report_content(const Trace& trace, const std::string& trace_name,
+                             const Assignment* assignment, std::size_t step,
+                             const std::string& assignment_name) {
+  ReportContent c;
+  const TraceSummary s = summarize_trace(trace);
+  c.title = "tgraph report: " + (trace.header.scene.empty() ? trace_name : trace.header.scene);
+  c.facts = {{"trace", trace_name},
+             {"scene", trace.header.scene},
+             {"engine", trace.header.engine},
+             {"machine", trace.header.machine},
+             {"steps", with_commas(s.steps)},
+             {"tasks per step", with_commas(s.tasks_min) + (s.tasks_min == s.tasks_max ? "" : " to " + with_commas(s.tasks_max))},
+             {"dependencies", with_commas(s.edges) + " (all steps)"},
+             {"loops", with_commas(s.loops) + ", " + with_commas(s.loop_iterations) + " iterations"},
+             {"work, span", round3(static_cast<double>(s.work_ns) / 1e6) + " ms, " +
+                                round3(static_cast<double>(s.span_ns) / 1e6) + " ms (all steps)"},
+             {"parallelism (work/span)", round3(s.parallelism)},
+             {"contact changes", with_commas(s.contact_changes) + " steps"}};
+  c.parallelism = s.parallelism;
+  for (std::size_t i = 0; i < s.per_step.size(); ++i)
+    if (s.per_step[i].contacts_changed && i > 0) c.contact_changes.push_back(static_cast<std::uint32_t>(i));
+  if (step < trace.steps.size()) {
+    ViewOptions o;
+    o.collapse = Collapse::kObject;
+    o.assignment = assignment;
+    o.critical_path = true;
+    o.max_nodes = 0;
+    o.max_edges = 0;
+    o.title = trace_name + ", step " + std::to_string(step) +
+              (assignment ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors" : "");
+    c.graph_svg = inline_svg(render_graph(make_graph_view(trace.steps[step], o), GraphFormat::kSvg));
+    c.graph_caption = "Step " + std::to_string(step) +
+                      " collapsed by object (one node per object and loop level, work = cost × runs), "
+                      "coloured by processor" +
+                      (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
+                      "; vermillion edges cross processors; thick black: the critical path. "
+                      "Same picture: tgraph viz " + trace_name + " --step " + std::to_string(step) +
+                      " --collapse object --critical-path" + (assignment ? " --assign A.tga" : "") + " -o g.svg";
+  }
+  return c;
+}
+
+void add_compare_json(ReportContent& c, std::string_view text, const std::string& name) {
+  const json j = json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("rows") || !j["rows"].is_array())
+    throw InputError(name, std::nullopt, "not a comparison (expected tgraph compare --json output with \"rows\")");
+  std::size_t i = 0;
+  try {
+    for (const json& r : j["rows"]) {
+      MethodRow row;
+      row.method = r.contains("label") ? r.at("label").get<std::string>() : r.at("method").get<std::string>();
+      row.k = r.at("k").get<std::uint32_t>();
+      row.partitioned = true;
+      row.partition_ms = r.at("partition_ms").get<double>();
+      row.imbalance = r.at("imbalance").get<double>();
+      row.cut_bytes = r.at("cut_bytes").get<std::uint64_t>();
+      row.migrated_tasks = r.at("migrated_tasks").get<std::uint64_t>();
+      row.predicted_speedup = r.at("predicted_speedup").get<double>();
+      c.rows.push_back(row);
+      ++i;
+    }
+  } catch (const json::exception& e) {
+    std::string why = e.what();
+    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+    throw InputError(name, std::nullopt, "rows[" + std::to_string(i) + "]: " + why);
+  }
+}
+
+void add_replay_json(ReportContent& c, std::string_view text, const std::string& name) {
+  const json j = json::parse(text, nullptr, false);
+  if (!j.is_discarded() && j.is_object() && j.contains("tasks")) {
+    Timeline t = parse_timeline(text, name);
+    if (!c.timeline) {
+      c.timeline = std::move(t);
+      c.timeline_caption = "From " + name + ".";
+    }
+    return;
+  }
+  if (j.is_discarded() || !j.is_object() || !j.contains("policy") || !j.contains("speedup"))
+    throw InputError(name, std::nullopt,
+                     "expected a replay timeline (tgraph replay --timeline) or a measurement (tgraph replay --json)");
+  try {
+    MethodRow row;
+    const std::string policy = j.at("policy").get<std::string>();
+    const std::string assignment = j.value("assignment", std::string());
+    row.method = policy == "partition" && !assignment.empty() ? assignment : policy;
+    row.k = j.at("threads").get<std::uint32_t>();
+    row.measured_ms = j.at("wall_ns").get<double>() / 1e6;
+    row.sequential_ms = j.at("sequential_wall_ns").get<double>() / 1e6;
+    row.speedup = j.at("speedup").get<double>();
+    row.efficiency = j.at("efficiency").get<double>();
+    row.signals = j.at("signals").get<std::uint64_t>();
+    c.rows.push_back(row);
+  } catch (const json::exception& e) {
+    std::string why = e.what();
+    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
+    throw InputError(name, std::nullopt, why);
+  }
+}
+
+std::string report_html(const ReportContent& c) {
+  json specs = json::object();
+  std::string body;
+  body += "<h1>" + escape(c.title) + "</h1>";
+  for (const std::string& n : c.notes) body += "<p>" + escape(n) + "</p>";
+  body += "<h2>Scene and machine</h2><dl>";
+  for (const auto& [k, v] : c.facts)
+    if (!v.empty()) body += "<dt>" + escape(k) + "</dt><dd>" + escape(v) + "</dd>";
+  body += "</dl>";
+  if (!c.rows.empty()) {
+    body += "<h2>Methods</h2>" + table_html(c);
+    body += "<div class=\"charts\"><div class=\"chart\" id=\"chart-speedup\"></div>"
+            "<div class=\"chart\" id=\"chart-methods\"></div></div>";
+    specs["chart-speedup"] = speedup_spec(c);
+    specs["chart-methods"] = methods_spec(c);
+  }
+  if (!c.series.empty()) {
+    body += "<h2>Over the run</h2><div class=\"charts\"><div class=\"chart\" id=\"chart-partition-time\"></div>"
+            "<div class=\"chart\" id=\"chart-migrations\"></div></div>";
+    specs["chart-partition-time"] = series_spec(c, false);
+    specs["chart-migrations"] = series_spec(c, true);
+  }
+  if (c.timeline) {
+    std::string caption = c.timeline_caption;
+    specs["chart-timeline"] = timeline_spec(*c.timeline, &caption);
+    body += "<h2>Replay timeline</h2><figure><div class=\"chart\" id=\"chart-timeline\"></div><figcaption>" +
+            escape(caption) + "</figcaption></figure>";
+  }
+  if (!c.graph_svg.empty())
+    body += "<h2>Step graph</h2><figure><div class=\"graph\">" + c.graph_svg + "</div><figcaption>" +
+            escape(c.graph_caption) + "</figcaption></figure>";
+  body += "<p><small>Charts: " + escape(std::string(detail::web_asset_versions())) +
+          " (BSD-3-Clause), inlined; the page uses no network.</small></p>";
+
+  std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(c.title) +
+                  "</title><style>" + kStyle + "</style><script>" + kErrorHook + "</script>";
+  for (const char* lib : {"vega", "vega-lite", "vega-embed"}) {
+    h += "<script>/* ";
+    h += lib;
+    h += " */\n";
+    h += detail::web_asset(lib);
+    h += "\n</script>";
+  }
+  h += "</head><body>" + body;
+  h += "<script type=\"application/json\" id=\"tgraph-specs\">" + script_json(specs) + "</script>";
+  h += "<script>" + std::string(kRenderScript) + "</script></body></html>\n";
+  return h;
+}
+
+}  // namespace tgraph::viz
