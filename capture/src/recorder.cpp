@@ -198,7 +198,19 @@ StepGraph Recorder::finish_step() {
     h = (h ^ occ) * 1099511628211ull;
     task.key = h;
   }
-  if (derive_edges_) g.derive_edges();
+  last_update_ = {};
+  if (derive_edges_) {
+    if (incremental_edges_) {
+      last_update_ = deriver_.derive(g);
+    } else {
+      const auto t0 = std::chrono::steady_clock::now();
+      g.derive_edges();
+      last_update_.edges = g.edges.size() + g.carried_edges.size();
+      last_update_.ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                            std::chrono::steady_clock::now() - t0)
+                            .count();
+    }
+  }
   return g;
 }
 

@@ -20,110 +20,121 @@
 #include <limits>
 #include <vector>
 
+#include "dependencies.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
 namespace tgraph {
 namespace {
 
-struct DatumState {
-  std::vector<TaskId> writers;      // last plain writer, or the CW group since
-  std::vector<TaskId> readers;      // readers since the last write
-  std::vector<TaskId> group_preds;  // shared predecessors of the current CW group
-  EdgeKind group_kind = EdgeKind::WAW;
-  bool cw_group = false;
-};
-
 struct TooManyEdges {};
+
+}  // namespace
+
+namespace detail {
+
+// Where the state machine's edges go: pass 1 emits every edge; pass 2 (offset != 0, ids >=
+// offset are second-pass copies) keeps only edges from a first-pass body task to a
+// second-pass task, as loop-carried edges (iteration i -> i + 1).
+void EdgeSink::emit(TaskId from, TaskId to, DatumId d, EdgeKind kind) {
+  if (from == to) return;
+  if (out->size() >= max_edges) throw TooManyEdges{};
+  if (offset == 0) {
+    out->push_back({from, to, d, kind});
+    return;
+  }
+  if (from >= offset) return;
+  if (from < body_first || from >= body_last) return;
+  if (from == to - offset) return;  // a task always follows its own previous iteration
+  out->push_back({from, to - offset, d, kind});
+}
+
+void apply_access(DatumState& s, TaskId id, Access a, EdgeSink& sink) {
+  switch (a.mode) {
+    case AccessMode::R:
+      for (TaskId w : s.writers) sink.emit(w, id, a.datum, EdgeKind::RAW);
+      // A task's accesses are processed together: a repeated reader is the last one.
+      if (s.readers.empty() || s.readers.back() != id) s.readers.push_back(id);
+      break;
+    case AccessMode::W:
+    case AccessMode::RW:
+      if (a.mode == AccessMode::RW)
+        for (TaskId w : s.writers) sink.emit(w, id, a.datum, EdgeKind::RAW);
+      if (!s.readers.empty()) {
+        for (TaskId r : s.readers) sink.emit(r, id, a.datum, EdgeKind::WAR);
+      } else if (a.mode == AccessMode::W) {
+        for (TaskId w : s.writers) sink.emit(w, id, a.datum, EdgeKind::WAW);
+      }
+      s.writers.assign(1, id);
+      s.readers.clear();
+      s.cw_group = false;
+      break;
+    case AccessMode::CW:
+      if (!(s.cw_group && s.readers.empty())) {
+        // A new group: its members share what precedes the group.
+        if (!s.readers.empty()) {
+          s.group_preds = s.readers;
+          s.group_kind = EdgeKind::WAR;
+        } else {
+          s.group_preds = s.writers;
+          s.group_kind = EdgeKind::WAW;
+        }
+        s.writers.clear();
+        s.readers.clear();
+        s.cw_group = true;
+      }
+      for (TaskId p : s.group_preds) sink.emit(p, id, a.datum, s.group_kind);
+      if (s.writers.empty() || s.writers.back() != id) s.writers.push_back(id);
+      break;
+  }
+}
+
+bool edge_less(const Edge& a, const Edge& b) {
+  if (a.to != b.to) return a.to < b.to;
+  if (a.from != b.from) return a.from < b.from;
+  if (a.datum != b.datum) return a.datum < b.datum;
+  return a.kind < b.kind;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::DatumState;
+using detail::EdgeSink;
 
 class Extractor {
  public:
   Extractor(const StepGraph& g, std::vector<Edge>& out, std::size_t max_edges)
-      : g_(g), out_(out), state_(g.data.size()), max_edges_(max_edges) {}
+      : g_(g), state_(g.data.size()) {
+    sink_.out = &out;
+    sink_.max_edges = max_edges;
+  }
 
-  // Second-pass mode: ids >= offset_ are second-pass copies; only edges from a first-pass
-  // body task to a second-pass task are emitted (as carried edges).
+  // Second-pass mode (see EdgeSink).
   void set_pass(TaskId offset, TaskId body_first, TaskId body_last) {
-    offset_ = offset;
-    body_first_ = body_first;
-    body_last_ = body_last;
+    sink_.offset = offset;
+    sink_.body_first = body_first;
+    sink_.body_last = body_last;
   }
 
   void process(TaskId t) {
-    const TaskId id = t + offset_;
-    for (const Access& a : g_.accesses_of(t)) {
-      DatumState& s = state_[a.datum];
-      switch (a.mode) {
-        case AccessMode::R:
-          for (TaskId w : s.writers) emit(w, id, a.datum, EdgeKind::RAW);
-          // A task's accesses are processed together: a repeated reader is the last one.
-          if (s.readers.empty() || s.readers.back() != id) s.readers.push_back(id);
-          break;
-        case AccessMode::W:
-        case AccessMode::RW:
-          if (a.mode == AccessMode::RW)
-            for (TaskId w : s.writers) emit(w, id, a.datum, EdgeKind::RAW);
-          if (!s.readers.empty()) {
-            for (TaskId r : s.readers) emit(r, id, a.datum, EdgeKind::WAR);
-          } else if (a.mode == AccessMode::W) {
-            for (TaskId w : s.writers) emit(w, id, a.datum, EdgeKind::WAW);
-          }
-          s.writers.assign(1, id);
-          s.readers.clear();
-          s.cw_group = false;
-          break;
-        case AccessMode::CW:
-          if (!(s.cw_group && s.readers.empty())) {
-            // A new group: its members share what precedes the group.
-            if (!s.readers.empty()) {
-              s.group_preds = s.readers;
-              s.group_kind = EdgeKind::WAR;
-            } else {
-              s.group_preds = s.writers;
-              s.group_kind = EdgeKind::WAW;
-            }
-            s.writers.clear();
-            s.readers.clear();
-            s.cw_group = true;
-          }
-          for (TaskId p : s.group_preds) emit(p, id, a.datum, s.group_kind);
-          if (s.writers.empty() || s.writers.back() != id) s.writers.push_back(id);
-          break;
-      }
-    }
+    const TaskId id = t + sink_.offset;
+    for (const Access& a : g_.accesses_of(t)) detail::apply_access(state_[a.datum], id, a, sink_);
   }
 
   std::vector<DatumState>& state() { return state_; }
 
  private:
-  void emit(TaskId from, TaskId to, DatumId d, EdgeKind kind) {
-    if (from == to) return;
-    if (out_.size() >= max_edges_) throw TooManyEdges{};
-    if (offset_ == 0) {
-      out_.push_back({from, to, d, kind});
-      return;
-    }
-    // Second pass: keep only first-pass body sources (carried), drop the rest.
-    if (from >= offset_) return;
-    if (from < body_first_ || from >= body_last_) return;
-    if (from == to - offset_) return;  // a task always follows its own previous iteration
-    out_.push_back({from, to - offset_, d, kind});
-  }
-
   const StepGraph& g_;
-  std::vector<Edge>& out_;
   std::vector<DatumState> state_;
-  std::size_t max_edges_;
-  TaskId offset_ = 0;
-  TaskId body_first_ = 0;
-  TaskId body_last_ = 0;
+  EdgeSink sink_;
 };
 
 void sort_unique(std::vector<Edge>& edges) {
-  std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
-    if (a.to != b.to) return a.to < b.to;
-    if (a.from != b.from) return a.from < b.from;
-    return a.datum < b.datum;
-  });
+  // The kind breaks ties so that of duplicate (from, to, datum) triples emitted with two
+  // kinds (a task both reading and cumulatively writing a datum that a later RW task
+  // updates) the same one is kept whatever order the edges were emitted in.
+  std::sort(edges.begin(), edges.end(), detail::edge_less);
   edges.erase(std::unique(edges.begin(), edges.end(),
                           [](const Edge& a, const Edge& b) {
                             return a.from == b.from && a.to == b.to && a.datum == b.datum;

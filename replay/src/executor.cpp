@@ -97,6 +97,12 @@ struct Executor::CacheEntry {
 Executor::Executor(Policy policy, ExecOptions options) : options_(options), policy_(policy) {}
 Executor::~Executor() = default;
 
+std::shared_ptr<void> Executor::rebuild(const ExecGraph& x, const ExecGraph&, const void*) {
+  return build(x);
+}
+
+std::uint32_t Executor::rebuilt_procs(const void*) const { return options_.threads; }
+
 CwMode Executor::cw_mode() const { return options_.cw.value_or(CwMode::kReduce); }
 
 ReduceScope Executor::reduce_scope() const {
@@ -189,8 +195,16 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
       entry->assignment = *a;
       entry->has_assignment = true;
     }
-    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible);
-    entry->plan = build(entry->exec);
+    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible,
+                        options_.incremental_plans ? &exec_edges_ : nullptr);
+    const std::int64_t t_lowered = now_ns();
+    if (last_entry_ && options_.incremental_plans) {
+      entry->plan = rebuild(entry->exec, last_entry_->exec, last_entry_->plan.get());
+    } else {
+      entry->plan = build(entry->exec);
+    }
+    stats.rebuild_ns = now_ns() - t_lowered;
+    stats.rebuilt_procs = rebuilt_procs(entry->plan.get());
     ++plans_built_;
     stats.rebuilt = true;
     if (cache_.size() >= 16) cache_.erase(cache_.begin());
@@ -206,6 +220,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
   if (stats.rebuilt) stats.build_ns = t_built - t0;
   stats.prepare_ns = t_built - t0;
   last_exec_ = &entry->exec;
+  last_entry_ = entry;
   for (Observer* o : observers_) o->on_step_begin(entry->exec, options_.threads, t_built);
   try {
     execute(entry->plan.get(), entry->exec, w, fresh, stats);

@@ -288,6 +288,7 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
         cur = std::move(next);
       }
       m.recorded = !reused;
+      if (!reused) m.graph_update_ns = cur.graph_update_ns;
       const std::int64_t t1 = now_ns();
       if (partition) {
         const StepGraph& measured = reused ? cur.graph : prev_graph;
@@ -319,6 +320,8 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
       m.partition_ns = t2 - t1;
       m.prepare_ns = ss.prepare_ns;
       m.build_ns = ss.build_ns;
+      m.rebuild_ns = ss.rebuild_ns;
+      m.rebuilt_procs = ss.rebuilt_procs;
       m.execute_ns = ss.wall_ns - ss.prepare_ns;
       m.wall_ns = t3 - t0;
       m.rebuilt = ss.rebuilt;
@@ -426,6 +429,9 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
     m.prepare_ns = med(&LiveStepMeasure::prepare_ns);
     m.execute_ns = med(&LiveStepMeasure::execute_ns);
     m.build_ns = passes[0].steps[s].build_ns;
+    m.rebuild_ns = passes[0].steps[s].rebuild_ns;
+    m.rebuilt_procs = passes[0].steps[s].rebuilt_procs;
+    m.graph_update_ns = passes[0].steps[s].graph_update_ns;
     m.rebuilt = passes[0].steps[s].rebuilt;
     m.recorded = passes[0].steps[s].recorded;
     m.partitioned = passes[0].steps[s].partitioned;
@@ -547,6 +553,12 @@ std::string to_json(const LiveResult& r) {
                         {"partition_ns", m.partition_ns},
                         {"prepare_ns", m.prepare_ns},
                         {"build_ns", m.build_ns},
+                        {"rebuild_ns", m.rebuild_ns},
+                        {"rebuilt_procs", m.rebuilt_procs},
+                        {"rebuild_over_wall", m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) /
+                                                                  static_cast<double>(m.wall_ns)
+                                                            : 0.0},
+                        {"graph_update_ns", m.graph_update_ns},
                         {"execute_ns", m.execute_ns},
                         {"rebuilt", m.rebuilt},
                         {"recorded", m.recorded},

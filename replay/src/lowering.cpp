@@ -31,7 +31,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
 }
 
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
-                const std::vector<bool>* reducible) {
+                const std::vector<bool>* reducible, EdgeDeriver* deriver) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   auto proc = [&](TaskId t) -> ProcId { return a ? a->proc[t] : 0; };
   const bool per_writer = scope == ReduceScope::kPerWriter;
@@ -220,7 +220,11 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
     l.first = x.exec_of[l.first];
     l.last = x.exec_of[l.last - 1] + 1;
   }
-  out.derive_edges();
+  if (deriver != nullptr) {
+    deriver->derive(out);
+  } else {
+    out.derive_edges();
+  }
 
   // 3. The assignment on exec tasks. With explicit orders, each processor's order is first
   // put in the form the partitioned executor runs (a loop's tasks gathered into one block at

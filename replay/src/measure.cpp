@@ -76,6 +76,12 @@ std::int64_t ReplayResult::build_ns() const {
   for (const auto& m : steps) s += m.build_ns;
   return s;
 }
+
+std::int64_t ReplayResult::rebuild_ns() const {
+  std::int64_t s = 0;
+  for (const auto& m : steps) s += m.rebuild_ns;
+  return s;
+}
 std::uint64_t ReplayResult::remote_bytes() const {
   std::uint64_t s = 0;
   for (const auto& m : steps) s += m.remote_bytes;
@@ -174,6 +180,8 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       if (pass == 0) {
         StepMeasure& m = r.steps[i];
         m.build_ns = s.build_ns;
+        m.rebuild_ns = s.rebuild_ns;
+        m.rebuilt_procs = s.rebuilt_procs;
         m.signals = s.signals();
         m.waits = s.waits();
         m.blocked_waits = s.blocked_waits();
@@ -239,6 +247,11 @@ std::string to_json(const ReplayResult& r) {
               {"wall_ns", m.wall_ns},
               {"sequential_wall_ns", m.sequential_wall_ns},
               {"build_ns", m.build_ns},
+              {"rebuild_ns", m.rebuild_ns},
+              {"rebuilt_procs", m.rebuilt_procs},
+              {"rebuild_over_wall", m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) /
+                                                        static_cast<double>(m.wall_ns)
+                                                  : 0.0},
               {"run_ns", m.run_ns},
               {"signals", m.signals},
               {"waits", m.waits},
@@ -272,6 +285,7 @@ std::string to_json(const ReplayResult& r) {
             {"waits", r.waits()},
             {"wait_ns", r.wait_ns()},
             {"build_ns", r.build_ns()},
+            {"rebuild_ns", r.rebuild_ns()},
             {"plans_built", r.plans_built},
             {"order_fallbacks", r.order_fallbacks},
             {"remote_bytes", r.remote_bytes()},

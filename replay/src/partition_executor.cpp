@@ -18,6 +18,7 @@
 #include <memory>
 #include <mutex>
 #include <queue>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -43,6 +44,7 @@ struct WaitPoint {
   TaskId producer = 0;
   LoopId loop = kNoLoop;  // kAfterLoop: the producer's loop
   WaitKind kind = WaitKind::kOnce;
+  friend bool operator==(const WaitPoint&, const WaitPoint&) = default;
 };
 
 enum class OpKind : std::uint8_t { kTask, kLoopBegin, kLoopEnd };
@@ -55,12 +57,14 @@ struct Op {
   LoopId loop = kNoLoop;
   std::uint32_t wait_begin = 0, wait_end = 0;
   std::uint32_t jump = 0;  // kLoopEnd: first op of the body
+  friend bool operator==(const Op&, const Op&) = default;
 };
 
 struct ProcPlan {
   std::vector<Op> ops;
   std::vector<WaitPoint> waits;
   std::vector<DatumId> owned;
+  friend bool operator==(const ProcPlan&, const ProcPlan&) = default;
 };
 
 struct Plan {
@@ -68,7 +72,21 @@ struct Plan {
   bool program_order = true;  // false: the assignment's explicit order is followed
   std::size_t tasks = 0;
   std::size_t loops = 0;
+  // What the next incremental build compares with (by exec task of this plan).
+  bool elide = true;
+  std::vector<StableKey> keys;
+  std::vector<LoopId> task_loop;
+  std::vector<ProcId> proc;
+  std::vector<std::int64_t> pos;  // position in its processor's ops
+  std::vector<TaskId> breaks;     // by loop: its break task
+  detail::Csr intra, carried;     // predecessors along intra-step and loop-carried edges
+  std::uint32_t rebuilt_procs = 0;  // processors whose wait points this build computed
 };
+
+/// The programs of two plans are the same (ops, waits, owned data, order mode).
+bool same_programs(const Plan& a, const Plan& b) {
+  return a.program_order == b.program_order && a.procs == b.procs;
+}
 
 /// `order` made consistent with the dependencies among its own tasks (a stable topological
 /// sort: lowering can add edges between tasks of one processor, e.g. serialised CW writers,
@@ -99,37 +117,46 @@ std::vector<TaskId> local_topological(const ExecGraph& x, const std::vector<Task
   return out.size() == order.size() ? out : order;
 }
 
-/// Builds the per-processor programs.
-Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide) {
+/// Step 1 of a plan: the ops of every processor (its tasks in order, each loop's body tasks
+/// gathered in one block), each task's position, and what a later incremental build needs.
+void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide, Plan& plan) {
   const StepGraph& g = x.graph;
   const auto n = static_cast<TaskId>(g.tasks.size());
   const Assignment& a = x.assignment;
-  Plan plan;
   plan.program_order = !use_order || a.order.empty();
   plan.tasks = n;
   plan.loops = g.loops.size();
-  plan.procs.resize(k);
-  std::vector<std::int64_t> pos(n, 0);  // position of each task in its processor's ops
-  std::vector<bool> signal(n, false);
-
-  // 1. Ops per processor: its tasks in order, each loop's body tasks gathered in one block.
+  plan.elide = elide;
+  plan.procs.assign(k, {});
+  plan.pos.assign(n, 0);
+  plan.keys.resize(n);
+  plan.task_loop.resize(n);
+  for (TaskId t = 0; t < n; ++t) {
+    plan.keys[t] = g.tasks[t].key;
+    plan.task_loop[t] = g.tasks[t].loop;
+  }
+  plan.proc = a.proc;
+  plan.breaks.resize(g.loops.size());
+  for (LoopId l = 0; l < g.loops.size(); ++l) plan.breaks[l] = g.loops[l].last - 1;
+  std::vector<std::vector<TaskId>> seqs(k);
+  if (use_order && !a.order.empty()) {
+    for (ProcId p = 0; p < k; ++p) seqs[p] = local_topological(x, a.order[p]);
+  } else {
+    for (TaskId t = 0; t < n; ++t) seqs[a.proc[t]].push_back(t);
+  }
+  std::vector<std::vector<TaskId>> in_loop(g.loops.size());
+  std::vector<bool> opened(g.loops.size(), false);
   for (ProcId p = 0; p < k; ++p) {
-    std::vector<TaskId> seq;
-    if (use_order && !a.order.empty()) {
-      seq = local_topological(x, a.order[p]);
-    } else {
-      for (TaskId t = 0; t < n; ++t)
-        if (a.proc[t] == p) seq.push_back(t);
-    }
-    std::vector<std::vector<TaskId>> in_loop(g.loops.size());
+    const std::vector<TaskId>& seq = seqs[p];
+    for (auto& v : in_loop) v.clear();
     for (TaskId t : seq)
       if (g.tasks[t].loop != kNoLoop) in_loop[g.tasks[t].loop].push_back(t);
-    std::vector<bool> opened(g.loops.size(), false);
+    std::fill(opened.begin(), opened.end(), false);
     auto& ops = plan.procs[p].ops;
     for (TaskId t : seq) {
       const LoopId l = g.tasks[t].loop;
       if (l == kNoLoop) {
-        pos[t] = static_cast<std::int64_t>(ops.size());
+        plan.pos[t] = static_cast<std::int64_t>(ops.size());
         ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0});
         continue;
       }
@@ -138,24 +165,32 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide)
       ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0});
       const auto body = static_cast<std::uint32_t>(ops.size());
       for (TaskId u : in_loop[l]) {
-        pos[u] = static_cast<std::int64_t>(ops.size());
+        plan.pos[u] = static_cast<std::int64_t>(ops.size());
         ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0});
       }
       ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body});
     }
   }
+}
 
-  // 2. Wait points, reduced along each processor's program. Processor q runs its ops in
-  // order, so a wait on the task at position i of q implies every wait on q's earlier
-  // positions in the same context: outside loops (kOnce, kAfterLoop: q finished what comes
-  // before), in the same iteration of a loop (kSameIter), and in the previous iteration
-  // (kPrevIter, also implied by any kSameIter wait on q: q finished iteration i - 1 before
-  // starting i). Per op the candidates are taken latest first, and across ops the latest
-  // position waited for on each processor is remembered (reset at each loop begin for
-  // the loop contexts), so that a reducer waits for the last of another processor's CW
-  // writers, not for each of them, and only the tasks still waited for signal.
-  const detail::Csr intra = detail::build_csr(n, g.edges, true);
-  const detail::Csr carried = detail::build_csr(n, g.carried_edges, true);
+/// Step 2 of a plan for processor p: its wait points, reduced along its program. Processor
+/// q runs its ops in order, so a wait on the task at position i of q implies every wait on
+/// q's earlier positions in the same context: outside loops (kOnce, kAfterLoop: q finished
+/// what comes before), in the same iteration of a loop (kSameIter), and in the previous
+/// iteration (kPrevIter, also implied by any kSameIter wait on q: q finished iteration
+/// i - 1 before starting i). Per op the candidates are taken per producing processor,
+/// latest first, and across ops the latest position waited for on each processor is
+/// remembered (reset at each loop begin for the loop contexts), so that a reducer waits for
+/// the last of another processor's CW writers, not for each of them, and only the tasks
+/// still waited for signal. The waits of an op are listed by processor, then latest
+/// position first: an order that only depends on each processor's order of its tasks (an
+/// incremental rebuild relies on it).
+void build_waits(const ExecGraph& x, ProcId p, Plan& plan) {
+  const StepGraph& g = x.graph;
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  const std::vector<ProcId>& proc = x.assignment.proc;
+  const std::size_t k = plan.procs.size();
+  const std::vector<std::int64_t>& pos = plan.pos;
   constexpr std::int64_t kNever = -1;
   struct Candidate {
     WaitPoint w;
@@ -163,92 +198,249 @@ Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide)
     std::int64_t at = 0;  // position of the producer in its processor's ops
   };
   std::vector<Candidate> cands;
-  for (ProcId p = 0; p < k; ++p) {
-    ProcPlan& pp = plan.procs[p];
-    std::vector<std::int64_t> done_outside(k, kNever), done_iter(k, kNever), done_prev(k, kNever);
-    std::vector<std::uint8_t> seen_once, seen_iter, seen_prev;  // without elision only
-    std::vector<TaskId> marks;
-    if (!elide) seen_once.assign(n, 0), seen_iter.assign(n, 0), seen_prev.assign(n, 0);
-    for (Op& op : pp.ops) {
-      if (op.kind == OpKind::kLoopBegin) {
-        std::fill(done_iter.begin(), done_iter.end(), kNever);
-        std::fill(done_prev.begin(), done_prev.end(), kNever);
-        for (TaskId u : marks) seen_iter[u] = seen_prev[u] = 0;
-        marks.clear();
-      }
-      if (op.kind != OpKind::kTask) continue;
-      const TaskId v = op.task;
-      cands.clear();
-      for (auto i = intra.begin[v]; i < intra.begin[v + 1]; ++i) {
-        const TaskId u = intra.ids[i];
-        if (a.proc[u] == p && pos[u] < pos[v]) continue;  // program order on p guarantees it
-        const LoopId lu = g.tasks[u].loop;
-        WaitPoint w{u, lu, WaitKind::kOnce};
-        if (lu == kNoLoop) {
-          w.kind = WaitKind::kOnce;
-        } else if (lu == g.tasks[v].loop) {
-          w.kind = WaitKind::kSameIter;
-        } else {
-          w.kind = WaitKind::kAfterLoop;
-        }
-        cands.push_back({w, a.proc[u], pos[u]});
-      }
-      for (auto i = carried.begin[v]; i < carried.begin[v + 1]; ++i) {
-        const TaskId u = carried.ids[i];
-        if (a.proc[u] == p) continue;  // p finishes iteration i before starting i + 1
-        cands.push_back({{u, g.tasks[u].loop, WaitKind::kPrevIter}, a.proc[u], pos[u]});
-      }
-      // kSameIter first (they imply kPrevIter), then the latest position first.
-      std::sort(cands.begin(), cands.end(), [](const Candidate& x, const Candidate& y) {
-        const bool xs = x.w.kind == WaitKind::kSameIter, ys = y.w.kind == WaitKind::kSameIter;
-        if (xs != ys) return xs;
-        return x.at > y.at;
-      });
-      op.wait_begin = static_cast<std::uint32_t>(pp.waits.size());
-      for (const Candidate& c : cands) {
-        std::int64_t* done = nullptr;
-        bool implied = false;
-        switch (c.w.kind) {
-          case WaitKind::kOnce:
-          case WaitKind::kAfterLoop:
-            done = &done_outside[c.proc];
-            implied = c.at <= *done;
-            break;
-          case WaitKind::kSameIter:
-            done = &done_iter[c.proc];
-            implied = c.at <= *done;
-            break;
-          case WaitKind::kPrevIter:
-            done = &done_prev[c.proc];
-            implied = c.at <= *done || done_iter[c.proc] != kNever;
-            break;
-        }
-        if (!elide) {
-          // Only one wait per producer and context along the program (the dedupe every plan
-          // needs), as before the reduction.
-          std::vector<std::uint8_t>& seen = c.w.kind == WaitKind::kSameIter   ? seen_iter
-                                            : c.w.kind == WaitKind::kPrevIter ? seen_prev
-                                                                              : seen_once;
-          implied = seen[c.w.producer] != 0;
-          if (!implied && c.w.kind != WaitKind::kOnce && c.w.kind != WaitKind::kAfterLoop)
-            marks.push_back(c.w.producer);
-          seen[c.w.producer] = 1;
-        }
-        if (implied) continue;
-        *done = c.at;
-        signal[c.w.producer] = true;
-        pp.waits.push_back(c.w);
-      }
-      op.wait_end = static_cast<std::uint32_t>(pp.waits.size());
+  ProcPlan& pp = plan.procs[p];
+  pp.waits.clear();
+  std::vector<std::int64_t> done_outside(k, kNever), done_iter(k, kNever), done_prev(k, kNever);
+  std::vector<std::uint8_t> seen_once, seen_iter, seen_prev;  // without elision only
+  std::vector<TaskId> marks;
+  if (!plan.elide) seen_once.assign(n, 0), seen_iter.assign(n, 0), seen_prev.assign(n, 0);
+  for (Op& op : pp.ops) {
+    if (op.kind == OpKind::kLoopBegin) {
+      std::fill(done_iter.begin(), done_iter.end(), kNever);
+      std::fill(done_prev.begin(), done_prev.end(), kNever);
+      for (TaskId u : marks) seen_iter[u] = seen_prev[u] = 0;
+      marks.clear();
     }
+    if (op.kind != OpKind::kTask) continue;
+    const TaskId v = op.task;
+    cands.clear();
+    for (auto i = plan.intra.begin[v]; i < plan.intra.begin[v + 1]; ++i) {
+      const TaskId u = plan.intra.ids[i];
+      if (proc[u] == p && pos[u] < pos[v]) continue;  // program order on p guarantees it
+      const LoopId lu = g.tasks[u].loop;
+      WaitPoint w{u, lu, WaitKind::kOnce};
+      if (lu == kNoLoop) {
+        w.kind = WaitKind::kOnce;
+      } else if (lu == g.tasks[v].loop) {
+        w.kind = WaitKind::kSameIter;
+      } else {
+        w.kind = WaitKind::kAfterLoop;
+      }
+      cands.push_back({w, proc[u], pos[u]});
+    }
+    for (auto i = plan.carried.begin[v]; i < plan.carried.begin[v + 1]; ++i) {
+      const TaskId u = plan.carried.ids[i];
+      if (proc[u] == p) continue;  // p finishes iteration i before starting i + 1
+      cands.push_back({{u, g.tasks[u].loop, WaitKind::kPrevIter}, proc[u], pos[u]});
+    }
+    // Per processor: kSameIter first (they imply kPrevIter), then the latest position first.
+    std::sort(cands.begin(), cands.end(), [](const Candidate& c, const Candidate& d) {
+      if (c.proc != d.proc) return c.proc < d.proc;
+      const bool cs = c.w.kind == WaitKind::kSameIter, ds = d.w.kind == WaitKind::kSameIter;
+      if (cs != ds) return cs;
+      if (c.at != d.at) return c.at > d.at;
+      return c.w.kind < d.w.kind;
+    });
+    op.wait_begin = static_cast<std::uint32_t>(pp.waits.size());
+    for (const Candidate& c : cands) {
+      std::int64_t* done = nullptr;
+      bool implied = false;
+      switch (c.w.kind) {
+        case WaitKind::kOnce:
+        case WaitKind::kAfterLoop:
+          done = &done_outside[c.proc];
+          implied = c.at <= *done;
+          break;
+        case WaitKind::kSameIter:
+          done = &done_iter[c.proc];
+          implied = c.at <= *done;
+          break;
+        case WaitKind::kPrevIter:
+          done = &done_prev[c.proc];
+          implied = c.at <= *done || done_iter[c.proc] != kNever;
+          break;
+      }
+      if (!plan.elide) {
+        // Only one wait per producer and context along the program (the dedupe every plan
+        // needs), as before the reduction.
+        std::vector<std::uint8_t>& seen = c.w.kind == WaitKind::kSameIter   ? seen_iter
+                                          : c.w.kind == WaitKind::kPrevIter ? seen_prev
+                                                                            : seen_once;
+        implied = seen[c.w.producer] != 0;
+        if (!implied && c.w.kind != WaitKind::kOnce && c.w.kind != WaitKind::kAfterLoop)
+          marks.push_back(c.w.producer);
+        seen[c.w.producer] = 1;
+      }
+      if (implied) continue;
+      *done = c.at;
+      pp.waits.push_back(c.w);
+    }
+    op.wait_end = static_cast<std::uint32_t>(pp.waits.size());
   }
+}
+
+/// Step 3: signal flags (the tasks some processor waits for) and first-touch owners.
+void finish_plan(const ExecGraph& x, Plan& plan) {
+  std::vector<bool> signal(plan.tasks, false);
+  for (const ProcPlan& pp : plan.procs)
+    for (const WaitPoint& w : pp.waits) signal[w.producer] = true;
   for (ProcPlan& pp : plan.procs)
     for (Op& op : pp.ops)
       if (op.kind == OpKind::kTask) op.signal = signal[op.task];
-
-  // 3. First-touch owners.
   const auto owner = detail::first_accessor_owner(x);
+  const std::size_t k = plan.procs.size();
+  for (ProcPlan& pp : plan.procs) pp.owned.clear();
   for (DatumId d = 0; d < owner.size(); ++d) plan.procs[owner[d] % k].owned.push_back(d);
+}
+
+/// Builds the per-processor programs from scratch.
+Plan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide) {
+  Plan plan;
+  build_ops(x, k, use_order, elide, plan);
+  const auto n = plan.tasks;
+  plan.intra = detail::build_csr(n, x.graph.edges, true);
+  plan.carried = detail::build_csr(n, x.graph.carried_edges, true);
+  for (ProcId p = 0; p < k; ++p) build_waits(x, p, plan);
+  plan.rebuilt_procs = k;
+  finish_plan(x, plan);
+  return plan;
+}
+
+/// Builds the per-processor programs from those of `prev` (the plan of an earlier exec
+/// graph): every processor gets its ops afresh (cheap), but keeps its previous wait points,
+/// task ids renumbered, when nothing they depend on changed: its ops are the previous ones
+/// (tasks matched by stable key), each of its tasks has the same predecessors (matched),
+/// each predecessor is on the same processor, in the same loop, and every other processor
+/// it waits on kept the order of its matched tasks. Otherwise (and for the processors whose
+/// task list changed) the wait points are computed again. Equals build_plan().
+Plan update_plan(const ExecGraph& x, const Plan& prev, std::uint32_t k, bool use_order,
+                 bool elide) {
+  if (prev.procs.size() != k || prev.elide != elide) return build_plan(x, k, use_order, elide);
+  const StepGraph& g = x.graph;
+  Plan plan;
+  build_ops(x, k, use_order, elide, plan);
+  const auto n = static_cast<TaskId>(plan.tasks);
+  plan.intra = detail::build_csr(n, g.edges, true);
+  plan.carried = detail::build_csr(n, g.carried_edges, true);
+  auto from_scratch = [&] {
+    for (ProcId p = 0; p < k; ++p) build_waits(x, p, plan);
+    plan.rebuilt_procs = k;
+    finish_plan(x, plan);
+    return std::move(plan);
+  };
+  if (plan.program_order != prev.program_order) return from_scratch();
+
+  // Tasks and loops matched by stable key (both ways; keys must be unique). The keys are
+  // hashes: an open-addressing table with linear probing.
+  std::size_t size = 16;
+  while (size < 2 * prev.keys.size()) size *= 2;
+  const std::size_t mask = size - 1;
+  std::vector<TaskId> slot(size, kNoTask);
+  auto home = [mask](StableKey key) { return static_cast<std::size_t>(key ^ (key >> 29)) & mask; };
+  for (TaskId t = 0; t < prev.keys.size(); ++t) {
+    std::size_t i = home(prev.keys[t]);
+    for (; slot[i] != kNoTask; i = (i + 1) & mask)
+      if (prev.keys[slot[i]] == prev.keys[t]) return from_scratch();
+    slot[i] = t;
+  }
+  std::vector<TaskId> old_of(n, kNoTask), new_of(prev.keys.size(), kNoTask);
+  for (TaskId t = 0; t < n; ++t)
+    for (std::size_t i = home(plan.keys[t]); slot[i] != kNoTask; i = (i + 1) & mask)
+      if (prev.keys[slot[i]] == plan.keys[t]) {
+        if (new_of[slot[i]] != kNoTask) return from_scratch();
+        old_of[t] = slot[i];
+        new_of[slot[i]] = t;
+        break;
+      }
+  constexpr LoopId kUnmatched = kNoLoop - 1;
+  std::vector<LoopId> old_loop(g.loops.size(), kUnmatched), new_loop(prev.breaks.size(), kUnmatched);
+  for (LoopId l = 0; l < g.loops.size(); ++l) {
+    const TaskId ob = old_of[plan.breaks[l]];
+    if (ob == kNoTask) continue;
+    const LoopId ol = prev.task_loop[ob];
+    if (ol == kNoLoop || prev.breaks[ol] != ob) continue;
+    old_loop[l] = ol;
+    new_loop[ol] = l;
+  }
+  auto same_loop = [&](LoopId l, LoopId ol) {
+    return l == kNoLoop ? ol == kNoLoop : old_loop[l] == ol;
+  };
+
+  // Processors whose ops are the previous ones, and those that kept their tasks' order.
+  std::vector<bool> same_ops(k, false), same_order(k, true);
+  for (ProcId p = 0; p < k; ++p) {
+    const auto& ops = plan.procs[p].ops;
+    const auto& old = prev.procs[p].ops;
+    bool same = ops.size() == old.size();
+    for (std::size_t i = 0; same && i < ops.size(); ++i) {
+      const Op& o = ops[i];
+      const Op& q = old[i];
+      same = o.kind == q.kind && o.is_break == q.is_break && o.jump == q.jump &&
+             same_loop(o.loop, q.loop) && (o.kind != OpKind::kTask || old_of[o.task] == q.task);
+    }
+    same_ops[p] = same;
+    std::int64_t last = -1;
+    for (const Op& o : ops) {
+      if (o.kind != OpKind::kTask || old_of[o.task] == kNoTask) continue;
+      const TaskId ot = old_of[o.task];
+      if (prev.proc[ot] != p) continue;
+      if (prev.pos[ot] <= last) {
+        same_order[p] = false;
+        break;
+      }
+      last = prev.pos[ot];
+    }
+  }
+
+  std::vector<std::uint32_t> mark(n, 0);
+  std::uint32_t stamp = 0;
+  // Predecessor lists of v and of its previous task ov are the same, each predecessor where
+  // it was, in the same loop, on a processor that kept its order.
+  auto same_preds = [&](const detail::Csr& now, const detail::Csr& before, TaskId v, TaskId ov,
+                        ProcId p) {
+    if (now.size(v) != before.size(ov)) return false;
+    ++stamp;
+    for (auto i = now.begin[v]; i < now.begin[v + 1]; ++i) {
+      const TaskId u = now.ids[i];
+      const TaskId ou = old_of[u];
+      if (ou == kNoTask || prev.proc[ou] != plan.proc[u] || !same_loop(g.tasks[u].loop, prev.task_loop[ou]))
+        return false;
+      if (plan.proc[u] != p && !same_order[plan.proc[u]]) return false;
+      mark[u] = stamp;
+    }
+    for (auto i = before.begin[ov]; i < before.begin[ov + 1]; ++i) {
+      const TaskId nu = new_of[before.ids[i]];
+      if (nu == kNoTask || mark[nu] != stamp) return false;
+    }
+    return true;
+  };
+  for (ProcId p = 0; p < k; ++p) {
+    bool reuse = same_ops[p];
+    for (const Op& op : plan.procs[p].ops) {
+      if (!reuse) break;
+      if (op.kind != OpKind::kTask) continue;
+      const TaskId ov = old_of[op.task];
+      reuse = same_preds(plan.intra, prev.intra, op.task, ov, p) &&
+              same_preds(plan.carried, prev.carried, op.task, ov, p);
+    }
+    if (!reuse) {
+      build_waits(x, p, plan);
+      ++plan.rebuilt_procs;
+      continue;
+    }
+    ProcPlan& pp = plan.procs[p];
+    const ProcPlan& old = prev.procs[p];
+    for (std::size_t i = 0; i < pp.ops.size(); ++i) {
+      pp.ops[i].wait_begin = old.ops[i].wait_begin;
+      pp.ops[i].wait_end = old.ops[i].wait_end;
+    }
+    pp.waits.resize(old.waits.size());
+    for (std::size_t i = 0; i < old.waits.size(); ++i) {
+      const WaitPoint& w = old.waits[i];
+      pp.waits[i] = {new_of[w.producer], w.loop == kNoLoop ? kNoLoop : new_loop[w.loop], w.kind};
+    }
+  }
+  finish_plan(x, plan);
   return plan;
 }
 
@@ -389,9 +581,27 @@ class PartitionExecutor final : public Executor {
   };
 
   std::shared_ptr<void> build(const ExecGraph& x) override {
-    auto plan = std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits));
-    // Program order on every processor never deadlocks (every wait names an earlier task in
-    // program order); only an explicit order needs the check.
+    return checked(x, std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits)));
+  }
+
+  std::shared_ptr<void> rebuild(const ExecGraph& x, const ExecGraph&,
+                                const void* previous) override {
+    const Plan& prev = *static_cast<const Plan*>(previous);
+    auto plan = std::make_shared<Plan>(
+        update_plan(x, prev, options_.threads, true, options_.elide_waits));
+    if (options_.verify_plans &&
+        !same_programs(*plan, build_plan(x, options_.threads, true, options_.elide_waits)))
+      throw std::logic_error("partition executor: the incremental plan differs from a full build");
+    return checked(x, std::move(plan));
+  }
+
+  std::uint32_t rebuilt_procs(const void* plan) const override {
+    return static_cast<const Plan*>(plan)->rebuilt_procs;
+  }
+
+  // Program order on every processor never deadlocks (every wait names an earlier task in
+  // program order); only an explicit order needs the check.
+  std::shared_ptr<Plan> checked(const ExecGraph& x, std::shared_ptr<Plan> plan) {
     if (plan->program_order) return plan;
     try {
       run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks

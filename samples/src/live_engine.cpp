@@ -30,6 +30,7 @@ class SceneEngine final : public replay::LiveEngine {
     step.bodies = std::move(p.bodies);
     step.conditions = std::move(p.conditions);
     step.accumulators = std::move(p.accumulators);
+    step.graph_update_ns = rec_.last_edge_update().ns;
     return step;
   }
 

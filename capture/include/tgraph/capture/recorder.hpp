@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tgraph/graph/cumulative.hpp"
+#include "tgraph/graph/incremental.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -100,6 +101,16 @@ class Recorder {
   /// streams steps to a trace file turns it off: traces do not store edges, readers derive
   /// them, and the capture's hot path saves the time.
   void set_derive_edges(bool on) { derive_edges_ = on; }
+  /// Whether edges are derived from the previous step's (tgraph::EdgeDeriver: only the data
+  /// whose access sequence changed are derived again; default true) or from scratch. Both
+  /// give the same edges.
+  void set_incremental_edges(bool on) {
+    incremental_edges_ = on;
+    if (!on) deriver_.reset();
+  }
+  /// What the last end_step() did to derive the edges (its time in `ns`; all zero when the
+  /// edges were not derived).
+  const EdgeUpdate& last_edge_update() const { return last_update_; }
 
   /// Declares an object (or interaction) with a name that is stable across steps.
   /// Declaring an existing name returns its id.
@@ -278,6 +289,9 @@ class Recorder {
   TaskId body_first_ = 0, body_last_ = 0;  // body of the open loop, once recorded
   bool in_step_ = false;
   bool derive_edges_ = true;
+  bool incremental_edges_ = true;
+  EdgeDeriver deriver_;       // the previous derived step's edges, by datum
+  EdgeUpdate last_update_{};
   bool time_task_ = true;                   // time the tasks of the current iteration
   std::vector<std::uint32_t> loop_timed_;   // per loop: timed iterations so far
   std::uint64_t errors_ = 0;

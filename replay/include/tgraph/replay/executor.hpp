@@ -38,6 +38,13 @@ struct ExecOptions {
   /// Partition only: run the per-processor programs interleaved on the calling thread
   /// (deterministic, same plans and waits; the serial twin of the threaded executor).
   bool serial = false;
+  /// Partition only: on a structure or assignment change, update the previous step's plan
+  /// (only the processors whose task lists or wait points changed are rebuilt) instead of
+  /// building it from scratch. Both give the same plan.
+  bool incremental_plans = true;
+  /// Partition only: also build every incrementally updated plan from scratch and throw
+  /// std::logic_error when the two differ (tests).
+  bool verify_plans = false;
   /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
   std::string starpu_sched = "lws";
 };
@@ -56,6 +63,10 @@ struct ThreadCounters {
 struct StepStats {
   std::int64_t wall_ns = 0;   ///< whole step, structure build included
   std::int64_t build_ns = 0;  ///< lowering + plan build (0 when the plan was reused)
+  /// The plan build alone, without lowering (0 when the plan was reused): the per-processor
+  /// programs, updated from the previous step's plan where the policy can.
+  std::int64_t rebuild_ns = 0;
+  std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built this step
   std::int64_t prepare_ns = 0;  ///< plan lookup + build_ns + binding the workload
   bool rebuilt = false;       ///< a new plan was built for this step
   std::vector<ThreadCounters> threads;
@@ -120,6 +131,13 @@ class Executor {
   Executor(Policy policy, ExecOptions options);
   /// Builds the policy's plan for `x` (called on a cache miss). Returns an opaque plan.
   virtual std::shared_ptr<void> build(const ExecGraph& x) = 0;
+  /// Builds the plan for `x` from `previous`, the plan this executor built for the exec
+  /// graph `previous_exec` (called on a cache miss after a step; the partition policy updates
+  /// it incrementally). Default: build(x).
+  virtual std::shared_ptr<void> rebuild(const ExecGraph& x, const ExecGraph& previous_exec,
+                                        const void* previous);
+  /// Processors whose program the build of `plan` computed (default: every thread).
+  virtual std::uint32_t rebuilt_procs(const void* plan) const;
   /// Runs one step with a plan. Fills `stats.threads` and `stats.loop_iterations`.
   virtual void execute(void* plan, const ExecGraph& x, Workload& w, bool fresh,
                        StepStats& stats) = 0;
@@ -136,6 +154,8 @@ class Executor {
   struct CacheEntry;
   Policy policy_;
   std::vector<std::shared_ptr<CacheEntry>> cache_;
+  std::shared_ptr<CacheEntry> last_entry_;  // the plan of the previous step
+  EdgeDeriver exec_edges_;                  // the last lowered graph's edges, by datum
   std::uint64_t plans_built_ = 0;
   const ExecGraph* last_exec_ = nullptr;
 };

@@ -90,6 +90,7 @@ struct LiveStep {
   std::vector<std::function<void()>> bodies;      ///< by task (empty for a loop's break)
   std::vector<std::function<bool()>> conditions;  ///< by loop: leave after this iteration?
   std::vector<const Accumulator*> accumulators;   ///< by datum, or nullptr
+  std::int64_t graph_update_ns = 0;  ///< deriving the graph's edges (part of recording)
 };
 
 /// The engine side of a live run (the physics engine behind a small interface; see the
@@ -153,6 +154,9 @@ struct LiveStepMeasure {
   std::int64_t partition_ns = 0;  ///< the partitioner callback
   std::int64_t prepare_ns = 0;    ///< plan lookup, lowering and plan build, binding
   std::int64_t build_ns = 0;      ///< lowering and plan build (0: plan reused), first pass
+  std::int64_t rebuild_ns = 0;    ///< the plan part of build_ns (no lowering), first pass
+  std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built, first pass
+  std::int64_t graph_update_ns = 0;  ///< edge derivation within record_ns, first pass
   std::int64_t execute_ns = 0;    ///< the executor running the tasks
   std::int64_t baseline_ns = 0;   ///< the same step of the uninstrumented engine
   bool rebuilt = false;           ///< a plan was built for this step (first pass)

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/incremental.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/replay/policy.hpp"
 
@@ -51,9 +52,11 @@ struct ExecGraph {
 /// With kReduce and kPerProcessor, reducers are only needed where a CW group spans
 /// processors; with kPerWriter, wherever a group has two writers or more. `reducible`
 /// (optional, by original datum) marks the data whose CW groups may use temporaries; the
-/// groups of other data are serialised (live bodies that cannot be redirected).
+/// groups of other data are serialised (live bodies that cannot be redirected). `deriver`
+/// (optional) derives the exec graph's edges from those of the exec graph it derived last
+/// (same edges as from scratch, faster after a small change).
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
-                const std::vector<bool>* reducible = nullptr);
+                const std::vector<bool>* reducible = nullptr, EdgeDeriver* deriver = nullptr);
 /// Same with the scope implied by `a`: kPerProcessor with an assignment, else kNone.
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode);
 

@@ -54,6 +54,9 @@ struct StepMeasure {
   std::int64_t wall_ns = 0;
   std::int64_t sequential_wall_ns = 0;
   std::int64_t build_ns = 0;  ///< plan build in the first pass (0: reused)
+  /// The plan part of build_ns (per-processor programs, without lowering), first pass.
+  std::int64_t rebuild_ns = 0;
+  std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built, first pass
   /// Median over passes of each pass's wall time minus that pass's own plan build.
   std::int64_t run_ns = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
@@ -89,6 +92,7 @@ struct ReplayResult {
   std::uint64_t waits() const;
   std::int64_t wait_ns() const;
   std::int64_t build_ns() const;
+  std::int64_t rebuild_ns() const;
   std::uint64_t remote_bytes() const;
   std::uint64_t migrated_bytes() const;
   std::optional<std::uint64_t> predicted_makespan_ns() const;
