@@ -15,21 +15,19 @@ void add_diff(CLI::App& app) {
   auto* cmd = app.add_subcommand("diff", "Structural difference of two steps by stable task key");
   cmd->add_option("trace", o->input, "Trace file (.tgt)")->required();
   cmd->add_option("--steps", *steps, "The two steps A B (0-based)")->required()->expected(2);
-  cmd->add_option("--assignment,-a", o->second,
+  cmd->add_option("--assignment,-a", o->assignment,
                   "Assignment file (.tga): also list tasks whose processor changed");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o, steps] {
-    const Trace trace = load_trace(o->input);
+    const Trace trace = read_trace(o->input);
     if (steps->size() != 2) throw UsageError("--steps: expected two step indices A B");
-    for (std::size_t s : *steps)
-      if (s >= trace.steps.size())
-        throw UsageError("--steps " + std::to_string(s) + ": trace " + o->input + " has " +
-                         std::to_string(trace.steps.size()) + " steps");
     const std::size_t a = (*steps)[0], b = (*steps)[1];
-    StepDiff d = diff_steps(trace.steps[a], trace.steps[b]);
-    if (!o->second.empty()) {
-      const TraceAssignment as = partition::load_assignment(o->second, trace, o->input);
-      add_processor_changes(d, trace.steps[a], as.steps[a], trace.steps[b], as.steps[b]);
+    const StepGraph &ga = step_at(trace, a, o->input, "--steps"),
+                    &gb = step_at(trace, b, o->input, "--steps");
+    StepDiff d = diff_steps(ga, gb);
+    if (!o->assignment.empty()) {
+      const TraceAssignment as = partition::load_assignment(o->assignment, trace, o->input);
+      add_processor_changes(d, ga, as.steps[a], gb, as.steps[b]);
     }
     std::cout << (o->json ? step_diff_json(d, a, b) + "\n" : step_diff_text(d, a, b));
   });

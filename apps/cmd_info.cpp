@@ -15,7 +15,7 @@ void add_info(CLI::App& app) {
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->add_flag("--recover", o->recover, "Read the complete steps of an interrupted capture");
   cmd->callback([o] {
-    const TraceSummary s = summarize_trace(load_trace(o->input, o->recover));
+    const TraceSummary s = summarize_trace(read_trace(o->input, {.recover = o->recover}));
     std::cout << (o->json ? trace_summary_json(s, o->input) + "\n"
                           : trace_summary_text(s, o->input));
   });

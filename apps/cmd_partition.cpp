@@ -40,9 +40,9 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--rebalance", n.rebalance, "sticky: greedy (whole objects) or scotch")
       ->check(CLI::IsMember({"greedy", "scotch"}));
   cmd->add_option("--sticky-fallback", n.sticky_fallback,
-                  "sticky, when solver loops merge or split: fresh (base method + relabel) or "
+                  "sticky, when solver loops merge or split: refine (default; local search from the incremental placement), fresh (base method + relabel) or "
                   "repartition (Scotch graphRepart from the incremental placement)")
-      ->check(CLI::IsMember({"fresh", "repartition"}));
+      ->check(CLI::IsMember({"fresh", "repartition", "refine"}));
   cmd->add_option("--migration-cost", o.migration_cost,
                   "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
   add_model_flags(cmd, n);
@@ -71,7 +71,7 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga)");
   add_strategy_flags(cmd, *n);
   cmd->callback([a, n] {
-    const Trace trace = load_trace(a->input);
+    const Trace trace = read_trace(a->input);
     if (a->k == 0) throw UsageError("-k: expected at least 1");
     const auto r = tp::partition_trace(trace, a->method, a->k, n->options());
     if (!a->output.empty()) tp::write_assignment(a->output, r.assignment, trace);
@@ -82,12 +82,12 @@ void add_partition_verbs(CLI::App& app) {
   n = std::make_shared<tp::NamedOptions>();
   cmd = verb(app, "evaluate", "Cut, imbalance, syncs, migrations and predicted makespan", a);
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
-  cmd->add_option("assignment", a->second, "Assignment file (.tga)")->required();
+  cmd->add_option("assignment", a->assignment, "Assignment file (.tga)")->required();
   add_model_flags(cmd, *n);
   cmd->callback([a, n] {
-    const Trace trace = load_trace(a->input);
-    const TraceAssignment as = tp::load_assignment(a->second, trace, a->input);
-    const tp::Report rep = tp::evaluate(trace, as, n->cost_model(), a->second);
+    const Trace trace = read_trace(a->input);
+    const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
+    const tp::Report rep = tp::evaluate(trace, as, n->cost_model(), a->assignment);
     std::cout << (a->json ? tp::report_json(rep) + "\n" : tp::report_text(rep));
   });
 
@@ -107,7 +107,7 @@ void add_partition_verbs(CLI::App& app) {
   add_strategy_flags(cmd, *n);
   cmd->callback([a, n] {
     const tp::Comparison r =
-        tp::compare(load_trace(a->input), a->names, a->counts, n->options(), a->values);
+        tp::compare(read_trace(a->input), a->names, a->counts, n->options(), a->values);
     if (!a->csv.empty()) write_file_atomic(a->csv, tp::comparison_csv(r));
     std::cout << (a->json ? tp::comparison_json(r, a->input) + "\n" : tp::comparison_table(r));
   });
@@ -135,12 +135,7 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("--rounds", cal->rounds, "Ping-pong round trips (default 20000)")
       ->check(CLI::Range(500, 10000000));
   cmd->callback([a, cal] {
-    tp::Calibration c;
-    try {
-      c = tp::measure_calibration(*cal);
-    } catch (const Error& e) {
-      throw Failure(e.what());
-    }
+    const tp::Calibration c = tp::measure_calibration(*cal);  // runtime_error: exit 1
     std::cout << tp::calibration_report(c, tp::save_calibration(c, a->output), a->json);
   });
 }

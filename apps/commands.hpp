@@ -4,11 +4,14 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdint>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
@@ -28,30 +31,22 @@ class Failure : public std::runtime_error {
 /// Values of a verb's flags that no module's option struct holds (each verb owns one; module
 /// options such as partition::NamedOptions or replay::LiveOptions hold the rest).
 struct Args {
-  std::string input, second, output, method, policy, format, cw, timeline, chrome, csv;
+  std::string input, assignment, output, method, policy, format, cw, timeline, chrome, csv;
+  std::string compare, range, collapse = "none";
   std::vector<std::string> names;
   std::vector<std::uint32_t> counts;
   std::vector<double> values;
   std::optional<int> steps;
+  std::size_t step = 0;
   std::uint32_t k = 0;
   std::uint64_t unit_ns = 1000, edge_bytes = 8;
-  bool json = false, recover = false, no_pin = false, no_touch = false, no_baseline = false;
-  bool no_observe = false, no_reuse = false, no_elide_waits = false;
+  bool json = false, recover = false;
 };
 
 /// Prints a JSON object on stdout (one line, as `--json` promises).
-void print_json(const nlohmann::json& j);
-/// Reads a trace for a verb; malformed input throws InputError (exit 2).
-Trace load_trace(const std::string& path, bool recover = false);
-/// A whole file as text (InputError when it cannot be read).
-inline std::string read_file_text(const std::string& path) {
-  const std::vector<std::uint8_t> bytes = read_file_bytes(path);
-  return std::string(bytes.begin(), bytes.end());
-}
-/// "<cpu model>, N hardware threads", for trace headers (libgraph).
-using tgraph::machine_description;
+inline void print_json(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 /// Threads a verb uses by default: all hardware threads (at least 1).
-std::uint32_t default_threads();
+inline std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 /// Header of a trace captured from a scene (samples).
 using samples::scene_header;
 
@@ -61,6 +56,7 @@ void add_export(CLI::App& app);
 void add_diff(CLI::App& app);
 void add_capture(CLI::App& app);
 void add_demo(CLI::App& app);
+void add_experiment(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
 void add_replay_verbs(CLI::App& app);     // replay, run
 void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)

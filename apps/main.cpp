@@ -1,34 +1,20 @@
 // SPDX-License-Identifier: MIT
 // `tgraph`: parses the verb and hands over to the modules. Exit 0 ok, 1 failure of the
 // work, 2 bad usage or bad input (one line on stderr naming the file or flag).
-#include <algorithm>
-#include <cstdio>
 #include <exception>
 #include <iostream>
-#include <thread>
+#include <new>
 
 #include "commands.hpp"
 
-namespace tgraph::app {
-
-void print_json(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
-
-Trace load_trace(const std::string& path, bool recover) {
-  ReadOptions options;
-  options.recover = recover;
-  return read_trace(path, options);
-}
-
-std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
-
-}  // namespace tgraph::app
-
 int main(int argc, char** argv) {
   using namespace tgraph::app;
-  CLI::App app{"tgraph: capture, partition, evaluate and replay task graphs of physics simulations"};
+  CLI::App app{
+      "tgraph: capture, partition, evaluate and replay task graphs of physics simulations"};
   app.set_version_flag("--version", std::string("tgraph ") + TGRAPH_VERSION);
   app.require_subcommand(0, 1);
   add_demo(app);
+  add_experiment(app);
   add_capture(app);
   add_info(app);
   add_export(app);
@@ -45,27 +31,14 @@ int main(int argc, char** argv) {
       char* demo_argv[] = {argv[0], demo};
       app.parse(2, demo_argv);
     }
-  } catch (const CLI::CallForHelp& e) {
+  } catch (const CLI::Success& e) {  // --help, --help-all, --version
     return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "tgraph: " << e.what() << "\n";
-    return 2;
-  } catch (const tgraph::Error& e) {
-    std::cerr << "tgraph: " << e.what() << "\n";
-    return 2;
-  } catch (const Failure& e) {
-    std::cerr << "tgraph: " << e.what() << "\n";
-    return 1;
-  } catch (const std::bad_alloc&) {
-    std::cerr << "tgraph: out of memory\n";
-    return 1;
   } catch (const std::exception& e) {
-    std::cerr << "tgraph: " << e.what() << "\n";
-    return 1;
+    const bool bad_input =
+        dynamic_cast<const CLI::ParseError*>(&e) || dynamic_cast<const tgraph::Error*>(&e);
+    const bool no_memory = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
+    std::cerr << "tgraph: " << (no_memory ? "out of memory" : e.what()) << "\n";
+    return bad_input ? 2 : 1;  // Failure and other errors of the work: 1
   }
   return 0;
 }

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # `cmake --install`: headers, static libraries, the `tgraph` binary, the CMake package
 # (find_package(tgraph) -> tgraph::graph, tgraph::capture, tgraph::partition, tgraph::replay,
-# tgraph::viz, as built) and tgraph.pc for pkg-config users of the capture API.
+# tgraph::viz, tgraph::samples, tgraph::experiment, as built) and tgraph.pc for pkg-config users of the capture API.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -13,7 +13,8 @@ set(TGRAPH_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/tgraph"
 # partition library.
 set(_tgraph_exported tgraph_options)
 set(_tgraph_modules "")
-foreach(pair graph:libgraph capture:capture partition:partition replay:replay viz:viz)
+foreach(pair graph:libgraph capture:capture partition:partition replay:replay viz:viz
+             samples:samples experiment:experiment)
   string(REPLACE ":" ";" pair "${pair}")
   list(GET pair 0 module)
   list(GET pair 1 folder)
@@ -60,6 +61,10 @@ endif()
 set(TGRAPH_PACKAGE_GRAPHVIZ OFF)
 if(TARGET tgraph_viz)
   set(TGRAPH_PACKAGE_GRAPHVIZ ON)
+endif()
+set(TGRAPH_PACKAGE_EIGEN OFF)
+if(TARGET tgraph_samples)
+  set(TGRAPH_PACKAGE_EIGEN ON)
 endif()
 set(TGRAPH_PACKAGE_MODULES "${_tgraph_modules}")
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/tgraphConfig.cmake.in"

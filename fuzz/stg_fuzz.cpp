@@ -6,12 +6,12 @@
 
 #include "fuzz_util.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/stg.hpp"
+#include "tgraph/graph/stg.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const tgraph::partition::StgGraph g =
-        tgraph::partition::parse_stg(tgraph::fuzz::as_text(data, size), "fuzz.stg");
+    const tgraph::StgGraph g =
+        tgraph::parse_stg(tgraph::fuzz::as_text(data, size), "fuzz.stg");
     if (g.trace.steps.size() != 1 || !g.trace.steps[0].validate().empty())
       tgraph::fuzz::invariant_failed();
   } catch (const tgraph::Error&) {

@@ -48,7 +48,8 @@ tgraph_build() {
 }
 
 # Optional: Debian's chromium for the browser test of the HTML report (tests/viz). Installed
-# when running as root; otherwise, or when apt fails, a notice says the test will be skipped.
+# when running as root; otherwise, or when apt fails, a notice says the test will be skipped,
+# unless TGRAPH_REQUIRE_BROWSER=1 (CI sets it), which makes a missing browser an error.
 tgraph_install_browser() {
   command -v chromium >/dev/null 2>&1 && return 0
   if [ "$(id -u)" -eq 0 ] &&
@@ -56,6 +57,11 @@ tgraph_install_browser() {
       DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends chromium; } >/dev/null 2>&1; then
     echo "tgraph: installed chromium (browser test of the HTML report)" >&2
     return 0
+  fi
+  if [ "${TGRAPH_REQUIRE_BROWSER:-0}" = "1" ]; then
+    echo "tgraph: error: chromium is not installed and could not be installed (run as root:" \
+      "apt-get install chromium); TGRAPH_REQUIRE_BROWSER=1 asks for the browser test" >&2
+    return 1
   fi
   echo "tgraph: NOTICE: chromium is not installed and could not be installed (run as root:" \
     "apt-get install chromium); the browser test of the HTML report will be skipped" >&2

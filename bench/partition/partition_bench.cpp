@@ -1,17 +1,28 @@
 // SPDX-License-Identifier: MIT
-// Strategies side by side on one graph, plus the simulator: `partition_bench`.
-// The graph: a synthetic bars-like step (objects with per-object chains inside a CG-like
-// loop with global dot products), or the STG graph given by TGRAPH_BENCH_STG.
-#include <benchmark/benchmark.h>
-
+// Strategies side by side on each scene's step graph, plus the simulator: `partition_bench`.
+//
+//  * Partition/<graph>/<method>/k:K: Strategy::partition from scratch (no previous step).
+//    Counters: tasks, predicted_speedup (work / simulated makespan of the result).
+//  * StickyReuse/<graph>/k:K: sticky on an unchanged step given its own previous assignment
+//    (the path the paper relies on while the structure repeats).
+//  * Simulate/<graph>/k:K: the simulator on owner's assignment (items: task instances).
+//
+// Graphs: step 3 of the scenes bars64, cloth128, falling and torso (captured at start-up,
+// edges derived), `synthetic` (a bars-like step: 64 objects with per-object chains in a
+// CG-like loop with global dot products), and the STG graph given by TGRAPH_BENCH_STG.
+// Sticky after a contact change against a full METIS: incremental_bench (FallingPartition).
 #include <cstdlib>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "bench_main.hpp"
+#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/metrics.hpp"
-#include "tgraph/partition/simulator.hpp"
 #include "tgraph/graph/stg.hpp"
+#include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
+#include "tgraph/samples/scene.hpp"
 
 namespace {
 
@@ -53,7 +64,8 @@ StepGraph bars_like(int objects) {
   }
   task(kNoObject, {{dot, AccessMode::R}, {alpha, AccessMode::W}, {cond, AccessMode::W}}, 100);
   for (int i = 0; i < objects; ++i)
-    task(static_cast<ObjectId>(i), {{alpha, AccessMode::R}, {q[i], AccessMode::R}, {p[i], AccessMode::RW}}, 400);
+    task(static_cast<ObjectId>(i),
+         {{alpha, AccessMode::R}, {q[i], AccessMode::R}, {p[i], AccessMode::RW}}, 400);
   task(kNoObject, {{cond, AccessMode::R}}, 50);
   const auto last = static_cast<TaskId>(g.tasks.size());
   for (TaskId t = first; t < last; ++t) g.tasks[t].loop = 0;
@@ -62,16 +74,29 @@ StepGraph bars_like(int objects) {
   return g;
 }
 
-const StepGraph& graph() {
-  static const StepGraph g = [] {
-    if (const char* stg = std::getenv("TGRAPH_BENCH_STG")) return read_stg(stg).trace.steps[0];
-    return bars_like(64);
-  }();
-  return g;
+/// The step graph called `name` (built once).
+const StepGraph& graph(const std::string& name) {
+  static std::map<std::string, StepGraph> cache;
+  auto it = cache.find(name);
+  if (it != cache.end()) return it->second;
+  StepGraph g;
+  if (name == "synthetic") {
+    g = bars_like(64);
+  } else if (name == "stg") {
+    g = read_stg(std::getenv("TGRAPH_BENCH_STG")).trace.steps[0];
+  } else {
+    auto scene = samples::make_scene(name);
+    capture::Recorder rec(capture::Mode::kCapture);
+    for (int s = 0; s < 4; ++s) {
+      scene->step(rec);
+      g = rec.end_step();
+    }
+  }
+  return cache.emplace(name, std::move(g)).first->second;
 }
 
-void BM_Partition(benchmark::State& state, const std::string& method) {
-  const StepGraph& g = graph();
+void BM_Partition(benchmark::State& state, const std::string& name, const std::string& method) {
+  const StepGraph& g = graph(name);
   const auto k = static_cast<std::uint32_t>(state.range(0));
   auto s = make_strategy(method);
   Result r;
@@ -82,12 +107,13 @@ void BM_Partition(benchmark::State& state, const std::string& method) {
   const Schedule sched = simulate(g, r.assignment, CostModel::defaults());
   const Metrics m = compute_metrics(g);
   state.counters["tasks"] = static_cast<double>(g.tasks.size());
-  state.counters["predicted_speedup"] = static_cast<double>(m.work_ns) / static_cast<double>(sched.makespan_ns);
+  state.counters["predicted_speedup"] =
+      static_cast<double>(m.work_ns) / static_cast<double>(sched.makespan_ns);
 }
 
 // Sticky on an unchanged step: the reuse path the paper relies on.
-void BM_StickyReuse(benchmark::State& state) {
-  const StepGraph& g = graph();
+void BM_StickyReuse(benchmark::State& state, const std::string& name) {
+  const StepGraph& g = graph(name);
   const auto k = static_cast<std::uint32_t>(state.range(0));
   auto s = make_strategy("sticky");
   const Result first = s->partition(g, k, {}, {});
@@ -97,9 +123,10 @@ void BM_StickyReuse(benchmark::State& state) {
   }
 }
 
-void BM_Simulate(benchmark::State& state) {
-  const StepGraph& g = graph();
-  const Result r = make_strategy("owner")->partition(g, static_cast<std::uint32_t>(state.range(0)), {}, {});
+void BM_Simulate(benchmark::State& state, const std::string& name) {
+  const StepGraph& g = graph(name);
+  const Result r =
+      make_strategy("owner")->partition(g, static_cast<std::uint32_t>(state.range(0)), {}, {});
   std::uint64_t instances = 0;
   for (auto _ : state) {
     const Schedule s = simulate(g, r.assignment, CostModel::defaults());
@@ -109,13 +136,36 @@ void BM_Simulate(benchmark::State& state) {
   state.SetItemsProcessed(static_cast<std::int64_t>(instances) * state.iterations());
 }
 
+void register_all(bench::Size size) {
+  std::vector<std::string> graphs = {"bars64", "cloth128", "falling", "torso", "synthetic"};
+  if (std::getenv("TGRAPH_BENCH_STG") != nullptr) graphs.push_back("stg");
+  if (size == bench::Size::kSmoke) graphs = {"synthetic"};
+  const std::vector<std::string> methods = {"owner", "metis", "scotch", "list", "roundrobin"};
+  const std::vector<int> ks = bench::by_size<std::vector<int>>(size, {2}, {2, 16}, {2, 8, 32});
+  for (const std::string& g : graphs) {
+    for (const std::string& m : methods) {
+      auto* b =
+          benchmark::RegisterBenchmark(("BM_Partition/" + g + "/" + m).c_str(), BM_Partition, g, m)
+              ->ArgName("k")
+              ->Unit(benchmark::kMicrosecond);
+      for (int k : ks) b->Arg(k);
+      bench::timed(b, size, 0.05);
+    }
+    auto* sticky = benchmark::RegisterBenchmark(("BM_StickyReuse/" + g).c_str(), BM_StickyReuse, g)
+                       ->ArgName("k")
+                       ->Unit(benchmark::kMicrosecond);
+    auto* sim = benchmark::RegisterBenchmark(("BM_Simulate/" + g).c_str(), BM_Simulate, g)
+                    ->ArgName("k")
+                    ->Unit(benchmark::kMicrosecond);
+    for (int k : ks) {
+      sticky->Arg(k);
+      sim->Arg(k);
+    }
+    bench::timed(sticky, size, 0.05);
+    bench::timed(sim, size, 0.05);
+  }
+}
+
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_Partition, owner, std::string("owner"))->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Partition, metis, std::string("metis"))->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Partition, scotch, std::string("scotch"))->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Partition, list, std::string("list"))->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Partition, roundrobin, std::string("roundrobin"))->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_StickyReuse)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_Simulate)->Arg(4)->Arg(16)->Unit(benchmark::kMicrosecond);
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return tgraph::bench::run_main(argc, argv, register_all); }

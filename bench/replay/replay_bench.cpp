@@ -4,17 +4,21 @@
 //    iteration is two cross-thread hand-offs after `work_ns` of work each. Per hand-off
 //    overhead = time per iteration / 2 - work. Where the spin budget is shorter than the
 //    wait, the waiter parks (futex) and the hand-off costs microseconds: the switch point.
-//  * Policy/<policy>/<threads>: a synthetic bars64-like step (64 bars, a CG loop of 25
+//  * Policy/<policy>/threads:N: a synthetic bars64-like step (64 bars, a CG loop of 25
 //    iterations with per-bar matrix products and global dot products) under each policy.
-//  * TaskOverhead/<policy>/<threads>: the same step with empty bodies (no spin, no data):
-//    what each executor costs per task instance (ns_per_task), StarPU included.
-#include <benchmark/benchmark.h>
-
+//  * TaskOverhead/<policy>/threads:N: the same step with empty bodies (no spin, no data):
+//    what each executor costs per task instance (ns_per_task): sequential, partition,
+//    worksteal, barrier, and starpu when the build has StarPU.
+//  * SignalWait/<spin|futex>: the floor under a hand-off: two threads bouncing a counter
+//    through one std::atomic, by spinning on it or by std::atomic::wait/notify_one;
+//    latency_ns is one signal -> wait (half a round trip).
+#include <atomic>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
-#include "tgraph/graph/error.hpp"
+#include "bench_main.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
@@ -62,12 +66,6 @@ void BM_Handoff(benchmark::State& state) {
   state.counters["parks_per_step"] =
       static_cast<double>(parks) / static_cast<double>(state.iterations());
 }
-BENCHMARK(BM_Handoff)
-    ->ArgNames({"work_ns", "spin_ns"})
-    ->ArgsProduct({{0, 2'000, 20'000}, {0, 1'000, 5'000, 20'000, 50'000, 200'000}})
-    ->Unit(benchmark::kMicrosecond)
-    ->UseRealTime();
-
 /// A bars64-like step: per bar b: addForce (CW f_b); CG loop: per bar addDForce (R p_b,
 /// W q_b), dot pq (R p_b q_b, CW pq), scalars, per bar cgUpdate (R q_b, RW x_b r_b), dot rr
 /// (R r_b, CW rr), residual (R rr, W cond), per bar cgDirection (R r_b, RW p_b), break.
@@ -137,9 +135,8 @@ Assignment owner_like(const StepGraph& g, std::uint32_t k, std::uint32_t bars) {
   return a;
 }
 
-void BM_Policy(benchmark::State& state) {
-  const auto policy = static_cast<Policy>(state.range(0));
-  const auto k = static_cast<std::uint32_t>(state.range(1));
+void BM_Policy(benchmark::State& state, Policy policy) {
+  const auto k = static_cast<std::uint32_t>(state.range(0));
   const StepGraph g = bars_like(64, 25);
   const Assignment a = owner_like(g, k, 64);
   ExecOptions o;
@@ -149,52 +146,134 @@ void BM_Policy(benchmark::State& state) {
   w.set_step(g);
   ex->run_step(g, &a, w);
   for (auto _ : state) ex->run_step(g, &a, w);
-  state.SetLabel(std::string(to_string(policy)));
 }
-BENCHMARK(BM_Policy)
-    ->ArgNames({"policy", "threads"})
-    ->Args({0, 1})
-    ->ArgsProduct({{1, 2, 3}, {2}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MinTime(1.0);
 
-void BM_TaskOverhead(benchmark::State& state) {
-  const auto policy = static_cast<Policy>(state.range(0));
-  const auto k = static_cast<std::uint32_t>(state.range(1));
+void BM_TaskOverhead(benchmark::State& state, Policy policy) {
+  const auto k = static_cast<std::uint32_t>(state.range(0));
   const StepGraph g = bars_like(64, 25);
   const Assignment a = owner_like(g, k, 64);
   ExecOptions o;
   o.threads = k;
-  std::unique_ptr<Executor> ex;
-  try {
-    ex = make_executor(policy, o);
-  } catch (const Error& e) {
-    state.SkipWithError(e.what());  // e.g. built without StarPU
-    return;
-  }
+  std::unique_ptr<Executor> ex = make_executor(policy, o);
   SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
   w.set_step(g);
   const StepStats first = ex->run_step(g, &a, w);
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : first.threads) instances += c.tasks;
   for (auto _ : state) ex->run_step(g, &a, w);
-  state.SetLabel(std::string(to_string(policy)));
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * instances));
   state.counters["ns_per_task"] =
       benchmark::Counter(static_cast<double>(state.iterations() * instances),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_TaskOverhead)
-    ->ArgNames({"policy", "threads"})
-    ->ArgsProduct({{static_cast<int>(Policy::kPartition), static_cast<int>(Policy::kWorksteal),
-                    static_cast<int>(Policy::kStarpu)},
-                   {2}})
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime()
-    ->MinTime(0.5);
+
+void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
+/// Two threads, one counter: the main thread publishes odd values, the partner answers each
+/// with the next even one; `futex` waits with std::atomic::wait, else spins.
+void BM_SignalWait(benchmark::State& state, bool futex) {
+  constexpr std::uint64_t kRounds = 1000;
+  // relaxed would not do: each side reads the other's write and must see what preceded it
+  // (an acquire/release pair, as an executor's completion counter).
+  std::atomic<std::uint64_t> counter{0};
+  std::atomic<bool> stop{false};
+  auto await = [&](std::uint64_t value) {
+    if (futex) {
+      for (std::uint64_t v = counter.load(std::memory_order_acquire); v != value;
+           v = counter.load(std::memory_order_acquire))
+        counter.wait(v, std::memory_order_acquire);
+    } else {
+      while (counter.load(std::memory_order_acquire) != value) cpu_relax();
+    }
+  };
+  auto publish = [&](std::uint64_t value) {
+    counter.store(value, std::memory_order_release);
+    if (futex) counter.notify_one();
+  };
+  std::thread partner([&] {
+    for (std::uint64_t v = 1;; v += 2) {
+      if (futex) {
+        for (std::uint64_t c = counter.load(std::memory_order_acquire); c != v;
+             c = counter.load(std::memory_order_acquire)) {
+          // relaxed: stop is only read to leave; the store below happens before the join.
+          if (stop.load(std::memory_order_relaxed)) return;
+          counter.wait(c, std::memory_order_acquire);
+        }
+      } else {
+        while (counter.load(std::memory_order_acquire) != v) {
+          if (stop.load(std::memory_order_relaxed)) return;  // relaxed: as above
+          cpu_relax();
+        }
+      }
+      publish(v + 1);
+    }
+  });
+  std::uint64_t next = 1;
+  for (auto _ : state) {
+    for (std::uint64_t r = 0; r < kRounds; ++r, next += 2) {
+      publish(next);
+      await(next + 1);
+    }
+  }
+  stop.store(true, std::memory_order_relaxed);      // relaxed: the partner only polls it
+  counter.fetch_add(2, std::memory_order_release);  // leaves a value the partner does not wait for
+  counter.notify_all();
+  partner.join();
+  state.counters["latency_ns"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * kRounds * 2),
+                         benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+void register_all(bench::Size size) {
+  const bool smoke = size == bench::Size::kSmoke;
+  for (const bool futex : {false, true})
+    bench::timed(benchmark::RegisterBenchmark(futex ? "BM_SignalWait/futex" : "BM_SignalWait/spin",
+                                              BM_SignalWait, futex)
+                     ->Unit(benchmark::kMicrosecond)
+                     ->UseRealTime(),
+                 size, 0.3);
+  auto* handoff = benchmark::RegisterBenchmark("BM_Handoff", BM_Handoff)
+                      ->ArgNames({"work_ns", "spin_ns"})
+                      ->Unit(benchmark::kMicrosecond)
+                      ->UseRealTime();
+  if (smoke)
+    handoff->Args({0, 5'000});
+  else
+    handoff->ArgsProduct({{0, 2'000}, {0, 5'000, 50'000}});
+  bench::timed(handoff, size, 0.3);
+
+  std::vector<Policy> parallel = {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier};
+#ifdef TGRAPH_HAVE_STARPU
+  parallel.push_back(Policy::kStarpu);
+#endif
+  const auto add = [&](const char* name, void (*fn)(benchmark::State&, Policy), Policy p,
+                       std::vector<std::int64_t> threads) {
+    auto* b = benchmark::RegisterBenchmark(
+                  (std::string(name) + "/" + std::string(to_string(p))).c_str(), fn, p)
+                  ->ArgName("threads")
+                  ->Unit(benchmark::kMillisecond)
+                  ->UseRealTime();
+    for (const std::int64_t t : threads) b->Arg(t);
+    bench::timed(b, size, 0.5);
+  };
+  add("BM_Policy", BM_Policy, Policy::kSequential, {1});
+  if (!smoke)
+    for (const Policy p : parallel) add("BM_Policy", BM_Policy, p, {2});
+  add("BM_TaskOverhead", BM_TaskOverhead, Policy::kSequential, {1});
+  for (const Policy p : parallel)
+    add("BM_TaskOverhead", BM_TaskOverhead, p,
+        smoke ? std::vector<std::int64_t>{2} : std::vector<std::int64_t>{1, 2});
+}
 
 }  // namespace
 }  // namespace tgraph::replay
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  return tgraph::bench::run_main(argc, argv, tgraph::replay::register_all);
+}

@@ -170,10 +170,17 @@ void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
       const Loop& loop = loops[next_loop++];
       for (TaskId u = loop.first; u < loop.last; ++u) main.process(u);
       // Second pass over the body from the end-of-body state, on a copy of the states of
-      // the data the body touches (the others cannot produce carried edges).
+      // the data the body touches (the others cannot produce carried edges). Each datum's
+      // state is copied once: a scalar every object reads would otherwise copy its reader
+      // list once per access, quadratic in the objects.
       Extractor second(*this, carried_edges, max_edges);
+      std::vector<char> copied(data.size(), 0);
       for (TaskId u = loop.first; u < loop.last; ++u)
-        for (const Access& a : accesses_of(u)) second.state()[a.datum] = main.state()[a.datum];
+        for (const Access& a : accesses_of(u))
+          if (!copied[a.datum]) {
+            copied[a.datum] = 1;
+            second.state()[a.datum] = main.state()[a.datum];
+          }
       second.set_pass(n, loop.first, loop.last);
       for (TaskId u = loop.first; u < loop.last; ++u) second.process(u);
       t = loop.last;

@@ -11,17 +11,30 @@
 namespace tgraph {
 
 std::vector<TaskId> match_tasks_by_key(const StepGraph& g, const StepGraph& prev) {
-  std::unordered_map<StableKey, std::vector<TaskId>> by_key;
-  by_key.reserve(prev.tasks.size());
-  for (TaskId t = 0; t < prev.tasks.size(); ++t) by_key[prev.tasks[t].key].push_back(t);
-  std::unordered_map<StableKey, std::size_t> seen;
+  // The i-th task of g with a key matches the i-th task of prev with that key. Both sides
+  // sorted by (key, position) and walked together: no allocation per key, O(n log n).
+  auto sorted = [](const StepGraph& s) {
+    std::vector<std::pair<StableKey, TaskId>> v(s.tasks.size());
+    for (TaskId t = 0; t < s.tasks.size(); ++t) v[t] = {s.tasks[t].key, t};
+    std::sort(v.begin(), v.end());
+    return v;
+  };
   std::vector<TaskId> match(g.tasks.size(), kNoTask);
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    auto it = by_key.find(g.tasks[t].key);
-    if (it == by_key.end()) continue;
-    std::size_t& i = seen[g.tasks[t].key];
-    if (i < it->second.size()) match[t] = it->second[i];
-    ++i;
+  if (g.tasks.size() == prev.tasks.size()) {  // fast path: same keys in the same order
+    TaskId t = 0;
+    while (t < g.tasks.size() && g.tasks[t].key == prev.tasks[t].key) ++t;
+    if (t == g.tasks.size()) {
+      for (TaskId i = 0; i < t; ++i) match[i] = i;
+      return match;
+    }
+  }
+  const auto a = sorted(g), b = sorted(prev);
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < a.size();) {
+    const StableKey key = a[i].first;
+    while (j < b.size() && b[j].first < key) ++j;
+    for (; i < a.size() && a[i].first == key; ++i)
+      if (j < b.size() && b[j].first == key) match[a[i].second] = b[j++].second;
   }
   return match;
 }

@@ -66,6 +66,11 @@ std::vector<std::uint8_t> read_file_bytes(const std::string& path) {
   return bytes;
 }
 
+std::string read_file_text(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+  return std::string(bytes.begin(), bytes.end());
+}
+
 void write_file_atomic(const std::string& path, std::string_view content) {
   namespace fs = std::filesystem;
   const fs::path target(path);

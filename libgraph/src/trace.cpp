@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/error.hpp"
 
 namespace tgraph {
 
@@ -21,6 +22,14 @@ std::string machine_description() {
   }
   if (model.empty()) model = "unknown cpu";
   return model + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads";
+}
+
+const StepGraph& step_at(const Trace& trace, std::size_t step, const std::string& trace_name,
+                         const std::string& flag) {
+  if (step >= trace.steps.size())
+    throw UsageError(flag + " " + std::to_string(step) + ": trace " + trace_name + " has " +
+                     std::to_string(trace.steps.size()) + " steps");
+  return trace.steps[step];
 }
 
 bool contacts_changed(const Trace& trace, std::size_t i) {

@@ -134,6 +134,7 @@ void encode_step_values(ByteWriter& w, const StepGraph& g) {
 // same_structure(), which compares exactly the fields of the structure section.
 class StepEncoder {
  public:
+  explicit StepEncoder(bool reuse_structure = true) : reuse_structure_(reuse_structure) {}
   void encode(const StepGraph& step, std::vector<std::uint8_t>& out) {
     const std::string reason = step.validate();
     if (!reason.empty())
@@ -143,7 +144,7 @@ class StepEncoder {
     ByteWriter w(out);
     const std::size_t at = begin_frame(out);
     const std::uint64_t hash = step.structural_hash();
-    const std::uint32_t earlier = find(hash, step);
+    const std::uint32_t earlier = reuse_structure_ ? find(hash, step) : kNone;
     if (earlier != kNone) {
       w.u32(earlier);
       encode_step_values(w, step);
@@ -152,7 +153,7 @@ class StepEncoder {
       encode_structure(w, step);
       encode_step_values(w, step);
       finish_frame(out, at, FrameType::FullStep);
-      remember(hash, step);
+      if (reuse_structure_) remember(hash, step);
     }
     ++steps_;
   }
@@ -186,6 +187,7 @@ class StepEncoder {
   std::vector<StepGraph> shapes_;
   std::vector<std::uint32_t> shape_step_;  // step index of each shape's full frame
   std::uint32_t steps_ = 0;
+  bool reuse_structure_ = true;
 };
 
 void encode_end(std::vector<std::uint8_t>& out, std::uint32_t steps) {
@@ -610,6 +612,7 @@ struct TraceWriter::Impl {
   StepEncoder encoder;
   std::vector<std::uint8_t> buffer;  // reused frame buffer
   std::uint64_t written = 0;
+  std::uint32_t steps = 0;  // step frames completely written
 
   std::string closed_because;  // why appends are refused once fd is closed
 
@@ -655,6 +658,7 @@ void TraceWriter::append(const StepGraph& step) {
   impl_->buffer.clear();
   impl_->encoder.encode(step, impl_->buffer);
   impl_->flush_buffer();
+  ++impl_->steps;
 }
 
 void TraceWriter::close() {
@@ -679,24 +683,25 @@ void TraceWriter::close() {
 
 const std::string& TraceWriter::partial_path() const { return impl_->partial; }
 
-std::uint32_t TraceWriter::steps_written() const { return impl_->encoder.steps(); }
+// Not encoder.steps(): a step whose write failed was encoded but is not in the file.
+std::uint32_t TraceWriter::steps_written() const { return impl_->steps; }
 
 std::uint64_t TraceWriter::bytes_written() const { return impl_->written; }
 
 // ---------------------------------------------------------------------------------------
 // Whole traces
 
-std::vector<std::uint8_t> encode_trace(const Trace& trace) {
+std::vector<std::uint8_t> encode_trace(const Trace& trace, const WriteOptions& options) {
   std::vector<std::uint8_t> out;
   encode_file_header(out, trace.header);
-  StepEncoder encoder;
+  StepEncoder encoder(options.reuse_structure);
   for (const StepGraph& step : trace.steps) encoder.encode(step, out);
   encode_end(out, encoder.steps());
   return out;
 }
 
-void write_trace(const std::string& path, const Trace& trace) {
-  const std::vector<std::uint8_t> bytes = encode_trace(trace);
+void write_trace(const std::string& path, const Trace& trace, const WriteOptions& options) {
+  const std::vector<std::uint8_t> bytes = encode_trace(trace, options);
   write_file_atomic(path,
                     std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }

@@ -193,11 +193,12 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
   return a;
 }
 
-TraceAssignment load_or_partition(const Trace& trace, const std::string& path,
-                                  const std::string& method, std::uint32_t k) {
+TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
+                                  const std::string& path, const std::string& method,
+                                  std::uint32_t k) {
+  if (k == 0) throw UsageError("--threads must be at least 1");
   if (path.empty()) return partition_trace(trace, method, k, Options{}).assignment;
-  TraceAssignment a = read_assignment(path);
-  check_fits(trace, a, path);
+  TraceAssignment a = load_assignment(path, trace, trace_name);
   if (a.k != k)
     throw UsageError(path + ": assignment has k = " + std::to_string(a.k) + " but --threads is " +
                      std::to_string(k));

@@ -8,10 +8,10 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
-#include "tgraph/graph/error.hpp"
 #include "tgraph/partition/cost_model.hpp"
 
 namespace tgraph::partition {
@@ -130,7 +130,8 @@ double measure_per_byte(int cpu_a, int cpu_b, std::size_t bytes, int repeats) {
 Calibration measure_calibration(const CalibrateOptions& options) {
   const std::vector<int> cpus = allowed_cpus();
   if (cpus.size() < 2)
-    throw Error("calibrate: needs two CPUs, this process may use " + std::to_string(cpus.size()));
+    throw std::runtime_error("calibrate: needs two CPUs, this process may use " +
+                             std::to_string(cpus.size()));
   Calibration c;
   c.cpu_a = cpus[0];
   c.cpu_b = cpus[1];

@@ -84,6 +84,7 @@ Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
     row.report = evaluate(trace, tp.assignment, o.model);
     c.rows.push_back(std::move(row));
   };
+  c.sticky_fallback = options.sticky_fallback;
   for (const std::string& m : methods)
     for (std::uint32_t k : ks) run(m, k, options, std::nullopt);
   for (double cost : sticky_migration_costs)

@@ -66,6 +66,13 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
     // e.byte is the 1-based position of the offending byte.
     throw InputError(name, e.byte > 0 ? std::optional<std::uint64_t>(e.byte - 1) : std::nullopt,
                      "expected a JSON calibration object (malformed JSON)");
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond double range ("1e400"): nlohmann reports it without an offset.
+    const std::string what = e.what();
+    const auto at = what.find("] ");
+    throw InputError(name, std::nullopt,
+                     "expected numbers within double range, found a " +
+                         (at == std::string::npos ? what : what.substr(at + 2)));
   }
   auto number = [&](const char* key) {
     if (!j.is_object() || !j.contains(key) || !j[key].is_number())

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
+// The graph files of gpmetis and scotch_gpart, and `tgraph export`'s choice of format.
 #include <sstream>
 
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/step_json.hpp"
 #include "tgraph/partition/export.hpp"
 #include "tgraph/partition/partition_graph.hpp"
 
@@ -31,5 +34,38 @@ std::string scotch_graph_file(const UndirectedGraph& u) {
 
 std::string metis_graph_file(const StepGraph& g) { return metis_graph_file(library_graph(g)); }
 std::string scotch_graph_file(const StepGraph& g) { return scotch_graph_file(library_graph(g)); }
+
+std::string_view to_string(GraphFileFormat f) {
+  switch (f) {
+    case GraphFileFormat::kJson:
+      return "json";
+    case GraphFileFormat::kMetis:
+      return "metis";
+    case GraphFileFormat::kScotch:
+      return "scotch";
+  }
+  return "?";
+}
+
+GraphFileFormat parse_graph_file_format(std::string_view name) {
+  for (GraphFileFormat f :
+       {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch})
+    if (to_string(f) == name) return f;
+  throw UsageError("--format " + std::string(name) + ": expected json, metis or scotch");
+}
+
+std::string graph_file(const Trace& trace, std::size_t step, const std::string& trace_name,
+                       GraphFileFormat format) {
+  const StepGraph& g = step_at(trace, step, trace_name);
+  switch (format) {
+    case GraphFileFormat::kJson:
+      return step_graph_json(g, step);
+    case GraphFileFormat::kMetis:
+      return metis_graph_file(g);
+    case GraphFileFormat::kScotch:
+      return scotch_graph_file(g);
+  }
+  return {};
+}
 
 }  // namespace tgraph::partition

@@ -199,6 +199,7 @@ std::string comparison_json(const Comparison& c, const std::string& trace_name) 
               {"model", c.model},
               {"rows", rows},
               {"sticky_moves", moves},
+              {"sticky_fallback", to_string(c.sticky_fallback)},
               {"pareto", pareto}}
       .dump();
 }
@@ -252,7 +253,9 @@ std::string comparison_table(const Comparison& c) {
         line, sizeof line, "%s k=%u: %llu steps reused, %llu fallback (%s), %llu rebalanced",
         row_label(r).c_str(), r.k, static_cast<unsigned long long>(r.partition.reused_steps),
         static_cast<unsigned long long>(r.partition.fallback_steps),
-        r.migration_cost ? "repartition" : "fresh + relabel",
+        r.migration_cost                                   ? "repartition"
+        : c.sticky_fallback == StickyFallback::kFresh ? "fresh + relabel"
+                                                       : std::string(to_string(c.sticky_fallback)).c_str(),
         static_cast<unsigned long long>(r.partition.rebalanced_steps));
     out += line;
     if (const StickyMoves* s = r.migration_cost ? nullptr : sticky_moves_at(c, r.k)) {

@@ -74,6 +74,8 @@ std::string_view to_string(StickyFallback f) {
       return "fresh";
     case StickyFallback::kRepartition:
       return "repartition";
+    case StickyFallback::kRefine:
+      return "refine";
   }
   return "?";
 }
@@ -81,7 +83,8 @@ std::string_view to_string(StickyFallback f) {
 StickyFallback parse_sticky_fallback(std::string_view s) {
   if (s == "fresh") return StickyFallback::kFresh;
   if (s == "repartition") return StickyFallback::kRepartition;
-  throw UsageError("--sticky-fallback: expected fresh or repartition, got '" + std::string(s) + "'");
+  if (s == "refine") return StickyFallback::kRefine;
+  throw UsageError("--sticky-fallback: expected fresh, repartition or refine, got '" + std::string(s) + "'");
 }
 
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {

@@ -120,6 +120,11 @@ std::optional<StateDifference> compare(const StateSnapshot& expected, const Stat
   return std::nullopt;
 }
 
+std::string to_string(const StateDifference& d) {
+  return "first differing datum " + d.datum + " (byte " + std::to_string(d.offset) + ", " +
+         std::to_string(d.differing_bytes) + " bytes differ)";
+}
+
 // ---- live runs ---------------------------------------------------------------------------
 
 namespace {

@@ -104,6 +104,7 @@ std::optional<std::uint64_t> ReplayResult::predicted_makespan_ns() const {
 ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments,
                           const ReplayOptions& o, const std::vector<std::uint64_t>* predicted,
                           TimelineObserver* timeline) {
+  if (o.exec.threads == 0) throw UsageError("--threads must be at least 1");
   if (trace.steps.empty()) throw UsageError("the trace has no steps");
   if (o.first_step >= trace.steps.size())
     throw UsageError("--first-step " + std::to_string(o.first_step) + ": the trace has " +
@@ -123,14 +124,15 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
 
   ReplayResult r;
   r.policy = o.policy;
-  r.threads = o.exec.threads;
   r.calibration = SyntheticWorkload::calibration();
   CacheMissCounter misses;
   const std::uint64_t misses0 = misses.read();
 
   auto ex = make_executor(o.policy, o.exec);
+  r.threads = ex->threads();  // 1 for the sequential policy, which is its own baseline
   std::unique_ptr<Executor> seq;
-  if (o.sequential_baseline) seq = make_executor(Policy::kSequential, o.exec);
+  if (o.sequential_baseline && o.policy != Policy::kSequential)
+    seq = make_executor(Policy::kSequential, o.exec);
   SyntheticWorkload w(o.synthetic), ws(o.synthetic);
   std::uint64_t working_set = 0;
   for (const Datum& d : trace.steps[o.first_step].data) working_set += d.bytes;

@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Built-in observers: per-thread stats, locality, timeline (+ Chrome trace-event export).
+// Built-in observers: per-thread stats, locality, timeline (JSON; viz draws and converts it).
 #include <algorithm>
 #include <nlohmann/json.hpp>
 
-#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::replay {
@@ -180,68 +179,6 @@ std::string TimelineObserver::to_json() const {
                      {"parked", w.parked}});
   nlohmann::json j = {{"threads", threads_}, {"steps", step_}, {"tasks", tasks}, {"waits", waits}};
   return j.dump();
-}
-
-std::string TimelineObserver::to_chrome_json() const {
-  nlohmann::json ev = nlohmann::json::array();
-  // Steps are laid end to end: each step starts after the previous one's last event.
-  std::int64_t offset = 0, step_end = 0;
-  std::uint32_t cur = 0;
-  for (const TimelineEvent& e : events_) {
-    if (e.step != cur) {
-      offset += step_end;
-      step_end = 0;
-      cur = e.step;
-    }
-    step_end = std::max(step_end, e.end_ns);
-    ev.push_back({{"name", e.task < labels_.size() ? labels_[e.task] : std::string("task")},
-                  {"ph", "X"},
-                  {"pid", 0},
-                  {"tid", e.thread},
-                  {"ts", static_cast<double>(offset + e.start_ns) / 1000.0},
-                  {"dur", static_cast<double>(e.end_ns - e.start_ns) / 1000.0},
-                  {"args", {{"step", e.step}, {"task", e.task}, {"iteration", e.iteration}}}});
-  }
-  for (std::uint32_t t = 0; t < threads_; ++t)
-    ev.push_back({{"name", "thread_name"},
-                  {"ph", "M"},
-                  {"pid", 0},
-                  {"tid", t},
-                  {"args", {{"name", "thread " + std::to_string(t)}}}});
-  nlohmann::json j = {{"traceEvents", ev}, {"displayTimeUnit", "ns"}};
-  return j.dump();
-}
-
-std::string chrome_from_timeline_json(std::string_view timeline_json, const std::string& name) {
-  const nlohmann::json j = nlohmann::json::parse(timeline_json, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || !j.contains("tasks") || !j["tasks"].is_array())
-    throw InputError(name, std::nullopt, "not a replay timeline (expected a JSON object with \"tasks\")");
-  TimelineObserver t;  // rebuilt through the observer's own exporter
-  std::uint32_t threads = 0;
-  std::vector<TimelineEvent> events;
-  std::vector<std::string> labels;
-  try {
-    for (const auto& e : j["tasks"]) {
-      TimelineEvent ev;
-      ev.step = e.at("step").get<std::uint32_t>();
-      ev.thread = e.at("thread").get<std::uint32_t>();
-      ev.task = e.at("task").get<TaskId>();
-      ev.origin = e.at("origin").is_null() ? kNoTask : e.at("origin").get<TaskId>();
-      ev.iteration = e.at("iteration").get<std::uint32_t>();
-      ev.start_ns = e.at("start_ns").get<std::int64_t>();
-      ev.end_ns = e.at("end_ns").get<std::int64_t>();
-      if (ev.task >= labels.size()) labels.resize(ev.task + 1);
-      labels[ev.task] = e.value("kind", std::string("task"));
-      threads = std::max(threads, ev.thread + 1);
-      events.push_back(ev);
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(name, std::nullopt, std::string("bad timeline event: ") + e.what());
-  }
-  t.events_ = std::move(events);
-  t.labels_ = std::move(labels);
-  t.threads_ = threads;
-  return t.to_chrome_json();
 }
 
 }  // namespace tgraph::replay

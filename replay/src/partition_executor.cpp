@@ -27,6 +27,7 @@
 #include "sync.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
+#include "watchdog.hpp"
 
 namespace tgraph::replay {
 namespace {
@@ -77,9 +78,9 @@ struct Plan {
   std::vector<StableKey> keys;
   std::vector<LoopId> task_loop;
   std::vector<ProcId> proc;
-  std::vector<std::int64_t> pos;  // position in its processor's ops
-  std::vector<TaskId> breaks;     // by loop: its break task
-  detail::Csr intra, carried;     // predecessors along intra-step and loop-carried edges
+  std::vector<std::int64_t> pos;    // position in its processor's ops
+  std::vector<TaskId> breaks;       // by loop: its break task
+  detail::Csr intra, carried;       // predecessors along intra-step and loop-carried edges
   std::uint32_t rebuilt_procs = 0;  // processors whose wait points this build computed
 };
 
@@ -353,7 +354,8 @@ Plan update_plan(const ExecGraph& x, const Plan& prev, std::uint32_t k, bool use
         break;
       }
   constexpr LoopId kUnmatched = kNoLoop - 1;
-  std::vector<LoopId> old_loop(g.loops.size(), kUnmatched), new_loop(prev.breaks.size(), kUnmatched);
+  std::vector<LoopId> old_loop(g.loops.size(), kUnmatched),
+      new_loop(prev.breaks.size(), kUnmatched);
   for (LoopId l = 0; l < g.loops.size(); ++l) {
     const TaskId ob = old_of[plan.breaks[l]];
     if (ob == kNoTask) continue;
@@ -403,7 +405,8 @@ Plan update_plan(const ExecGraph& x, const Plan& prev, std::uint32_t k, bool use
     for (auto i = now.begin[v]; i < now.begin[v + 1]; ++i) {
       const TaskId u = now.ids[i];
       const TaskId ou = old_of[u];
-      if (ou == kNoTask || prev.proc[ou] != plan.proc[u] || !same_loop(g.tasks[u].loop, prev.task_loop[ou]))
+      if (ou == kNoTask || prev.proc[ou] != plan.proc[u] ||
+          !same_loop(g.tasks[u].loop, prev.task_loop[ou]))
         return false;
       if (plan.proc[u] != p && !same_order[plan.proc[u]]) return false;
       mark[u] = stamp;
@@ -563,6 +566,7 @@ class PartitionExecutor final : public Executor {
   std::uint64_t order_fallbacks() const override { return order_fallbacks_; }
 
   ~PartitionExecutor() override {
+    watchdog_.reset();
     if (!workers_.empty()) {
       // relaxed: published by the seq_cst store of step_seq_ just below (a release); the
       // workers read shutdown_ after acquiring that value.
@@ -578,17 +582,23 @@ class PartitionExecutor final : public Executor {
  private:
   struct alignas(64) Slot {
     ThreadCounters c;
+    // For the watchdog (relaxed: diagnostics; only the owning thread writes them).
+    std::atomic<std::uint64_t> progress{0};       // tasks finished + blocked waits passed
+    std::atomic<std::uint32_t> at_task{kNoTask};  // the task run or waited for last
+    std::atomic<std::uint32_t> wait_kind{0};      // 0: none, 1: task, 2: loop, 3: first touch
+    std::atomic<std::uint32_t> wait_id{0};        // the producer task or the loop
   };
 
   std::shared_ptr<void> build(const ExecGraph& x) override {
-    return checked(x, std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits)));
+    return checked(
+        x, std::make_shared<Plan>(build_plan(x, options_.threads, true, options_.elide_waits)));
   }
 
   std::shared_ptr<void> rebuild(const ExecGraph& x, const ExecGraph&,
                                 const void* previous) override {
     const Plan& prev = *static_cast<const Plan*>(previous);
-    auto plan = std::make_shared<Plan>(
-        update_plan(x, prev, options_.threads, true, options_.elide_waits));
+    auto plan =
+        std::make_shared<Plan>(update_plan(x, prev, options_.threads, true, options_.elide_waits));
     if (options_.verify_plans &&
         !same_programs(*plan, build_plan(x, options_.threads, true, options_.elide_waits)))
       throw std::logic_error("partition executor: the incremental plan differs from a full build");
@@ -601,7 +611,9 @@ class PartitionExecutor final : public Executor {
 
   // Program order on every processor never deadlocks (every wait names an earlier task in
   // program order); only an explicit order needs the check.
+  // ExecOptions::test_lose_signal is applied here, to full and incremental builds alike.
   std::shared_ptr<Plan> checked(const ExecGraph& x, std::shared_ptr<Plan> plan) {
+    lose_signal(*plan, x);
     if (plan->program_order) return plan;
     try {
       run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
@@ -610,6 +622,7 @@ class PartitionExecutor final : public Executor {
       // The explicit order cannot be kept with the lowered graph's extra edges (serialised
       // CW writers): fall back to program order on each processor, which never deadlocks.
       plan = std::make_shared<Plan>(build_plan(x, options_.threads, false, options_.elide_waits));
+      lose_signal(*plan, x);
       ++order_fallbacks_;
     }
     return plan;
@@ -646,7 +659,9 @@ class PartitionExecutor final : public Executor {
     abort_.store(false, std::memory_order_relaxed);
     const std::uint64_t seq = ++steps_;
     epoch_ = seq << 32;
-    parking_.signal(step_seq_, seq);  // seq_cst store (a release): step context visible
+    start_watchdog();
+    if (watchdog_) watchdog_->begin_step(seq);  // a release: step context visible
+    parking_.signal(step_seq_, seq);            // seq_cst store (a release): step context visible
     run_proc(0);
     if (k > 1) {
       bool parked = false;
@@ -657,6 +672,7 @@ class PartitionExecutor final : public Executor {
           finished_, [target](std::uint64_t v) { return v >= target; }, never_abort_, parked,
           waited);
     }
+    if (watchdog_) watchdog_->end_step();
     stats.threads.resize(k);
     for (std::uint32_t p = 0; p < k; ++p) stats.threads[p] = counters_[p].c;
     stats.loop_iterations.resize(plan.loops);
@@ -713,17 +729,28 @@ class PartitionExecutor final : public Executor {
   }
 
   // Waits until ok(c); false when the step is aborting.
+  // `kind`/`id`: what is waited for, for the watchdog's report (1: task id's completion,
+  // 2: loop id's decision, 3: the first-touch barrier).
   template <class Ok>
   bool wait(std::atomic<std::uint64_t>& c, Ok ok, std::uint32_t thread, TaskId task,
-            ThreadCounters& tc, std::uint64_t& value) {
+            ThreadCounters& tc, std::uint64_t& value, std::uint32_t kind, std::uint32_t id) {
     ++tc.waits;
     // acquire: pairs with the signaller's store; its writes are visible to our task.
     value = c.load(std::memory_order_acquire);
     if (!ok(value)) {
+      Slot& slot = counters_[thread];
+      // relaxed: read by the watchdog for its report only.
+      slot.at_task.store(task, std::memory_order_relaxed);
+      slot.wait_id.store(id, std::memory_order_relaxed);
+      slot.wait_kind.store(kind, std::memory_order_relaxed);
       bool parked = false;
       std::int64_t waited = 0;
       const std::int64_t t0 = observers_.empty() ? 0 : now_ns();
       value = parking_.wait(c, ok, abort_, parked, waited);
+      // relaxed: as above; progress is only compared between two samples.
+      slot.wait_kind.store(0, std::memory_order_relaxed);
+      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
+                          std::memory_order_relaxed);
       ++tc.blocked_waits;
       tc.parks += parked ? 1 : 0;
       tc.wait_ns += waited;
@@ -732,6 +759,67 @@ class PartitionExecutor final : public Executor {
     }
     // relaxed: a hint; when set, no task runs after this point, so nothing depends on it.
     return !abort_.load(std::memory_order_relaxed);
+  }
+
+  // ExecOptions::test_lose_signal: the task's completion is never published.
+  void lose_signal(Plan& plan, const ExecGraph& x) const {
+    if (!options_.test_lose_signal || *options_.test_lose_signal >= x.exec_of.size()) return;
+    const TaskId t = x.exec_of[*options_.test_lose_signal];
+    for (ProcPlan& pp : plan.procs)
+      for (Op& op : pp.ops)
+        if (op.kind == OpKind::kTask && op.task == t) op.signal = false;
+  }
+
+  void start_watchdog() {
+    if (watchdog_ || options_.timeout_ms <= 0) return;
+    watchdog_ = std::make_unique<detail::Watchdog>(
+        options_.timeout_ms,
+        [this] {
+          std::uint64_t sum = 0;
+          for (std::uint32_t p = 0; p < options_.threads; ++p)
+            sum += counters_[p].progress.load(std::memory_order_relaxed);  // relaxed: a sample
+          return sum;
+        },
+        [this] { return stall_report(); }, [this](std::exception_ptr e) { fail(e); },
+        options_.timeout_exits);
+  }
+
+  // Where each thread stands (the watchdog's report; the step context is valid).
+  std::string stall_report() const {
+    const ExecGraph& x = *exec_;
+    std::string out;
+    for (std::uint32_t p = 0; p < options_.threads; ++p) {
+      const Slot& s = counters_[p];
+      // relaxed: diagnostics, a racy snapshot is fine.
+      const std::uint32_t kind = s.wait_kind.load(std::memory_order_relaxed);
+      const std::uint32_t id = s.wait_id.load(std::memory_order_relaxed);
+      const std::uint32_t task = s.at_task.load(std::memory_order_relaxed);
+      if (!out.empty()) out += "; ";
+      out += "thread " + std::to_string(p);
+      const auto label = [&x](TaskId t) {
+        return t < x.graph.tasks.size()
+                   ? "task " + std::to_string(t) + " (" + x.graph.kind_name(t) + ")"
+                   : std::string("no task");
+      };
+      if (kind == 1 && id < x.graph.tasks.size()) {
+        out += " waits for " + label(id) + " on thread " + std::to_string(x.assignment.proc[id]);
+        for (const Edge& e : x.graph.edges)
+          if (e.from == id && e.to == task && e.datum < x.graph.data.size()) {
+            out += " (datum '" + x.graph.data[e.datum].name + "')";
+            break;
+          }
+        if (task < x.graph.tasks.size()) out += " before running " + label(task);
+      } else if (kind == 2) {
+        out += " waits for the decision of loop " + std::to_string(id);
+      } else if (kind == 3) {
+        out += " waits at the first-touch barrier";
+      } else if (task < x.graph.tasks.size()) {
+        out += " runs or last ran " + label(task);
+      } else {
+        out += " has run no task yet";
+      }
+    }
+    return out;
   }
 
   void run_proc(std::uint32_t p) {
@@ -743,10 +831,18 @@ class PartitionExecutor final : public Executor {
     const std::uint64_t E = epoch_;
     const bool observe = !observers_.empty();
     const std::uint32_t stride = observe_stride_;
+    const bool watch = watchdog_ != nullptr;
+    Slot& slot = counters_[p];
     try {
       if (fresh_) {
-        for (DatumId d : pp.owned)
-          if (w.needs_touch(d)) w.first_touch(d);
+        // A failed allocation still arrives at the barrier below (the others would wait
+        // for it forever otherwise) and then leaves with the step aborted.
+        try {
+          for (DatumId d : pp.owned)
+            if (w.needs_touch(d)) w.first_touch(d);
+        } catch (...) {
+          fail(std::current_exception());
+        }
         // Every buffer exists before any task runs: a barrier over the k threads.
         // seq_cst RMW (a release): our allocations reach the threads acquiring the total.
         touched_.fetch_add(1, std::memory_order_seq_cst);
@@ -754,7 +850,7 @@ class PartitionExecutor final : public Executor {
         const std::uint64_t all = touch_rounds_ * options_.threads;
         std::uint64_t seen = 0;
         if (!wait(
-                touched_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, seen))
+                touched_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, seen, 3, 0))
           goto out;
       }
       std::uint32_t iter = 0;
@@ -770,7 +866,7 @@ class PartitionExecutor final : public Executor {
             const std::uint64_t need = E | (static_cast<std::uint64_t>(iter + 1) << 1);
             if (!wait(
                     loop_[op.loop].v, [need](std::uint64_t s) { return s >= need; }, p, kNoTask, tc,
-                    v))
+                    v, 2, op.loop))
               goto out;
             const std::uint64_t decided = (v & 0xffffffffu) >> 1;
             if (decided > iter + 1 || (v & 1u) == 0) {
@@ -804,7 +900,7 @@ class PartitionExecutor final : public Executor {
                           [epoch](std::uint64_t s) {
                             return (s >> 32) == (epoch >> 32) && (s & 1u);
                           },
-                          p, op.task, tc, v))
+                          p, op.task, tc, v, 2, wp.loop))
                     goto out;
                   target = E + ((v & 0xffffffffu) >> 1);
                   break;
@@ -812,12 +908,18 @@ class PartitionExecutor final : public Executor {
               }
               if (!wait(
                       done_[wp.producer].v, [target](std::uint64_t s) { return s >= target; }, p,
-                      op.task, tc, v))
+                      op.task, tc, v, 1, wp.producer))
                 goto out;
             }
-            if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride))
+              detail::notify_begin(observers_, p, op.task, iter);
+            if (watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // relaxed: report
             w.run(TaskRun{&x, op.task, x.origin[op.task], iter, p});
-            if (observe && detail::sampled(iter, stride)) detail::notify_end(observers_, p, op.task, iter);
+            if (observe && detail::sampled(iter, stride))
+              detail::notify_end(observers_, p, op.task, iter);
+            if (watch)  // relaxed: compared between two samples of the watchdog only
+              slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
+                                  std::memory_order_relaxed);
             ++tc.tasks;
             if (op.signal) {
               parking_.signal(done_[op.task].v, E + iter + 1);
@@ -869,6 +971,7 @@ class PartitionExecutor final : public Executor {
   const std::atomic<bool> never_abort_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
+  std::unique_ptr<detail::Watchdog> watchdog_;  // last member: stopped first
 };
 
 }  // namespace

@@ -366,6 +366,28 @@ TEST(TraceWriter, DedupeMakesTheFileSmallerThanFullFrames) {
   EXPECT_LT(deduped * 2, full) << "deduped " << deduped << " vs full frames " << full;
 }
 
+TEST(TraceWriter, WithoutStructureReuseWritesEveryStepAsAFullFrame) {
+  const Trace trace = make_trace({0, 1, 0, 0, 1});
+  const Bytes full = encode_trace(trace, {.reuse_structure = false});
+  EXPECT_EQ(frame_types(full), (std::vector<std::uint32_t>{1, 2, 2, 2, 2, 2, 4}));
+  // Each full frame is the frame of a one-step trace of that step.
+  Trace none;
+  none.header = trace.header;
+  const std::size_t base = encode_trace(none).size();
+  std::size_t expected = base;
+  for (const auto& s : trace.steps) {
+    Trace one = none;
+    one.steps.push_back(s);
+    expected += encode_trace(one).size() - base;
+  }
+  EXPECT_EQ(full.size(), expected);
+  EXPECT_GT(full.size(), encode_trace(trace).size());
+  EXPECT_EQ(read_trace_bytes(full, "full-frames"), trace);
+  const fs::path p = temp_path("full-frames.tgt");
+  write_trace(p.string(), trace, {.reuse_structure = false});
+  EXPECT_EQ(slurp(p), full);
+}
+
 TEST(TraceWriter, CompleteFramesReadBackBeforeClose) {
   const Trace trace = make_trace({0, 1, 0});
   const fs::path p = temp_path("open.tgt");
@@ -916,6 +938,32 @@ TEST(FileUtil, ReadFileBytesNamesAMissingFile) {
               std::string::npos);
   }
   EXPECT_THROW(read_file_bytes(::testing::TempDir()), InputError);  // a directory
+}
+
+TEST(FileUtil, ReadFileTextReturnsTheBytesAsWritten) {
+  const fs::path p = temp_path("text.json");
+  const std::string text = std::string("{\"a\": 1}\n") + '\0' + "tail";
+  write_file_atomic(p.string(), text);
+  EXPECT_EQ(read_file_text(p.string()), text);
+  EXPECT_THROW(read_file_text("/nonexistent-folder/none.json"), InputError);
+}
+
+TEST(Trace, StepAtNamesTheFlagTheTraceAndItsStepCount) {
+  Trace t;
+  t.steps.resize(3);
+  EXPECT_EQ(&step_at(t, 2, "f.tgt"), &t.steps[2]);
+  try {
+    step_at(t, 3, "f.tgt");
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--step 3: trace f.tgt has 3 steps");
+  }
+  try {
+    step_at(t, 7, "g.tgt", "--steps");
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--steps 7: trace g.tgt has 3 steps");
+  }
 }
 
 }  // namespace

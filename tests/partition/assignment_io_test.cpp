@@ -152,5 +152,32 @@ TEST(AssignmentFile, LoadsOnlyForTheTraceItWasMadeFor) {
   std::filesystem::remove(path);
 }
 
+TEST(AssignmentFile, LoadOrPartitionChecksTheThreadCount) {
+  Trace trace;
+  trace.steps = {testing::objects_scene(6, {}), testing::objects_scene(6, {{1, 2}})};
+  const TraceAssignment computed = load_or_partition(trace, "t.tgt", "", "owner", 2);
+  EXPECT_EQ(computed.k, 2u);
+  EXPECT_EQ(computed.steps, partition_trace(trace, "owner", 2).assignment.steps);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "tgraph_load_or_partition.tga").string();
+  write_assignment(path, computed, trace);
+  EXPECT_EQ(load_or_partition(trace, "t.tgt", path, "metis", 2), computed);  // the file wins
+  try {
+    load_or_partition(trace, "t.tgt", path, "owner", 3);
+    ADD_FAILURE() << "accepted K = 2 on 3 threads";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": assignment has k = 2 but --threads is 3");
+  }
+  for (const std::string& p : {std::string(), path}) {
+    try {
+      load_or_partition(trace, "t.tgt", p, "owner", 0);
+      ADD_FAILURE() << "accepted 0 threads";
+    } catch (const UsageError& e) {
+      EXPECT_STREQ(e.what(), "--threads must be at least 1");
+    }
+  }
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace tgraph::partition

@@ -77,6 +77,24 @@ TEST(StickyOnFalling, RepartitioningAtMergesMovesFewerTasksThanMetisRelabel) {
   }
 }
 
+TEST(StickyOnFalling, RefiningAtMergesMovesAQuarterOfMetisRelabelsTasksAtMetissMakespan) {
+  // Issue 13's targets on a real capture: moved tasks at most a quarter of metis-relabel's;
+  // the predicted makespan is guarded against gross regressions only (within 25 % of
+  // METIS's): the captured costs are measured, and under a loaded ctest their noise alone
+  // moved the ratio by 10 % (docs/partitioning.md has the measured -3 to -9 %).
+  const Trace& trace = falling_trace();
+  for (std::uint32_t k : {2u, 4u, 8u}) {
+    const TracePartition sticky = partition_trace(trace, "sticky", k);
+    const TracePartition relabel = partition_trace(trace, "metis-relabel", k);
+    EXPECT_LE(4 * summarize(sticky.stats).moved_tasks, summarize(relabel.stats).moved_tasks) << k;
+    const CostModel model = CostModel::defaults();
+    const double s = static_cast<double>(evaluate(trace, sticky.assignment, model).total.makespan_ns);
+    const double m = static_cast<double>(evaluate(trace, relabel.assignment, model).total.makespan_ns);
+    EXPECT_LE(s, 1.25 * m) << "k " << k;
+    EXPECT_NO_THROW(check_fits(trace, sticky.assignment, "sticky"));
+  }
+}
+
 TEST(DiffOnFalling, NamesTheContactThatMergedTheGroupsAtEveryMerge) {
   const Trace& trace = falling_trace();
   int merges = 0;

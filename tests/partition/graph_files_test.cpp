@@ -12,7 +12,9 @@
 #include <sstream>
 
 #include "test_graphs.hpp"
+#include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/step_json.hpp"
 #include "tgraph/partition/export.hpp"
 #include "tgraph/partition/partition_graph.hpp"
 #include "tgraph/graph/stg.hpp"
@@ -142,6 +144,32 @@ TEST_F(GraphFiles, WriteTheDocumentedLayout) {
   // Edges 0-1 (x: 16), 0-2 (x: 16), 1-2 (y: max(1, 0) = 1); task 2's weight is at least 1.
   EXPECT_EQ(metis_graph_file(g), "3 3 011\n5 2 16 3 16\n7 1 16 3 1\n1 1 16 2 1\n");
   EXPECT_EQ(scotch_graph_file(g), "0\n3 6\n0 011\n5 2 16 1 16 2\n7 2 16 0 1 2\n1 2 16 0 1 1\n");
+}
+
+TEST(GraphFile, WritesTheNamedStepInTheChosenFormat) {
+  testing::Builder b;
+  const DatumId x = b.datum("x", 16);
+  b.task({{x, testing::M::W}}, 5);
+  b.task({{x, testing::M::R}}, 7);
+  Trace trace;
+  trace.steps = {testing::two_halves(2), b.done()};
+  const StepGraph& g = trace.steps[1];
+  EXPECT_EQ(graph_file(trace, 1, "t.tgt", GraphFileFormat::kMetis), "2 1 011\n5 2 16\n7 1 16\n");
+  EXPECT_EQ(graph_file(trace, 1, "t.tgt", GraphFileFormat::kScotch),
+            "0\n2 2\n0 011\n5 1 16 1\n7 1 16 0\n");
+  EXPECT_EQ(graph_file(trace, 1, "t.tgt", GraphFileFormat::kJson), step_graph_json(g, 1));
+  EXPECT_NE(graph_file(trace, 0, "t.tgt", GraphFileFormat::kMetis),
+            graph_file(trace, 1, "t.tgt", GraphFileFormat::kMetis));
+  try {
+    graph_file(trace, 2, "t.tgt", GraphFileFormat::kJson);
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--step 2: trace t.tgt has 2 steps");
+  }
+  for (GraphFileFormat f :
+       {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch})
+    EXPECT_EQ(parse_graph_file_format(to_string(f)), f);
+  EXPECT_THROW(parse_graph_file_format("dot"), UsageError);
 }
 
 }  // namespace

@@ -318,10 +318,12 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
   const StepGraph merged = grouped_scene(8, {{0, 1, 2, 3, 4, 5, 6, 7}});
   ASSERT_EQ(apart.loops.size(), 2u);
   ASSERT_EQ(merged.loops.size(), 1u);
+  Options fresh;
+  fresh.sticky_fallback = StickyFallback::kFresh;
   for (std::uint32_t k : {2u, 3u, 4u}) {
     auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, {});
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, {});
+    const Result r0 = s->partition(apart, k, {}, fresh);
+    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, fresh);
     EXPECT_TRUE(r1.stats.fallback) << k;
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_FALSE(r1.stats.reused);
@@ -335,7 +337,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
     std::set<ProcId> used(r1.assignment.proc.begin(), r1.assignment.proc.end());
     EXPECT_EQ(used.size(), k);
     // The groups split again: another fallback.
-    const Result r2 = s->partition(apart, k, {&merged, &r1.assignment}, {});
+    const Result r2 = s->partition(apart, k, {&merged, &r1.assignment}, fresh);
     EXPECT_TRUE(r2.stats.fallback) << k;
     EXPECT_EQ(r2.stats.matched_tasks, apart.tasks.size() - 2) << "all but the second group's own tasks";
     EXPECT_NO_THROW(simulate(apart, r2.assignment, CostModel::defaults()));
@@ -375,6 +377,34 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   EXPECT_EQ(parse_sticky_fallback("repartition"), StickyFallback::kRepartition);
   EXPECT_EQ(to_string(StickyFallback::kFresh), "fresh");
   EXPECT_THROW(parse_sticky_fallback("magic"), UsageError);
+}
+
+TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeByDefault) {
+  using testing::grouped_scene;
+  const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
+  const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
+  EXPECT_EQ(Options{}.sticky_fallback, StickyFallback::kRefine);
+  for (std::uint32_t k : {2u, 3u, 4u}) {
+    auto s = make_strategy("sticky");
+    const Result r0 = s->partition(apart, k, {}, {});
+    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, {});
+    EXPECT_TRUE(r1.stats.fallback) << k;
+    EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
+    // Fewer moves than METIS afresh relabelled, at a predicted makespan no worse than 5 %
+    // above METIS's, and every processor keeps work.
+    const Result m1 = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, {});
+    EXPECT_LT(r1.stats.moved_tasks, m1.stats.moved_tasks) << k;
+    const auto makespan = [&](const Assignment& a) {
+      return static_cast<double>(simulate(merged, a, CostModel::defaults()).makespan_ns);
+    };
+    EXPECT_LE(makespan(r1.assignment), 1.05 * makespan(m1.assignment)) << k;
+    const auto l = loads_of(merged, r1.assignment);
+    EXPECT_EQ(std::count(l.begin(), l.end(), 0u), 0) << k;
+    // The split back is a fallback too, and the whole trace's assignment fits.
+    EXPECT_TRUE(s->partition(apart, k, {&merged, &r1.assignment}, {}).stats.fallback) << k;
+  }
+  EXPECT_EQ(parse_sticky_fallback("refine"), StickyFallback::kRefine);
+  EXPECT_EQ(to_string(StickyFallback::kRefine), "refine");
 }
 
 TEST(Sticky, StartsFromItsBaseMethodAndWhenKChanges) {

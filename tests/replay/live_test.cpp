@@ -155,6 +155,7 @@ TEST(LiveCompare, NamesTheFirstDifferingDatum) {
   EXPECT_EQ(diff->datum, "v");
   EXPECT_EQ(diff->offset, 8u);
   EXPECT_EQ(diff->differing_bytes, 1u);
+  EXPECT_EQ(to_string(*diff), "first differing datum v (byte 8, 1 bytes differ)");
 }
 
 TEST(Live, RefusesThePartitionPolicyWithoutAPartitioner) {

@@ -9,6 +9,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -181,6 +183,75 @@ TEST(GraphView, RendersSvgThroughLibgvc) {
   const std::string svg = render_graph(make_graph_view(g, o), GraphFormat::kSvg);
   EXPECT_NE(svg.find("<svg"), std::string::npos);
   EXPECT_NE(svg.find("loop 0: 3 iterations"), std::string::npos);
+}
+
+TEST(GraphView, TraceStepViewTitlesTheFileTheStepAndTheAssignment) {
+  Trace trace;
+  trace.steps = {fig2_fixed_costs(), fig2_fixed_costs()};
+  TraceAssignment as;
+  as.method = "owner";
+  as.k = 2;
+  as.steps = {fig2_assignment(trace.steps[0]), fig2_assignment(trace.steps[1])};
+  const std::string path = "/data/run/fig2.tgt";
+  GraphView v = trace_step_view(trace, path, 1, nullptr, {});
+  EXPECT_EQ(v.title.at(0), "fig2.tgt, step 1");
+  EXPECT_EQ(v.processors, 0u);
+  v = trace_step_view(trace, path, 1, &as, {});
+  EXPECT_EQ(v.title.at(0), "fig2.tgt, step 1, owner on 2 processors");
+  EXPECT_EQ(v.processors, 2u);
+  ViewOptions direct;  // the same picture as make_graph_view with step 1's assignment
+  direct.assignment = &as.steps[1];
+  direct.title = v.title.at(0);
+  EXPECT_EQ(to_dot(v), to_dot(make_graph_view(trace.steps[1], direct)));
+  try {
+    trace_step_view(trace, path, 2, nullptr, {});
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_STREQ(e.what(), "--step 2: trace /data/run/fig2.tgt has 2 steps");
+  }
+  ViewOptions small;
+  small.max_nodes = 3;
+  try {
+    trace_step_view(trace, path, 1, nullptr, small);
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/data/run/fig2.tgt: step 1: ", 0), 0u) << e.what();
+  }
+}
+
+// x of the SVG text element whose content is `label` (nullopt when absent).
+std::optional<double> svg_text_x(const std::string& svg, const std::string& label) {
+  const std::regex text("<text[^>]* x=\"(-?[0-9.]+)\"[^>]*>" + label + "</text>");
+  std::smatch m;
+  if (!std::regex_search(svg, m, text)) return std::nullopt;
+  return std::stod(m[1].str());
+}
+
+TEST(GraphView, LegendListsProcessorsFromP0LeftToRight) {
+  const StepGraph g = fig2_fixed_costs();
+  Assignment a;
+  a.k = 4;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 4);
+  ViewOptions o;
+  o.assignment = &a;
+  const GraphView v = make_graph_view(g, o);
+  // The laid-out picture: p0's sample left of p1's, p1's left of p2's...
+  const std::string svg = render_graph(v, GraphFormat::kSvg);
+  std::vector<double> xs;
+  for (int p = 0; p < 4; ++p) {
+    const std::optional<double> x = svg_text_x(svg, "p" + std::to_string(p));
+    ASSERT_TRUE(x.has_value()) << "p" << p;
+    xs.push_back(*x);
+  }
+  for (int p = 0; p < 3; ++p) EXPECT_LT(xs[p], xs[p + 1]) << "p" << p << " vs p" << p + 1;
+  // DOT: the samples are chained p0 -> p1 -> p2 -> p3 by invisible edges.
+  const std::string dot = to_dot(v);
+  for (int p = 0; p < 3; ++p) {
+    const std::string chain = "legend" + std::to_string(p) + " -> legend" + std::to_string(p + 1);
+    const std::size_t at = dot.find(chain);
+    ASSERT_NE(at, std::string::npos) << chain;
+    EXPECT_EQ(dot.substr(at + chain.size(), 14), "\t[style=invis]") << chain;
+  }
 }
 
 // Expected aggregates of --collapse object computed from the trace directly.

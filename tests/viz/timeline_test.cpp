@@ -4,10 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/synthetic.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/report.hpp"
 
@@ -82,6 +86,69 @@ TEST(Timeline, FlowGoesFromTheReleasingTaskToTheWait) {
   EXPECT_EQ(waits, 1);
 }
 
+// What `tgraph replay --chrome` writes: the replay observer's timeline through chrome_trace.
+TEST(Timeline, ConvertsAReplayObserversTimelineToChromeEvents) {
+  auto scene = samples::make_scene("fig2", {});
+  capture::Recorder rec(capture::Mode::kCapture);
+  scene->step(rec);
+  const StepGraph g = rec.end_step();
+  Assignment a;
+  a.k = 2;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
+  replay::ExecOptions eo;
+  eo.threads = 2;
+  eo.pin = false;
+  auto ex = replay::make_executor(replay::Policy::kPartition, eo);
+  replay::TimelineObserver observer;
+  ex->add_observer(observer);
+  replay::SyntheticWorkload w({.cost_scale = 0.0});
+  w.set_step(g);
+  ex->run_step(g, &a, w);
+
+  const Timeline t = parse_timeline(observer.to_json(), "r.json");
+  ASSERT_EQ(t.tasks.size(), observer.events().size());
+  ASSERT_EQ(t.waits.size(), observer.waits().size());
+  const nlohmann::json chrome = nlohmann::json::parse(chrome_trace(t));
+  std::size_t slices = 0, wait_slices = 0, names = 0, starts = 0, finishes = 0;
+  for (const auto& e : chrome.at("traceEvents")) {
+    if (e["ph"] == "X" && e["cat"] != "wait") {
+      const replay::TimelineEvent& ev = observer.events()[slices++];
+      EXPECT_EQ(e["name"], observer.labels()[ev.task]);
+      EXPECT_EQ(e["tid"], ev.thread);
+      EXPECT_EQ(e["cat"], ev.origin == kNoTask ? "reducer" : "task");
+      EXPECT_DOUBLE_EQ(e["dur"].get<double>(), static_cast<double>(ev.end_ns - ev.start_ns) / 1000);
+    }
+    if (e["ph"] == "X" && e["cat"] == "wait") ++wait_slices;
+    if (e["ph"] == "M") {
+      EXPECT_EQ(e["args"]["name"], "thread " + std::to_string(names++));
+    }
+    starts += e["ph"] == "s" ? 1 : 0;
+    finishes += e["ph"] == "f" ? 1 : 0;
+  }
+  EXPECT_EQ(slices, observer.events().size());
+  EXPECT_EQ(wait_slices, observer.waits().size());
+  EXPECT_EQ(names, 2u);
+  EXPECT_EQ(starts, timeline_flows(t).size());
+  EXPECT_EQ(finishes, starts);
+}
+
+TEST(Timeline, ReadsAFileAndTitlesItByFileName) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "viz_read";
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "r.json").string();
+  write_file_atomic(path, kTimeline);
+  const Timeline t = read_timeline(path);
+  EXPECT_EQ(t.tasks.size(), 5u);
+  EXPECT_EQ(timeline_title(t, path), "r.json: 2 threads, 5 task instances, 1 blocking waits");
+  try {
+    read_timeline((dir / "missing.json").string());
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.file(), (dir / "missing.json").string());
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(Timeline, RendersSvgAndPngWithCairo) {
   const Timeline t = parse_timeline(kTimeline, "t.json");
   const std::string svg = render_timeline(t, TimelineFormat::kSvg, "test");
@@ -127,6 +194,48 @@ TEST(Report, PageIsSelfContainedWithOneContainerPerChart) {
   EXPECT_EQ(round3(0.0123456), "0.0123");
   EXPECT_EQ(round3(1234.6), "1235");
   EXPECT_EQ(round3(4.47482), "4.47");
+}
+
+TEST(Report, FromFilesAddsTheComparisonAndReplaysAndFallsBackToStepZero) {
+  auto scene = samples::make_scene("fig2", {});
+  capture::Recorder rec(capture::Mode::kCapture);
+  Trace trace;
+  for (int s = 0; s < 2; ++s) {
+    scene->step(rec);
+    trace.steps.push_back(rec.end_step());
+  }
+  TraceAssignment as;
+  as.method = "owner";
+  as.k = 2;
+  for (const StepGraph& g : trace.steps) {
+    Assignment a;
+    a.k = 2;
+    for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
+    as.steps.push_back(a);
+  }
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "viz_report";
+  std::filesystem::create_directories(dir);
+  const std::string compare = (dir / "c.json").string(), replay = (dir / "r.json").string();
+  write_file_atomic(compare, R"({"rows":[{"method":"metis","k":2,"partition_ms":0.5,
+    "imbalance":1.25,"cut_bytes":96,"migrated_tasks":3,"predicted_speedup":1.5}]})");
+  write_file_atomic(replay, kTimeline);
+  const ReportContent c = report_from_files(trace, "f.tgt", &as, 7, compare, {replay});
+  ASSERT_EQ(c.rows.size(), 1u);
+  EXPECT_EQ(c.rows[0].method, "metis");
+  EXPECT_EQ(c.rows[0].cut_bytes, 96u);
+  ASSERT_TRUE(c.timeline.has_value());
+  EXPECT_EQ(c.timeline->tasks.size(), 5u);
+  EXPECT_EQ(c.timeline_caption, "From " + replay + ".");
+  // Step 7 does not exist: step 0 is drawn, coloured by the assignment's step 0.
+  EXPECT_EQ(c.graph_caption.rfind("Step 0 collapsed by object", 0), 0u) << c.graph_caption;
+  EXPECT_NE(c.graph_caption.find("(owner)"), std::string::npos) << c.graph_caption;
+  const ReportContent plain = report_from_files(trace, "f.tgt", nullptr, 1, "", {});
+  EXPECT_TRUE(plain.rows.empty());
+  EXPECT_FALSE(plain.timeline.has_value());
+  EXPECT_NE(plain.graph_caption.find("(no assignment: grey)"), std::string::npos);
+  EXPECT_THROW(report_from_files(trace, "f.tgt", nullptr, 1, (dir / "none.json").string(), {}),
+               InputError);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Report, RejectsFilesOfAnotherKind) {

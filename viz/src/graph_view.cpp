@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <set>
 #include <tuple>
@@ -667,6 +668,23 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
         "critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
         " over " + std::to_string(cp.instances.size()) + " task instances" + loop_summary(g, cp));
   return v;
+}
+
+GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std::size_t step,
+                          const TraceAssignment* assignment, ViewOptions options) {
+  const StepGraph& g = step_at(trace, step, trace_name);
+  options.title =
+      std::filesystem::path(trace_name).filename().string() + ", step " + std::to_string(step);
+  if (assignment) {
+    options.assignment = step < assignment->steps.size() ? &assignment->steps[step] : nullptr;
+    options.title +=
+        ", " + assignment->method + " on " + std::to_string(assignment->k) + " processors";
+  }
+  try {
+    return make_graph_view(g, options);
+  } catch (const UsageError& e) {
+    throw UsageError(trace_name + ": step " + std::to_string(step) + ": " + e.what());
+  }
 }
 
 }  // namespace tgraph::viz

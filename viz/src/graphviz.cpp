@@ -213,7 +213,9 @@ class Builder {
     }
   }
 
-  // A cluster of sample nodes and edges explaining colours, shapes and strokes.
+  // A cluster of sample nodes and edges explaining colours, shapes and strokes, left to
+  // right in the order added (p0, p1, ... first): dot orders the nodes of one rank freely
+  // unless flat edges join them, so consecutive samples are chained by invisible edges.
   void add_legend(Agraph_t* g) {
     Agraph_t* lg = agsubg(g, cs("cluster_legend"), 1);
     set(lg, "label", "legend");
@@ -222,9 +224,13 @@ class Builder {
     Agraph_t* row = agsubg(lg, cs("legend_row"), 1);
     set(row, "rank", "same");
     int count = 0;
-    auto sample = [&](const std::string& label, const std::string& fill, const char* shape) {
+    Agnode_t* last = nullptr;
+    auto sample = [&](const std::string& label, const std::string& fill, const char* shape,
+                      bool chain = true) {
       const std::string name = "legend" + std::to_string(count++);
       Agnode_t* n = agnode(row, cs(name.c_str()), 1);
+      if (last && chain) set(agedge(row, last, n, nullptr, 1), "style", "invis");
+      last = n;
       set(n, "label", label_text({label}));
       set(n, "fontsize", "9");
       if (shape) set(n, "shape", shape);
@@ -261,7 +267,7 @@ class Builder {
     auto has_edge = [&](auto pred) { return std::any_of(v_.edges.begin(), v_.edges.end(), pred); };
     auto edge_sample = [&](const std::string& label) {
       Agnode_t* a = sample("", "", "point");
-      Agnode_t* b = sample("", "", "point");
+      Agnode_t* b = sample("", "", "point", false);  // joined by the sample edge itself
       set(a, "width", "0.05");
       set(b, "width", "0.05");
       Agedge_t* e = agedge(row, a, b, nullptr, 1);

@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/summary.hpp"
 #include "tgraph/viz/graph_view.hpp"
@@ -22,6 +25,17 @@ namespace tgraph::viz {
 namespace {
 
 using nlohmann::json;
+
+// An unsigned integer field no larger than `max`: nlohmann's get<> would convert a float
+// (or a value out of range) with undefined behaviour.
+std::uint64_t get_count(const json& j, const char* key, std::uint64_t max = UINT64_MAX) {
+  const json& v = j.at(key);
+  if (!v.is_number_unsigned() || v.get<std::uint64_t>() > max)
+    throw json::type_error::create(
+        302, std::string("\"") + key + "\" must be an unsigned integer <= " + std::to_string(max),
+        &v);
+  return v.get<std::uint64_t>();
+}
 
 // Timeline events embedded in the page at most (the first steps up to this many).
 constexpr std::size_t kMaxTimelineEvents = 6000;
@@ -492,12 +506,12 @@ void add_compare_json(ReportContent& c, std::string_view text, const std::string
       MethodRow row;
       row.method = r.contains("label") ? r.at("label").get<std::string>()
                                        : r.at("method").get<std::string>();
-      row.k = r.at("k").get<std::uint32_t>();
+      row.k = static_cast<std::uint32_t>(get_count(r, "k", UINT32_MAX));
       row.partitioned = true;
       row.partition_ms = r.at("partition_ms").get<double>();
       row.imbalance = r.at("imbalance").get<double>();
-      row.cut_bytes = r.at("cut_bytes").get<std::uint64_t>();
-      row.migrated_tasks = r.at("migrated_tasks").get<std::uint64_t>();
+      row.cut_bytes = get_count(r, "cut_bytes");
+      row.migrated_tasks = get_count(r, "migrated_tasks");
       row.predicted_speedup = r.at("predicted_speedup").get<double>();
       c.rows.push_back(row);
       ++i;
@@ -528,18 +542,31 @@ void add_replay_json(ReportContent& c, std::string_view text, const std::string&
     const std::string policy = j.at("policy").get<std::string>();
     const std::string assignment = j.value("assignment", std::string());
     row.method = policy == "partition" && !assignment.empty() ? assignment : policy;
-    row.k = j.at("threads").get<std::uint32_t>();
+    row.k = static_cast<std::uint32_t>(get_count(j, "threads", UINT32_MAX));
     row.measured_ms = j.at("wall_ns").get<double>() / 1e6;
     row.sequential_ms = j.at("sequential_wall_ns").get<double>() / 1e6;
     row.speedup = j.at("speedup").get<double>();
     row.efficiency = j.at("efficiency").get<double>();
-    row.signals = j.at("signals").get<std::uint64_t>();
+    row.signals = get_count(j, "signals");
     c.rows.push_back(row);
   } catch (const json::exception& e) {
     std::string why = e.what();
     if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
     throw InputError(name, std::nullopt, why);
   }
+}
+
+ReportContent report_from_files(const Trace& trace, const std::string& trace_name,
+                                const TraceAssignment* assignment, std::size_t step,
+                                const std::string& compare_path,
+                                const std::vector<std::string>& replay_paths) {
+  if (step >= trace.steps.size()) step = 0;
+  const bool coloured = assignment && step < assignment->steps.size();
+  ReportContent c = report_content(trace, trace_name, coloured ? &assignment->steps[step] : nullptr,
+                                   step, assignment ? assignment->method : std::string());
+  if (!compare_path.empty()) add_compare_json(c, read_file_text(compare_path), compare_path);
+  for (const std::string& r : replay_paths) add_replay_json(c, read_file_text(r), r);
+  return c;
 }
 
 std::string report_html(const ReportContent& c) {

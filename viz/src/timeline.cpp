@@ -10,11 +10,13 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 #include "tgraph/viz/palette.hpp"
 
 namespace tgraph::viz {
@@ -250,6 +252,9 @@ std::vector<std::string> rank_kinds(const Timeline& t) {
   return out;
 }
 
+// Threads a timeline may have (rows of the picture).
+constexpr std::uint32_t kMaxThreads = 4096;
+
 std::uint32_t get_u32(const json& e, const char* key) {
   const json& v = e.at(key);
   if (!v.is_number_unsigned() || v.get<std::uint64_t>() > 0xffffffffu)
@@ -284,6 +289,16 @@ std::vector<std::int64_t> Timeline::step_offsets() const {
   return offsets;
 }
 
+Timeline read_timeline(const std::string& path) {
+  return parse_timeline(read_file_text(path), path);
+}
+
+std::string timeline_title(const Timeline& t, const std::string& path) {
+  return std::filesystem::path(path).filename().string() + ": " + std::to_string(t.threads) +
+         " threads, " + std::to_string(t.tasks.size()) + " task instances, " +
+         std::to_string(t.waits.size()) + " blocking waits";
+}
+
 Timeline parse_timeline(std::string_view text, const std::string& name) {
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded())
@@ -295,12 +310,34 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
   Timeline t;
   std::size_t index = 0;
   const char* what = "tasks";
+  // Ceilings before anything is sized by a value read: every step of a replay has task
+  // events, so step numbers stay below the number of events (step_offsets() allocates by
+  // step number); threads below kMaxThreads.
+  const std::size_t events = j["tasks"].size() + (j.contains("waits") ? j["waits"].size() : 0);
+  const auto step_of = [&](const json& e) {
+    const std::uint32_t s = get_u32(e, "step");
+    if (s >= events)
+      throw json::other_error::create(501,
+                                      "\"step\": " + std::to_string(s) + " (expected < " +
+                                          std::to_string(events) + ", the number of events)",
+                                      &e);
+    return s;
+  };
+  const auto thread_of = [&](const json& e) {
+    const std::uint32_t th = get_u32(e, "thread");
+    if (th >= kMaxThreads)
+      throw json::other_error::create(
+          501,
+          "\"thread\": " + std::to_string(th) + " (expected < " + std::to_string(kMaxThreads) + ")",
+          &e);
+    return th;
+  };
   try {
     t.threads = j.contains("threads") ? get_u32(j, "threads") : 0;
     for (const json& e : j["tasks"]) {
       TimelineTask ev;
-      ev.step = get_u32(e, "step");
-      ev.thread = get_u32(e, "thread");
+      ev.step = step_of(e);
+      ev.thread = thread_of(e);
       ev.task = get_u32(e, "task");
       ev.origin = get_optional_u32(e, "origin");
       ev.kind = e.contains("kind") && e["kind"].is_string() ? e["kind"].get<std::string>() : "task";
@@ -319,8 +356,8 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
         throw json::type_error::create(302, "\"waits\" must be an array", &j);
       for (const json& e : j["waits"]) {
         TimelineWait w;
-        w.step = get_u32(e, "step");
-        w.thread = get_u32(e, "thread");
+        w.step = step_of(e);
+        w.thread = thread_of(e);
         w.task = get_optional_u32(e, "task");
         w.start_ns = get_i64(e, "start_ns");
         w.end_ns = get_i64(e, "end_ns");
@@ -345,9 +382,24 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
     throw InputError(name, std::nullopt,
                      "thread " + std::to_string(seen - 1) +
                          " out of range (\"threads\": " + std::to_string(t.threads) + ")");
-  if (t.threads > 4096)
+  if (t.threads > kMaxThreads)
     throw InputError(name, std::nullopt,
-                     "\"threads\": " + std::to_string(t.threads) + " (expected at most 4096)");
+                     "\"threads\": " + std::to_string(t.threads) + " (expected at most " +
+                         std::to_string(kMaxThreads) + ")");
+  // The pictures add step offsets to times and sum durations in 64-bit integers: the steps
+  // laid end to end, and the tasks' total time, must fit (292 years of nanoseconds).
+  std::vector<std::int64_t> end(events, 0);
+  for (const TimelineTask& e : t.tasks) end[e.step] = std::max(end[e.step], e.end_ns);
+  for (const TimelineWait& w : t.waits) end[w.step] = std::max(end[w.step], w.end_ns);
+  std::int64_t sum = 0, busy = 0;
+  bool overflow = false;
+  for (const std::int64_t ns : end) overflow |= __builtin_add_overflow(sum, ns, &sum);
+  for (const TimelineTask& e : t.tasks)
+    overflow |= __builtin_add_overflow(busy, e.end_ns - e.start_ns, &busy);
+  if (overflow)
+    throw InputError(name, std::nullopt,
+                     "the steps laid end to end or the tasks' total time exceed 2^63-1 ns "
+                     "(expected a replay timeline's nanoseconds)");
   return t;
 }
 

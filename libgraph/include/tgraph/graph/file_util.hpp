@@ -11,6 +11,8 @@ namespace tgraph {
 
 /// Reads a whole file; throws InputError("cannot open ...") naming it.
 std::vector<std::uint8_t> read_file_bytes(const std::string& path);
+/// read_file_bytes as text (JSON, CSV and other text inputs).
+std::string read_file_text(const std::string& path);
 /// Writes `content` to `path` through a temporary file in the same folder renamed into
 /// place, so that a failure never leaves a half-written output. Throws tgraph::Error.
 void write_file_atomic(const std::string& path, std::string_view content);

@@ -25,6 +25,11 @@ struct Trace {
   friend bool operator==(const Trace&, const Trace&) = default;
 };
 
+/// trace.steps[step]; UsageError "<flag> <step>: trace <trace_name> has N steps" when out of
+/// range (the verbs that take one step of a trace).
+const StepGraph& step_at(const Trace& trace, std::size_t step, const std::string& trace_name,
+                         const std::string& flag = "--step");
+
 /// This machine for trace headers: "<cpu model>, N hardware threads".
 std::string machine_description();
 

@@ -20,6 +20,14 @@ struct ReadOptions {
   bool recover = false;
 };
 
+/// Options of write_trace and encode_trace.
+struct WriteOptions {
+  /// Store a step whose structure equals an earlier step's as a reference frame (the
+  /// default, as TraceWriter does); false writes every step as a full frame (what a trace
+  /// costs without the reuse: benchmarks and format tests).
+  bool reuse_structure = true;
+};
+
 /// Streams steps to a .tgt file, one self-delimiting frame per step, each written with
 /// write(2) before append() returns. The frames go to `<path>.partial`; close() writes the
 /// end frame, syncs and renames it to `path`, so an existing file at `path` is replaced only
@@ -63,8 +71,8 @@ Trace read_trace(const std::string& path, const ReadOptions& options = {});
 Trace read_trace_bytes(std::span<const std::uint8_t> bytes, const std::string& name,
                        const ReadOptions& options = {});
 /// Writes a whole trace (to a temporary file renamed into place).
-void write_trace(const std::string& path, const Trace& trace);
+void write_trace(const std::string& path, const Trace& trace, const WriteOptions& options = {});
 /// Encodes a whole trace into bytes (what write_trace writes).
-std::vector<std::uint8_t> encode_trace(const Trace& trace);
+std::vector<std::uint8_t> encode_trace(const Trace& trace, const WriteOptions& options = {});
 
 }  // namespace tgraph

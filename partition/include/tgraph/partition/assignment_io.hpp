@@ -40,9 +40,11 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
                                 const std::string& trace_name);
 
 /// The assignment `tgraph replay` runs on `k` threads: the .tga file `path` (checked against
-/// `trace`, and its K against `k`: UsageError) or, when `path` is empty, `method` applied to
-/// every step.
-TraceAssignment load_or_partition(const Trace& trace, const std::string& path,
-                                  const std::string& method, std::uint32_t k);
+/// `trace`, named `trace_name` in errors, as load_assignment does, and its K against `k`:
+/// UsageError) or, when `path` is empty, `method` applied to every step. UsageError naming
+/// --threads when `k` is 0.
+TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
+                                  const std::string& path, const std::string& method,
+                                  std::uint32_t k);
 
 }  // namespace tgraph::partition

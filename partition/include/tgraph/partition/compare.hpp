@@ -66,6 +66,8 @@ struct Comparison {
   std::string model;                      ///< cost model source
   std::vector<CompareRow> rows;           ///< methods outer, K inner, in the order given
   std::vector<StickyMoves> sticky_moves;  ///< one per K when `sticky` is in the grid
+  /// What the `sticky` rows (not the sweep rows) do when solver loops merge or split.
+  StickyFallback sticky_fallback = StickyFallback::kRefine;
 };
 
 /// Partitions `trace` with every method at every K (partition_trace) and evaluates each

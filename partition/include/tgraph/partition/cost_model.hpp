@@ -57,7 +57,8 @@ struct CalibrateOptions {
 };
 
 /// Measures this machine with two threads pinned to two different CPUs; throws
-/// tgraph::Error when fewer than two CPUs are available.
+/// std::runtime_error (a failure of the work, not a tgraph::Error about the input) when the
+/// calling thread may use fewer than two CPUs.
 Calibration measure_calibration(const CalibrateOptions& options = {});
 /// The calibration file's JSON text.
 std::string calibration_json(const Calibration& c);

@@ -3,9 +3,13 @@
 // (library_graph), as gpmetis and scotch_gpart read it.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
+#include <string_view>
 
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/undirected.hpp"
 
 namespace tgraph::partition {
@@ -24,5 +28,23 @@ std::string scotch_graph_file(const UndirectedGraph& u);
 std::string metis_graph_file(const StepGraph& g);
 /// scotch_graph_file of library_graph(g).
 std::string scotch_graph_file(const StepGraph& g);
+
+/// The interchange formats of one step (`tgraph export --format`).
+enum class GraphFileFormat : std::uint8_t {
+  kJson = 0,    ///< step_graph_json (libgraph): the whole step graph
+  kMetis = 1,   ///< metis_graph_file
+  kScotch = 2,  ///< scotch_graph_file
+};
+/// "json", "metis" or "scotch".
+std::string_view to_string(GraphFileFormat f);
+/// Inverse of to_string; UsageError naming --format and the formats otherwise.
+GraphFileFormat parse_graph_file_format(std::string_view name);
+
+/// Step `step` of `trace` in `format` (`tgraph export`); UsageError naming `trace_name` when
+/// the trace has no such step.
+///
+///   write_file_atomic("g.metis", graph_file(trace, 1, "b.tgt", GraphFileFormat::kMetis));
+std::string graph_file(const Trace& trace, std::size_t step, const std::string& trace_name,
+                       GraphFileFormat format);
 
 }  // namespace tgraph::partition

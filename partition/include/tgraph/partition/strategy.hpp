@@ -46,8 +46,9 @@ Rebalance parse_rebalance(std::string_view s);
 enum class StickyFallback : std::uint8_t {
   kFresh = 0,        ///< the base method afresh, parts relabelled to the previous step's
   kRepartition = 1,  ///< SCOTCH_graphRepart from the incremental placement, migration cost per task
+  kRefine = 2,       ///< local search from the incremental placement (units to their neighbours)
 };
-/// "fresh" or "repartition".
+/// "fresh", "repartition" or "refine".
 std::string_view to_string(StickyFallback f);
 /// Parses a fallback name; throws UsageError.
 StickyFallback parse_sticky_fallback(std::string_view s);
@@ -62,7 +63,7 @@ struct Options {
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
   Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
-  StickyFallback sticky_fallback = StickyFallback::kFresh;  ///< sticky: when the shape changed
+  StickyFallback sticky_fallback = StickyFallback::kRefine;  ///< sticky: when the shape changed
   /// sticky, Scotch repartitioning (rebalance or fallback): emraval, the weight of migrated
   /// load against the cut (quantised to 0.01 by Scotch)
   double migration_cost = 1.0;
@@ -76,7 +77,7 @@ struct NamedOptions {
   std::string objective = "cut";          ///< cut, vol
   std::string scotch = "quality";         ///< default, quality, speed, balance
   std::string rebalance = "greedy";       ///< greedy, scotch
-  std::string sticky_fallback = "fresh";  ///< fresh, repartition
+  std::string sticky_fallback = "refine";  ///< fresh, repartition, refine
   std::string model = "calibrated";       ///< calibrated, ideal (select_cost_model)
   std::string calibration;                ///< calibration file ("": the default one if present)
 

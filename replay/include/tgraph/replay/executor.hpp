@@ -21,6 +21,10 @@ namespace tgraph::replay {
 /// bench/replay: a futex hand-off costs 9-36 µs on this machine, a spinning one 0.1 µs).
 inline constexpr std::int64_t kDefaultSpinNs = 50'000;
 
+/// Default watchdog timeout (ExecOptions::timeout_ms): generous, a step of a real trace
+/// takes milliseconds.
+inline constexpr std::int64_t kDefaultTimeoutMs = 300'000;
+
 /// How an executor runs.
 struct ExecOptions {
   std::uint32_t threads = 1;  ///< threads (processors); partition: must equal Assignment::k
@@ -47,6 +51,17 @@ struct ExecOptions {
   bool verify_plans = false;
   /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
   std::string starpu_sched = "lws";
+  /// Partition only: the watchdog. A step during which no thread finishes a task or passes
+  /// a wait for this long ends with std::runtime_error naming what each thread waits for or
+  /// runs (0: no watchdog). Every thread is joined before run_step throws.
+  std::int64_t timeout_ms = kDefaultTimeoutMs;
+  /// With the watchdog: a step that still has not ended one timeout after the watchdog
+  /// fired (a task body that never returns, which nothing can interrupt) prints the report
+  /// on stderr and ends the process with exit status 1. For command-line tools.
+  bool timeout_exits = false;
+  /// Testing only: the completion of this task (original id) is never published, as if a
+  /// wake-up were lost; its readers on other processors wait until the watchdog fires.
+  std::optional<TaskId> test_lose_signal;
 };
 
 /// Counters of one thread in one step, kept by the executor itself.
@@ -160,7 +175,8 @@ class Executor {
   const ExecGraph* last_exec_ = nullptr;
 };
 
-/// Creates an executor; throws UsageError for threads == 0 (or != 1 for sequential).
+/// Creates an executor; throws UsageError for threads == 0 or above 1024 (the sequential
+/// policy runs on one thread whatever `options.threads` asks).
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options);
 
 /// Thread p's processing unit under pinning (hwloc, one PU per core first), for reports.

@@ -78,6 +78,8 @@ struct StateDifference {
 
 /// nullopt when equal bit for bit.
 std::optional<StateDifference> compare(const StateSnapshot& expected, const StateSnapshot& actual);
+/// "first differing datum <datum> (byte <offset>, <differing_bytes> bytes differ)".
+std::string to_string(const StateDifference& d);
 
 /// One step of an engine recorded in deferred mode: nothing has run yet.
 struct LiveStep {

@@ -42,10 +42,11 @@ struct ReplayOptions {
   ExecOptions exec;  ///< threads, spin, pinning, CW mode
   SyntheticOptions synthetic;
   std::uint32_t first_step = 0;
-  std::uint32_t steps = 0;          ///< 0: every step from first_step
-  std::uint32_t repeat = 3;         ///< timed passes per policy (medians reported)
-  bool sequential_baseline = true;  ///< also time sequential passes, interleaved
-  bool observe = true;              ///< one extra pass with observers (busy/wait/idle, locality)
+  std::uint32_t steps = 0;   ///< 0: every step from first_step
+  std::uint32_t repeat = 3;  ///< timed passes per policy (medians reported)
+  /// Also time sequential passes, interleaved (not under the sequential policy itself).
+  bool sequential_baseline = true;
+  bool observe = true;  ///< one extra pass with observers (busy/wait/idle, locality)
 };
 
 /// One step's figures (wall times: medians over the timed passes).
@@ -70,9 +71,9 @@ struct StepMeasure {
 /// The whole replay.
 struct ReplayResult {
   Policy policy = Policy::kPartition;
-  std::uint32_t threads = 1;
-  CwMode cw = CwMode::kReduce;              ///< how CW groups ran
-  ReduceScope scope = ReduceScope::kNone;   ///< where their temporaries lived
+  std::uint32_t threads = 1;               ///< ExecOptions::threads; 1 for the sequential policy
+  CwMode cw = CwMode::kReduce;             ///< how CW groups ran
+  ReduceScope scope = ReduceScope::kNone;  ///< where their temporaries lived
   std::vector<StepMeasure> steps;
   std::int64_t wall_ns = 0;             ///< median over passes of the pass total
   std::int64_t sequential_wall_ns = 0;  ///< same for sequential

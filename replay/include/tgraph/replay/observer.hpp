@@ -6,7 +6,6 @@
 #include <atomic>
 #include <cstdint>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -150,12 +149,11 @@ class TimelineObserver : public Observer {
   void set_max_steps(std::uint32_t n) { max_steps_ = n; }
   /// The timeline as JSON: {"threads", "steps", "tasks": [{step, thread, task, origin,
   /// kind, iteration, start_ns, end_ns}], "waits": [...]}.
+  /// viz::parse_timeline reads it back; viz::chrome_trace turns it into Chrome / Perfetto
+  /// trace events (`tgraph replay --chrome`, `tgraph export R.json --format chrome`).
   std::string to_json() const;
-  /// Chrome / Perfetto trace-event JSON (one complete event "X" per task, times in µs).
-  std::string to_chrome_json() const;
 
  private:
-  friend std::string chrome_from_timeline_json(std::string_view, const std::string&);
   std::vector<std::vector<TimelineEvent>> per_thread_;
   std::vector<std::vector<TimelineWait>> waits_per_thread_;
   std::vector<TimelineEvent> events_;
@@ -169,10 +167,5 @@ class TimelineObserver : public Observer {
   std::uint32_t max_steps_ = 0xffffffffu;
   bool recording_ = false;
 };
-
-/// Chrome / Perfetto trace events from a timeline file's text (TimelineObserver::to_json,
-/// `tgraph replay --timeline`), for converters such as `tgraph export`. Throws InputError
-/// naming `name` when the text is not such a timeline.
-std::string chrome_from_timeline_json(std::string_view timeline_json, const std::string& name);
 
 }  // namespace tgraph::replay

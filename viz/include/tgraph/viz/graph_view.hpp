@@ -12,6 +12,7 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
 
 namespace tgraph::viz {
 
@@ -119,6 +120,12 @@ struct GraphView {
 /// not fit the step, when --collapse processor has no assignment, and when the result has
 /// more than `max_nodes` nodes or `max_edges` edges (the message suggests --collapse).
 GraphView make_graph_view(const StepGraph& g, const ViewOptions& options);
+/// `tgraph viz`: the picture of step `step` of `trace` (read from `trace_name`), titled
+/// "<file name>, step S" plus ", <method> on K processors" when `assignment` (whose step S
+/// colours it) is given. UsageError when the trace has no such step; make_graph_view's
+/// errors are prefixed with "<trace_name>: step S: ".
+GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std::size_t step,
+                          const TraceAssignment* assignment, ViewOptions options);
 
 /// "96 B", "1.5 KiB", "2.25 MiB".
 std::string format_bytes(std::uint64_t bytes);

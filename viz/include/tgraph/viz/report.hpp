@@ -75,6 +75,14 @@ void add_compare_json(ReportContent& c, std::string_view json, const std::string
 /// a measurement (tgraph replay --json, one measured row). Throws InputError otherwise.
 void add_replay_json(ReportContent& c, std::string_view json, const std::string& name);
 
+/// `tgraph report`: report_content of step `step` (step 0 when the trace has no such step),
+/// coloured by that step of `assignment` (nullptr: none), then the comparison file
+/// `compare_path` (empty: none) and each replay file (add_compare_json, add_replay_json).
+ReportContent report_from_files(const Trace& trace, const std::string& trace_name,
+                                const TraceAssignment* assignment, std::size_t step,
+                                const std::string& compare_path,
+                                const std::vector<std::string>& replay_paths);
+
 /// The page. Charts are Vega-Lite specifications rendered as SVG by the inlined libraries; a
 /// chart that fails to render shows its error in place and on the console.
 std::string report_html(const ReportContent& c);

@@ -50,6 +50,8 @@ struct Timeline {
 /// Parses TimelineObserver::to_json text; throws InputError naming `name` and what is
 /// wrong (not JSON, missing field, thread out of range, end before start).
 Timeline parse_timeline(std::string_view json, const std::string& name);
+/// parse_timeline of the file at `path` (InputError naming it when unreadable or malformed).
+Timeline read_timeline(const std::string& path);
 
 /// Steps [first, last] (inclusive) of `t`; throws UsageError when none is in range.
 Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last);
@@ -67,6 +69,9 @@ TimelineFormat timeline_format_of(const std::string& path);
 /// by time), waits hatched grey, step boundaries as solid lines, the start of each loop
 /// iteration as dotted lines, axis in ms. `title` is drawn above the chart.
 std::string render_timeline(const Timeline& t, TimelineFormat format, const std::string& title);
+/// `tgraph timeline`'s title for `t` read from `path`: "<file name>: T threads, N task
+/// instances, W blocking waits".
+std::string timeline_title(const Timeline& t, const std::string& path);
 
 /// A cross-thread dependency in a timeline: `to` (a wait) was released when `from` (a task
 /// instance on another thread) ended.

@@ -1,0 +1,328 @@
+// SPDX-License-Identifier: MIT
+// Replays and live runs under faults: a task body (or a first touch) that throws ends the
+// step with its message and every thread joined; a wait that is never signalled ends with
+// the watchdog's report instead of a hang; a body that never returns ends the process.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tgraph/capture/recorder.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/partition/strategy.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/live.hpp"
+#include "tgraph/replay/lowering.hpp"
+#include "tgraph/samples/live_engine.hpp"
+#include "tgraph/samples/scene.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+// Threads of this process (/proc/self/status).
+int process_threads() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  return -1;
+}
+
+// Step 1 of the falling scene as captured (one CG loop per falling object), edges derived.
+const StepGraph& falling_step() {
+  static const StepGraph g = [] {
+    auto scene = samples::make_scene("falling");
+    capture::Recorder rec(capture::Mode::kCapture);
+    scene->step(rec);
+    rec.end_step();
+    scene->step(rec);
+    StepGraph s = rec.end_step();
+    s.derive_edges();
+    return s;
+  }();
+  return g;
+}
+
+// Tasks by object on two processors (any mapping is a valid assignment).
+Assignment by_object(const StepGraph& g, std::uint32_t k) {
+  Assignment a;
+  a.k = k;
+  for (const Task& t : g.tasks) a.proc.push_back(t.object == kNoObject ? 0 : t.object % k);
+  return a;
+}
+
+// Runs every task; throws in run() of `bad_task` or in first_touch() when asked; stops
+// loops after 2 iterations.
+class FaultyWorkload : public Workload {
+ public:
+  TaskId bad_task = kNoTask;
+  bool bad_touch = false;
+  std::atomic<std::uint64_t> ran{0};
+  void run(const TaskRun& r) override {
+    if (bad_task != kNoTask && r.origin == bad_task)
+      throw std::runtime_error("body of task " + std::to_string(r.origin) + " failed");
+    ran.fetch_add(1, std::memory_order_relaxed);  // relaxed: a count read after the step
+  }
+  bool needs_touch(DatumId) const override { return bad_touch; }
+  void first_touch(DatumId d) override {
+    if (bad_touch) throw std::runtime_error("allocation of datum " + std::to_string(d) + " failed");
+  }
+  bool stop_after(LoopId, std::uint32_t iteration) override { return iteration >= 1; }
+};
+
+struct PolicyCase {
+  Policy policy;
+  std::uint32_t threads;
+};
+
+std::vector<PolicyCase> policies() {
+  std::vector<PolicyCase> v = {{Policy::kSequential, 1},
+                               {Policy::kPartition, 2},
+                               {Policy::kPartition, 3},
+                               {Policy::kWorksteal, 2},
+                               {Policy::kBarrier, 2}};
+#ifdef TGRAPH_HAVE_STARPU
+  v.push_back({Policy::kStarpu, 2});
+#endif
+  return v;
+}
+
+std::string name_of(const PolicyCase& c) {
+  return std::string(to_string(c.policy)) + " k=" + std::to_string(c.threads);
+}
+
+TEST(ThrowingTask, EndsTheReplayStepWithItsMessageForEveryPolicy) {
+  const StepGraph& g = falling_step();
+  // A task in the middle of the step (inside a CG loop: the loop must not wait for it).
+  TaskId bad = kNoTask;
+  for (TaskId t = static_cast<TaskId>(g.tasks.size() / 2); t < g.tasks.size() && bad == kNoTask;
+       ++t)
+    if (g.tasks[t].loop != kNoLoop) bad = t;
+  ASSERT_NE(bad, kNoTask);
+  for (const PolicyCase& c : policies()) {
+    ExecOptions o;
+    o.threads = c.threads;
+    o.pin = false;
+    o.spin_ns = 1000;
+    const Assignment a = by_object(g, c.threads);
+    {
+      auto ex = make_executor(c.policy, o);
+      FaultyWorkload w;
+      w.bad_task = bad;
+      try {
+        ex->run_step(g, &a, w);
+        ADD_FAILURE() << name_of(c) << ": no exception";
+      } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "body of task " + std::to_string(bad) + " failed")
+            << name_of(c);
+      }
+      // The executor stays usable: the same step with a healthy workload runs every task.
+      FaultyWorkload ok;
+      ASSERT_NO_THROW(ex->run_step(g, &a, ok)) << name_of(c);
+      EXPECT_GE(ok.ran.load(), g.tasks.size()) << name_of(c);
+    }
+  }
+}
+
+// Regression: a first touch that threw left the other processors waiting at the
+// first-touch barrier forever (the failing thread never arrived).
+TEST(ThrowingTask, AFailedFirstTouchEndsThePartitionStepAndJoinsItsThreads) {
+  const StepGraph& g = falling_step();
+  const int before = process_threads();
+  for (std::uint32_t k : {2u, 3u}) {
+    ExecOptions o;
+    o.threads = k;
+    o.pin = false;
+    o.spin_ns = 0;
+    const Assignment a = by_object(g, k);
+    {
+      auto ex = make_executor(Policy::kPartition, o);
+      FaultyWorkload w;
+      w.bad_touch = true;
+      try {
+        ex->run_step(g, &a, w);
+        ADD_FAILURE() << "k=" << k << ": no exception";
+      } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("allocation of datum ", 0), 0u) << e.what();
+      }
+      EXPECT_EQ(w.ran.load(), 0u);  // no task ran on unallocated data
+    }
+    EXPECT_EQ(process_threads(), before) << "k=" << k;  // every worker joined
+  }
+}
+
+// A live engine whose body of one task throws at one step.
+class ThrowingEngine : public LiveEngine {
+ public:
+  ThrowingEngine(std::unique_ptr<LiveEngine> inner, std::uint32_t bad_step)
+      : inner_(std::move(inner)), bad_step_(bad_step) {}
+  LiveStep record_step(bool allow_reuse) override {
+    const std::uint32_t s = step_++;
+    LiveStep st = inner_->record_step(allow_reuse && s != bad_step_ && s != bad_step_ + 1);
+    if (s == bad_step_) {
+      for (std::size_t t = st.bodies.size() / 2; t < st.bodies.size(); ++t)
+        if (st.bodies[t]) {
+          st.bodies[t] = [s] {
+            throw std::runtime_error("engine body failed at step " + std::to_string(s));
+          };
+          break;
+        }
+    }
+    return st;
+  }
+  void plain_step() override { inner_->plain_step(); }
+  std::vector<StateRegion> state() const override { return inner_->state(); }
+
+ private:
+  std::unique_ptr<LiveEngine> inner_;
+  std::uint32_t bad_step_;
+  std::uint32_t step_ = 0;
+};
+
+TEST(ThrowingTask, EndsALiveRunWithItsMessageForEveryPolicy) {
+  std::shared_ptr<partition::Strategy> owner = partition::make_strategy("owner");
+  const LivePartitioner part = [owner](const StepGraph& g, std::uint32_t k, const StepGraph* pg,
+                                       const Assignment* pa) {
+    return owner->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
+  };
+  const int before = process_threads();
+  for (const PolicyCase& c : policies()) {
+    LiveOptions o;
+    o.policy = c.policy;
+    o.exec.threads = c.threads;
+    o.exec.pin = false;
+    o.exec.spin_ns = 1000;
+    o.steps = 4;
+    o.baseline = false;
+    o.observe = false;
+    try {
+      run_live(
+          [] { return std::make_unique<ThrowingEngine>(samples::make_live_engine("fig2"), 2); },
+          c.policy == Policy::kPartition ? &part : nullptr, o);
+      ADD_FAILURE() << name_of(c) << ": no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("engine body failed at step 2"), std::string::npos)
+          << name_of(c) << ": " << e.what();
+    }
+    // The partition executor's threads are the run's own (TBB, OpenMP and StarPU keep
+    // their pools): they are all joined when the run ends.
+    if (c.policy == Policy::kPartition) EXPECT_EQ(process_threads(), before) << name_of(c);
+  }
+}
+
+// ---- the watchdog -------------------------------------------------------------------------
+
+// A task outside loops read by a task of another processor.
+TaskId cross_producer(const StepGraph& g, const Assignment& a) {
+  for (const Edge& e : g.edges)
+    if (a.proc[e.from] != a.proc[e.to] && g.tasks[e.from].loop == kNoLoop &&
+        g.tasks[e.to].loop == kNoLoop && e.kind == EdgeKind::RAW)
+      return e.from;
+  return kNoTask;
+}
+
+TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
+  const StepGraph& g = falling_step();
+  const int before = process_threads();
+  for (std::uint32_t k : {2u, 3u}) {
+    const Assignment a = by_object(g, k);
+    const TaskId lost = cross_producer(g, a);
+    ASSERT_NE(lost, kNoTask);
+    ExecOptions o;
+    o.threads = k;
+    o.pin = false;
+    o.spin_ns = 1000;
+    o.timeout_ms = 200;
+    // Every cross-processor producer gets its own wait (none is implied by a later one of
+    // the same processor), so the lost signal is always waited for.
+    o.elide_waits = false;
+    o.test_lose_signal = lost;
+    {
+      auto ex = make_executor(Policy::kPartition, o);
+      FaultyWorkload w;
+      try {
+        ex->run_step(g, &a, w);
+        ADD_FAILURE() << "k=" << k << ": no exception";
+      } catch (const std::runtime_error& e) {
+        const std::string msg = e.what();
+        std::printf("k=%u: %s\n", k, msg.c_str());  // the report, for the record
+        EXPECT_EQ(msg.rfind("replay stopped making progress for ", 0), 0u) << msg;
+        // The report names exec tasks (the lowering may add reducers): map through them.
+        const ExecGraph* x = ex->last_exec();
+        ASSERT_NE(x, nullptr);
+        const TaskId xt = x->exec_of[lost];
+        EXPECT_NE(msg.find("waits for task " + std::to_string(xt) + " (" + x->graph.kind_name(xt) +
+                           ") on thread " + std::to_string(a.proc[lost])),
+                  std::string::npos)
+            << msg;
+        EXPECT_NE(msg.find("(datum '"), std::string::npos) << msg;
+      }
+    }
+    EXPECT_EQ(process_threads(), before) << "k=" << k;  // workers and watchdog joined
+    // Without the lost signal the same step runs to its end under the same watchdog.
+    o.test_lose_signal.reset();
+    auto ex = make_executor(Policy::kPartition, o);
+    FaultyWorkload ok;
+    EXPECT_NO_THROW(ex->run_step(g, &a, ok));
+    EXPECT_NO_THROW(ex->run_step(g, &a, ok));
+  }
+}
+
+// A workload whose body of one task never returns (it sleeps until the process ends).
+class HangingWorkload : public Workload {
+ public:
+  explicit HangingWorkload(TaskId t) : t_(t) {}
+  void run(const TaskRun& r) override {
+    if (r.origin == t_)
+      for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  bool stop_after(LoopId, std::uint32_t iteration) override { return iteration >= 1; }
+
+ private:
+  TaskId t_;
+};
+
+TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const StepGraph& g = falling_step();
+  const Assignment a = by_object(g, 2);
+  const TaskId stuck = cross_producer(g, a);
+  ASSERT_NE(stuck, kNoTask);
+  EXPECT_EXIT(
+      {
+        ExecOptions o;
+        o.threads = 2;
+        o.pin = false;
+        o.timeout_ms = 200;
+        o.timeout_exits = true;
+        auto ex = make_executor(Policy::kPartition, o);
+        HangingWorkload w(stuck);
+        ex->run_step(g, &a, w);
+      },
+      ::testing::ExitedWithCode(1),
+      "replay stopped making progress \\(--timeout\\): thread .* runs or last ran task .*; a task "
+      "body does not return, ending the process");
+}
+
+TEST(Watchdog, IsOffWithTimeoutZero) {
+  const StepGraph& g = falling_step();
+  const Assignment a = by_object(g, 2);
+  ExecOptions o;
+  o.threads = 2;
+  o.pin = false;
+  o.timeout_ms = 0;
+  auto ex = make_executor(Policy::kPartition, o);
+  FaultyWorkload w;
+  EXPECT_NO_THROW(ex->run_step(g, &a, w));
+  EXPECT_GE(w.ran.load(), g.tasks.size());
+}
+
+}  // namespace
+}  // namespace tgraph::replay
