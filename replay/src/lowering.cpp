@@ -232,7 +232,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   // processor that it transitively depends on, inside its loop's block there when it has a
   // loop. "Depends" follows what a processor actually waits for: the graph's edges, its
   // predecessor in its processor's order, and, for a task that follows a loop (by an edge or
-  // in its processor's order), the loop's break task (the exit decision). The orders plus
+  // in its processor's order), every task of the loop (its exit). The orders plus
   // these relations are acyclic (the orders do not deadlock); inserting a task after all its
   // ancestors on one processor keeps them acyclic. The graph's edges alone are not enough:
   // reducers placed early on two processors can each wait for tasks behind the other's
@@ -281,11 +281,16 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
           stack.push_back(u);
         }
       };
-      // t waits for u; when u is in a loop that t is not in, t also waits for its exit.
+      // t waits for u; when u is in a loop that t is not in, t waits for the loop's exit,
+      // and the exit waits for the last iteration of every task of the loop, on every
+      // processor: an iteration's tasks can wait, through loop-carried edges and each
+      // processor's order, for any task of the previous one (a reducer placed before its
+      // home processor's block of that loop would stall the loop it waits for).
       auto waits_for = [&](TaskId t, TaskId u) {
         visit(u);
         const LoopId lu = loop_of(u);
-        if (lu != kNoLoop && lu != loop_of(t)) visit(xg.loops[lu].last - 1);
+        if (lu != kNoLoop && lu != loop_of(t))
+          for (TaskId v = xg.loops[lu].first; v < xg.loops[lu].last; ++v) visit(v);
       };
       while (!stack.empty()) {
         const TaskId t = stack.back();

@@ -458,6 +458,65 @@ std::string task_label(const ExecGraph& x, TaskId t) {
   return "exec task " + std::to_string(t);
 }
 
+/// The waits of a plan with explicit orders between whole loops: each loop contracted to one
+/// node (a processor enters its block only after what precedes the block in its order, and
+/// what follows the block waits for the loop's exit, which needs every iteration of every
+/// block), plus the graph's edges between different nodes. A cycle can deadlock after any
+/// number of iterations (a task behind one processor's block that another processor's
+/// block waits for), which two simulated iterations need not show; "" when acyclic, else
+/// the loop or task where the cycle was found.
+std::string loop_wait_cycle(const Plan& plan, const ExecGraph& x) {
+  const StepGraph& g = x.graph;
+  if (g.loops.empty()) return "";
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  auto node = [&](TaskId t) { return g.tasks[t].loop == kNoLoop ? t : n + g.tasks[t].loop; };
+  const std::size_t nodes = n + g.loops.size();
+  std::vector<std::vector<std::uint32_t>> succ(nodes);
+  std::vector<std::uint32_t> indeg(nodes, 0);
+  auto link = [&](std::uint32_t a, std::uint32_t b) {
+    if (a == b) return;
+    succ[a].push_back(b);
+    ++indeg[b];
+  };
+  for (const Edge& e : g.edges) link(node(e.from), node(e.to));
+  for (const ProcPlan& pp : plan.procs) {
+    std::uint32_t prev = UINT32_MAX;
+    for (const Op& op : pp.ops) {
+      std::uint32_t v;
+      if (op.kind == OpKind::kLoopBegin) {
+        v = n + op.loop;
+      } else if (op.kind == OpKind::kTask && op.loop == kNoLoop) {
+        v = op.task;
+      } else {
+        continue;
+      }
+      if (prev != UINT32_MAX) link(prev, v);
+      prev = v;
+    }
+  }
+  std::vector<std::uint32_t> ready;
+  for (std::uint32_t v = 0; v < nodes; ++v)
+    if (indeg[v] == 0) ready.push_back(v);
+  std::size_t seen = 0;
+  while (!ready.empty()) {
+    const std::uint32_t v = ready.back();
+    ready.pop_back();
+    ++seen;
+    for (std::uint32_t s : succ[v])
+      if (--indeg[s] == 0) ready.push_back(s);
+  }
+  if (seen == nodes) return "";
+  for (std::uint32_t v = n; v < nodes; ++v)
+    if (indeg[v] != 0)
+      return "the processors' orders wait in a cycle through loop " + std::to_string(v - n) +
+             " (a task that one processor runs after its block of the loop is needed inside "
+             "the loop)";
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (indeg[v] != 0)
+      return "the processors' orders wait in a cycle through " + task_label(x, v);
+  return "";
+}
+
 /// Runs the per-processor programs interleaved on one thread (round robin, each processor
 /// advancing while its waits hold). With a workload: the serial executor (deterministic);
 /// without: the deadlock check of a plan (every loop runs two iterations).
@@ -543,15 +602,19 @@ void run_interleaved(const Plan& plan, const ExecGraph& x, Workload* w,
     }
     if (all_done) return;
     if (!progress) {
+      // Every processor that has not finished, and what it is stuck at.
+      std::string stuck;
       for (std::size_t p = 0; p < k; ++p)
         if (cur[p].pc < plan.procs[p].ops.size()) {
           const Op& op = plan.procs[p].ops[cur[p].pc];
-          throw UsageError("the assignment's task order deadlocks: processor " + std::to_string(p) +
-                           " cannot run " +
-                           (op.kind == OpKind::kTask ? task_label(x, op.task)
-                                                     : std::string("its loop control")) +
-                           " (" + g.kind_name(op.kind == OpKind::kTask ? op.task : 0) + ")");
+          stuck += (stuck.empty() ? "processor " : "; processor ") + std::to_string(p) +
+                   " cannot run " +
+                   (op.kind == OpKind::kTask
+                        ? task_label(x, op.task) + " (" + g.kind_name(op.task) + ")"
+                        : std::string("its loop control")) +
+                   " in iteration " + std::to_string(cur[p].iter);
         }
+      throw UsageError("the assignment's task order deadlocks: " + stuck);
     }
   }
 }
@@ -616,6 +679,8 @@ class PartitionExecutor final : public Executor {
     lose_signal(*plan, x);
     if (plan->program_order) return plan;
     try {
+      if (const std::string cycle = loop_wait_cycle(*plan, x); !cycle.empty())
+        throw UsageError("the assignment's task order deadlocks: " + cycle);
       run_interleaved(*plan, x, nullptr, nullptr, nullptr);  // throws if the order deadlocks
     } catch (const UsageError&) {
       if (plan->program_order || !x.added_edges) throw;  // the order itself is invalid

@@ -46,8 +46,12 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
                                     : AccessMode::RW;
       acc.push_back({d, m});
     }
-    const TaskId t = g.add_task(static_cast<KindId>(pick(4)), static_cast<ObjectId>(pick(4)), acc,
-                                static_cast<std::uint64_t>(pick(2000)));
+    // One pick per statement: the order of a call's arguments is unspecified (g++ and
+    // clang differ), and the graph of a seed must not depend on the compiler.
+    const auto kind = static_cast<KindId>(pick(4));
+    const auto object = static_cast<ObjectId>(pick(4));
+    const auto cost = static_cast<std::uint64_t>(pick(2000));
+    const TaskId t = g.add_task(kind, object, acc, cost);
     g.tasks[t].loop = loop;
   };
   for (int s = 0; s < segments; ++s) {

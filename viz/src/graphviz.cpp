@@ -335,14 +335,15 @@ std::string render_graph(const GraphView& view, GraphFormat format) {
   if (format == GraphFormat::kDot) return to_dot(view);
   std::lock_guard<std::mutex> lock(graphviz_mutex());
   agseterr(AGMAX);
-  struct ContextCloser {
-    void operator()(GVC_t* c) const { gvFreeContext(c); }
-  };
-  std::unique_ptr<GVC_t, ContextCloser> gvc(gvContext());
+  // One context for the whole process, never freed: Graphviz 2.42's pango plugin keeps a
+  // pointer to the last font name it measured, and that name lives in the context's font
+  // table. Freeing the context and rendering again with a new one reads the freed name
+  // (a heap-use-after-free that AddressSanitizer reports inside libgvplugin_pango).
+  static GVC_t* const gvc = gvContext();
   if (!gvc) throw std::runtime_error("Graphviz: no context (libgvc)");
   Builder b(view);
   GraphPtr g = b.build();
-  if (gvLayout(gvc.get(), g.get(), "dot") != 0) {
+  if (gvLayout(gvc, g.get(), "dot") != 0) {
     const char* why = aglasterr();
     throw std::runtime_error(std::string("Graphviz dot layout failed") +
                              (why ? ": " + std::string(why) : ""));
@@ -350,11 +351,11 @@ std::string render_graph(const GraphView& view, GraphFormat format) {
   char* data = nullptr;
   unsigned int length = 0;
   const std::string name(to_string(format));
-  const int rc = gvRenderData(gvc.get(), g.get(), name.c_str(), &data, &length);
+  const int rc = gvRenderData(gvc, g.get(), name.c_str(), &data, &length);
   std::string out;
   if (rc == 0 && data) out.assign(data, length);
   if (data) gvFreeRenderData(data);
-  gvFreeLayout(gvc.get(), g.get());
+  gvFreeLayout(gvc, g.get());
   if (rc != 0)
     throw std::runtime_error("Graphviz cannot render " + name +
                              " (is graphviz's cairo plugin, libgvplugin_pango, installed?)");
