@@ -64,4 +64,19 @@ void add_viz_verbs(CLI::App& app);        // viz, then add_timeline and add_repo
 void add_timeline(CLI::App& app);
 void add_report(CLI::App& app);
 
+/// Every verb, in the order `tgraph --help` lists them (main() and the command-line fuzz
+/// target register the same set).
+inline void add_all_verbs(CLI::App& app) {
+  add_demo(app);
+  add_experiment(app);
+  add_capture(app);
+  add_info(app);
+  add_export(app);
+  add_diff(app);
+  add_partition_verbs(app);
+  add_replay_verbs(app);
+  add_validate(app);
+  add_viz_verbs(app);
+}
+
 }  // namespace tgraph::app

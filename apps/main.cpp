@@ -13,16 +13,7 @@ int main(int argc, char** argv) {
       "tgraph: capture, partition, evaluate and replay task graphs of physics simulations"};
   app.set_version_flag("--version", std::string("tgraph ") + TGRAPH_VERSION);
   app.require_subcommand(0, 1);
-  add_demo(app);
-  add_experiment(app);
-  add_capture(app);
-  add_info(app);
-  add_export(app);
-  add_diff(app);
-  add_partition_verbs(app);
-  add_replay_verbs(app);
-  add_validate(app);
-  add_viz_verbs(app);
+  add_all_verbs(app);
   try {
     app.parse(argc, argv);
     if (app.get_subcommands().empty()) {

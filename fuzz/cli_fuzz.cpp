@@ -26,12 +26,7 @@ CLI::App& make_app() {
     auto* a = new CLI::App{"tgraph"};
     a->set_version_flag("--version", std::string("tgraph fuzz"));
     a->require_subcommand(0, 1);
-    tgraph::app::add_demo(*a);
-    tgraph::app::add_capture(*a);
-    tgraph::app::add_info(*a);
-    tgraph::app::add_export(*a);
-    tgraph::app::add_partition_verbs(*a);
-    tgraph::app::add_replay_verbs(*a);
+    tgraph::app::add_all_verbs(*a);
     // The verbs' callbacks keep their option storage alive: they stay registered.
     a->parse_complete_callback([] { throw Parsed{}; });
     return a;
