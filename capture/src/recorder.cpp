@@ -48,9 +48,10 @@ KindId Recorder::kind(std::string_view name) {
   return static_cast<KindId>(kinds_.size() - 1);
 }
 
-void Recorder::begin_step() {
+void Recorder::begin_step(std::uint64_t host_ns) {
   if (in_step_) ++errors_;
   in_step_ = true;
+  host_ns_ = host_ns;
   cur_.tasks.clear();
   cur_.accesses.clear();
   cur_.loops.clear();
@@ -172,6 +173,7 @@ StepGraph Recorder::finish_step() {
   g.loops = cur_.loops;
   g.contacts = std::move(cur_.contacts);
   g.groups = std::move(cur_.groups);
+  g.host_ns = host_ns_;
   g.kinds = kinds_;
   g.objects = objects_;
   g.data = data_;

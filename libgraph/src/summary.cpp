@@ -28,6 +28,7 @@ TraceSummary summarize_trace(const Trace& trace) {
     for (const Loop& l : g.loops) st.loop_iterations.push_back(l.iterations);
     st.work_ns = m.work_ns;
     st.span_ns = m.span_ns;
+    st.host_ns = g.host_ns;
     st.parallelism = m.parallelism;
     st.contacts = g.contacts.size();
     const std::set<std::uint32_t> groups(g.groups.begin(), g.groups.end());
@@ -50,6 +51,7 @@ TraceSummary summarize_trace(const Trace& trace) {
       s.max_loop_iterations = std::max(s.max_loop_iterations, it);
     s.work_ns += st.work_ns;
     s.span_ns += st.span_ns;
+    s.host_ns += st.host_ns;
     shapes.insert(st.structure);
     s.contact_changes += st.contacts_changed ? 1 : 0;
     s.last_step_collision_groups = st.collision_groups;
@@ -75,6 +77,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
                         {"loop_iterations", st.loop_iterations},
                         {"work_ns", st.work_ns},
                         {"span_ns", st.span_ns},
+                        {"host_ns", st.host_ns},
                         {"parallelism", st.parallelism},
                         {"contacts", st.contacts},
                         {"collision_groups", st.collision_groups},
@@ -99,6 +102,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"max_loop_iterations", s.max_loop_iterations},
       {"work_ns", s.work_ns},
       {"span_ns", s.span_ns},
+      {"host_ns", s.host_ns},
       {"parallelism", s.parallelism},
       {"distinct_structures", s.distinct_structures},
       {"contact_changes", s.contact_changes},
@@ -133,6 +137,8 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
                     static_cast<double>(s.work_ns) / 1e6));
   add(std::snprintf(line, sizeof line, "span           %.3f ms\n",
                     static_cast<double>(s.span_ns) / 1e6));
+  add(std::snprintf(line, sizeof line, "host           %.3f ms (engine work outside the tasks)\n",
+                    static_cast<double>(s.host_ns) / 1e6));
   add(std::snprintf(line, sizeof line, "parallelism    %.2f\n", s.parallelism));
   add(std::snprintf(line, sizeof line, "structures     %llu distinct\n",
                     static_cast<unsigned long long>(s.distinct_structures)));

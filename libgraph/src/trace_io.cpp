@@ -23,7 +23,9 @@ namespace tgraph {
 namespace {
 
 constexpr std::array<std::uint8_t, 4> kMagic = {'T', 'G', 'T', 'R'};
-constexpr std::uint32_t kFormatVersion = 1;
+constexpr std::uint32_t kFormatVersion = 2;
+// Version 1 lacks the step's host time (StepGraph::host_ns, read as 0); still read.
+constexpr std::uint32_t kOldestFormatVersion = 1;
 constexpr std::size_t kFileHeaderSize = 8;    // magic + u32 version
 constexpr std::size_t kFrameHeaderSize = 12;  // u32 type + u32 length + u32 crc
 
@@ -127,6 +129,7 @@ void encode_step_values(ByteWriter& w, const StepGraph& g) {
   }
   w.count(g.groups.size(), "groups");
   for (const auto g_id : g.groups) w.u32(g_id);
+  w.u64(g.host_ns);
 }
 
 // Encodes steps one frame each, remembering structures already written so that a repeat
@@ -336,9 +339,10 @@ class TraceDecoder {
       fail(0, "bad magic: expected \"TGTR\" (" + hex_bytes(kMagic.data(), 4) + "), found " +
                   hex_bytes(bytes_.data(), 4) + " (not a .tgt trace)");
     const std::uint32_t version = get_u32(4);
-    if (version != kFormatVersion)
+    if (version < kOldestFormatVersion || version > kFormatVersion)
       fail(4, "unsupported format version " + std::to_string(version) + ": expected " +
-                  std::to_string(kFormatVersion));
+                  std::to_string(kOldestFormatVersion) + " to " + std::to_string(kFormatVersion));
+    version_ = version;
   }
 
   // The data end cleanly or in a partial frame, without an end frame.
@@ -575,6 +579,7 @@ class TraceDecoder {
                    " collision groups (one per object), found " + std::to_string(n_groups));
     g.groups.resize(n_groups);
     for (auto& group : g.groups) group = p.u32("u32 collision group");
+    g.host_ns = version_ >= 2 ? p.u64("u64 host time") : 0;
   }
 
   std::span<const std::uint8_t> bytes_;
@@ -585,6 +590,7 @@ class TraceDecoder {
   std::vector<std::uint64_t> shape_memory_;  // structure_memory() of each step read
   std::uint64_t decoded_ = 0;
   std::uint64_t budget_ = 0;
+  std::uint32_t version_ = kFormatVersion;  // of the file being read
 };
 
 // Writes all of `bytes` with write(2): one call unless the kernel writes less.

@@ -26,6 +26,7 @@ json step_json(const StepReport& r) {
           {"max_load_ns", r.max_load_ns},
           {"work_ns", r.work_ns},
           {"span_ns", r.span_ns},
+          {"host_ns", r.host_ns},
           {"lower_bound_ns", r.lower_bound_ns},
           {"predicted_makespan_ns", r.makespan_ns},
           {"predicted_speedup", r.speedup},

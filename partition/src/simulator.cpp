@@ -88,6 +88,8 @@ class Simulator {
         for (TaskId t : a.order[p]) place(p, t);
     }
     state_.resize(k_);
+    // The step's serial host work (StepGraph::host_ns) runs before any of its tasks.
+    for (State& st : state_) st.time = g_.host_ns;
     s_.busy_ns.assign(k_, 0);
     s_.finish_ns.assign(k_, 0);
   }

@@ -3,6 +3,7 @@
 // a rec.task(...) body that captures pointers to scene state (never references to locals),
 // so the same code records a runnable program in capture::Mode::kDeferred.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <utility>
@@ -414,6 +415,8 @@ bool Scene::step_if_changed(Recorder& rec) { return advance(rec, true); }
 
 bool Scene::advance(Recorder& rec, bool allow_reuse) {
   finalize();
+  // From here to the first task: the step's serial work outside the graph (StepGraph::host_ns).
+  const auto host_start = std::chrono::steady_clock::now();
   detail::check_divergence(*this, *impl_);  // what the last step left (deferred: ran since)
   Impl& m = *impl_;
   Binding& b = m.bind;
@@ -509,7 +512,9 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
   ++steps_run_;
   if (reuse) return false;
 
-  rec.begin_step();
+  rec.begin_step(static_cast<std::uint64_t>(std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                             std::chrono::steady_clock::now() - host_start)
+                                             .count()));
   Stepper stepper(*this, m, rec);
   // Declare everything this step touches before the contact set names the objects.
   std::vector<Contact> contact_set;

@@ -160,7 +160,9 @@ Bytes frame(std::uint32_t type, const Bytes& payload) {
   return head.raw(payload).b;
 }
 
-Bytes file_header(std::uint32_t version = 1) {
+constexpr std::uint32_t kVersion = 2;  // what the writer writes (docs/trace-format.md)
+
+Bytes file_header(std::uint32_t version = kVersion) {
   return Buf().u8('T').u8('G').u8('T').u8('R').u32(version).b;
 }
 
@@ -200,6 +202,7 @@ struct RawStep {
   std::vector<std::uint32_t> iterations{3};
   std::vector<std::pair<std::uint32_t, std::uint32_t>> contacts{{0, 1}};
   std::vector<std::uint32_t> groups{0, 0};
+  std::uint64_t host_ns = 77;
 
   Bytes structure() const {
     Buf w;
@@ -228,6 +231,7 @@ struct RawStep {
     for (auto [a, b] : contacts) w.u32(a).u32(b);
     w.u32(static_cast<std::uint32_t>(groups.size()));
     for (auto g : groups) w.u32(g);
+    w.u64(host_ns);
     return w.b;
   }
   Bytes full_frame() const { return frame(2, Buf().raw(structure()).raw(values()).b); }
@@ -565,6 +569,27 @@ TEST(TraceReader, EncoderOutputMatchesTheHandMadeBytes) {
   EXPECT_EQ(encode_trace(t), trace_of(s));
 }
 
+TEST(TraceReader, ReadsVersion1FramesWithoutTheHostTime) {
+  RawStep s;
+  const Trace v2 = read_trace_bytes(trace_of(s), "hand");
+  ASSERT_EQ(v2.steps.size(), 1u);
+  EXPECT_EQ(v2.steps[0].host_ns, 77u);
+  // The same step as version 1 wrote it: no host time after the groups.
+  Bytes payload = Buf().raw(s.structure()).raw(s.values()).b;
+  payload.resize(payload.size() - 8);
+  const Bytes v1_bytes =
+      Buf().raw(file_header(1)).raw(header_frame()).raw(frame(2, payload)).raw(end_frame(1)).b;
+  const Trace v1 = read_trace_bytes(v1_bytes, "hand-v1");
+  ASSERT_EQ(v1.steps.size(), 1u);
+  EXPECT_EQ(v1.steps[0].host_ns, 0u);
+  StepGraph g = v1.steps[0];
+  g.host_ns = 77;
+  EXPECT_EQ(g, v2.steps[0]);
+  // A version 2 frame cut before its host time is truncated, not read as version 1.
+  EXPECT_READ_ERROR(Buf().raw(file_header(2)).raw(header_frame()).raw(frame(2, payload)).raw(end_frame(1)).b,
+                    "u64 host time");
+}
+
 // ---- corruption, one class at a time ----------------------------------------------------
 
 TEST(TraceReader, RejectsATruncatedFileHeader) {
@@ -580,8 +605,10 @@ TEST(TraceReader, RejectsBadMagic) {
 
 TEST(TraceReader, RejectsAnUnsupportedVersion) {
   Bytes b = trace_of(RawStep{});
-  b[4] = 2;
-  EXPECT_READ_ERROR(b, "offset 4: unsupported format version 2: expected 1");
+  b[4] = 3;
+  EXPECT_READ_ERROR(b, "offset 4: unsupported format version 3: expected 1 to 2");
+  b[4] = 0;
+  EXPECT_READ_ERROR(b, "offset 4: unsupported format version 0: expected 1 to 2");
 }
 
 TEST(TraceReader, RejectsATruncatedFrame) {
@@ -646,7 +673,7 @@ TEST(TraceReader, RejectsAbsurdCountsWithoutAllocatingForThem) {
   at += 4 + 8;
   counts.push_back({at, "groups"});
   const Bytes values = s.values();
-  ASSERT_EQ(at + 4 + 8, structure.size() + values.size());
+  ASSERT_EQ(at + 4 + 8 + 8, structure.size() + values.size());  // groups, host time
   for (const auto& [offset, what] : counts) {
     Bytes payload = Buf().raw(structure).raw(values).b;
     for (int i = 0; i < 4; ++i) payload[offset + static_cast<std::size_t>(i)] = 0xFF;
@@ -881,8 +908,20 @@ TEST(TraceReader, ReadsTheCommittedValidTraces) {
   EXPECT_EQ(small.steps[2].loops[0].iterations, 5u);
   EXPECT_TRUE(small.steps[0].same_structure(small.steps[2]));
   EXPECT_EQ(small.steps[1].contacts.size(), 0u);
+  EXPECT_EQ(small.steps[0].host_ns, 700u);
+  EXPECT_EQ(small.steps[1].host_ns, 0u);
+  EXPECT_EQ(small.steps[2].host_ns, 900u);
   // Writing it again gives the committed bytes: the format has not drifted.
   EXPECT_EQ(encode_trace(small), slurp(data_dir() / "small.tgt"));
+  // A version 1 file (no host times) reads as the same steps with host_ns 0.
+  const Trace v1 = read_trace((data_dir() / "small-v1.tgt").string());
+  ASSERT_EQ(v1.steps.size(), small.steps.size());
+  for (std::size_t s = 0; s < v1.steps.size(); ++s) {
+    EXPECT_EQ(v1.steps[s].host_ns, 0u);
+    StepGraph with_host = v1.steps[s];
+    with_host.host_ns = small.steps[s].host_ns;
+    EXPECT_EQ(with_host, small.steps[s]) << "step " << s;
+  }
   EXPECT_EQ(read_trace((data_dir() / "empty.tgt").string()).steps.size(), 0u);
   ReadOptions recover;
   recover.recover = true;

@@ -34,7 +34,10 @@ def frame(ftype, payload):
     return head + u32(crc) + payload
 
 
-def file_header(magic=b"TGTR", version=1):
+VERSION = 2  # what the C++ writer writes; version 1 lacks the host time of each step
+
+
+def file_header(magic=b"TGTR", version=VERSION):
     return magic + u32(version)
 
 
@@ -53,11 +56,13 @@ def structure(kinds, objects, data, accesses, tasks, loops):
     return out
 
 
-def values(costs, iterations, contacts, groups):
+def values(costs, iterations, contacts, groups, host_ns, version=VERSION):
     out = u32(len(costs)) + b"".join(u64(c) for c in costs)
     out += u32(len(iterations)) + b"".join(u32(i) for i in iterations)
     out += u32(len(contacts)) + b"".join(u32(a) + u32(b) for a, b in contacts)
     out += u32(len(groups)) + b"".join(u32(g) for g in groups)
+    if version >= 2:
+        out += u64(host_ns)
     return out
 
 
@@ -79,12 +84,12 @@ def full(s, v):
     return frame(2, structure(**s) + v)
 
 
-def small_parts(magic=b"TGTR", version=1, s0=S0, ref=0):
+def small_parts(magic=b"TGTR", version=VERSION, s0=S0, ref=0):
     return [file_header(magic, version),
             header_frame("hand-made", "make_traces.py", "none", "0.1.0"),
-            full(s0, values([40, 50], [3], [(0, 1)], [0, 0])),
-            full(S1, values([1, 2, 3, 4], [], [], [])),
-            frame(3, u32(ref) + values([41, 51], [5], [(0, 1)], [1, 1])),
+            full(s0, values([40, 50], [3], [(0, 1)], [0, 0], 700, version)),
+            full(S1, values([1, 2, 3, 4], [], [], [], 0, version)),
+            frame(3, u32(ref) + values([41, 51], [5], [(0, 1)], [1, 1], 900, version)),
             frame(4, u32(3))]
 
 
@@ -97,7 +102,8 @@ def main():
     files["interrupted.tgt"] = b"".join(small_parts()[:4])
     files["truncated.tgt"] = b"".join(small_parts()[:4]) + small_parts()[4][:20]
     files["bad_magic.tgt"] = b"".join(small_parts(magic=b"TGTX"))
-    files["bad_version.tgt"] = b"".join(small_parts(version=2))
+    files["small-v1.tgt"] = b"".join(small_parts(version=1))  # older files stay readable
+    files["bad_version.tgt"] = b"".join(small_parts(version=3))
     broken = bytearray(small)
     step1 = len(b"".join(small_parts()[:3]))
     broken[step1 + 12 + 6] ^= 0x20  # a byte of step 1's payload; the CRC no longer matches

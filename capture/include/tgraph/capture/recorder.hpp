@@ -130,8 +130,10 @@ class Recorder {
   /// (paper section 3.2). Data without one keep their CW writers in program order live.
   void accumulator(DatumId d, Accumulator a);
 
-  /// Starts recording a step.
-  void begin_step();
+  /// Starts recording a step. `host_ns`: what the engine spent on this step before it, on
+  /// its main thread outside any task (collision detection, contact bookkeeping); stored
+  /// as StepGraph::host_ns so that replays and the simulator pay it too.
+  void begin_step(std::uint64_t host_ns = 0);
   /// Sets the step's contact set (object pairs) and collision group per object.
   void set_contacts(std::vector<Contact> contacts, std::vector<std::uint32_t> groups);
   /// Ends the step and returns its graph with edges derived (empty graph in kOff mode).
@@ -280,6 +282,7 @@ class Recorder {
   std::vector<std::uint64_t> object_hash_, kind_hash_;  // name hashes (0: not computed)
   std::chrono::steady_clock::time_point step_clock_{};  // begin_step: ticks -> ns per step
   std::uint64_t step_ticks_ = 0;
+  std::uint64_t host_ns_ = 0;  // begin_step: the engine's serial time before the step
   std::vector<std::function<void()>> bodies_;
   std::vector<std::function<bool()>> conditions_;
   std::vector<Access> range_buffer_;  // accesses of task() given as a non-contiguous range

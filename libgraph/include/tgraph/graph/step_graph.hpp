@@ -117,6 +117,10 @@ class StepGraph {
   /// Collision group of objects [0, groups.size()) (bodies; interaction objects declared
   /// after them may have none). Empty: one group.
   std::vector<std::uint32_t> groups;
+  /// Time the engine spent this step on its main thread outside the step's tasks and before
+  /// them (collision detection, contact and group bookkeeping): serial work that every
+  /// execution of the step pays before its first task. Replays run it, the simulator adds it.
+  std::uint64_t host_ns = 0;
 
   /// Derived by derive_edges(): intra-step edges (within one loop iteration for loop bodies).
   std::vector<Edge> edges;

@@ -19,6 +19,7 @@ struct StepSummary {
   std::vector<std::uint32_t> loop_iterations;  ///< per loop
   std::uint64_t work_ns = 0;
   std::uint64_t span_ns = 0;
+  std::uint64_t host_ns = 0;  ///< StepGraph::host_ns: serial engine time outside the tasks
   double parallelism = 0.0;
   std::uint64_t contacts = 0;
   std::uint64_t collision_groups = 0;  ///< distinct group ids (1 when none are recorded)
@@ -42,6 +43,7 @@ struct TraceSummary {
   std::uint32_t max_loop_iterations = 0;  ///< in one loop of one step
   std::uint64_t work_ns = 0;
   std::uint64_t span_ns = 0;  ///< sum of the steps' spans
+  std::uint64_t host_ns = 0;  ///< sum of the steps' host times (outside the tasks)
   double parallelism = 0.0;   ///< work / span (0 when the span is 0)
   std::uint64_t distinct_structures = 0;
   std::uint64_t contact_changes = 0;

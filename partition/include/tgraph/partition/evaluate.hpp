@@ -25,9 +25,10 @@ struct StepReport {
   std::uint64_t max_load_ns = 0;
   std::uint64_t work_ns = 0;
   std::uint64_t span_ns = 0;
-  std::uint64_t lower_bound_ns = 0;   ///< max(ceil(work / K), span)
-  std::uint64_t makespan_ns = 0;      ///< predicted by simulate()
-  double speedup = 1.0;               ///< work / makespan
+  std::uint64_t host_ns = 0;          ///< serial engine time outside the tasks (StepGraph::host_ns)
+  std::uint64_t lower_bound_ns = 0;   ///< host + max(ceil(work / K), span)
+  std::uint64_t makespan_ns = 0;      ///< predicted by simulate() (host time included)
+  double speedup = 1.0;               ///< (work + host) / makespan
   std::uint64_t migrated_tasks = 0;   ///< tasks (by stable key) whose processor changed
   std::uint64_t migrated_bytes = 0;   ///< bytes of the data those tasks access
   double partition_ms = 0.0;
@@ -41,10 +42,10 @@ struct Report {
   std::uint32_t k = 1;
   std::string model;                  ///< cost model source
   std::vector<StepReport> steps;
-  StepReport total;  ///< sums; imbalance = sum max load / sum mean load; speedup = work / makespan
+  StepReport total;  ///< sums; imbalance = sum max load / sum mean load; speedup = (work + host) / makespan
   double imbalance_max = 1.0;         ///< worst step
   std::uint64_t cyclic_steps = 0;     ///< steps whose quotient graph has a cycle
-  double speedup_with_partitioning = 1.0;  ///< work / (makespan + partition time)
+  double speedup_with_partitioning = 1.0;  ///< (work + host) / (makespan + partition time)
 };
 
 /// Evaluates `a` on `trace`; throws InputError (naming `a_name`) when the assignment does

@@ -28,6 +28,8 @@ struct Schedule {
 
 /// Simulates step `g` (edges derived) under assignment `a`:
 ///
+/// * the step starts with its host time (StepGraph::host_ns: the engine's serial work
+///   outside the graph), which every processor waits for;
 /// * every processor runs its tasks one after the other, in `a.order[p]` or program order;
 /// * a task starts when its processor is free and every dependency (intra-step edges;
 ///   loop-carried edges from the previous iteration) has finished, plus

@@ -64,6 +64,9 @@ struct StepMeasure {
   std::int64_t wait_ns = 0;
   std::uint64_t remote_bytes = 0, migrated_bytes = 0;  ///< from the observed pass
   std::uint64_t work_ns = 0, span_ns = 0;
+  /// The step's host time (StepGraph::host_ns), spun on the calling thread before each run of
+  /// the step and counted in wall_ns, sequential_wall_ns and run_ns.
+  std::uint64_t host_ns = 0;
   std::optional<std::uint64_t> predicted_makespan_ns;
   std::vector<StatsObserver::Thread> threads;  ///< from the observed pass
 };
@@ -82,6 +85,7 @@ struct ReplayResult {
   double bound = 1;       ///< min(threads, work / span)
   double efficiency = 0;  ///< speedup / bound
   std::uint64_t work_ns = 0, span_ns = 0;
+  std::uint64_t host_ns = 0;  ///< sum of the steps' host times (StepMeasure::host_ns)
   std::uint64_t plans_built = 0;
   std::uint64_t order_fallbacks = 0;  ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;
