@@ -19,7 +19,8 @@ void add_validate(CLI::App& app) {
   cmd->add_option("--method", o->method,
                   "Partitioning strategy, or a baseline policy (worksteal, barrier, sequential)");
   cmd->add_option("--steps", o->steps, "Steps (default 20)");
-  cmd->add_option("--repeat", o->repeat, "Timed passes of each (medians; default 3)");
+  cmd->add_option("--repeat", o->repeat,
+                  "Rounds of live pass, capture, replay pass and simulation (medians; default 3)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([o, a] {
     const samples::Validation v = samples::validate_scene(*o);

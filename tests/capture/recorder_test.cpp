@@ -151,6 +151,21 @@ TEST(Recorder, StableKeysRepeatAcrossStepsAndStructureIsEqual) {
   EXPECT_EQ(a.structural_hash(), b.structural_hash());
 }
 
+TEST(Recorder, KeepsTheHostTimeGivenToBeginStepForThatStepOnly) {
+  Recorder rec(Mode::kCapture);
+  const KindId k = rec.kind("k");
+  const ObjectId o = rec.object("o");
+  const DatumId x = rec.datum("x", o, 8);
+  rec.begin_step(1234);
+  rec.task(k, o, {{x, AccessMode::RW}}, [] {});
+  EXPECT_EQ(rec.end_step().host_ns, 1234u);
+  rec.begin_step();
+  rec.task(k, o, {{x, AccessMode::RW}}, [] {});
+  const StepGraph g = rec.end_step();
+  EXPECT_EQ(g.host_ns, 0u);
+  EXPECT_EQ(g.tasks.size(), 1u);
+}
+
 TEST(Recorder, OffModeRunsBodiesAndRecordsNothing) {
   Scene s(Mode::kOff);
   s.step();

@@ -59,6 +59,17 @@ TEST(Scenes, Bars64HasSixtyFourIdenticalBarsInOneCgLoop) {
   EXPECT_TRUE(rec.end_step().same_structure(g));
 }
 
+TEST(Scenes, FallingRecordsItsCollisionDetectionAsTheStepsHostTime) {
+  // Collision detection runs on the engine's thread before the step's tasks, outside the
+  // graph: each step carries its duration, which replays and the simulator pay.
+  auto s = make_scene("falling");
+  capture::Recorder rec(capture::Mode::kCapture);
+  for (int k = 0; k < 3; ++k) {
+    s->step(rec);
+    EXPECT_GT(rec.end_step().host_ns, 0u) << "step " << k;
+  }
+}
+
 TEST(Scenes, FallingMergesIntoOneCollisionGroup) {
   auto s = make_scene("falling");
   capture::Recorder rec(capture::Mode::kCapture);

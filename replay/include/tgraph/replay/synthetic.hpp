@@ -29,7 +29,9 @@ struct SyntheticOptions {
 
 /// Bodies that cost what the trace recorded and move the memory the data would.
 ///
-/// A task reads every word of its R/RW data, then writes its W/RW/CW data (W: overwrite,
+/// A task reads every word of its R/RW data (or, when its recorded cost is shorter than that
+/// pass at in-cache speed, the leading fraction of each datum that fits in its cost), then
+/// writes its W/RW/CW data (W: overwrite,
 /// RW: combine, CW: add), with values derived from what it read, so that the final buffer
 /// contents depend on the order the dataflow graph prescribes (and CW sums are exact
 /// integers: any reduction order gives the same bits). It then spins for its recorded cost

@@ -17,20 +17,34 @@ struct ValidateOptions {
   std::string method = "owner";  ///< strategy, or a baseline policy (worksteal, barrier...)
   std::uint32_t threads = 1;
   std::uint32_t steps = 20;
-  std::uint32_t repeat = 3;  ///< timed passes of each (medians)
+  std::uint32_t repeat = 3;  ///< rounds (live pass, capture, replay pass, simulation); medians
 };
 
-/// The three figures of one validation.
+/// One round of a validation: the three measured back to back, so that a machine whose
+/// speed drifts (a shared VM) moves all three alike and their ratios stay comparable.
+struct ValidationRound {
+  std::int64_t live_ns = 0;    ///< live run, one pass
+  std::int64_t engine_ns = 0;  ///< uninstrumented engine, same round
+  std::int64_t replay_ns = 0;  ///< synthetic replay of this round's capture, one pass
+  std::uint64_t predicted_ns = 0;  ///< simulator on this round's capture (0: no partition)
+  std::uint64_t host_ns = 0;       ///< the capture's host time (outside the graph)
+};
+
+/// The three figures of one validation: medians over the rounds, and the medians of each
+/// round's own ratios.
 struct Validation {
   replay::MethodChoice choice;
   std::uint32_t threads = 1;
-  replay::LiveResult live;
-  replay::ReplayResult replay;
+  std::vector<ValidationRound> rounds;
+  std::int64_t live_ns = 0, engine_ns = 0, replay_ns = 0;
   std::uint64_t predicted_ns = 0;  ///< simulator, partition policy only (0: none)
+  double replay_over_live = 0, predicted_over_live = 0, predicted_over_replay = 0;
 };
 
-/// Runs the live run, captures the same steps and replays them under the same policy, and
-/// simulates the partition. UsageError for zero threads, steps or passes, or an unknown method.
+/// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a
+/// capture of the same steps, its replay under the same policy (one pass) and the
+/// simulation of the partition. UsageError for zero threads, steps or rounds, or an unknown
+/// method.
 Validation validate_scene(const ValidateOptions& options);
 
 /// `tgraph validate --json` (ratios replay / live, predicted / live, predicted / replay).
