@@ -1,0 +1,88 @@
+// SPDX-License-Identifier: MIT
+// `tgraph validate` (samples::validate_scene): rounds of live pass, capture, replay pass and
+// simulation; medians of the rounds and of each round's own ratios.
+#include "tgraph/samples/validate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <vector>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::samples {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
+}
+
+TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
+  ValidateOptions o;
+  o.scene = "falling";
+  o.method = "metis";
+  o.threads = 2;
+  o.steps = 2;
+  o.repeat = 3;
+  const Validation v = validate_scene(o);
+  ASSERT_EQ(v.rounds.size(), 3u);
+  std::vector<double> live, replay_over_live, predicted_over_live;
+  for (const ValidationRound& r : v.rounds) {
+    EXPECT_GT(r.live_ns, 0);
+    EXPECT_GT(r.engine_ns, 0);
+    EXPECT_GT(r.replay_ns, 0);
+    EXPECT_GT(r.predicted_ns, 0u);
+    // falling's collision detection runs outside the graph: every capture carries it, and the
+    // simulator's makespan includes it.
+    EXPECT_GT(r.host_ns, 0u);
+    EXPECT_GE(r.predicted_ns, r.host_ns);
+    live.push_back(static_cast<double>(r.live_ns));
+    replay_over_live.push_back(static_cast<double>(r.replay_ns) / static_cast<double>(r.live_ns));
+    predicted_over_live.push_back(static_cast<double>(r.predicted_ns) /
+                                  static_cast<double>(r.live_ns));
+  }
+  EXPECT_EQ(v.live_ns, static_cast<std::int64_t>(median(live)));
+  EXPECT_DOUBLE_EQ(v.replay_over_live, median(replay_over_live));
+  EXPECT_DOUBLE_EQ(v.predicted_over_live, median(predicted_over_live));
+
+  const auto j = nlohmann::json::parse(validation_json(v, o));
+  ASSERT_EQ(j.at("rounds").size(), 3u);
+  EXPECT_EQ(j.at("rounds")[1].at("live_wall_ns").get<std::int64_t>(), v.rounds[1].live_ns);
+  EXPECT_EQ(j.at("method"), "metis");
+  EXPECT_EQ(j.at("threads"), 2);
+  EXPECT_DOUBLE_EQ(j.at("replay_over_live").get<double>(), v.replay_over_live);
+}
+
+TEST(Validate, ABaselinePolicyHasNoPrediction) {
+  ValidateOptions o;
+  o.scene = "falling";
+  o.method = "worksteal";
+  o.threads = 2;
+  o.steps = 1;
+  o.repeat = 1;
+  const Validation v = validate_scene(o);
+  ASSERT_EQ(v.rounds.size(), 1u);
+  EXPECT_EQ(v.predicted_ns, 0u);
+  const auto j = nlohmann::json::parse(validation_json(v, o));
+  EXPECT_TRUE(j.at("predicted_ns").is_null());
+  EXPECT_TRUE(j.at("predicted_over_live").is_null());
+  EXPECT_GT(j.at("replay_over_live").get<double>(), 0.0);
+}
+
+TEST(Validate, RefusesZeroThreadsStepsOrRounds) {
+  ValidateOptions o;
+  o.scene = "falling";
+  o.threads = 0;
+  EXPECT_THROW(validate_scene(o), UsageError);
+  o.threads = 1;
+  o.steps = 0;
+  EXPECT_THROW(validate_scene(o), UsageError);
+  o.steps = 1;
+  o.repeat = 0;
+  EXPECT_THROW(validate_scene(o), UsageError);
+}
+
+}  // namespace
+}  // namespace tgraph::samples
