@@ -208,6 +208,10 @@ PYBIND11_MODULE(_tgraph, m) {
                                for (const Contact& c : s.g().contacts) pairs.emplace_back(c.a, c.b);
                                return pairs;
                              })
+      .def_property_readonly(
+          "host_ns", [](const StepView& s) { return s.g().host_ns; },
+          "engine time outside the step's tasks, before them (collision detection); 0 in "
+          "version 1 traces")
       .def_property_readonly("structural_hash",
                              [](const StepView& s) { return s.g().structural_hash(); })
       .def("metrics", [](const StepView& s) { return compute_metrics(s.g()); })

@@ -60,6 +60,7 @@ def test_steps_and_metrics_equal_tgraph_info(name, request):
         assert step.num_data == row["data"]
         assert step.loops()["iterations"] == row["loop_iterations"]
         assert step.structural_hash == row["structure"]
+        assert step.host_ns == row["host_ns"]
     # The module's summary is the command line's JSON, figure for figure.
     mine = tgraph.summary(t, path)
     assert mine == info
