@@ -37,6 +37,7 @@
 #include "bench_main.hpp"
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/incremental.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/executor.hpp"
@@ -45,6 +46,7 @@
 
 namespace {
 
+using tgraph::median;
 using tgraph::StepGraph;
 
 struct Falling {
@@ -69,12 +71,6 @@ const Falling& falling() {
     return r;
   }();
   return f;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
 }
 
 // Counters from per-change samples (ns): median and max of the per-change medians.

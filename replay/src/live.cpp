@@ -11,6 +11,7 @@
 
 #include "sync.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
@@ -128,12 +129,6 @@ std::string to_string(const StateDifference& d) {
 // ---- live runs ---------------------------------------------------------------------------
 
 namespace {
-
-std::int64_t median(std::vector<std::int64_t> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
 
 /// Mean measured duration of each exec task in the last step (sampled iterations), for the
 /// next step's partitioning: deferred recording measures nothing itself.

@@ -8,12 +8,12 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <nlohmann/json.hpp>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/graph/metrics.hpp"
 
 namespace tgraph::replay {
@@ -46,31 +46,6 @@ std::uint64_t CacheMissCounter::read() const {
   if (::read(fd_, &v, sizeof v) != static_cast<ssize_t>(sizeof v)) return 0;
   return v;
 }
-
-namespace {
-
-// Runs step `g`'s host time (StepGraph::host_ns: the engine's serial work outside the graph,
-// before the step's tasks) on this thread as a calibrated spin; returns the wall time taken.
-std::int64_t run_host(const StepGraph& g, const SyntheticOptions& o) {
-  if (g.host_ns == 0) return 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  const double ns = static_cast<double>(g.host_ns) * o.cost_scale;
-  volatile std::uint64_t sink = spin_iterations(
-      static_cast<std::uint64_t>(ns * SyntheticWorkload::calibration().spin_iterations_per_ns),
-      g.host_ns);
-  (void)sink;
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() -
-                                                              t0)
-      .count();
-}
-
-std::int64_t median(std::vector<std::int64_t> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
-
-}  // namespace
 
 std::uint64_t ReplayResult::signals() const {
   std::uint64_t s = 0;
@@ -183,7 +158,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       for (std::uint32_t i = 0; i < n; ++i) {
         const StepGraph& g = trace.steps[o.first_step + i];
         ws.set_step(g);
-        const std::int64_t host = run_host(g, o.synthetic);
+        const std::int64_t host = ws.run_host(g);
         const StepStats s = seq->run_step(g, nullptr, ws);
         seq_walls[i].push_back(host + s.wall_ns);
         total += host + s.wall_ns;
@@ -194,7 +169,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
     for (std::uint32_t i = 0; i < n; ++i) {
       const StepGraph& g = trace.steps[o.first_step + i];
       w.set_step(g);
-      const std::int64_t host = run_host(g, o.synthetic);
+      const std::int64_t host = w.run_host(g);
       const StepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
       walls[i].push_back(host + s.wall_ns);
       runs[i].push_back(host + s.wall_ns - s.build_ns);

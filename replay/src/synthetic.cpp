@@ -173,8 +173,8 @@ void SyntheticWorkload::run(const TaskRun& r) {
   const auto orig = step_ ? step_->accesses_of(r.origin) : acc_list;
   const std::size_t na = std::min(acc_list.size(), orig.size());
   const Calibration& c = calibration();
-  const double cost =
-      static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0) * options_.cost_scale;
+  const double recorded = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0);
+  const double cost = recorded * options_.cost_scale;
   // A task whose recorded time is shorter than a pass over all its data at in-cache speed
   // cannot have touched all of it: a force field reads a few nodes of a body's whole
   // position vector. Its pass covers the leading fraction of each datum that such a pass
@@ -185,10 +185,8 @@ void SyntheticWorkload::run(const TaskRun& r) {
   std::uint64_t all_bytes = 0;
   for (std::size_t i = 0; i < na; ++i) {
     const Buffer* b = buffers_[acc_list[i].datum].get();
-    if (b && (reads(orig[i].mode) || writes(orig[i].mode)))
-      all_bytes += b->words * 8 * ((reads(orig[i].mode) ? 1 : 0) + (writes(orig[i].mode) ? 1 : 0));
+    if (b) all_bytes += b->words * 8 * ((reads(orig[i].mode) ? 1 : 0) + (writes(orig[i].mode) ? 1 : 0));
   }
-  const double recorded = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0);
   const double pass_ns = static_cast<double>(all_bytes) * c.touch_ns_per_byte;
   const double fraction = recorded > 0 && pass_ns > recorded ? recorded / pass_ns : 1.0;
   auto words_of = [fraction](const Buffer& b) {
@@ -213,12 +211,21 @@ void SyntheticWorkload::run(const TaskRun& r) {
     write_pass(orig[i].mode, b->w.get(), words, acc);
     bytes += words * 8;
   }
-  const double rest = cost - static_cast<double>(bytes) * touch_ns_per_byte_;
-  if (rest > 0) {
-    const auto n = static_cast<std::uint64_t>(rest * c.spin_iterations_per_ns);
-    volatile std::uint64_t sink = spin_iterations(n, acc);
-    (void)sink;
-  }
+  spin_ns(cost - static_cast<double>(bytes) * touch_ns_per_byte_, acc);
+}
+
+void SyntheticWorkload::spin_ns(double ns, std::uint64_t seed) {
+  if (ns <= 0) return;
+  volatile std::uint64_t sink =
+      spin_iterations(static_cast<std::uint64_t>(ns * calibration().spin_iterations_per_ns), seed);
+  (void)sink;
+}
+
+std::int64_t SyntheticWorkload::run_host(const StepGraph& g) const {
+  if (g.host_ns == 0) return 0;
+  const std::int64_t t0 = now_ns();
+  spin_ns(static_cast<double>(g.host_ns) * options_.cost_scale, g.host_ns);
+  return now_ns() - t0;
 }
 
 bool SyntheticWorkload::stop_after(LoopId loop, std::uint32_t iteration) {

@@ -2,13 +2,13 @@
 // `tgraph validate`'s pipeline: live run, capture + replay, simulation.
 #include "tgraph/samples/validate.hpp"
 
-#include <algorithm>
 #include <cstdio>
 #include <vector>
 #include <nlohmann/json.hpp>
 
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -16,16 +16,6 @@
 #include "tgraph/samples/live_engine.hpp"
 
 namespace tgraph::samples {
-
-namespace {
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : (v[v.size() / 2 - 1] + v[v.size() / 2]) / 2;
-}
-
-}  // namespace
 
 Validation validate_scene(const ValidateOptions& o) {
   Validation v;

@@ -71,6 +71,10 @@ class SyntheticWorkload : public Workload {
   double calibrate_touch(std::uint64_t bytes);
   /// Touch cost per byte in use.
   double touch_ns_per_byte() const { return touch_ns_per_byte_; }
+  /// Runs step `g`'s host time (StepGraph::host_ns: the engine's serial work outside the
+  /// graph, before the step's tasks) on the calling thread as a calibrated spin, scaled like
+  /// the task costs; returns the wall time it took (ns).
+  std::int64_t run_host(const StepGraph& g) const;
 
  private:
   struct Buffer;
@@ -80,6 +84,8 @@ class SyntheticWorkload : public Workload {
   std::vector<std::uint64_t> want_words_;         // by exec datum
   std::vector<bool> is_temp_;                     // by exec datum
   double touch_ns_per_byte_ = 0;
+  // Busy loop for `ns` nanoseconds at the calibrated rate (nothing when ns <= 0).
+  static void spin_ns(double ns, std::uint64_t seed);
 };
 
 /// Busy loop of `iterations` dependent multiply-adds; returns a value to keep it alive.
