@@ -416,7 +416,7 @@ bool Scene::step_if_changed(Recorder& rec) { return advance(rec, true); }
 bool Scene::advance(Recorder& rec, bool allow_reuse) {
   finalize();
   // From here to the first task: the step's serial work outside the graph (StepGraph::host_ns).
-  const auto host_start = std::chrono::steady_clock::now();
+  auto host_start = std::chrono::steady_clock::now();
   detail::check_divergence(*this, *impl_);  // what the last step left (deferred: ran since)
   Impl& m = *impl_;
   Binding& b = m.bind;
@@ -448,6 +448,8 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
       b.body_object[i] = rec.object(bodies_[i]->name());
       b.object_body[b.body_object[i]] = static_cast<int>(i);
     }
+    // Declaring ids is once per recorder, not this step's work.
+    host_start = std::chrono::steady_clock::now();
   }
 
   // Collision detection: sequential, outside the task graph.
