@@ -54,6 +54,14 @@ std::vector<std::vector<Item>> programs(const StepGraph& g, const Assignment& a)
   return items;
 }
 
+std::string deadlock_message(const StepGraph& g, const Item& it, std::size_t pos, ProcId p) {
+  const TaskId t = it.task != kNoTask ? it.task
+                   : pos < it.body.size() ? it.body[pos]
+                                          : g.loops[it.loop].last - 1;
+  return "assignment order deadlocks: processor " + std::to_string(p) +
+         " waits forever before task " + std::to_string(t);
+}
+
 }  // namespace detail
 
 }  // namespace tgraph::partition
