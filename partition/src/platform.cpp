@@ -57,6 +57,8 @@ ClusterShape parse_cluster(std::string_view text, std::string_view flag) {
 }
 
 std::string platform_xml(const ClusterShape& c, const CostModel& m) {
+  std::string source;  // inside an XML comment: no "--", no markup
+  for (char ch : m.source) source += ch == '-' || ch == '<' || ch == '>' || ch == '&' ? '_' : ch;
   std::string config;
   for (std::string_view item : kSimgridNetworkConfig) {
     const auto colon = item.find(':');
@@ -66,7 +68,7 @@ std::string platform_xml(const ClusterShape& c, const CostModel& m) {
   return "<?xml version='1.0'?>\n"
          "<!DOCTYPE platform SYSTEM \"https://simgrid.org/simgrid.dtd\">\n"
          "<!-- tgraph platform: " + std::to_string(c.nodes) + " nodes x " +
-         std::to_string(c.cores) + " cores; costs from " + m.source + " -->\n"
+         std::to_string(c.cores) + " cores; costs from " + source + " -->\n"
          "<platform version=\"4.1\">\n"
          "  <config>\n" + config + "  </config>\n"
          "  <zone id=\"world\" routing=\"Full\">\n"

@@ -499,6 +499,13 @@ std::string last_line(std::FILE* f) {
   return text.substr(begin == std::string::npos ? 0 : begin + 1, end + 1 - (begin == std::string::npos ? 0 : begin + 1));
 }
 
+// One line: SimGrid's messages may span several.
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
+
 }  // namespace
 
 Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
@@ -540,16 +547,17 @@ Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  const std::string said = log ? last_line(log) : "";
+  const std::string said = log ? one_line(last_line(log)) : "";
   if (log) std::fclose(log);
   const std::string where = platform.file.empty() ? "the cluster platform" : platform.file;
   const bool loaded = !got.empty() && got[0] == kLoaded;
   const std::string rest = loaded ? got.substr(1) : got;
   if (!rest.empty() && rest[0] == kInputError) {
-    if (!loaded && !platform.file.empty()) throw InputError(platform.file, std::nullopt, rest.substr(1));
-    throw Error(rest.substr(1));
+    if (!loaded && !platform.file.empty())
+      throw InputError(platform.file, std::nullopt, one_line(rest.substr(1)));
+    throw Error(one_line(rest.substr(1)));
   }
-  if (!rest.empty() && rest[0] == kFailure) throw std::runtime_error("simgrid: " + rest.substr(1));
+  if (!rest.empty() && rest[0] == kFailure) throw std::runtime_error("simgrid: " + one_line(rest.substr(1)));
   const std::size_t step_bytes = 5 * sizeof(std::uint64_t);
   if (rest.empty() || rest[0] != kResult || rest.size() < 1 + 2 * sizeof(std::uint64_t) ||
       (rest.size() - 1 - 2 * sizeof(std::uint64_t)) % step_bytes != 0) {
