@@ -15,6 +15,7 @@ namespace tp = tgraph::partition;
 void add_simulate(CLI::App& app) {
   struct Flags {
     std::string engine = "builtin", platform, cluster, model = "calibrated", calibration;
+    std::string intra_node = "reader";
   };
   auto a = std::make_shared<Args>();
   auto f = std::make_shared<Flags>();
@@ -29,6 +30,10 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("--cluster", f->cluster,
                   "N nodes x C cores (e.g. 64x16): processor p on core p % C of node p / C")
       ->excludes(platform);
+  cmd->add_option("--intra-node", f->intra_node,
+                  "simgrid, bytes between two cores of a node: reader (default; the reading core "
+                  "spends size / loopback bandwidth) or link (the loopback link carries them)")
+      ->check(CLI::IsMember({"reader", "link"}));
   cmd->add_option("--model", f->model, "Cost model: calibrated (default) or ideal (free syncs)")
       ->check(CLI::IsMember({"ideal", "calibrated"}));
   cmd->add_option("--calibration", f->calibration,
@@ -39,6 +44,8 @@ void add_simulate(CLI::App& app) {
     p.model = tp::select_cost_model(f->model, f->calibration);
     if (!f->cluster.empty()) p.cluster = tp::parse_cluster(f->cluster, "--cluster");
     p.file = f->platform;
+    p.intra_node =
+        f->intra_node == "link" ? tp::IntraNodeTransfer::link : tp::IntraNodeTransfer::reader;
     const tp::SimulationEngine engine =
         f->engine == "simgrid" ? tp::SimulationEngine::simgrid : tp::SimulationEngine::builtin;
     if (engine == tp::SimulationEngine::builtin && !p.file.empty())

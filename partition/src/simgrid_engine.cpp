@@ -58,11 +58,30 @@ struct InFlight {
   ProcId proc;  ///< exec: where it runs; comm: the receiving processor
 };
 
-/// Runs the steps of a trace one after the other on the given hosts (host of processor p).
+/// A datum version received by a processor (the reader pays its bytes once).
+struct Received {
+  std::uint64_t instance;
+  DatumId datum;
+  ProcId proc;
+  friend bool operator==(const Received&, const Received&) = default;
+};
+struct ReceivedHash {
+  std::size_t operator()(const Received& r) const {
+    std::uint64_t h = r.instance * 0x9E3779B97F4A7C15ull;
+    h ^= (static_cast<std::uint64_t>(r.datum) << 32 | r.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+/// Runs the steps of a trace one after the other on the given hosts (host of processor p);
+/// `read_ns_per_byte[p]`: what reading a byte written by another core of its node costs
+/// processor p (its host's loopback link) when the reader pays for transfers in a node.
 class Driver {
  public:
-  Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts)
-      : trace_(trace), a_(a), hosts_(std::move(hosts)),
+  Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts,
+         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node)
+      : trace_(trace), a_(a), hosts_(std::move(hosts)), read_ns_per_byte_(std::move(read_ns_per_byte)),
+        reader_pays_(intra_node == IntraNodeTransfer::reader),
         steps_(std::min(trace.steps.size(), a.steps.size())) {}
 
   /// Starts step 0; the engine's run() does the rest through on_completion().
@@ -137,6 +156,7 @@ class Driver {
     build_outs();
     done_.assign(first_.back(), 0);
     arrived_.clear();
+    received_.clear();
     waiters_.clear();
     state_.assign(k_, State{});
     finished_ = 0;
@@ -240,6 +260,23 @@ class Driver {
     return true;
   }
 
+  // Inside a node, when the reader pays: the bytes of the datum versions task t (iteration
+  // i) is the first on p to receive, at p's loopback cost per byte (the built-in
+  // simulator's rule: once per version and processor, reads only).
+  std::uint64_t read_cost(ProcId p, TaskId t, std::uint32_t i) {
+    if (!reader_pays_) return 0;
+    std::uint64_t bytes = 0;
+    for (const Dep& d : deps_[t]) {
+      const ProcId from = pa_->proc[d.from];
+      if (from == p || hosts_[from] != hosts_[p]) continue;
+      const std::uint64_t src = dependency_source(*g_, first_, d, t, i);
+      if (src == kNoInstance) continue;
+      if (received_.insert({src, d.datum, p}).second && d.raw) bytes += g_->data[d.datum].bytes;
+    }
+    current_.bytes += bytes;
+    return static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * read_ns_per_byte_[p]));
+  }
+
   void step_forward(ProcId p) {
     State& st = state_[p];
     if (items_[p][st.item].task != kNoTask)
@@ -260,7 +297,7 @@ class Driver {
         const TaskId t = it.task != kNoTask ? it.task : it.body[st.pos];
         const std::uint32_t i = it.task != kNoTask ? 0 : st.iter;
         if (!ready(p, t, i)) return;
-        const std::uint64_t cost = g_->tasks[t].cost_ns;
+        const std::uint64_t cost = g_->tasks[t].cost_ns + read_cost(p, t, i);
         if (cost == 0) {  // nothing to simulate: it finishes when it starts
           step_forward(p);
           finish_instance(t, i, p);
@@ -317,7 +354,8 @@ class Driver {
           bytes += g_->data[o.datum].bytes;
         }
       }
-      if (any) send(t, i, owner, outs[b].to, bytes);
+      // The reader pays for the bytes inside a node (read_cost): the link carries the signal.
+      if (any) send(t, i, owner, outs[b].to, reader_pays_ && hosts_[owner] == hosts_[outs[b].to] ? 0 : bytes);
       b = e;
     }
   }
@@ -338,6 +376,8 @@ class Driver {
   const Trace& trace_;
   const TraceAssignment& a_;
   const std::vector<sg::Host*> hosts_;
+  const std::vector<double> read_ns_per_byte_;
+  const bool reader_pays_;
   const std::size_t steps_;
   std::size_t step_ = 0;
   const StepGraph* g_ = nullptr;
@@ -349,6 +389,7 @@ class Driver {
   std::vector<std::vector<Out>> outs_;
   std::vector<std::uint8_t> done_;
   std::unordered_set<std::uint64_t> arrived_;
+  std::unordered_set<Received, ReceivedHash> received_;
   std::unordered_map<std::uint64_t, std::vector<ProcId>> waiters_;
   std::vector<State> state_;
   std::deque<ProcId> ready_;
@@ -459,7 +500,18 @@ void send_message(int fd, char tag, const std::string& text) {
                        std::to_string(all.size()) + " hosts");
       ::_exit(0);
     }
-    Driver driver(trace, a, proc_hosts);
+    // A host's loopback link (its route to itself) prices a byte read from another core.
+    std::vector<double> read_ns_per_byte;
+    for (const sg::Host* h : proc_hosts) {
+      std::vector<sg::Link*> links;
+      double latency = 0;
+      h->route_to(h, links, &latency);
+      double bandwidth = 0;
+      for (const sg::Link* l : links)
+        bandwidth = bandwidth == 0 ? l->get_bandwidth() : std::min(bandwidth, l->get_bandwidth());
+      read_ns_per_byte.push_back(bandwidth > 0 ? 1e9 / bandwidth : 0.0);
+    }
+    Driver driver(trace, a, proc_hosts, std::move(read_ns_per_byte), platform.intra_node);
     sg::Activity::on_completion_cb([&](const sg::Activity& act) { driver.on_completion(act); });
     sg::Engine::on_time_advance_cb([&](double) { driver.on_time_advance(); });
     driver.start();

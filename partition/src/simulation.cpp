@@ -18,6 +18,14 @@ std::string to_string(SimulationEngine e) {
   return "?";
 }
 
+std::string to_string(IntraNodeTransfer t) {
+  switch (t) {
+    case IntraNodeTransfer::reader: return "reader";
+    case IntraNodeTransfer::link: return "link";
+  }
+  return "?";
+}
+
 bool simgrid_available() {
 #ifdef TGRAPH_HAVE_SIMGRID
   return true;
@@ -72,6 +80,7 @@ Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, Simulati
 #endif
       break;
   }
+  r.intra_node = platform.intra_node;
   r.simulation_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   r.makespan_ns = 0;
@@ -92,6 +101,7 @@ std::string prediction_json(const Prediction& p) {
   }
   const nlohmann::json j = {{"engine", to_string(p.engine)},
                             {"platform", p.platform},
+                            {"intra_node", to_string(p.intra_node)},
                             {"k", p.k},
                             {"hosts", p.hosts},
                             {"cores", p.cores},

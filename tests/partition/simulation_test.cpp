@@ -134,14 +134,17 @@ TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
   m.mpi_per_byte_ns = 0.5;
   const Trace t = writer_reader(1 << 20, 300);
   const TraceAssignment a = split(2, {0, 1});
-  // One node of two cores: the loopback link.
-  const Prediction in = simulate_trace(t, a, SimulationEngine::simgrid,
-                                       {.cluster = ClusterShape{1, 2}, .model = m});
+  // One node of two cores: the loopback link, the bytes paid by the reader or the link.
   const double inside = 300 + 1000 + 100 + (1 << 20) * 0.05 + 2000;
-  ASSERT_EQ(in.steps.size(), 1u);
-  EXPECT_NEAR(static_cast<double>(in.steps[0].makespan_ns), inside, 2);
-  EXPECT_EQ(in.steps[0].bytes, 1u << 20);
-  EXPECT_EQ(in.steps[0].inter_node_bytes, 0u);
+  for (IntraNodeTransfer mode : {IntraNodeTransfer::reader, IntraNodeTransfer::link}) {
+    const Prediction in = simulate_trace(
+        t, a, SimulationEngine::simgrid,
+        {.cluster = ClusterShape{1, 2}, .model = m, .intra_node = mode});
+    ASSERT_EQ(in.steps.size(), 1u);
+    EXPECT_NEAR(static_cast<double>(in.steps[0].makespan_ns), inside, 2) << to_string(mode);
+    EXPECT_EQ(in.steps[0].bytes, 1u << 20);
+    EXPECT_EQ(in.steps[0].inter_node_bytes, 0u);
+  }
   // The built-in simulator charges the same latency and bytes.
   const Prediction builtin = simulate_trace(t, a, SimulationEngine::builtin, {.model = m});
   EXPECT_NEAR(static_cast<double>(builtin.steps[0].makespan_ns), inside, 2);
@@ -154,6 +157,32 @@ TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
   EXPECT_EQ(between.steps[0].inter_node_bytes, 1u << 20);
   EXPECT_EQ(between.hosts, 2u);
   EXPECT_EQ(between.cores, 2u);
+}
+
+TEST(SimgridEngine, TheReaderPaysInsideANodeUnlessTheLinkCarriesTheBytes) {
+  // Processor 1 is busy with an unrelated 5000 ns task while the datum is on its way: when
+  // the loopback link carries the bytes they overlap that task; when the reading core pays
+  // them (the default, as the built-in simulator does) they come after it.
+  CostModel m;
+  m.sync_latency_ns = 100;
+  m.per_byte_ns = 0.05;
+  Builder b;
+  const DatumId d = b.datum("d", 40000), e = b.datum("e", 8);
+  b.task({{d, M::W}}, 1000);  // 0 on processor 0
+  b.task({{e, M::W}}, 5000);  // 1 on processor 1
+  b.task({{d, M::R}}, 2000);  // 2 on processor 1, after 1
+  Trace t;
+  t.steps = {b.done()};
+  const TraceAssignment a = split(2, {0, 1, 1});
+  SimulatedPlatform p{.cluster = ClusterShape{1, 2}, .model = m};
+  const Prediction reader = simulate_trace(t, a, SimulationEngine::simgrid, p);
+  EXPECT_EQ(reader.steps[0].makespan_ns, 5000u + 40000 / 20 + 2000);
+  EXPECT_EQ(reader.steps[0].makespan_ns,
+            simulate_trace(t, a, SimulationEngine::builtin, p).steps[0].makespan_ns);
+  p.intra_node = IntraNodeTransfer::link;
+  const Prediction link = simulate_trace(t, a, SimulationEngine::simgrid, p);
+  EXPECT_EQ(link.steps[0].makespan_ns, 5000u + 2000);  // 1000 + 100 + 2000 < 5000
+  EXPECT_EQ(link.steps[0].bytes, reader.steps[0].bytes);
 }
 
 TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
@@ -176,10 +205,12 @@ TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
             2000u);
 }
 
-// Random graphs with loops, several processor counts, steps of one trace: with the ideal
-// model (no latency, no transfer) both engines impose the same precedence, program order
-// and loop control, so the makespans agree to SimGrid's 1 ns timing precision per event.
-TEST(SimgridEngine, EqualsTheBuiltinSimulatorWithoutCommunicationCostsOnRandomGraphs) {
+// Random graphs with loops, several processor counts, steps of one trace: on one host with
+// the reader paying for bytes, both engines impose the same precedence, program order, loop
+// control, latencies and transfer costs, so the makespans agree to SimGrid's 1 ns timing
+// precision per event, with the ideal model and with the default one.
+TEST(SimgridEngine, EqualsTheBuiltinSimulatorOnOneHostOnRandomGraphs) {
+  for (const CostModel& model : {CostModel::ideal(), CostModel::defaults()})
   for (std::uint32_t k : {1u, 2u, 3u, 5u}) {
     Trace trace;
     for (std::uint64_t seed = 0; seed < 40; ++seed)
@@ -187,7 +218,7 @@ TEST(SimgridEngine, EqualsTheBuiltinSimulatorWithoutCommunicationCostsOnRandomGr
                                                   5, seed % 3 != 0));
     for (const char* method : {"roundrobin", "random", "list"}) {
       const TracePartition tp = partition_trace(trace, method, k);
-      const SimulatedPlatform p{.cluster = ClusterShape{1, k}, .model = CostModel::ideal()};
+      const SimulatedPlatform p{.cluster = ClusterShape{1, k}, .model = model};
       const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
       const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
       ASSERT_EQ(b.steps.size(), s.steps.size());
@@ -197,7 +228,7 @@ TEST(SimgridEngine, EqualsTheBuiltinSimulatorWithoutCommunicationCostsOnRandomGr
         const std::uint64_t instances = trace.steps[i].tasks.size() * 4;
         EXPECT_NEAR(static_cast<double>(s.steps[i].makespan_ns),
                     static_cast<double>(b.steps[i].makespan_ns), static_cast<double>(instances))
-            << method << " k " << k << " step " << i;
+            << model.source << " " << method << " k " << k << " step " << i;
         EXPECT_EQ(s.steps[i].bytes, b.steps[i].bytes) << method << " k " << k << " step " << i;
       }
     }

@@ -25,6 +25,18 @@ std::string to_string(SimulationEngine e);
 /// Whether this build has the SimGrid engine (Debian libsimgrid-dev found by pkg-config).
 bool simgrid_available();
 
+/// Who pays for the bytes of a transfer between two cores of one node (SimGrid engine).
+enum class IntraNodeTransfer {
+  /// The reading core, size / loopback bandwidth of its own time, once per datum version
+  /// (cache misses: what the built-in simulator and `tgraph calibrate` measure); the
+  /// loopback link carries the signal (its latency).
+  reader,
+  /// The loopback link, latency + size / bandwidth, overlapping the reader's other work.
+  link,
+};
+/// "reader" or "link".
+std::string to_string(IntraNodeTransfer t);
+
 /// Where the processors of a simulation live: a SimGrid platform file or an N x C cluster
 /// made from the cost model (platform_xml()).
 ///
@@ -34,6 +46,7 @@ struct SimulatedPlatform {
   std::string file;                    ///< `--platform P.xml` (SimGrid engine only), or empty
   std::optional<ClusterShape> cluster; ///< `--cluster NxC`, or none
   CostModel model;                     ///< the built-in engine's costs; the links of `cluster`
+  IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: who pays bytes in a node
 };
 
 /// One step's prediction.
@@ -55,6 +68,7 @@ struct Prediction {
   std::uint32_t hosts = 0;        ///< hosts of the platform (simgrid; builtin: nodes or 1)
   std::uint64_t cores = 0;        ///< cores of the platform (simgrid; builtin: N x C or k)
   std::string platform;           ///< the platform file, "NxC", or "one machine"
+  IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: as asked
   double simulation_ms = 0;       ///< wall time of the simulation itself
 };
 
