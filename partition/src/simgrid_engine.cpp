@@ -55,7 +55,8 @@ struct InFlight {
   Kind kind;
   TaskId task;
   std::uint32_t iteration;
-  ProcId proc;  ///< exec: where it runs; comm: the receiving processor
+  ProcId proc;  ///< exec: where it runs
+  std::vector<ProcId> receivers;  ///< comm: the processors that know the instance on arrival
 };
 
 /// A datum version received by a processor (the reader pays its bytes once).
@@ -93,7 +94,7 @@ class Driver {
   void on_completion(const sg::Activity& activity) {
     const auto found = live_.find(&activity);
     if (found == live_.end()) return;
-    const InFlight f = found->second;
+    InFlight f = std::move(found->second);
     // The engine still uses the activity after this callback: keep it alive until the
     // clock moves on (on_time_advance()).
     graveyard_.push_back(f.activity);
@@ -109,12 +110,13 @@ class Driver {
         finish_instance(f.task, f.iteration, f.proc);
         wake_proc(f.proc);
         break;
-      case Kind::comm: {
-        const std::uint64_t key = (first_[f.task] + f.iteration) * k_ + f.proc;
-        arrived_.insert(key);
-        wake(key);
+      case Kind::comm:
+        for (ProcId q : f.receivers) {
+          const std::uint64_t key = (first_[f.task] + f.iteration) * k_ + q;
+          arrived_.insert(key);
+          wake(key);
+        }
         break;
-      }
     }
     drain();
     while (step_ < steps_ && finished_ == k_ && outstanding_ == 0) end_step();
@@ -217,7 +219,7 @@ class Driver {
   }
 
   void track(const sg::ActivityPtr& act, Kind kind, TaskId t, std::uint32_t i, ProcId p) {
-    live_.emplace(act.get(), InFlight{act, kind, t, i, p});
+    live_.emplace(act.get(), InFlight{act, kind, t, i, p, {}});
     ++outstanding_;
   }
 
@@ -337,33 +339,42 @@ class Driver {
     wake(inst * k_ + owner);
     const std::uint64_t runs = g_->runs(t);
     const std::vector<Out>& outs = outs_[t];
+    // Receivers in the owner's node get one transfer each; another node gets one message
+    // for all its receivers (outs are sorted by processor, a node's processors contiguous).
+    auto same_group = [&](const Out& x, const Out& y) {
+      return hosts_[x.to] == hosts_[owner] ? x.to == y.to : hosts_[x.to] == hosts_[y.to];
+    };
     for (std::size_t b = 0; b < outs.size();) {
       std::size_t e = b;
-      bool any = false;
       std::uint64_t bytes = 0;
       sent_.clear();
-      for (; e < outs.size() && outs[e].to == outs[b].to; ++e) {
+      receivers_.clear();
+      for (; e < outs.size() && same_group(outs[e], outs[b]); ++e) {
         const Out& o = outs[e];
         const bool applies = o.when == When::every ||
                              (o.when == When::not_last ? i + 1 < runs : i + 1 == runs);
         if (!applies) continue;
-        any = true;
-        // Each datum version is sent once per receiving processor (bytes of reads only).
+        if (receivers_.empty() || receivers_.back() != o.to) receivers_.push_back(o.to);
+        // Each datum version is sent once per receiving processor or node (reads only).
         if (o.raw && std::find(sent_.begin(), sent_.end(), o.datum) == sent_.end()) {
           sent_.push_back(o.datum);
           bytes += g_->data[o.datum].bytes;
         }
       }
       // The reader pays for the bytes inside a node (read_cost): the link carries the signal.
-      if (any) send(t, i, owner, outs[b].to, reader_pays_ && hosts_[owner] == hosts_[outs[b].to] ? 0 : bytes);
+      if (!receivers_.empty())
+        send(t, i, owner, reader_pays_ && hosts_[owner] == hosts_[outs[b].to] ? 0 : bytes);
       b = e;
     }
   }
 
-  void send(TaskId t, std::uint32_t i, ProcId from, ProcId to, std::uint64_t bytes) {
+  // One transfer of instance (t, i) from processor `from` to receivers_ (one node).
+  void send(TaskId t, std::uint32_t i, ProcId from, std::uint64_t bytes) {
+    const ProcId to = receivers_.front();
     sg::CommPtr c = sg::Comm::sendto_init(hosts_[from], hosts_[to]);
     c->set_payload_size(bytes);
-    track(c, Kind::comm, t, i, to);
+    live_.emplace(c.get(), InFlight{c, Kind::comm, t, i, to, receivers_});
+    ++outstanding_;
     ++current_.messages;
     current_.bytes += bytes;
     if (hosts_[from] != hosts_[to]) {
@@ -394,6 +405,7 @@ class Driver {
   std::vector<State> state_;
   std::deque<ProcId> ready_;
   std::vector<DatumId> sent_;
+  std::vector<ProcId> receivers_;
   std::uint32_t finished_ = 0;
   std::uint64_t outstanding_ = 0;
   double start_ = 0;

@@ -185,6 +185,26 @@ TEST(SimgridEngine, TheReaderPaysInsideANodeUnlessTheLinkCarriesTheBytes) {
   EXPECT_EQ(link.steps[0].bytes, reader.steps[0].bytes);
 }
 
+TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
+  // Processor 0 (node 0) writes d; processors 2 and 3 (both on node 1) read it: one
+  // message between the nodes, its bytes once; each reader starts when it arrives.
+  CostModel m;
+  m.mpi_latency_ns = 1000;
+  m.mpi_per_byte_ns = 0.1;
+  Builder b;
+  const DatumId d = b.datum("d", 10000);
+  b.task({{d, M::W}}, 500);
+  b.task({{d, M::R}}, 700);
+  b.task({{d, M::R}}, 900);
+  Trace t;
+  t.steps = {b.done()};
+  const Prediction r = simulate_trace(t, split(4, {0, 2, 3}), SimulationEngine::simgrid,
+                                      {.cluster = ClusterShape{2, 2}, .model = m});
+  EXPECT_EQ(r.steps[0].inter_node_messages, 1u);
+  EXPECT_EQ(r.steps[0].inter_node_bytes, 10000u);
+  EXPECT_NEAR(static_cast<double>(r.steps[0].makespan_ns), 500 + 1000 + 10000 * 0.1 + 900, 2);
+}
+
 TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
   // Four independent tasks of 1000 ns on one processor of a one-core host, and on two
   // processors of a two-core host: 4000 ns and 2000 ns, never shared CPU time.
