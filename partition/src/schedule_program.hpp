@@ -32,6 +32,22 @@ struct Item {
   std::vector<TaskId> body;
 };
 
+/// A datum version (the instance that wrote it) known on a processor: what both simulators
+/// count once (a wait, a transfer's bytes).
+struct VersionOnProc {
+  std::uint64_t instance;
+  std::uint32_t datum;
+  std::uint32_t proc;
+  friend bool operator==(const VersionOnProc&, const VersionOnProc&) = default;
+};
+struct VersionOnProcHash {
+  std::size_t operator()(const VersionOnProc& k) const {
+    std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
+    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    return static_cast<std::size_t>(h);
+  }
+};
+
 /// Per task, the first of its instances (iteration i of task t is `first[t] + i`), plus the
 /// total number of instances at the end.
 std::vector<std::uint64_t> first_instances(const StepGraph& g);

@@ -59,21 +59,6 @@ struct InFlight {
   std::vector<ProcId> receivers;  ///< comm: the processors that know the instance on arrival
 };
 
-/// A datum version received by a processor (the reader pays its bytes once).
-struct Received {
-  std::uint64_t instance;
-  DatumId datum;
-  ProcId proc;
-  friend bool operator==(const Received&, const Received&) = default;
-};
-struct ReceivedHash {
-  std::size_t operator()(const Received& r) const {
-    std::uint64_t h = r.instance * 0x9E3779B97F4A7C15ull;
-    h ^= (static_cast<std::uint64_t>(r.datum) << 32 | r.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    return static_cast<std::size_t>(h);
-  }
-};
-
 /// Runs the steps of a trace one after the other on the given hosts (host of processor p);
 /// `read_ns_per_byte[p]`: what reading a byte written by another core of its node costs
 /// processor p (its host's loopback link) when the reader pays for transfers in a node.
@@ -400,7 +385,7 @@ class Driver {
   std::vector<std::vector<Out>> outs_;
   std::vector<std::uint8_t> done_;
   std::unordered_set<std::uint64_t> arrived_;
-  std::unordered_set<Received, ReceivedHash> received_;
+  std::unordered_set<VersionOnProc, VersionOnProcHash> received_;  // the reader paid
   std::unordered_map<std::uint64_t, std::vector<ProcId>> waiters_;
   std::vector<State> state_;
   std::deque<ProcId> ready_;

@@ -17,19 +17,8 @@ using detail::Dep;
 using detail::Item;
 constexpr std::uint64_t kUnknown = detail::kNoInstance;
 
-struct SyncKey {
-  std::uint64_t instance;
-  std::uint32_t datum;
-  std::uint32_t proc;
-  friend bool operator==(const SyncKey&, const SyncKey&) = default;
-};
-struct SyncKeyHash {
-  std::size_t operator()(const SyncKey& k) const {
-    std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
-    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    return static_cast<std::size_t>(h);
-  }
-};
+using SyncKey = detail::VersionOnProc;
+using SyncKeyHash = detail::VersionOnProcHash;
 
 void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
