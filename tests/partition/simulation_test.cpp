@@ -27,6 +27,22 @@ namespace {
 using testing::Builder;
 using testing::M;
 
+SimulatedPlatform on_cluster(ClusterShape c, const CostModel& m,
+                             IntraNodeTransfer intra = IntraNodeTransfer::reader) {
+  SimulatedPlatform p;
+  p.cluster = c;
+  p.model = m;
+  p.intra_node = intra;
+  return p;
+}
+
+SimulatedPlatform on_file(const std::string& file, const CostModel& m) {
+  SimulatedPlatform p;
+  p.file = file;
+  p.model = m;
+  return p;
+}
+
 TEST(ParseCluster, ReadsNodesAndCores) {
   const ClusterShape c = parse_cluster("64x16", "--cluster");
   EXPECT_EQ(c.nodes, 64u);
@@ -83,7 +99,7 @@ TEST(SimulateTrace, BuiltinEngineIsTheScheduleSimulator) {
   Trace trace;
   trace.steps = {testing::random_graph(3, 30, 6, true), testing::random_graph(4, 30, 6, true)};
   const TracePartition tp = partition_trace(trace, "roundrobin", 3);
-  const SimulatedPlatform p{.model = CostModel::defaults()};
+  const SimulatedPlatform p = on_file("", CostModel::defaults());
   const Prediction r = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
   ASSERT_EQ(r.steps.size(), 2u);
   for (std::size_t s = 0; s < 2; ++s)
@@ -100,7 +116,7 @@ TEST(SimulateTrace, RefusesMoreProcessorsThanTheClusterHas) {
   Trace trace;
   trace.steps = {testing::random_graph(5, 20, 4, false)};
   const TracePartition tp = partition_trace(trace, "roundrobin", 5);
-  const SimulatedPlatform p{.cluster = ClusterShape{2, 2}, .model = CostModel::defaults()};
+  const SimulatedPlatform p = on_cluster(ClusterShape{2, 2}, CostModel::defaults());
   EXPECT_THROW(simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p), Error);
   EXPECT_THROW(simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p), Error);
 }
@@ -139,18 +155,18 @@ TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
   for (IntraNodeTransfer mode : {IntraNodeTransfer::reader, IntraNodeTransfer::link}) {
     const Prediction in = simulate_trace(
         t, a, SimulationEngine::simgrid,
-        {.cluster = ClusterShape{1, 2}, .model = m, .intra_node = mode});
+        on_cluster(ClusterShape{1, 2}, m, mode));
     ASSERT_EQ(in.steps.size(), 1u);
     EXPECT_NEAR(static_cast<double>(in.steps[0].makespan_ns), inside, 2) << to_string(mode);
     EXPECT_EQ(in.steps[0].bytes, 1u << 20);
     EXPECT_EQ(in.steps[0].inter_node_bytes, 0u);
   }
   // The built-in simulator charges the same latency and bytes.
-  const Prediction builtin = simulate_trace(t, a, SimulationEngine::builtin, {.model = m});
+  const Prediction builtin = simulate_trace(t, a, SimulationEngine::builtin, on_file("", m));
   EXPECT_NEAR(static_cast<double>(builtin.steps[0].makespan_ns), inside, 2);
   // Two nodes of one core: two private links, the MPI latency and bandwidth.
   const Prediction between = simulate_trace(t, a, SimulationEngine::simgrid,
-                                            {.cluster = ClusterShape{2, 1}, .model = m});
+                                            on_cluster(ClusterShape{2, 1}, m));
   EXPECT_NEAR(static_cast<double>(between.steps[0].makespan_ns),
               300 + 1000 + 2000 + (1 << 20) * 0.5 + 2000, 2);
   EXPECT_EQ(between.steps[0].inter_node_messages, 1u);
@@ -174,7 +190,7 @@ TEST(SimgridEngine, TheReaderPaysInsideANodeUnlessTheLinkCarriesTheBytes) {
   Trace t;
   t.steps = {b.done()};
   const TraceAssignment a = split(2, {0, 1, 1});
-  SimulatedPlatform p{.cluster = ClusterShape{1, 2}, .model = m};
+  SimulatedPlatform p = on_cluster(ClusterShape{1, 2}, m);
   const Prediction reader = simulate_trace(t, a, SimulationEngine::simgrid, p);
   EXPECT_EQ(reader.steps[0].makespan_ns, 5000u + 40000 / 20 + 2000);
   EXPECT_EQ(reader.steps[0].makespan_ns,
@@ -199,7 +215,7 @@ TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
   Trace t;
   t.steps = {b.done()};
   const Prediction r = simulate_trace(t, split(4, {0, 2, 3}), SimulationEngine::simgrid,
-                                      {.cluster = ClusterShape{2, 2}, .model = m});
+                                      on_cluster(ClusterShape{2, 2}, m));
   EXPECT_EQ(r.steps[0].inter_node_messages, 1u);
   EXPECT_EQ(r.steps[0].inter_node_bytes, 10000u);
   EXPECT_NEAR(static_cast<double>(r.steps[0].makespan_ns), 500 + 1000 + 10000 * 0.1 + 900, 2);
@@ -212,15 +228,15 @@ TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
   for (int i = 0; i < 4; ++i) b.task({{b.datum(testing::name("d", i), 8), M::W}}, 1000);
   Trace t;
   t.steps = {b.done()};
-  const SimulatedPlatform one{.cluster = ClusterShape{1, 1}, .model = CostModel::defaults()};
+  const SimulatedPlatform one = on_cluster(ClusterShape{1, 1}, CostModel::defaults());
   EXPECT_EQ(simulate_trace(t, split(1, {0, 0, 0, 0}), SimulationEngine::simgrid, one).makespan_ns,
             4000u);
-  const SimulatedPlatform two{.cluster = ClusterShape{1, 2}, .model = CostModel::defaults()};
+  const SimulatedPlatform two = on_cluster(ClusterShape{1, 2}, CostModel::defaults());
   EXPECT_EQ(simulate_trace(t, split(2, {0, 1, 0, 1}), SimulationEngine::simgrid, two).makespan_ns,
             2000u);
   // Three processors on one two-core host would share it: the engine's mapping gives
   // processor 2 the first core of node 1 instead.
-  const SimulatedPlatform twonodes{.cluster = ClusterShape{2, 2}, .model = CostModel::defaults()};
+  const SimulatedPlatform twonodes = on_cluster(ClusterShape{2, 2}, CostModel::defaults());
   EXPECT_EQ(simulate_trace(t, split(3, {0, 1, 2, 2}), SimulationEngine::simgrid, twonodes).makespan_ns,
             2000u);
 }
@@ -238,7 +254,7 @@ TEST(SimgridEngine, EqualsTheBuiltinSimulatorOnOneHostOnRandomGraphs) {
                                                   5, seed % 3 != 0));
     for (const char* method : {"roundrobin", "random", "list"}) {
       const TracePartition tp = partition_trace(trace, method, k);
-      const SimulatedPlatform p{.cluster = ClusterShape{1, k}, .model = model};
+      const SimulatedPlatform p = on_cluster(ClusterShape{1, k}, model);
       const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
       const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
       ASSERT_EQ(b.steps.size(), s.steps.size());
@@ -267,7 +283,7 @@ TEST(SimgridEngine, ReportsADeadlockedOrder) {
   a.steps[0].order = {{2, 0}, {1}};  // processor 0 runs 2 before 0: it waits forever
   try {
     simulate_trace(t, a, SimulationEngine::simgrid,
-                   {.cluster = ClusterShape{1, 2}, .model = CostModel::defaults()});
+                   on_cluster(ClusterShape{1, 2}, CostModel::defaults()));
     ADD_FAILURE() << "no deadlock reported";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("deadlocks"), std::string::npos) << e.what();
@@ -297,9 +313,9 @@ TEST_F(PlatformFiles, AWrittenPlatformGivesWhatTheClusterGives) {
   const CostModel m = CostModel::defaults();
   const std::string file = write("p.xml", platform_xml({2, 2}, m));
   const Prediction from_file =
-      simulate_trace(t, a, SimulationEngine::simgrid, {.file = file, .model = m});
+      simulate_trace(t, a, SimulationEngine::simgrid, on_file(file, m));
   const Prediction from_shape =
-      simulate_trace(t, a, SimulationEngine::simgrid, {.cluster = ClusterShape{2, 2}, .model = m});
+      simulate_trace(t, a, SimulationEngine::simgrid, on_cluster(ClusterShape{2, 2}, m));
   EXPECT_EQ(from_file.steps, from_shape.steps);
   EXPECT_EQ(from_file.steps[0].inter_node_messages, 1u);  // processor 2 is on node 1
 }
@@ -312,7 +328,7 @@ TEST_F(PlatformFiles, MissingOrMalformedPlatformIsAnInputErrorNamingTheFile) {
   const std::string empty = write("empty.xml", "");
   for (const std::string& f : {missing, garbage, empty}) {
     try {
-      simulate_trace(t, a, SimulationEngine::simgrid, {.file = f, .model = CostModel::defaults()});
+      simulate_trace(t, a, SimulationEngine::simgrid, on_file(f, CostModel::defaults()));
       ADD_FAILURE() << "accepted " << f;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(f), std::string::npos) << e.what();
@@ -325,7 +341,7 @@ TEST_F(PlatformFiles, TooFewCoresIsAnError) {
   const Trace t = writer_reader(8);
   const std::string file = write("p.xml", platform_xml({1, 1}, CostModel::defaults()));
   EXPECT_THROW(simulate_trace(t, split(2, {0, 1}), SimulationEngine::simgrid,
-                              {.file = file, .model = CostModel::defaults()}),
+                              on_file(file, CostModel::defaults())),
                Error);
 }
 
@@ -346,7 +362,7 @@ Trace capture(const char* scene, int steps) {
 // the built-in simulator agree within 1 % on every step of bars64 and falling.
 void expect_agreement(const Trace& trace, const char* method, std::uint32_t k) {
   const TracePartition tp = partition_trace(trace, method, k);
-  const SimulatedPlatform p{.cluster = ClusterShape{1, k}, .model = CostModel::defaults()};
+  const SimulatedPlatform p = on_cluster(ClusterShape{1, k}, CostModel::defaults());
   const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
   const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
   ASSERT_EQ(b.steps.size(), trace.steps.size());

@@ -40,7 +40,8 @@ std::string to_string(IntraNodeTransfer t);
 /// Where the processors of a simulation live: a SimGrid platform file or an N x C cluster
 /// made from the cost model (platform_xml()).
 ///
-///   SimulatedPlatform p{.cluster = ClusterShape{4, 16}, .model = CostModel::defaults()};
+///   SimulatedPlatform p;
+///   p.cluster = ClusterShape{4, 16};                 // or p.file = "P.xml"
 ///   Prediction r = simulate_trace(trace, assignment, SimulationEngine::simgrid, p);
 struct SimulatedPlatform {
   std::string file;                    ///< `--platform P.xml` (SimGrid engine only), or empty
