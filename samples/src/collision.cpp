@@ -60,6 +60,14 @@ class PointGrid {
 };
 
 
+// Whether box a grown by `by` on every side intersects box b (the broad phase's test).
+bool within(const Eigen::AlignedBox3d& a, const Eigen::AlignedBox3d& b, double by) {
+  Eigen::AlignedBox3d grown = a;
+  grown.min().array() -= by;
+  grown.max().array() += by;
+  return grown.intersects(b);
+}
+
 // Writes a body's proxy from its positions.
 void update_proxy(const Body& b, CollisionProxy& p, std::uint64_t epoch) {
   double motion2 = 0.0;
@@ -80,10 +88,7 @@ void update_proxy(const Body& b, CollisionProxy& p, std::uint64_t epoch) {
 std::vector<ContactPair> pair_contacts(const Body& a, const Body& b, const CollisionProxy& pa,
                                        const CollisionProxy& pb, double reach) {
   std::vector<ContactPair> pairs;
-  Eigen::AlignedBox3d grown = pa.box;
-  grown.min().array() -= reach;
-  grown.max().array() += reach;
-  if (!grown.intersects(pb.box)) return pairs;
+  if (!within(pa.box, pb.box, reach)) return pairs;
   const PointGrid grid_b(pb.points, reach);
   for (std::size_t k = 0; k < pa.points.size(); ++k) {
     const Vec3& p = pa.points[k];
@@ -194,10 +199,7 @@ void detect_collisions(Scene& scene, Scene::Impl& m) {
           pairs = std::move(found->second->pairs);
         } else {
           const double reach = reach_of(a, b, cs);
-          Eigen::AlignedBox3d grown = c.proxies[i].box;
-          grown.min().array() -= reach;
-          grown.max().array() += reach;
-          if (grown.intersects(c.proxies[j].box)) {  // a narrow phase no task covered
+          if (within(c.proxies[i].box, c.proxies[j].box, reach)) {  // a narrow phase no task covered
             ++c.host_narrow;
             pairs = pair_contacts(a, b, c.proxies[i], c.proxies[j], reach);
           }
@@ -241,10 +243,7 @@ void plan_detection(Scene& scene, Scene::Impl& m) {
     for (std::size_t j = i + 1; j < n; ++j) {
       if (!pair_tested(scene, c, i, j)) continue;
       const double grow = reach_of(*bodies[i], *bodies[j], cs) + margin[i] + margin[j];
-      Eigen::AlignedBox3d grown = c.proxies[i].box;
-      grown.min().array() -= grow;
-      grown.max().array() += grow;
-      if (!grown.intersects(c.proxies[j].box)) continue;
+      if (!within(c.proxies[i].box, c.proxies[j].box, grow)) continue;
       c.planned_pairs.emplace_back(static_cast<int>(i), static_cast<int>(j));
       pair_slot(c, static_cast<int>(i), static_cast<int>(j));
     }
