@@ -24,9 +24,11 @@ class CacheMissCounter {
   ~CacheMissCounter();
   CacheMissCounter(const CacheMissCounter&) = delete;
   CacheMissCounter& operator=(const CacheMissCounter&) = delete;
-  /// False where the kernel refused (containers, VMs without PMU): report "unavailable".
+  /// False where the kernel refused (containers, VMs without PMU): not a failure, the
+  /// reports say so in place of the count.
   bool available() const { return fd_ >= 0; }
-  /// Why it is unavailable (errno text), empty when available.
+  /// Why it is unavailable ("not counted: the kernel refused ... (errno text)"), empty when
+  /// available.
   const std::string& reason() const { return reason_; }
   /// Misses counted so far (0 when unavailable).
   std::uint64_t read() const;
