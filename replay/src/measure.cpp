@@ -304,6 +304,7 @@ std::string to_json(const ReplayResult& r) {
               {"working_set_bytes", r.working_set_bytes}}},
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
+  j["warnings"] = r.warnings;
   const auto pred = r.predicted_makespan_ns();
   j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
   // Ratio of measured to predicted, both without plan builds: the sum over steps of the

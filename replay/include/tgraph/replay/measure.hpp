@@ -92,6 +92,9 @@ struct ReplayResult {
   std::uint64_t order_fallbacks = 0;  ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;
   std::string cache_misses_note;
+  /// What the caller was warned of (a partitioner's fallback, processors without tasks);
+  /// filled by the caller, "warnings" in the JSON.
+  std::vector<std::string> warnings;
   Calibration calibration;
   double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
   std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data
