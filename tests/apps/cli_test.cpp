@@ -193,21 +193,25 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
 }
 
 // A step whose tasks have no object (kNoObject tasks and data, as an engine outside physics
-// declares them): `layers` layers of `width` tasks, each reading the data of two tasks of the
-// layer before and writing its own; parallelism `width`.
+// declares them): a setup task writes a shared table, then `layers` layers of `width` tasks
+// each read the table and the data of two tasks of the layer before and write their own.
+// Owner-compute by data affinity alone would follow the table onto one processor.
 void write_objectless_trace(const fs::path& path, int layers, int width, std::uint64_t cost_ns) {
   tgraph::Trace trace;
   trace.header.scene = "layers";
   trace.header.engine = "cli_test";
   tgraph::StepGraph& g = trace.steps.emplace_back();
   const tgraph::KindId k = g.intern_kind("cell");
+  g.data.push_back({"table", tgraph::kNoObject, 65536});
+  g.add_task(g.intern_kind("setup"), tgraph::kNoObject,
+             std::vector<tgraph::Access>{{0, tgraph::AccessMode::W}}, cost_ns, 999999);
   for (int l = 0; l < layers; ++l)
     for (int i = 0; i < width; ++i) {
       const auto d = static_cast<tgraph::DatumId>(g.data.size());
       g.data.push_back({"d" + std::to_string(l) + "_" + std::to_string(i), tgraph::kNoObject, 64});
-      std::vector<tgraph::Access> acc{{d, tgraph::AccessMode::W}};
+      std::vector<tgraph::Access> acc{{d, tgraph::AccessMode::W}, {0, tgraph::AccessMode::R}};
       if (l > 0) {
-        const auto prev = static_cast<tgraph::DatumId>((l - 1) * width);
+        const auto prev = static_cast<tgraph::DatumId>(1 + (l - 1) * width);
         acc.push_back({static_cast<tgraph::DatumId>(prev + i), tgraph::AccessMode::R});
         acc.push_back({static_cast<tgraph::DatumId>(prev + (i + 1) % width), tgraph::AccessMode::R});
       }
@@ -258,16 +262,16 @@ TEST_F(Cli, InfoUnitCostGivesTheSpanInTasks) {
   Result r = run("info t.tgt --unit-cost --json");
   ASSERT_EQ(r.code, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["span_tasks"], 5);
-  EXPECT_EQ(j["work_tasks"], 40);
-  EXPECT_EQ(j["span_tasks_max"], 5);
-  EXPECT_EQ(j["per_step"][0]["span_tasks"], 5);
-  EXPECT_DOUBLE_EQ(j["unit_parallelism"].get<double>(), 8.0);
+  EXPECT_EQ(j["span_tasks"], 6);  // setup, then one task per layer
+  EXPECT_EQ(j["work_tasks"], 41);
+  EXPECT_EQ(j["span_tasks_max"], 6);
+  EXPECT_EQ(j["per_step"][0]["span_tasks"], 6);
+  EXPECT_DOUBLE_EQ(j["unit_parallelism"].get<double>(), 41.0 / 6.0);
   // The text never claims a span of 0 ms for a trace without costs: it gives the tasks.
   r = run("info t.tgt");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.out.find("0.000 ms"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("span (unit)    5 tasks"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("span (unit)    6 tasks"), std::string::npos) << r.out;
   // A timed trace: the totals say they sum over steps, with the longest step's span.
   ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
   r = run("info f.tgt --json");

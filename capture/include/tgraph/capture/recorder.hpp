@@ -342,6 +342,10 @@ class Recorder {
   bool time_task_ = true;                   // time the tasks of the current iteration
   std::vector<std::uint32_t> loop_timed_;   // per loop: timed iterations so far
   std::uint64_t errors_ = 0;
+  std::uint32_t cost_passes_ = 1;           // timed passes per body (capture mode)
+  std::uint64_t single_pass_runs_ = 0;      // runs timed once: unrestorable written data
+  std::vector<unsigned char> saved_;        // written data of the task being timed
+  std::vector<std::uint64_t> pass_ticks_;   // timings of its passes
 };
 
 }  // namespace tgraph::capture
