@@ -2,6 +2,7 @@
 // The barrier policy's phases: one per dependency level (default) or one per operation.
 #include <gtest/gtest.h>
 
+#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
