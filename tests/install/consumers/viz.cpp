@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // tgraph::viz: the step's picture through Graphviz's libraries, as SVG.
 #include <cstdio>
+#include <string>
 
 #include "fork_join.hpp"
 #include "tgraph/viz/graph_view.hpp"
@@ -14,7 +15,8 @@ int main() {
   expect(view.edges.size() == consumer::kWidth, "edges");
   const std::string svg = tgraph::viz::render_graph(view, tgraph::viz::GraphFormat::kSvg);
   std::size_t nodes = 0, edges = 0;
-  for (std::size_t at = 0; (at = svg.find("class=\"node\"", at)) != std::string::npos; ++at) ++nodes;
+  for (std::uint32_t t = 0; t < g.tasks.size(); ++t)  // a node per task, titled t<id>
+    if (svg.find("<title>t" + std::to_string(t) + "</title>") != std::string::npos) ++nodes;
   for (std::size_t at = 0; (at = svg.find("class=\"edge\"", at)) != std::string::npos; ++at) ++edges;
   expect(svg.find("<svg") != std::string::npos, "an SVG document");
   expect(nodes == consumer::kWidth + 1 && edges == consumer::kWidth, "drawn nodes and edges");
