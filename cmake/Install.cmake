@@ -20,6 +20,7 @@ set(_tgraph_find_TBB::tbb "find_package(TBB QUIET CONFIG)\nset(_ok \${TBB_FOUND}
 set(_tgraph_find_OpenMP::OpenMP_CXX
     "find_package(OpenMP QUIET COMPONENTS CXX)\nset(_ok \${OpenMP_CXX_FOUND})")
 set(_tgraph_find_Eigen3::Eigen "find_package(Eigen3 3.4 QUIET CONFIG)\nset(_ok \${Eigen3_FOUND})")
+set(_tgraph_find_MPI::MPI_CXX "find_package(MPI QUIET COMPONENTS CXX)\nset(_ok \${MPI_CXX_FOUND})")
 # What to install to get them (the message of a failed find_package(tgraph)).
 set(_tgraph_debian_Threads::Threads "libc6-dev")
 set(_tgraph_debian_ZLIB::ZLIB "zlib1g-dev")
@@ -27,6 +28,7 @@ set(_tgraph_debian_nlohmann_json::nlohmann_json "nlohmann-json3-dev")
 set(_tgraph_debian_TBB::tbb "libtbb-dev")
 set(_tgraph_debian_OpenMP::OpenMP_CXX "g++ (libgomp)")
 set(_tgraph_debian_Eigen3::Eigen "libeigen3-dev")
+set(_tgraph_debian_MPI::MPI_CXX "libopenmpi-dev")
 set(_tgraph_debian_PkgConfig::HWLOC "libhwloc-dev")
 set(_tgraph_debian_PkgConfig::STARPU "libstarpu-dev")
 set(_tgraph_debian_PkgConfig::GRAPHVIZ "libgraphviz-dev")
@@ -144,6 +146,13 @@ foreach(module IN LISTS _tgraph_modules)
     if(import MATCHES "^PkgConfig::(.*)$")
       set(name "${CMAKE_MATCH_1}")
       get_property(pc_modules GLOBAL PROPERTY TGRAPH_PKG_CONFIG_${name})
+      if(NOT pc_modules AND DEFINED __pkg_config_arguments_${name})
+        # Made by a plain pkg_check_modules: its arguments (an internal cache entry of
+        # FindPkgConfig) less the keywords are the modules.
+        set(pc_modules ${__pkg_config_arguments_${name}})
+        list(REMOVE_ITEM pc_modules REQUIRED QUIET IMPORTED_TARGET GLOBAL NO_CMAKE_PATH
+             NO_CMAKE_ENVIRONMENT_PATH)
+      endif()
       if(NOT pc_modules)
         message(FATAL_ERROR "cmake/Install.cmake: tgraph_${module} links ${import}, not made "
                             "by tgraph_pkg_config (cmake/Dependencies.cmake)")
