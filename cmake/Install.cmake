@@ -33,6 +33,7 @@ set(_tgraph_debian_PkgConfig::HWLOC "libhwloc-dev")
 set(_tgraph_debian_PkgConfig::STARPU "libstarpu-dev")
 set(_tgraph_debian_PkgConfig::GRAPHVIZ "libgraphviz-dev")
 set(_tgraph_debian_PkgConfig::CAIRO "libcairo2-dev")
+set(_tgraph_debian_PkgConfig::SIMGRID "libsimgrid-dev")
 
 # The modules, as library targets tgraph_<module> in folder <folder>, in dependency order.
 set(_tgraph_modules "")
