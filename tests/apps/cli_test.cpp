@@ -12,6 +12,7 @@
 #include <string>
 
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/version.hpp"
 
 namespace {
 
@@ -61,6 +62,18 @@ TEST_F(Cli, UnknownVerbExits2WithOneLine) {
   const Result r = run("frobnicate");
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;
+}
+
+TEST_F(Cli, VersionPrintsTheProjectVersionFromVersionHeader) {
+  const Result r = run("--version");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "tgraph " + std::string(tgraph::kVersionString) + "\n");
+  // One source: the project version in CMakeLists.txt (TGRAPH_VERSION, set by CMake).
+  EXPECT_EQ(tgraph::kVersionString, TGRAPH_VERSION);
+  EXPECT_EQ(std::to_string(tgraph::kVersionMajor) + "." + std::to_string(tgraph::kVersionMinor) +
+                "." + std::to_string(tgraph::kVersionPatch),
+            TGRAPH_VERSION);
+  EXPECT_EQ(tgraph::linked_version(), tgraph::kVersionString);
 }
 
 TEST_F(Cli, InfoOnMissingFileExits2NamingIt) {
