@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,7 @@ const Variant kVariants[] = {
     {Policy::kPartition, true, "partition_serial"},
     {Policy::kWorksteal, false, "worksteal"},
     {Policy::kBarrier, false, "barrier"},
+    {Policy::kOmpTasks, false, "omp_tasks"},
 };
 
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
@@ -81,7 +83,8 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads1To8, EveryPolicy,
-                         ::testing::Combine(::testing::Range(0, 4), ::testing::Range(1u, 9u)),
+                         ::testing::Combine(::testing::Range(0, static_cast<int>(std::size(kVariants))),
+                                            ::testing::Range(1u, 9u)),
                          [](const auto& param_info) {
                            return std::string(kVariants[std::get<0>(param_info.param)].name) +
                                   "_k" + std::to_string(std::get<1>(param_info.param));

@@ -83,7 +83,7 @@ INSTANTIATE_TEST_SUITE_P(
 
 TEST(Live, EveryPolicyAndThreadCountMatchesItsReferenceOnBarsAndCloth) {
   for (const char* scene : {"bars64", "cloth128"})
-    for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+    for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier, Policy::kOmpTasks})
       for (std::uint32_t k = 1; k <= 4; ++k) {
         const LiveResult r = live(scene, p, "owner", k, 2);
         EXPECT_EQ(r.check, "identical") << scene << " " << to_string(p) << " k=" << k << ": "
