@@ -50,7 +50,12 @@ struct MetgPoint {
   std::uint64_t task_ns = 0;      ///< the duration of every task
   std::uint64_t instances = 0;    ///< task instances per step (loop iterations unrolled)
   std::int64_t wall_ns = 0;       ///< median step wall time
-  double efficiency = 0;          ///< instances x task_ns / (threads x wall_ns)
+  /// The sequential policy's wall time on the same step, same durations, same run, over
+  /// threads x wall_ns: the efficiency METG is computed from (1 for the sequential policy).
+  double efficiency = 0;
+  /// Task Bench's own reference, the work the spins were calibrated to do: instances x
+  /// task_ns / (threads x wall_ns) (the calibration is only as good as this machine is quiet).
+  double work_efficiency = 0;
   std::uint64_t granularity_ns = 0;  ///< threads x wall_ns / instances (Task Bench)
 };
 
