@@ -52,8 +52,8 @@ Sweep sweep_for(bool quick) {
     s.work_ns = 8'000'000;
     s.repeat = 1;
   } else {
-    for (std::uint64_t d = 1'024'000; d >= 250; d /= 2) s.task_ns.push_back(d);
-    s.work_ns = 100'000'000;
+    for (std::uint64_t d = 256'000; d >= 250; d /= 2) s.task_ns.push_back(d);
+    s.work_ns = 40'000'000;
     s.repeat = 3;
   }
   return s;
