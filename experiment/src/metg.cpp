@@ -332,6 +332,7 @@ MetgResult run_metg(const MetgOptions& options, Progress& progress) {
     std::vector<MetgPoint> points;
     int below = 0;  // consecutive points under 50 %: the run's sweep stops after two
   };
+  progress.set_total(std::size(kShapes));
   for (MetgShape shape : kShapes) {
     const std::string shape_name(to_string(shape));
     std::vector<Run> runs;
