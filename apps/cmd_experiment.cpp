@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "tgraph/experiment/experiment.hpp"
+#include "tgraph/experiment/metg.hpp"
 
 namespace tgraph::app {
 
@@ -13,9 +14,13 @@ void add_experiment(CLI::App& app) {
   auto a = std::make_shared<Args>();
   auto* cmd = app.add_subcommand(
       "experiment", "Run one of the paper's experiments: live speed-ups, replays, predictions");
-  cmd->add_option("name", a->method, "independent, heterogeneous, domain or medical")
+  std::vector<std::string> names = experiment::experiment_names();
+  names.emplace_back("metg");
+  cmd->add_option("name", a->method,
+                  "independent, heterogeneous, domain or medical (the paper's), or metg (Task "
+                  "Bench's minimum effective task granularity for every policy)")
       ->required()
-      ->check(CLI::IsMember(experiment::experiment_names()));
+      ->check(CLI::IsMember(names));
   cmd->add_option("--threads", o->threads,
                   "Thread counts, e.g. 1-4,8,16 (default: 1 to the cores, then powers of 2 to "
                   "64); counts above the cores are predicted only");
@@ -34,6 +39,15 @@ void add_experiment(CLI::App& app) {
       "--no-replay", [o] { o->replay = false; }, "Skip the synthetic replays");
   cmd->add_flag("--json", a->json, "Print results.json on stdout");
   cmd->callback([o, a] {
+    if (a->method == "metg") {
+      // The sweep takes --quick, --threads, --out, --json and --methods (policies).
+      const experiment::MetgOptions mo{o->quick, o->out_dir, o->threads, o->methods};
+      experiment::Progress progress(stderr, experiment::Progress::is_terminal(stderr));
+      const experiment::MetgResult r = experiment::run_metg(mo, progress);
+      std::cout << (a->json ? experiment::metg_json(r) + "\n" : experiment::metg_text(r))
+                << std::flush;
+      return;
+    }
     o->name = *experiment::parse_experiment_name(a->method);
     experiment::Progress progress(stderr, experiment::Progress::is_terminal(stderr));
     const experiment::ExperimentResult r = experiment::run_experiment(*o, progress);

@@ -123,7 +123,7 @@ void add_replay_verbs(CLI::App& app) {
                   "Assignment file (.tga; partition policy; default: --method)");
   add_exec_flags(cmd, *a, o->exec);
   cmd->add_option("--policy", a->policy,
-                  "partition (default), worksteal, barrier, starpu or sequential");
+                  "partition (default), worksteal, barrier, starpu, omp-tasks or sequential");
   cmd->add_option("--method", a->method,
                   "Strategy used when no assignment file is given (default: owner when the "
                   "trace's tasks work on objects, else list)");
@@ -152,7 +152,7 @@ void add_replay_verbs(CLI::App& app) {
   add_exec_flags(cmd, *a, live->exec);
   cmd->add_option("--method", a->method,
                   "Strategy (owner, metis, scotch, sticky, list, roundrobin) or a baseline "
-                  "(worksteal, barrier, starpu, sequential)");
+                  "(worksteal, barrier, starpu, omp-tasks, sequential)");
   cmd->add_option("--policy", a->policy, "Override the policy");
   cmd->add_option("--steps", a->steps, "Steps (default: the scene's)");
   cmd->add_option("--repeat", live->repeat, "Timed passes (medians reported; default 1)");

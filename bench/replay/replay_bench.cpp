@@ -9,6 +9,9 @@
 //  * TaskOverhead/<policy>/threads:N: the same step with empty bodies (no spin, no data):
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
 //    worksteal, barrier, and starpu when the build has StarPU.
+//  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
+//    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
+//    CG iteration: which way of writing it a competent OpenMP user should pick here.
 //  * SignalWait/<spin|futex>: the floor under a hand-off: two threads bouncing a counter
 //    through one std::atomic, by spinning on it or by std::atomic::wait/notify_one;
 //    latency_ns is one signal -> wait (half a round trip).
@@ -167,6 +170,20 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
+  const auto k = static_cast<std::uint32_t>(state.range(0));
+  const StepGraph g = bars_like(64, 25);
+  ExecOptions o;
+  o.threads = k;
+  o.reduce_scope = mutex ? ReduceScope::kNone : ReduceScope::kPerWriter;
+  o.omp_iteration_wait = iteration_wait;
+  auto ex = make_executor(Policy::kOmpTasks, o);
+  SyntheticWorkload w;
+  w.set_step(g);
+  ex->run_step(g, nullptr, w);
+  for (auto _ : state) ex->run_step(g, nullptr, w);
+}
+
 void cpu_relax() {
 #if defined(__x86_64__) || defined(__i386__)
   __builtin_ia32_pause();
@@ -248,7 +265,8 @@ void register_all(bench::Size size) {
     handoff->ArgsProduct({{0, 2'000}, {0, 5'000, 50'000}});
   bench::timed(handoff, size, 0.3);
 
-  std::vector<Policy> parallel = {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier};
+  std::vector<Policy> parallel = {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier,
+                                  Policy::kOmpTasks};
 #ifdef TGRAPH_HAVE_STARPU
   parallel.push_back(Policy::kStarpu);
 #endif
@@ -265,6 +283,18 @@ void register_all(bench::Size size) {
   add("BM_Policy", BM_Policy, Policy::kSequential, {1});
   if (!smoke)
     for (const Policy p : parallel) add("BM_Policy", BM_Policy, p, {2});
+  if (!smoke)
+    for (const bool mutex : {false, true})
+      for (const bool wait : {true, false}) {
+        const std::string name = std::string("BM_OmpTasks/") + (mutex ? "mutexinoutset" : "reduce") +
+                                 (wait ? "/taskwait" : "/nowait");
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), BM_OmpTasks, mutex, wait)
+                      ->ArgName("threads")
+                      ->Arg(2)
+                      ->Unit(benchmark::kMillisecond)
+                      ->UseRealTime();
+        bench::timed(b, size, 0.5);
+      }
   add("BM_TaskOverhead", BM_TaskOverhead, Policy::kSequential, {1});
   for (const Policy p : parallel)
     add("BM_TaskOverhead", BM_TaskOverhead, p,

@@ -150,7 +150,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
       assignments.push_back(part.assignment);
     }
   }
-  std::vector<tr::Policy> baselines = {tr::Policy::kWorksteal, tr::Policy::kBarrier};
+  std::vector<tr::Policy> baselines = {tr::Policy::kWorksteal, tr::Policy::kBarrier,
+                                       tr::Policy::kOmpTasks};
 #ifdef TGRAPH_HAVE_STARPU
   baselines.push_back(tr::Policy::kStarpu);
 #else

@@ -13,9 +13,9 @@ namespace tgraph::experiment {
 namespace {
 
 // The paper compares its partitioned executor with work stealing and per-operation
-// barriers; the toolkit adds METIS, Scotch, sticky and StarPU.
-const std::vector<std::string> kAllMethods = {"owner",     "metis",   "scotch", "sticky",
-                                              "worksteal", "barrier", "starpu"};
+// barriers; the toolkit adds METIS, Scotch, sticky, OpenMP tasks and StarPU.
+const std::vector<std::string> kAllMethods = {"owner",   "metis",     "scotch", "sticky", "worksteal",
+                                              "barrier", "omp-tasks", "starpu"};
 
 std::vector<std::string> split_list(std::string_view text) {
   std::vector<std::string> out;
@@ -55,7 +55,7 @@ std::vector<std::string> parse_methods(std::string_view text) {
     if (!p && !is_strategy(m))
       throw UsageError("--methods " + std::string(text) + ": unknown method '" + m +
                        "' (expected strategies " + join(partition::strategy_names(), ", ") +
-                       " or baselines worksteal, barrier, starpu)");
+                       " or baselines worksteal, barrier, omp-tasks, starpu)");
 #ifndef TGRAPH_HAVE_STARPU
     if (p == replay::Policy::kStarpu)
       throw UsageError("--methods " + std::string(text) +

@@ -21,6 +21,20 @@ inline bool leave_loop(const ExecGraph& x, LoopId l, std::uint32_t i, Workload& 
          i + 1 >= kIterationCap;
 }
 
+/// Iterations an unrolled loop runs when the workload knows `known` in advance: at least
+/// one, at most the loop's maximum and the hard cap.
+inline std::uint32_t unrolled_count(const Loop& loop, std::uint32_t known) {
+  std::uint32_t count = known < 1 ? 1 : known;
+  if (loop.max_iterations != 0 && loop.max_iterations < count) count = loop.max_iterations;
+  return count < kIterationCap ? count : kIterationCap;
+}
+
+/// An unrolled loop's break task, iteration `i` of `count`: evaluates the condition (still
+/// the workload's, which must agree with its known_iterations) and throws UsageError when
+/// it disagrees. Returns the condition.
+bool check_unrolled(const ExecGraph& x, LoopId l, std::uint32_t i, std::uint32_t count,
+                    Workload& w);
+
 /// Whether observers see loop iteration `it` under Executor::set_observe_stride(stride):
 /// iterations 0 and 1 and every stride-th one (every instance outside loops).
 inline bool sampled(std::uint32_t it, std::uint32_t stride) { return it < 2 || it % stride == 0; }

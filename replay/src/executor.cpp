@@ -43,6 +43,16 @@ Csr build_csr(std::size_t n, const std::vector<Edge>& edges, bool by_to) {
   return c;
 }
 
+bool check_unrolled(const ExecGraph& x, LoopId l, std::uint32_t i, std::uint32_t count,
+                    Workload& w) {
+  const bool stop = leave_loop(x, l, i, w);
+  if (stop != (i + 1 == count))
+    throw UsageError("loop " + std::to_string(l) + ": the workload's condition " +
+                     (stop ? "stops" : "continues") + " after iteration " + std::to_string(i) +
+                     ", against its known_iterations");
+  return stop;
+}
+
 std::vector<std::uint32_t> first_accessor_owner(const ExecGraph& x) {
   std::vector<std::uint32_t> owner(x.graph.data.size(), 0);
   std::vector<bool> seen(x.graph.data.size(), false);
@@ -115,6 +125,7 @@ ReduceScope Executor::reduce_scope() const {
     case Policy::kWorksteal:
     case Policy::kBarrier:
     case Policy::kStarpu:
+    case Policy::kOmpTasks:
       return ReduceScope::kPerWriter;
   }
   return ReduceScope::kNone;
@@ -288,6 +299,7 @@ std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_omp_tasks_executor(const ExecOptions& o);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
   if (options.threads == 0) throw UsageError("--threads must be at least 1");
@@ -307,6 +319,8 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
       return make_barrier_executor(options);
     case Policy::kStarpu:
       return make_starpu_executor(options);
+    case Policy::kOmpTasks:
+      return make_omp_tasks_executor(options);
   }
   throw UsageError("unknown policy");
 }

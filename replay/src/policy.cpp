@@ -19,13 +19,15 @@ std::string_view to_string(Policy policy) {
       return "barrier";
     case Policy::kStarpu:
       return "starpu";
+    case Policy::kOmpTasks:
+      return "omp-tasks";
   }
   return "?";
 }
 
 std::optional<Policy> parse_policy(std::string_view name) {
   for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier,
-                   Policy::kStarpu})
+                   Policy::kStarpu, Policy::kOmpTasks})
     if (to_string(p) == name) return p;
   return std::nullopt;
 }
@@ -33,7 +35,7 @@ std::optional<Policy> parse_policy(std::string_view name) {
 Policy policy_flag(std::string_view name, std::string_view flag) {
   if (const auto p = parse_policy(name)) return *p;
   throw UsageError(std::string(flag) + " " + std::string(name) +
-                   ": expected partition, worksteal, barrier, starpu or sequential");
+                   ": expected partition, worksteal, barrier, starpu, omp-tasks or sequential");
 }
 
 MethodChoice choose_method(std::string_view method, std::string_view policy) {

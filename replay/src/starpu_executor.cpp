@@ -294,14 +294,13 @@ class StarpuExecutor final : public Executor {
         workload_->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
         if (!observers_.empty()) detail::notify_end(observers_, thread, in.task, in.iteration);
         ++tc.tasks;
-        if (in.check != Check::kNone) {
-          const LoopId l = x.graph.tasks[in.task].loop;
-          const bool stop = detail::leave_loop(x, l, in.iteration, *workload_);
-          in.decision = stop ? 1 : 0;
-          if ((in.check == Check::kStop && !stop) || (in.check == Check::kContinue && stop))
-            throw UsageError("loop " + std::to_string(l) + ": the workload's condition " +
-                             (stop ? "stops" : "continues") + " after iteration " +
-                             std::to_string(in.iteration) + ", against its known_iterations");
+        const LoopId l = x.graph.tasks[in.task].loop;
+        if (in.check == Check::kDecide) {
+          in.decision = detail::leave_loop(x, l, in.iteration, *workload_) ? 1 : 0;
+        } else if (in.check != Check::kNone) {
+          // The count is only compared with: any count past the next iteration continues.
+          const std::uint32_t count = in.iteration + (in.check == Check::kStop ? 1 : 2);
+          in.decision = detail::check_unrolled(x, l, in.iteration, count, *workload_) ? 1 : 0;
         }
       } catch (...) {
         fail(std::current_exception());
@@ -368,9 +367,7 @@ class StarpuExecutor final : public Executor {
         const Loop& loop = g.loops[l];
         if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
           // Unrolled: the break tasks still evaluate the condition, which must agree.
-          std::uint32_t count = std::max<std::uint32_t>(1, *known);
-          if (loop.max_iterations != 0) count = std::min(count, loop.max_iterations);
-          count = std::min(count, detail::kIterationCap);
+          const std::uint32_t count = detail::unrolled_count(loop, *known);
           for (std::uint32_t it = 0; it < count; ++it)
             for (TaskId u = loop.first; u < loop.last; ++u)
               submit(u, it,

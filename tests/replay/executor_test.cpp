@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -32,6 +33,7 @@ const Variant kVariants[] = {
     {Policy::kWorksteal, false, "worksteal"},
     {Policy::kBarrier, false, "barrier"},
     {Policy::kBarrier, false, "barrier_operation", BarrierRule::kOperation},
+    {Policy::kOmpTasks, false, "omp_tasks"},
 };
 
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
@@ -84,7 +86,8 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads1To8, EveryPolicy,
-                         ::testing::Combine(::testing::Range(0, 5), ::testing::Range(1u, 9u)),
+                         ::testing::Combine(::testing::Range(0, static_cast<int>(std::size(kVariants))),
+                                            ::testing::Range(1u, 9u)),
                          [](const auto& param_info) {
                            return std::string(kVariants[std::get<0>(param_info.param)].name) +
                                   "_k" + std::to_string(std::get<1>(param_info.param));

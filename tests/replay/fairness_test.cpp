@@ -83,8 +83,13 @@ TEST_P(DynamicBaseline, SerializeIsStillAvailableAndOrdersTheWriters) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Policies, DynamicBaseline,
-                         ::testing::Values(Policy::kWorksteal, Policy::kBarrier),
-                         [](const auto& p) { return std::string(to_string(p.param)); });
+                         ::testing::Values(Policy::kWorksteal, Policy::kBarrier,
+                                           Policy::kOmpTasks),
+                         [](const auto& p) {
+                           std::string name(to_string(p.param));
+                           std::replace(name.begin(), name.end(), '-', '_');  // gtest names
+                           return name;
+                         });
 
 // Sum of the synthetic CW bodies is exact integer arithmetic: every policy and scope must
 // reach the sequential result, and the per-writer reducer must add each temporary once.
@@ -104,7 +109,7 @@ TEST(FairReduction, EveryPolicyReachesTheSequentialSums) {
     return std::vector<std::uint64_t>(y.begin(), y.end());
   };
   const auto want = run(Policy::kSequential, 1);
-  for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier})
+  for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier, Policy::kOmpTasks})
     for (std::uint32_t k : {2u, 3u}) EXPECT_EQ(run(p, k), want) << to_string(p) << " k=" << k;
 }
 

@@ -4,7 +4,8 @@
 // (replay/src/tsan.hpp); what the libraries themselves pass between threads (their task
 // objects, the functor's fields, the omp shared-variable block) is only reachable here.
 // The partitioned executor (std::thread + atomics) needs no suppression. StarPU (the starpu
-// policy) is not instrumented either: the executor annotates its hand-offs the same way.
+// policy) and libgomp's task queues (the omp-tasks policy) are not instrumented either: the
+// executors annotate their hand-offs the same way.
 #if defined(__SANITIZE_THREAD__)
 extern "C" const char* __tsan_default_suppressions() {
   return
@@ -15,6 +16,14 @@ extern "C" const char* __tsan_default_suppressions() {
       // libgomp hands the shared-variable block of `omp parallel` to its threads; the
       // region's own data is annotated (replay/src/tsan.hpp).
       "race_top:BarrierExecutor::execute\n"
+      // omp-tasks: libgomp copies each task's firstprivate block into a task it allocates,
+      // queues it and frees it after another thread ran it, all inside libgomp (not
+      // instrumented): the outlined task body's read of its own arguments, the region's
+      // shared block, and libgomp's malloc/free of those task objects. The task bodies'
+      // data hand-off is annotated per dependence object (replay/src/omp_tasks_executor.cpp).
+      "race_top:OmpTasksExecutor::submit\n"
+      "race_top:OmpTasksExecutor::execute\n"
+      "called_from_lib:libgomp.so.1\n"
       // libstarpu allocates its job structures in one thread and frees them in another after
       // a hand-off through its own (uninstrumented) locks; tgraph's side is annotated.
       "called_from_lib:libstarpu-1.3.so\n";

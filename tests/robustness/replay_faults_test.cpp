@@ -87,7 +87,8 @@ std::vector<PolicyCase> policies() {
                                {Policy::kPartition, 2},
                                {Policy::kPartition, 3},
                                {Policy::kWorksteal, 2},
-                               {Policy::kBarrier, 2}};
+                               {Policy::kBarrier, 2},
+                               {Policy::kOmpTasks, 2}};
 #ifdef TGRAPH_HAVE_STARPU
   v.push_back({Policy::kStarpu, 2});
 #endif

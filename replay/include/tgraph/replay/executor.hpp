@@ -32,7 +32,8 @@ struct ExecOptions {
   std::int64_t spin_ns = kDefaultSpinNs;  ///< spin this long before parking (0: park at once)
   std::optional<CwMode> cw;               ///< default: kReduce for every policy
   /// Temporaries of kReduce; default: kPerProcessor for partition, kPerWriter for the
-  /// dynamic policies (worksteal, barrier, starpu), kNone for sequential. A sequential run
+  /// dynamic policies (worksteal, barrier, starpu, omp-tasks), kNone for sequential. omp-tasks
+  /// with kNone leaves CW groups whole and declares them `mutexinoutset`. A sequential run
   /// given the scope of another policy reproduces that policy's reduction order.
   std::optional<ReduceScope> reduce_scope;
   /// Partition only: drop the waits that program order on the producing processor already
@@ -53,6 +54,10 @@ struct ExecOptions {
   BarrierRule barrier_rule = BarrierRule::kLevel;
   /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
   std::string starpu_sched = "lws";
+  /// omp-tasks only: a `taskwait` after each iteration of an unrolled loop (what an OpenMP
+  /// program testing convergence writes; libgomp's dependence lists stay short). Off: the
+  /// whole step is submitted at once, as the other dynamic baselines unroll it.
+  bool omp_iteration_wait = true;
   /// Partition only: the watchdog. A step during which no thread finishes a task or passes
   /// a wait for this long ends with std::runtime_error naming what each thread waits for or
   /// runs (0: no watchdog). Every thread is joined before run_step throws.

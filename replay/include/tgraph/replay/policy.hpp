@@ -15,9 +15,10 @@ enum class Policy : unsigned char {
   kWorksteal = 2,   ///< oneTBB, dependency counting over the dataflow graph, no affinity
   kBarrier = 3,     ///< a parallel loop per operation, barrier after each (OpenMP)
   kStarpu = 4,      ///< StarPU tasks with one data handle per datum (implicit dependencies)
+  kOmpTasks = 5,    ///< OpenMP tasks with one `depend` object per datum (libgomp)
 };
 
-/// "sequential", "partition", "worksteal", "barrier" or "starpu".
+/// "sequential", "partition", "worksteal", "barrier", "starpu" or "omp-tasks".
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);

@@ -1,0 +1,297 @@
+// SPDX-License-Identifier: MIT
+// OpenMP tasks with `depend` clauses as a peer policy: the lowered step submitted, in
+// program order, by one thread of a parallel region (`omp single`) as OpenMP tasks, with
+// one dependence object per exec datum and the recorded modes; the OpenMP runtime (GCC's
+// libgomp here) derives the order from the clauses and places the tasks.
+//
+// Modes: R -> in, W -> out, RW -> inout. CW: under the default per-writer lowering (one CW
+// writer per datum and group, later writers on temporaries of their own, then a reducer
+// task with inout on the target and the temporaries) -> inout, which keeps the sum in
+// program order (bit-identical to a sequential run of the same reduction order). With the
+// reduce scope none (CW groups left with several writers) -> mutexinoutset, OpenMP 5.0's
+// "any order, one at a time"; GCC 12's libgomp treats it as out (the writers serialise in
+// program order), see docs/replay.md for the measured comparison. Task reductions
+// (`task_reduction`/`in_reduction`) need the writers to add into the runtime's private copy,
+// which opaque bodies cannot, and a taskgroup per CW group, which blocks the submitting
+// thread: they are not used.
+//
+// Loops: a loop whose iteration count the workload knows (a replay) is unrolled at
+// submission, with a `taskwait` after each iteration when ExecOptions::omp_iteration_wait
+// (as an OpenMP program testing convergence must do; it also keeps libgomp's dependence
+// lists short). Otherwise (live physics) one iteration is submitted, the submitting thread
+// waits for it and reads the break task's decision. A loop task that writes none of its data
+// with W or RW also has a private inout object so that its iterations never overlap.
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <vector>
+
+#include "common.hpp"
+#include "sync.hpp"
+#include "tgraph/replay/executor.hpp"
+#include "tsan.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+/// Dependence list of one exec task: `ids[first ...]` holds its in, out, inout and
+/// mutexinoutset objects, in that order.
+struct TaskDeps {
+  std::uint32_t first = 0;
+  std::uint16_t in = 0, out = 0, inout = 0, mutex = 0;
+};
+
+struct OmpPlan {
+  std::uint32_t objects = 0;  // exec data, then private objects of loop tasks
+  std::vector<TaskDeps> deps;
+  std::vector<std::uint32_t> ids;
+  std::unique_ptr<char[]> object;  // the dependence objects (their addresses)
+};
+
+/// What the break task of a loop iteration does after its body.
+enum class Check : std::uint8_t {
+  kNone = 0,      ///< not a break task
+  kDecide = 1,    ///< evaluate the condition and store it (the submitter waits for it)
+  kUnrolled = 2,  ///< unrolled: the condition must agree with the known count
+};
+
+class OmpTasksExecutor final : public Executor {
+ public:
+  explicit OmpTasksExecutor(const ExecOptions& o)
+      : Executor(Policy::kOmpTasks, o), counters_(std::make_unique<Slot[]>(o.threads)) {}
+  ~OmpTasksExecutor() override {
+    if (pinned_main_) detail::restore_binding(main_binding_);
+  }
+
+ private:
+  struct alignas(64) Slot {
+    ThreadCounters c;
+  };
+
+  std::shared_ptr<void> build(const ExecGraph& x) override {
+    const StepGraph& g = x.graph;
+    auto plan = std::make_shared<OmpPlan>();
+    plan->objects = static_cast<std::uint32_t>(g.data.size());
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    plan->deps.resize(n);
+    const bool mutex_cw = x.scope != ReduceScope::kPerWriter;
+    std::vector<Access> merged;
+    std::vector<std::uint32_t> by_mode[4];
+    for (TaskId t = 0; t < n; ++t) {
+      // A datum listed twice by one task becomes one dependence (RW when the modes differ).
+      merged.clear();
+      for (const Access& a : g.accesses_of(t)) {
+        auto m = std::find_if(merged.begin(), merged.end(),
+                              [&](const Access& b) { return b.datum == a.datum; });
+        if (m == merged.end())
+          merged.push_back(a);
+        else if (m->mode != a.mode)
+          m->mode = AccessMode::RW;
+      }
+      for (auto& v : by_mode) v.clear();
+      bool ordered = false;  // a W or RW access orders consecutive instances already
+      for (const Access& a : merged) {
+        switch (a.mode) {
+          case AccessMode::R:
+            by_mode[0].push_back(a.datum);
+            break;
+          case AccessMode::W:
+            by_mode[1].push_back(a.datum);
+            ordered = true;
+            break;
+          case AccessMode::RW:
+            by_mode[2].push_back(a.datum);
+            ordered = true;
+            break;
+          case AccessMode::CW:
+            by_mode[mutex_cw ? 3 : 2].push_back(a.datum);
+            ordered |= !mutex_cw;
+            break;
+        }
+      }
+      if (g.tasks[t].loop != kNoLoop && !ordered) by_mode[2].push_back(plan->objects++);
+      TaskDeps& d = plan->deps[t];
+      d.first = static_cast<std::uint32_t>(plan->ids.size());
+      d.in = static_cast<std::uint16_t>(by_mode[0].size());
+      d.out = static_cast<std::uint16_t>(by_mode[1].size());
+      d.inout = static_cast<std::uint16_t>(by_mode[2].size());
+      d.mutex = static_cast<std::uint16_t>(by_mode[3].size());
+      for (const auto& v : by_mode) plan->ids.insert(plan->ids.end(), v.begin(), v.end());
+    }
+    plan->object = std::make_unique<char[]>(std::max<std::uint32_t>(1, plan->objects));
+    return plan;
+  }
+
+  void fail(std::exception_ptr e) {
+    std::lock_guard lock(error_mutex_);
+    if (!error_) error_ = std::move(e);
+    // relaxed: a hint for the tasks still to run; error_ itself is read under the mutex.
+    failed_.store(true, std::memory_order_relaxed);
+  }
+
+  /// Body of one task instance (runs on whichever thread of the team libgomp picks).
+  void run_instance(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
+    const OmpPlan& p = *plan_;
+    const TaskDeps& d = p.deps[t];
+    const std::uint32_t nd = d.in + d.out + d.inout + d.mutex;
+    // TSan: libgomp's dependence release is not instrumented; each object stands for it.
+    TGRAPH_TSAN_ACQUIRE(&submit_token_);
+    for (std::uint32_t i = 0; i < nd; ++i) TGRAPH_TSAN_ACQUIRE(&p.object[p.ids[d.first + i]]);
+    const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
+    // relaxed: only skips work after a failure; the error itself is passed under a mutex.
+    if (!failed_.load(std::memory_order_relaxed)) {
+      try {
+        const ExecGraph& x = *exec_;
+        const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
+        if (observe) detail::notify_begin(observers_, thread, t, it);
+        workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
+        if (observe) detail::notify_end(observers_, thread, t, it);
+        ++counters_[thread].c.tasks;
+        const LoopId l = x.graph.tasks[t].loop;
+        if (check == Check::kDecide)
+          decision_ = detail::leave_loop(x, l, it, *workload_) ? 1 : 0;
+        else if (check == Check::kUnrolled)
+          detail::check_unrolled(x, l, it, count, *workload_);
+      } catch (...) {
+        fail(std::current_exception());
+      }
+    }
+    for (std::uint32_t i = 0; i < nd; ++i) TGRAPH_TSAN_RELEASE(&p.object[p.ids[d.first + i]]);
+    TGRAPH_TSAN_RELEASE(&join_token_);
+  }
+
+  /// Creates the OpenMP task of instance (t, it), its dependences from the plan.
+  void submit(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
+    const OmpPlan& p = *plan_;
+    const TaskDeps& d = p.deps[t];
+    char* obj = p.object.get();
+    const std::uint32_t* in = p.ids.data() + d.first;
+    const std::uint32_t* out = in + d.in;
+    const std::uint32_t* inout = out + d.out;
+    const std::uint32_t* mutex = inout + d.inout;
+    const int n_in = d.in, n_out = d.out, n_inout = d.inout, n_mutex = d.mutex;
+    (void)obj;  // GCC 12 warns it unused when only iterator clauses read it
+    TGRAPH_TSAN_RELEASE(&submit_token_);
+#pragma omp task firstprivate(t, it, check, count)                                   \
+    depend(iterator(i = 0 : n_in), in : obj[in[i]])                                   \
+    depend(iterator(i = 0 : n_out), out : obj[out[i]])                                \
+    depend(iterator(i = 0 : n_inout), inout : obj[inout[i]])                          \
+    depend(iterator(i = 0 : n_mutex), mutexinoutset : obj[mutex[i]])
+    run_instance(t, it, check, count);
+  }
+
+  /// Submits the whole step from the `single` thread; returns early on failure.
+  void submit_step(const ExecGraph& x, Workload& w) {
+    const StepGraph& g = x.graph;
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    std::size_t next_loop = 0;
+    for (TaskId t = 0; t < n;) {
+      if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
+        const auto l = static_cast<LoopId>(next_loop++);
+        const Loop& loop = g.loops[l];
+        if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
+          const std::uint32_t count = detail::unrolled_count(loop, *known);
+          for (std::uint32_t it = 0; it < count; ++it) {
+            for (TaskId u = loop.first; u < loop.last; ++u)
+              submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
+            if (options_.omp_iteration_wait) {
+#pragma omp taskwait
+              TGRAPH_TSAN_ACQUIRE(&join_token_);
+              if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+            }
+          }
+          iterations_[l] = count;
+        } else {
+          for (std::uint32_t it = 0;; ++it) {
+            decision_ = -1;
+            for (TaskId u = loop.first; u < loop.last; ++u)
+              submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
+#pragma omp taskwait
+            TGRAPH_TSAN_ACQUIRE(&join_token_);
+            iterations_[l] = it + 1;
+            if (decision_ != 0) break;  // leave, or the break task did not run (failure)
+          }
+        }
+        t = loop.last;
+        continue;
+      }
+      submit(t, 0, Check::kNone, 0);
+      ++t;
+    }
+  }
+
+  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
+               StepStats& stats) override {
+    const StepGraph& g = x.graph;
+    if (fresh)
+      for (DatumId d = 0; d < g.data.size(); ++d)
+        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
+    if (options_.pin && !saved_) {
+      saved_ = true;
+      detail::save_binding(main_binding_);
+      pinned_main_ = true;
+    }
+    plan_ = static_cast<OmpPlan*>(plan_ptr);
+    exec_ = &x;
+    workload_ = &w;
+    error_ = nullptr;
+    failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
+    iterations_.assign(g.loops.size(), 0);
+    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    const bool pin = options_.pin;
+    TGRAPH_TSAN_RELEASE(&submit_token_);
+#pragma omp parallel num_threads(static_cast<int>(options_.threads))
+    {
+      TGRAPH_TSAN_ACQUIRE(&submit_token_);
+      if (pin) detail::pin_current_thread(static_cast<std::uint32_t>(omp_get_thread_num()));
+#pragma omp single
+      {
+        try {
+          submit_step(x, w);
+        } catch (...) {
+          fail(std::current_exception());
+        }
+      }  // the implicit barrier waits for every task
+      TGRAPH_TSAN_RELEASE(&join_token_);
+    }
+    TGRAPH_TSAN_ACQUIRE(&join_token_);
+    stats.loop_iterations = iterations_;
+    stats.threads.resize(options_.threads);
+    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    std::exception_ptr error;
+    {
+      std::lock_guard lock(error_mutex_);
+      error = error_;
+    }
+    if (error) std::rethrow_exception(error);
+  }
+
+  std::unique_ptr<Slot[]> counters_;
+  OmpPlan* plan_ = nullptr;
+  const ExecGraph* exec_ = nullptr;
+  Workload* workload_ = nullptr;
+  std::vector<std::uint32_t> iterations_;
+  int decision_ = -1;  // the live loop's break: 1 leave, 0 continue (read after taskwait)
+  std::atomic<bool> failed_{false};
+  std::mutex error_mutex_;
+  std::exception_ptr error_;
+  bool saved_ = false;
+  bool pinned_main_ = false;
+  detail::SavedBinding main_binding_;
+  char submit_token_ = 0;  // TSan: address standing for libgomp's task creation hand-off
+  char join_token_ = 0;    // TSan: address standing for taskwait and the region's end
+};
+
+}  // namespace
+
+std::unique_ptr<Executor> make_omp_tasks_executor(const ExecOptions& o) {
+  return std::make_unique<OmpTasksExecutor>(o);
+}
+
+}  // namespace tgraph::replay
