@@ -4,7 +4,11 @@
 
 Fails when the page reports a JavaScript error (uncaught exception, console.error, a chart
 that failed to render) or Chromium logs one, when a chart container holds no non-empty SVG
-or canvas, or when fewer charts rendered than the page declared. Saves a PNG screenshot.
+or canvas, or when fewer charts rendered than the page declared. Checks the step graph's
+pan and zoom (a copy of the page with a probe script wheels, clicks the zoom buttons and
+records the SVG's transform each time) and the quotient graph (K processor nodes p0..pK-1,
+K from the page's title, with loads that add up to the step's tasks and to 100 %, and
+edges labelled with bytes and signals). Saves a PNG screenshot.
 
   browser_check.py --tgraph build/release/apps/tgraph --chromium /usr/bin/chromium \
       --screenshot report.png            # runs `tgraph demo` and checks its report
@@ -12,6 +16,7 @@ or canvas, or when fewer charts rendered than the page declared. Saves a PNG scr
 """
 import argparse
 import html.parser
+import json
 import os
 import re
 import subprocess
@@ -71,6 +76,159 @@ class ChartScan(html.parser.HTMLParser):
             if self.stack[i][0] == tag:
                 del self.stack[i:]
                 break
+
+
+class GraphScan(html.parser.HTMLParser):
+    """Collects the Graphviz nodes and edges inside the element with id `container`: for each
+    <g class="node"> or <g class="edge">, its <title> and the texts of its <text> elements."""
+
+    def __init__(self, container):
+        super().__init__()
+        self.container = container
+        self.depth = 0  # open elements inside the container (0: outside)
+        self.items = []  # {"class": "node"|"edge", "title": str, "texts": [str]}
+        self.current = None
+        self.current_depth = 0
+        self.field = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if self.depth == 0:
+            if a.get("id") == self.container:
+                self.depth = 1
+            return
+        self.depth += 1
+        if tag == "g" and a.get("class") in ("node", "edge") and self.current is None:
+            self.current = {"class": a["class"], "title": "", "texts": []}
+            self.current_depth = self.depth
+            self.items.append(self.current)
+        elif self.current is not None and tag in ("title", "text"):
+            self.field = tag
+            if tag == "text":
+                self.current["texts"].append("")
+
+    def handle_endtag(self, tag):
+        if self.depth == 0:
+            return
+        if self.current is not None and self.depth == self.current_depth:
+            self.current = None
+        self.field = None
+        self.depth -= 1
+
+    def handle_data(self, data):
+        if self.current is None or self.field is None:
+            return
+        if self.field == "title":
+            self.current["title"] += data
+        else:
+            self.current["texts"][-1] += data
+
+
+# Appended to a copy of the page: after the charts ran, zooms the step graph with the wheel
+# and the buttons and records the SVG's CSS transform before and after each on <html
+# data-probe>.
+PROBE = """<script>
+setTimeout(function () {
+  var box = document.getElementById('graph-step');
+  var svg = box ? box.querySelector('svg') : null;
+  var p = {ready: box ? (box.dataset.panzoom || '') : 'no #graph-step',
+           inside: !!svg && svg.parentElement === box};
+  if (svg) {
+    p.start = svg.style.transform;
+    var r = box.getBoundingClientRect();
+    box.dispatchEvent(new WheelEvent('wheel', {deltaY: -400, clientX: r.left + r.width / 3,
+        clientY: r.top + r.height / 3, bubbles: true, cancelable: true}));
+    p.wheel = svg.style.transform;
+    document.querySelector('[data-zoom="fit"]').click();
+    p.fit = svg.style.transform;
+    document.querySelector('[data-zoom="in"]').click();
+    p.zoom_in = svg.style.transform;
+  }
+  document.documentElement.dataset.probe = JSON.stringify(p);
+}, 1000);
+</script>"""
+
+
+def scale_of(transform):
+    m = re.search(r"scale\(([0-9.eE+-]+)\)", transform or "")
+    return float(m.group(1)) if m else None
+
+
+def check_pan_zoom(binary, report, tmp):
+    """Failures of the step graph's pan and zoom, from a probed copy of the page."""
+    with open(report, encoding="utf-8") as f:
+        page = f.read()
+    at = page.rfind("</body>")
+    if at < 0:
+        return ["the page has no </body>"]
+    probed = os.path.join(tmp, "probed-report.html")
+    with open(probed, "w", encoding="utf-8") as f:
+        f.write(page[:at] + PROBE + page[at:])
+    run = chromium(binary, "--dump-dom", "file://" + probed)
+    scan = ChartScan()
+    scan.feed(run.stdout)
+    raw = scan.root_attrs.get("data-probe")
+    if not raw:
+        return ["pan/zoom probe did not run (chromium exited %d)" % run.returncode]
+    p = json.loads(raw)
+    failures = []
+    if p.get("ready") != "ready":
+        failures.append("pan/zoom not initialised on #graph-step: %r" % p.get("ready"))
+    if not p.get("inside"):
+        failures.append("the step graph's SVG is not directly inside the pan/zoom box #graph-step")
+    start, wheel, fit, zoom_in = (scale_of(p.get(k)) for k in ("start", "wheel", "fit", "zoom_in"))
+    if start is None or abs(start - 1) > 1e-9:
+        failures.append("the step graph does not start fitted (scale 1): transform %r" % p.get("start"))
+    if wheel is None or start is None or not wheel > start:
+        failures.append("wheel up did not zoom in: %r -> %r" % (p.get("start"), p.get("wheel")))
+    if fit is None or abs(fit - 1) > 1e-9:
+        failures.append("the fit button did not reset to scale 1: %r" % p.get("fit"))
+    if zoom_in is None or not zoom_in > 1:
+        failures.append("the + button did not zoom in: %r" % p.get("zoom_in"))
+    return failures
+
+
+def check_quotient(dom):
+    """Failures of the quotient graph beside the step graph."""
+    title = re.search(r"<h1>[^<]*?, (\d+) threads</h1>", dom)
+    if not title:
+        return ["no '<N> threads' in the page's title"]
+    k = int(title.group(1))
+    scan = GraphScan("graph-quotient")
+    scan.feed(dom)
+    nodes = [i for i in scan.items if i["class"] == "node"]
+    edges = [i for i in scan.items if i["class"] == "edge"]
+    failures = []
+    names = sorted(n["title"] for n in nodes)
+    want = sorted("p%d" % p for p in range(k))
+    if names != want:
+        return ["quotient graph nodes %s, expected %s" % (names, want)]
+    tasks = share = 0.0
+    for n in nodes:
+        t = n["texts"]
+        load = re.fullmatch(r"work [0-9.]+ (ns|µs|ms|s) \(([0-9.]+)%\)", t[1]) if len(t) == 3 else None
+        count = re.fullmatch(r"(\d+) tasks?", t[2]) if len(t) == 3 else None
+        if t[:1] != [n["title"]] or not load or not count:
+            failures.append("quotient node %s labelled %r, expected [name, work (share %%), tasks]"
+                            % (n["title"], t))
+            continue
+        share += float(load.group(2))
+        tasks += int(count.group(1))
+    step_tasks = re.search(r">(\d+) tasks · (\d+) dependencies", dom)
+    if not step_tasks:
+        failures.append("the step graph's title has no task count")
+    elif int(step_tasks.group(1)) != tasks:
+        failures.append("quotient nodes hold %d tasks, the step graph %s" % (tasks, step_tasks.group(1)))
+    if abs(share - 100) > 0.05 * k + 0.1:  # shares rounded to 3 significant digits
+        failures.append("quotient node shares add up to %.2f %%" % share)
+    if k > 1 and not edges:
+        failures.append("the quotient graph has no edge on %d processors" % k)
+    for e in edges:
+        text = " / ".join(e["texts"])
+        if not re.fullmatch(r"\d+ deps?( \(\d+ carried\))? · [0-9.]+ (B|KiB|MiB|GiB) / \d+ signals?", text):
+            failures.append("quotient edge %s labelled %r, expected 'N deps · bytes / N signals'"
+                            % (e["title"], text))
+    return failures
 
 
 def chromium(binary, *args):
@@ -134,6 +292,9 @@ def main():
         if declared is None or declared != rendered:
             failures.append("charts declared %s, rendered %s" % (declared, rendered))
 
+        failures += check_quotient(dom_run.stdout)
+        failures += check_pan_zoom(args.chromium, report, tmp)
+
         shot = chromium(args.chromium, "--hide-scrollbars", "--window-size=1280,4200",
                         "--screenshot=" + os.path.abspath(args.screenshot), url)
         if shot.returncode != 0 or not os.path.exists(args.screenshot) or os.path.getsize(args.screenshot) == 0:
@@ -143,8 +304,8 @@ def main():
             for f in failures:
                 print("FAIL: " + f, file=sys.stderr)
             return 1
-        print("report %s: %d charts rendered, no JavaScript error; screenshot %s" %
-              (report, len(scan.charts), args.screenshot))
+        print("report %s: %d charts rendered, no JavaScript error, step graph pans and zooms, "
+              "quotient graph drawn; screenshot %s" % (report, len(scan.charts), args.screenshot))
         return 0
 
 

@@ -318,6 +318,79 @@ TEST(GraphView, CollapsedByKindAndProcessorSumTheWork) {
   EXPECT_EQ(groups, want.size());
 }
 
+// Two "integrate" tasks chained through x, then two "sum" readers: collapsed by kind, the
+// chain is a self-loop of the integrate node, the title says so.
+TEST(GraphView, CollapsedViewsCountTheDependenciesTheyHide) {
+  Builder b;
+  b.g.kinds = {"integrate", "sum"};
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{x, M::W}}, 1, 1);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{x, M::RW}}, 1, 2);
+  b.g.add_task(1, kNoObject, std::vector<Access>{{x, M::R}}, 1, 3);
+  b.g.add_task(1, kNoObject, std::vector<Access>{{x, M::R}, {y, M::W}}, 1, 4);
+  const StepGraph g = b.done();
+  ASSERT_EQ(g.edges.size(), 3u);  // 0 -> 1, 1 -> 2, 1 -> 3
+  ViewOptions o;
+  o.collapse = Collapse::kKind;
+  const GraphView v = make_graph_view(g, o);
+  EXPECT_EQ(v.hidden_deps, 1u);
+  EXPECT_EQ(v.deps, 3u);
+  ASSERT_EQ(v.edges.size(), 1u);
+  EXPECT_EQ(v.edges[0].deps, 2u);  // drawn + hidden = all
+  EXPECT_EQ(hidden_deps_note(v),
+            "1 of 3 dependencies join tasks of one node (self-loops, not drawn)");
+  EXPECT_NE(v.title.back().find(hidden_deps_note(v)), std::string::npos) << v.title.back();
+  EXPECT_NE(to_dot(v).find("1 of 3 dependencies join tasks of one node"), std::string::npos);
+  // One node per task: nothing hidden.
+  o.collapse = Collapse::kLoop;
+  EXPECT_EQ(make_graph_view(g, o).hidden_deps, 0u);
+}
+
+// On bars64 collapsed by kind, the hidden dependencies are some of those inside one kind and
+// loop level (the others go through a datum node and are drawn).
+TEST(GraphView, Bars64CollapsedByKindHidesTheDependenciesInsideAKind) {
+  const StepGraph g = capture_step("bars64", 1);
+  ViewOptions o;
+  o.collapse = Collapse::kKind;
+  const GraphView v = make_graph_view(g, o);
+  std::uint64_t inside = 0;  // both ends of one kind at one loop level
+  for (const auto* edges : {&g.edges, &g.carried_edges})
+    for (const Edge& e : *edges)
+      inside += g.tasks[e.from].kind == g.tasks[e.to].kind &&
+                g.tasks[e.from].loop == g.tasks[e.to].loop;
+  EXPECT_GT(v.hidden_deps, 0u);
+  EXPECT_LE(v.hidden_deps, inside);  // those routed through a datum node are drawn
+  EXPECT_EQ(v.deps, g.edges.size() + g.carried_edges.size());
+}
+
+TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
+  QuotientGraph q;
+  q.load_ns = {3'000'000, 1'000'000, 0};
+  q.tasks = {30, 10, 0};
+  q.edges = {{0, 1, 4, 2, 2048, 5}, {1, 0, 1, 0, 512, 1}, {2, 0, 0, 0, 0, 3}};
+  const GraphView v = quotient_view(q, "quotient graph, step 1");
+  ASSERT_EQ(v.nodes.size(), 3u);
+  EXPECT_EQ(v.nodes[0].lines, (std::vector<std::string>{"p0", "work 3 ms (75%)", "30 tasks"}));
+  EXPECT_EQ(v.nodes[1].lines, (std::vector<std::string>{"p1", "work 1 ms (25%)", "10 tasks"}));
+  EXPECT_EQ(v.nodes[2].lines, (std::vector<std::string>{"p2", "work 0 ns (0%)", "0 tasks"}));
+  EXPECT_EQ(v.nodes[1].procs, (std::vector<ProcessorShare>{{1, 1'000'000}}));
+  ASSERT_EQ(v.edges.size(), 3u);
+  EXPECT_EQ(v.edges[0].lines,
+            (std::vector<std::string>{"6 deps (2 carried) \xC2\xB7 2 KiB", "5 signals"}));
+  EXPECT_EQ(v.edges[1].lines, (std::vector<std::string>{"1 dep \xC2\xB7 512 B", "1 signal"}));
+  EXPECT_EQ(v.edges[2].style, EdgeStyle::kOrder);  // loop decisions only
+  EXPECT_DOUBLE_EQ(v.edges[0].width, 6.0);         // the most bytes: the widest
+  EXPECT_DOUBLE_EQ(v.edges[1].width, 1.0 + 5.0 * 512 / 2048);
+  EXPECT_FALSE(v.legend);
+  EXPECT_EQ(v.title, (std::vector<std::string>{
+                         "quotient graph, step 1", "3 processors \xC2\xB7 40 tasks \xC2\xB7 work 4 ms",
+                         "cut: 7 dependencies \xC2\xB7 2.5 KiB \xC2\xB7 9 signals per execution"}));
+  const std::string svg = render_graph(v, GraphFormat::kSvg);
+  for (const char* text : {">p0<", ">p2<", ">5 signals<", ">work 3 ms (75%)<"})
+    EXPECT_NE(svg.find(text), std::string::npos) << text;
+  EXPECT_EQ(svg.find("legend"), std::string::npos);
+}
+
 TEST(GraphView, Bars64WithoutCollapseIsRefusedWithAHint) {
   const StepGraph g = capture_step("bars64", 1);
   ViewOptions o;

@@ -97,7 +97,7 @@ class Builder {
     std::vector<std::string> title = v_.title;
     set(g, "label", label_text(title, "\\l") + "\\l");
 
-    add_legend(g);
+    if (v_.legend) add_legend(g);
     std::vector<Agraph_t*> cluster_of;  // by loop id
     for (const ViewCluster& c : v_.clusters) {
       const std::string name = "cluster_loop" + std::to_string(c.loop);
@@ -128,6 +128,7 @@ class Builder {
  private:
   void style_node(Agnode_t* an, const ViewNode& n) {
     set(an, "label", label_text(n.lines));
+    if (!v_.edge_labels) set(an, "tooltip", label_text(n.lines));  // hover text, not the id
     const std::string fill = node_fill(n);
     switch (n.kind) {
       case NodeKind::kTask:
@@ -184,7 +185,10 @@ class Builder {
   }
 
   void style_edge(Agedge_t* ae, const ViewEdge& e) {
-    if (!e.lines.empty()) set(ae, "label", label_text(e.lines));
+    if (!e.lines.empty()) {
+      // Without drawn labels the text stays reachable: SVG viewers show it on hover.
+      set(ae, v_.edge_labels ? "label" : "tooltip", label_text(e.lines));
+    }
     switch (e.style) {
       case EdgeStyle::kData:
         break;
@@ -210,6 +214,10 @@ class Builder {
     } else if (critical) {
       set(ae, "color", kInkColour);
       set(ae, "penwidth", "4");
+    } else if (e.width > 0) {
+      char width[32];
+      std::snprintf(width, sizeof width, "%.2f", e.width);
+      set(ae, "penwidth", width);
     }
   }
 
