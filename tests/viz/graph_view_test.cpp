@@ -346,21 +346,24 @@ TEST(GraphView, CollapsedViewsCountTheDependenciesTheyHide) {
   EXPECT_EQ(make_graph_view(g, o).hidden_deps, 0u);
 }
 
-// On bars64 collapsed by kind, the hidden dependencies are some of those inside one kind and
-// loop level (the others go through a datum node and are drawn).
-TEST(GraphView, Bars64CollapsedByKindHidesTheDependenciesInsideAKind) {
+// On bars64 collapsed by object, the hidden dependencies are some of those inside one object
+// and loop level (the others go through a datum node and are drawn).
+TEST(GraphView, Bars64CollapsedByObjectHidesTheDependenciesInsideAnObject) {
   const StepGraph g = capture_step("bars64", 1);
   ViewOptions o;
-  o.collapse = Collapse::kKind;
+  o.collapse = Collapse::kObject;
   const GraphView v = make_graph_view(g, o);
-  std::uint64_t inside = 0;  // both ends of one kind at one loop level
+  auto key = [&](TaskId t) {
+    const Task& task = g.tasks[t];
+    return std::make_tuple(task.object, task.object == kNoObject ? task.kind : 0, task.loop);
+  };
+  std::uint64_t inside = 0;
   for (const auto* edges : {&g.edges, &g.carried_edges})
-    for (const Edge& e : *edges)
-      inside += g.tasks[e.from].kind == g.tasks[e.to].kind &&
-                g.tasks[e.from].loop == g.tasks[e.to].loop;
+    for (const Edge& e : *edges) inside += key(e.from) == key(e.to);
   EXPECT_GT(v.hidden_deps, 0u);
-  EXPECT_LE(v.hidden_deps, inside);  // those routed through a datum node are drawn
+  EXPECT_LE(v.hidden_deps, inside);
   EXPECT_EQ(v.deps, g.edges.size() + g.carried_edges.size());
+  EXPECT_NE(v.title.at(v.title.size() - 1).find(hidden_deps_note(v)), std::string::npos);
 }
 
 TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
@@ -376,8 +379,8 @@ TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
   EXPECT_EQ(v.nodes[1].procs, (std::vector<ProcessorShare>{{1, 1'000'000}}));
   ASSERT_EQ(v.edges.size(), 3u);
   EXPECT_EQ(v.edges[0].lines,
-            (std::vector<std::string>{"6 deps (2 carried) \xC2\xB7 2 KiB", "5 signals"}));
-  EXPECT_EQ(v.edges[1].lines, (std::vector<std::string>{"1 dep \xC2\xB7 512 B", "1 signal"}));
+            (std::vector<std::string>{"6 deps (2 carried)", "2 KiB", "5 signals"}));
+  EXPECT_EQ(v.edges[1].lines, (std::vector<std::string>{"1 dep", "512 B", "1 signal"}));
   EXPECT_EQ(v.edges[2].style, EdgeStyle::kOrder);  // loop decisions only
   EXPECT_DOUBLE_EQ(v.edges[0].width, 6.0);         // the most bytes: the widest
   EXPECT_DOUBLE_EQ(v.edges[1].width, 1.0 + 5.0 * 512 / 2048);

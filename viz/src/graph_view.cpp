@@ -702,6 +702,7 @@ GraphView quotient_view(const QuotientGraph& q, const std::string& title) {
   v.processors = static_cast<std::uint32_t>(q.load_ns.size());
   v.collapse = Collapse::kProcessor;
   v.legend = false;  // every node names its processor
+  v.nodesep = 0.8;   // room for the labels of the edges both ways between two processors
   std::uint64_t work = 0, tasks = 0, deps = 0, bytes = 0, signals = 0, max_bytes = 0;
   for (ProcId p = 0; p < v.processors; ++p) {
     work += q.load_ns[p];
@@ -729,9 +730,10 @@ GraphView quotient_view(const QuotientGraph& q, const std::string& title) {
     ve.deps = e.deps + e.carried_deps;
     ve.bytes = e.bytes;
     ve.style = ve.deps == 0 ? EdgeStyle::kOrder : EdgeStyle::kData;  // only loop decisions
+    // Short lines: labels of the edges both ways between two processors sit side by side.
     std::string first = std::to_string(ve.deps) + (ve.deps == 1 ? " dep" : " deps");
     if (e.carried_deps > 0) first += " (" + std::to_string(e.carried_deps) + " carried)";
-    ve.lines = {first + " \xC2\xB7 " + format_bytes(e.bytes),
+    ve.lines = {first, format_bytes(e.bytes),
                 std::to_string(e.signals) + (e.signals == 1 ? " signal" : " signals")};
     ve.width = max_bytes == 0 ? 1.0
                               : 1.0 + 5.0 * static_cast<double>(e.bytes) /

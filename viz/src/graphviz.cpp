@@ -83,7 +83,9 @@ class Builder {
     agattr(g, AGRAPH, cs("labelloc"), cs("t"));
     agattr(g, AGRAPH, cs("labeljust"), cs("l"));
     agattr(g, AGRAPH, cs("newrank"), cs("true"));
-    agattr(g, AGRAPH, cs("nodesep"), cs("0.25"));
+    char nodesep[32];
+    std::snprintf(nodesep, sizeof nodesep, "%g", v_.nodesep);
+    agattr(g, AGRAPH, cs("nodesep"), nodesep);
     agattr(g, AGRAPH, cs("ranksep"), cs("0.45"));
     agattr(g, AGNODE, cs("shape"), cs("box"));
     agattr(g, AGNODE, cs("style"), cs("rounded,filled"));

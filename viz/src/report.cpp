@@ -404,8 +404,8 @@ const char* kStyle =
     ".graphs{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}"
     ".graphs figure{margin:0}.step-figure{flex:3 1 600px;min-width:0}"
     ".quotient-figure{flex:1 1 300px;min-width:0}"
-    "#graph-step{height:640px;overflow:hidden;background:#fff}"
-    "#graph-step svg{width:100%;height:100%}#graph-step text{text-rendering:geometricPrecision}"
+    "#graph-step{height:700px;overflow:hidden;background:#fff}"
+    "#graph-step text{text-rendering:geometricPrecision}"
     "#graph-quotient svg{max-width:100%;height:auto}"
     ".graph-tools{font-size:0.85em;color:#555;margin-bottom:4px}"
     ".graph-tools button{font-size:1em;min-width:2.2em;margin-right:4px}";
@@ -443,21 +443,45 @@ const char* kRenderScript = R"js(
 })();
 )js";
 
-// Pan and zoom on the step graph (Panzoom, inlined): the SVG starts fitted to its box
-// (scale 1); the wheel zooms at the pointer, dragging pans, the buttons zoom and reset.
-// Sets <div id="graph-step" data-panzoom="ready"> once bound (what the browser test reads).
+// Pan and zoom on the step graph (Panzoom, inlined). The first view shows the whole graph
+// when its labels stay readable (scale >= kReadable), else the left end at the scale that
+// fits the graph's height (readable labels, the rest a drag away). The wheel zooms at the
+// pointer, dragging pans; buttons zoom in and out, go back to the first view ("reset") or
+// show the whole graph ("whole"). Sets data-panzoom="ready" and data-start-scale on
+// #graph-step once bound (what the browser test reads).
 const char* kPanZoomScript = R"js(
 (function () {
   const box = document.getElementById('graph-step');
   if (!box) return;
-  const pz = Panzoom(box.querySelector('svg'), {canvas: true, maxScale: 60, minScale: 0.5, step: 0.3});
+  const svg = box.querySelector('svg');
+  const kReadable = 0.6;
+  const w = svg.width.baseVal.value, h = svg.height.baseVal.value;  // px
+  const W = box.clientWidth, H = box.clientHeight;
+  const whole = Math.min(W / w, H / h);
+  // Panzoom scales the <svg> about its centre (transform-origin 50% 50%): the translation
+  // that puts its top-left corner at (left, top) of the box at scale s.
+  function at(s, left, top) {
+    return {scale: s, x: (left - (w / 2) * (1 - s)) / s, y: (top - (h / 2) * (1 - s)) / s};
+  }
+  const all = at(whole, (W - whole * w) / 2, (H - whole * h) / 2);
+  const readable = Math.min(1, Math.max(kReadable, H / h));
+  const view = whole >= kReadable ? all
+                                  : at(readable, 8, Math.max(0, (H - readable * h) / 2));
+  const pz = Panzoom(svg, {canvas: true, maxScale: 8, minScale: Math.min(whole, 1) / 2, step: 0.3,
+                           startScale: view.scale, startX: view.x, startY: view.y});
   box.addEventListener('wheel', function (e) { pz.zoomWithWheel(e); });
+  const actions = {
+    in: function () { pz.zoomIn(); },
+    out: function () { pz.zoomOut(); },
+    reset: function () { pz.reset(); },
+    whole: function () {
+      pz.zoom(all.scale, {force: true});
+      pz.pan(all.x, all.y, {force: true});
+    }
+  };
   for (const b of document.querySelectorAll('[data-zoom]'))
-    b.addEventListener('click', function () {
-      if (b.dataset.zoom === 'in') pz.zoomIn();
-      else if (b.dataset.zoom === 'out') pz.zoomOut();
-      else pz.reset();
-    });
+    b.addEventListener('click', actions[b.dataset.zoom]);
+  box.dataset.startScale = String(view.scale);
   box.dataset.panzoom = 'ready';
 })();
 )js";
@@ -650,8 +674,10 @@ std::string report_html(const ReportContent& c) {
             "</h2><div class=\"graphs\"><figure class=\"step-figure\"><div "
             "class=\"graph-tools\"><button data-zoom=\"in\" title=\"zoom in\">+</button>"
             "<button data-zoom=\"out\" title=\"zoom out\">&minus;</button><button "
-            "data-zoom=\"fit\" title=\"fit the graph to the box\">fit</button> wheel: zoom "
-            "&middot; drag: pan &middot; hover: labels</div><div class=\"graph\" "
+            "data-zoom=\"reset\" title=\"back to the first view\">reset</button><button "
+            "data-zoom=\"whole\" title=\"the whole graph in the box\">whole graph</button> "
+            "wheel: zoom &middot; drag: pan &middot; hover a node or an edge: its text</div><div "
+            "class=\"graph\" "
             "id=\"graph-step\">" +
             c.graph_svg + "</div><figcaption>" + escape(c.graph_caption) + "</figcaption></figure>";
     if (!c.quotient_svg.empty())

@@ -123,6 +123,7 @@ struct GraphView {
   std::uint64_t deps = 0;    ///< dependencies of the step (intra-step + loop-carried)
   bool edge_labels = true;   ///< ViewOptions::edge_labels
   bool legend = true;        ///< a legend cluster (processors, shapes, strokes)
+  double nodesep = 0.25;     ///< inches between neighbours of one rank (dot's nodesep)
 };
 
 /// Builds the picture of `g` (edges derived). Throws UsageError when the assignment does
