@@ -27,12 +27,12 @@ void add_report(CLI::App& app) {
     const Trace trace = read_trace(a->input);
     std::optional<TraceAssignment> as;
     if (!a->assignment.empty()) as = partition::load_assignment(a->assignment, trace, a->input);
-    viz::ReportContent c = viz::report_from_files(trace, a->input, as ? &*as : nullptr, a->step,
-                                                  a->compare, a->names);
+    viz::ReportContent c =
+        viz::report_from_files(trace, a->input, as ? &*as : nullptr, a->step, a->compare, a->names);
     if (as && !c.graph_svg.empty())
-      viz::set_quotient(c, partition::step_quotient(trace.steps[c.graph_step],
-                                                    as->steps[c.graph_step]),
-                        as->method);
+      viz::set_quotient(
+          c, partition::step_quotient(trace.steps[c.graph_step], as->steps[c.graph_step]),
+          as->method);
     write_file_atomic(a->output, viz::report_html(c));
     std::printf("report: %s\n", a->output.c_str());
   });

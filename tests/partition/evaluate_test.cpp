@@ -185,9 +185,9 @@ TEST(StepQuotient, SplitsTheCutAndTheSignalsByProcessorPair) {
 TEST(StepQuotient, CountsLoopDecisionsAsSignals) {
   Builder b;
   const DatumId y = b.datum("y", 8), cond = b.datum("cond", 1);
-  b.task({{y, M::RW}}, 3);     // 0 p1
-  b.task({{cond, M::W}}, 1);   // 1 p0
-  b.task({{cond, M::R}}, 1);   // 2 p0, the break
+  b.task({{y, M::RW}}, 3);    // 0 p1
+  b.task({{cond, M::W}}, 1);  // 1 p0
+  b.task({{cond, M::R}}, 1);  // 2 p0, the break
   b.loop(cond, 0, 3, 4);
   const QuotientGraph q = step_quotient(b.done(), Assignment{2, {1, 0, 0}, {}});
   ASSERT_EQ(q.edges.size(), 1u);

@@ -385,9 +385,10 @@ TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
   EXPECT_DOUBLE_EQ(v.edges[0].width, 6.0);         // the most bytes: the widest
   EXPECT_DOUBLE_EQ(v.edges[1].width, 1.0 + 5.0 * 512 / 2048);
   EXPECT_FALSE(v.legend);
-  EXPECT_EQ(v.title, (std::vector<std::string>{
-                         "quotient graph, step 1", "3 processors \xC2\xB7 40 tasks \xC2\xB7 work 4 ms",
-                         "cut: 7 dependencies \xC2\xB7 2.5 KiB \xC2\xB7 9 signals per execution"}));
+  EXPECT_EQ(v.title,
+            (std::vector<std::string>{
+                "quotient graph, step 1", "3 processors \xC2\xB7 40 tasks \xC2\xB7 work 4 ms",
+                "cut: 7 dependencies \xC2\xB7 2.5 KiB \xC2\xB7 9 signals per execution"}));
   const std::string svg = render_graph(v, GraphFormat::kSvg);
   for (const char* text : {">p0<", ">p2<", ">5 signals<", ">work 3 ms (75%)<"})
     EXPECT_NE(svg.find(text), std::string::npos) << text;

@@ -671,8 +671,7 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   v.edge_labels = o.edge_labels;
   if (o.collapse != Collapse::kNone)
     v.title.push_back("collapsed by " + std::string(to_string(o.collapse)) +
-                      ": work = cost \xC3\x97 runs, edge bytes per step; " +
-                      hidden_deps_note(v));
+                      ": work = cost \xC3\x97 runs, edge bytes per step; " + hidden_deps_note(v));
   if (o.critical_path)
     v.title.push_back(
         "critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
@@ -735,18 +734,17 @@ GraphView quotient_view(const QuotientGraph& q, const std::string& title) {
     if (e.carried_deps > 0) first += " (" + std::to_string(e.carried_deps) + " carried)";
     ve.lines = {first, format_bytes(e.bytes),
                 std::to_string(e.signals) + (e.signals == 1 ? " signal" : " signals")};
-    ve.width = max_bytes == 0 ? 1.0
-                              : 1.0 + 5.0 * static_cast<double>(e.bytes) /
-                                          static_cast<double>(max_bytes);
+    ve.width = max_bytes == 0
+                   ? 1.0
+                   : 1.0 + 5.0 * static_cast<double>(e.bytes) / static_cast<double>(max_bytes);
     v.edges.push_back(std::move(ve));
     deps += e.deps + e.carried_deps;
     bytes += e.bytes;
     signals += e.signals;
   }
   if (!title.empty()) v.title.push_back(title);
-  v.title.push_back(std::to_string(v.processors) + " processors \xC2\xB7 " +
-                    std::to_string(tasks) + " tasks \xC2\xB7 work " +
-                    format_ns(static_cast<double>(work)));
+  v.title.push_back(std::to_string(v.processors) + " processors \xC2\xB7 " + std::to_string(tasks) +
+                    " tasks \xC2\xB7 work " + format_ns(static_cast<double>(work)));
   v.title.push_back("cut: " + std::to_string(deps) + " dependencies \xC2\xB7 " +
                     format_bytes(bytes) + " \xC2\xB7 " + std::to_string(signals) +
                     " signals per execution");

@@ -551,8 +551,8 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
 }
 
 void set_quotient(ReportContent& c, const QuotientGraph& q, const std::string& method) {
-  const std::string title = "quotient graph, step " + std::to_string(c.graph_step) + ", " +
-                            method + " on " + std::to_string(q.load_ns.size()) + " processors";
+  const std::string title = "quotient graph, step " + std::to_string(c.graph_step) + ", " + method +
+                            " on " + std::to_string(q.load_ns.size()) + " processors";
   c.quotient_svg = inline_svg(render_graph(quotient_view(q, title), GraphFormat::kSvg));
   c.quotient_caption =
       "The partition seen from the processors: a node per processor with its work (cost × "

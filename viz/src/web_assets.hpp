@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The charting and pan/zoom libraries inlined into the HTML report, compiled in at build time from the
-// npm packages pinned by viz/web/package-lock.json (the page needs no network).
+// The charting and pan/zoom libraries inlined into the HTML report, compiled in at build time from
+// the npm packages pinned by viz/web/package-lock.json (the page needs no network).
 #pragma once
 
 #include <string_view>

@@ -120,10 +120,10 @@ struct GraphView {
   std::vector<ViewCluster> clusters;
   /// Collapsed views: dependencies whose two tasks fall in one node (self-loops, not drawn).
   std::uint64_t hidden_deps = 0;
-  std::uint64_t deps = 0;    ///< dependencies of the step (intra-step + loop-carried)
-  bool edge_labels = true;   ///< ViewOptions::edge_labels
-  bool legend = true;        ///< a legend cluster (processors, shapes, strokes)
-  double nodesep = 0.25;     ///< inches between neighbours of one rank (dot's nodesep)
+  std::uint64_t deps = 0;   ///< dependencies of the step (intra-step + loop-carried)
+  bool edge_labels = true;  ///< ViewOptions::edge_labels
+  bool legend = true;       ///< a legend cluster (processors, shapes, strokes)
+  double nodesep = 0.25;    ///< inches between neighbours of one rank (dot's nodesep)
 };
 
 /// Builds the picture of `g` (edges derived). Throws UsageError when the assignment does
