@@ -258,13 +258,16 @@ TEST(GraphView, LegendListsProcessorsFromP0LeftToRight) {
 TEST(GraphView, CollapsedBars64HasOneNodePerObjectAndLoopWithSummedWork) {
   const StepGraph g = capture_step("bars64", 1);
   ASSERT_GT(g.tasks.size(), 900u);
-  std::map<std::pair<std::string, LoopId>, std::uint64_t> expected;  // key -> work
+  ASSERT_EQ(g.loops.size(), 1u);
+  // key, loop, before (0) or after (1) the loop for tasks outside it -> work
+  std::map<std::tuple<std::string, LoopId, int>, std::uint64_t> expected;
   std::uint64_t total = 0;
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     const Task& task = g.tasks[t];
     const std::string key = task.object == kNoObject ? "k" + std::to_string(task.kind)
                                                      : "o" + std::to_string(task.object);
-    expected[{key, task.loop}] += task.cost_ns * g.runs(t);
+    const int region = task.loop == kNoLoop && t >= g.loops[0].last ? 1 : 0;
+    expected[{key, task.loop, region}] += task.cost_ns * g.runs(t);
     total += task.cost_ns * g.runs(t);
   }
   ViewOptions o;
@@ -311,11 +314,29 @@ TEST(GraphView, CollapsedByKindAndProcessorSumTheWork) {
     EXPECT_EQ(tasks, g.tasks.size()) << to_string(c);
   }
   o.collapse = Collapse::kProcessor;
-  std::set<std::pair<ProcId, LoopId>> want;
-  for (TaskId t = 0; t < g.tasks.size(); ++t) want.insert({a.proc[t], g.tasks[t].loop});
+  std::set<std::tuple<ProcId, LoopId, bool>> want;  // outside the loop: before or after it
+  for (TaskId t = 0; t < g.tasks.size(); ++t)
+    want.insert({a.proc[t], g.tasks[t].loop,
+                 g.tasks[t].loop == kNoLoop && t >= g.loops.at(0).last});
   std::size_t groups = 0;
   for (const ViewNode& n : make_graph_view(g, o).nodes) groups += n.kind == NodeKind::kGroup;
   EXPECT_EQ(groups, want.size());
+}
+
+// body0 has tasks before, inside and after the loop: three nodes (one node for before and
+// after would form a cycle with the loop's node); body1 has none after it.
+TEST(GraphView, CollapsedViewsSplitTheTasksBeforeAndAfterALoop) {
+  const StepGraph g = cw_loop_graph();
+  ViewOptions o;
+  o.collapse = Collapse::kObject;
+  std::set<std::pair<std::string, std::string>> heads;
+  for (const ViewNode& n : make_graph_view(g, o).nodes)
+    if (n.kind == NodeKind::kGroup) heads.insert({n.lines.at(0), n.lines.at(1)});
+  EXPECT_TRUE(heads.count({"body0", "before loop 0"}));
+  EXPECT_TRUE(heads.count({"body0", "after loop 0"}));
+  EXPECT_TRUE(heads.count({"body0", "2 tasks \xC3\x97 3 it."}));
+  EXPECT_TRUE(heads.count({"body1", "before loop 0"}));
+  EXPECT_FALSE(heads.count({"body1", "after loop 0"}));
 }
 
 // Two "integrate" tasks chained through x, then two "sum" readers: collapsed by kind, the
@@ -355,7 +376,8 @@ TEST(GraphView, Bars64CollapsedByObjectHidesTheDependenciesInsideAnObject) {
   const GraphView v = make_graph_view(g, o);
   auto key = [&](TaskId t) {
     const Task& task = g.tasks[t];
-    return std::make_tuple(task.object, task.object == kNoObject ? task.kind : 0, task.loop);
+    return std::make_tuple(task.object, task.object == kNoObject ? task.kind : 0, task.loop,
+                           task.loop == kNoLoop && t >= g.loops.at(0).last);
   };
   std::uint64_t inside = 0;
   for (const auto* edges : {&g.edges, &g.carried_edges})

@@ -292,6 +292,7 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
   std::vector<std::map<ProcId, std::uint64_t>> shares;
   std::vector<std::string> names;
   std::vector<LoopId> body;  // Collapse::kLoop: the loop a node stands for
+  std::uint32_t region = 0;  // loops that ended before task t
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     const Task& task = g.tasks[t];
     std::string key, name;
@@ -328,6 +329,15 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
         break;
       case Collapse::kNone:
         break;
+    }
+    // Outside loops, tasks are grouped by the region they run in (before loop 0, after loop
+    // 0, ...): one node for an object's tasks before and after a loop would form a cycle
+    // with its loop node, which dot draws as long arcs across the picture.
+    while (region < g.loops.size() && g.loops[region].last <= t) ++region;
+    if (loop == kNoLoop && o.collapse != Collapse::kLoop && !g.loops.empty()) {
+      key += "r" + std::to_string(region);
+      name += region == 0 ? std::string("\nbefore loop 0")
+                          : "\nafter loop " + std::to_string(region - 1);
     }
     auto [it, fresh] = index.try_emplace({key, loop}, static_cast<std::uint32_t>(v.nodes.size()));
     if (fresh) {

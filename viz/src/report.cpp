@@ -537,7 +537,8 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
     c.graph_svg = inline_svg(render_graph(view, GraphFormat::kSvg));
     c.graph_caption =
         "Step " + std::to_string(step) +
-        " collapsed by object (one node per object and loop level, work = cost × runs), "
+        " collapsed by object (one node per object and loop, and per object before and "
+        "after each loop; work = cost × runs), "
         "coloured by processor" +
         (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
         "; vermillion edges cross processors; thick black: the critical path; " +

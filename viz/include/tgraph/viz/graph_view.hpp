@@ -16,7 +16,8 @@
 
 namespace tgraph::viz {
 
-/// How tasks are aggregated into nodes.
+/// How tasks are aggregated into nodes. Object, kind and processor groups are made per loop
+/// body and, outside loops, per region between loops (before loop 0, after loop 0, ...).
 enum class Collapse : std::uint8_t {
   kNone = 0,       ///< one node per task (+ signal, wait and reducer nodes with an assignment)
   kObject = 1,     ///< one node per object and loop level (shared tasks: per kind)
