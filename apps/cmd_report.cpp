@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // `tgraph report T.tgt [--replay R.json ...] [--compare C.json] [--assign A.tga] -o report.html`:
-// one self-contained HTML page (viz::report_from_files, viz::report_html).
+// one self-contained HTML page (viz::report_from_files, the assignment's quotient graph from
+// partition::step_quotient, viz::report_html).
 #include <cstdio>
 
 #include "commands.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/evaluate.hpp"
 #include "tgraph/viz/report.hpp"
 
 namespace tgraph::app {
@@ -25,9 +27,13 @@ void add_report(CLI::App& app) {
     const Trace trace = read_trace(a->input);
     std::optional<TraceAssignment> as;
     if (!a->assignment.empty()) as = partition::load_assignment(a->assignment, trace, a->input);
-    write_file_atomic(a->output,
-                      viz::report_html(viz::report_from_files(trace, a->input, as ? &*as : nullptr,
-                                                              a->step, a->compare, a->names)));
+    viz::ReportContent c =
+        viz::report_from_files(trace, a->input, as ? &*as : nullptr, a->step, a->compare, a->names);
+    if (as && !c.graph_svg.empty())
+      viz::set_quotient(
+          c, partition::step_quotient(trace.steps[c.graph_step], as->steps[c.graph_step]),
+          as->method);
+    write_file_atomic(a->output, viz::report_html(c));
     std::printf("report: %s\n", a->output.c_str());
   });
 }

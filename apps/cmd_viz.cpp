@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `tgraph viz`: one step's graph through Graphviz (DOT, SVG, PNG, PDF): viz::trace_step_view.
+#include <cstdio>
+
 #include "commands.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/viz/graphviz.hpp"
@@ -33,6 +35,8 @@ void add_viz_verbs(CLI::App& app) {
     const viz::GraphView v =
         viz::trace_step_view(trace, a->input, a->step, as ? &*as : nullptr, *o);
     write_file_atomic(a->output, viz::render_graph(v, format));
+    if (v.collapse != viz::Collapse::kNone && v.hidden_deps > 0)
+      std::fprintf(stderr, "tgraph viz: %s\n", viz::hidden_deps_note(v).c_str());
   });
   add_timeline(app);
   add_report(app);

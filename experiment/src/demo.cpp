@@ -178,6 +178,9 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   const std::size_t graph_step = trace.steps.size() > 1 ? 1 : 0;
   viz::ReportContent c = viz::report_content(
       trace, res.trace_path, &assignments[best].steps[graph_step], graph_step, rows[best].method);
+  viz::set_quotient(c,
+                    tp::step_quotient(trace.steps[graph_step], assignments[best].steps[graph_step]),
+                    rows[best].method);
   c.title = "tgraph demo: " + o.scene + ", " + std::to_string(o.steps) + " steps, " +
             std::to_string(o.threads) + " threads";
   c.notes = {

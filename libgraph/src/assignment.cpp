@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "tgraph/graph/assignment.hpp"
 
+#include <map>
 #include <string>
+#include <utility>
 
 namespace tgraph {
 
@@ -40,6 +42,28 @@ std::string validate(const StepGraph& g, const Assignment& a, std::uint32_t k) {
     return "assignment order lists " + std::to_string(listed) + " of " +
            std::to_string(g.tasks.size()) + " tasks";
   return {};
+}
+
+QuotientGraph quotient_graph(const StepGraph& g, const Assignment& a) {
+  QuotientGraph q;
+  q.load_ns.assign(a.k, 0);
+  q.tasks.assign(a.k, 0);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    q.load_ns[a.proc[t]] += g.tasks[t].cost_ns * g.runs(t);
+    ++q.tasks[a.proc[t]];
+  }
+  std::map<std::pair<ProcId, ProcId>, QuotientEdge> pairs;  // ordered: edges come out sorted
+  auto cut = [&](const Edge& e, bool carried) {
+    const ProcId from = a.proc[e.from], to = a.proc[e.to];
+    if (from == to) return;
+    QuotientEdge& qe = pairs.try_emplace({from, to}, QuotientEdge{from, to}).first->second;
+    ++(carried ? qe.carried_deps : qe.deps);
+    qe.bytes += g.data[e.datum].bytes;
+  };
+  for (const Edge& e : g.edges) cut(e, false);
+  for (const Edge& e : g.carried_edges) cut(e, true);
+  for (const auto& [pair, qe] : pairs) q.edges.push_back(qe);
+  return q;
 }
 
 }  // namespace tgraph

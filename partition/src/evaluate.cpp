@@ -48,11 +48,11 @@ std::uint64_t count_reducers(const StepGraph& g, const Assignment& a) {
   return reducers;
 }
 
-void quotient(const StepGraph& g, const Assignment& a, StepReport& r) {
-  const std::uint32_t k = a.k;
+// Cycles and ping-pong pairs of the processor graph of intra-step cross dependencies.
+void quotient(const QuotientGraph& qg, std::uint32_t k, StepReport& r) {
   std::vector<std::uint8_t> adj(static_cast<std::size_t>(k) * k, 0);
-  for (const Edge& e : g.edges)
-    if (a.proc[e.from] != a.proc[e.to]) adj[static_cast<std::size_t>(a.proc[e.from]) * k + a.proc[e.to]] = 1;
+  for (const QuotientEdge& e : qg.edges)
+    if (e.deps > 0) adj[static_cast<std::size_t>(e.from) * k + e.to] = 1;
   r.ping_pong_pairs = 0;
   for (ProcId p = 0; p < k; ++p)
     for (ProcId q = p + 1; q < k; ++q)
@@ -93,23 +93,19 @@ void migrations(const StepGraph& g, const Assignment& a, const StepGraph& prev,
 StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostModel& model) {
   StepReport r;
   r.tasks = g.tasks.size();
-  std::vector<std::uint64_t> load(a.k, 0);
-  for (TaskId t = 0; t < g.tasks.size(); ++t) load[a.proc[t]] += g.tasks[t].cost_ns * g.runs(t);
-  for (std::uint64_t l : load) {
+  const QuotientGraph q = quotient_graph(g, a);
+  for (std::uint64_t l : q.load_ns) {
     r.work_ns += l;
     r.max_load_ns = std::max(r.max_load_ns, l);
   }
   r.imbalance = r.work_ns == 0 ? 1.0
                                : static_cast<double>(r.max_load_ns) * a.k / static_cast<double>(r.work_ns);
-  auto cut = [&](const Edge& e) {
-    if (a.proc[e.from] == a.proc[e.to]) return;
-    ++r.cut_edges;
-    r.cut_bytes += g.data[e.datum].bytes;
-  };
-  for (const Edge& e : g.edges) cut(e);
-  for (const Edge& e : g.carried_edges) cut(e);
+  for (const QuotientEdge& e : q.edges) {
+    r.cut_edges += e.deps + e.carried_deps;
+    r.cut_bytes += e.bytes;
+  }
   r.reducers = count_reducers(g, a);
-  quotient(g, a, r);
+  quotient(q, a.k, r);
 
   const Schedule s = simulate(g, a, model);
   r.makespan_ns = s.makespan_ns;
@@ -189,6 +185,25 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
   const double with_partitioning = static_cast<double>(tot.makespan_ns) + sum_partition_ms * 1e6;
   rep.speedup_with_partitioning = with_partitioning <= 0 ? 1.0 : sequential / with_partitioning;
   return rep;
+}
+
+QuotientGraph step_quotient(const StepGraph& g, const Assignment& a) {
+  const Schedule s = simulate(g, a, CostModel::ideal());  // checks that `a` fits `g`
+  QuotientGraph q = quotient_graph(g, a);
+  std::vector<QuotientEdge> edges;  // every (from, to) in order: q.edges merged with the waits
+  std::size_t i = 0;
+  for (ProcId from = 0; from < a.k; ++from)
+    for (ProcId to = 0; to < a.k; ++to) {
+      const std::uint64_t n = s.waits_between[static_cast<std::size_t>(from) * a.k + to];
+      if (i < q.edges.size() && q.edges[i].from == from && q.edges[i].to == to) {
+        edges.push_back(q.edges[i++]);
+        edges.back().signals = n;
+      } else if (n > 0) {
+        edges.push_back({from, to, 0, 0, 0, n});
+      }
+    }
+  q.edges = std::move(edges);
+  return q;
 }
 
 }  // namespace tgraph::partition

@@ -40,6 +40,7 @@ class Simulator {
     for (State& st : state_) st.time = g_.host_ns;
     s_.busy_ns.assign(k_, 0);
     s_.finish_ns.assign(k_, 0);
+    s_.waits_between.assign(static_cast<std::size_t>(k_) * k_, 0);
   }
 
   Schedule run() {
@@ -72,11 +73,12 @@ class Simulator {
     return detail::dependency_source(g_, s_.first_instance, d, t, i);
   }
 
-  // Records that processor p receives (instance, datum) from another processor; returns
+  // Records that processor p receives (instance, datum) from processor `from`; returns
   // true the first time (a wait, and a signal if nobody received it before).
-  bool receive(std::uint64_t instance, DatumId datum, ProcId p) {
+  bool receive(std::uint64_t instance, DatumId datum, ProcId from, ProcId p) {
     if (!waits_.insert({instance, datum, p}).second) return false;
     ++s_.waits;
+    ++s_.waits_between[static_cast<std::size_t>(from) * k_ + p];
     if (signals_.insert({instance, datum, 0}).second) ++s_.signals;
     return true;
   }
@@ -94,7 +96,7 @@ class Simulator {
       std::uint64_t arrival = s_.end_ns[src];
       if (a_.proc[d.from] != p) {
         arrival += latency_;
-        if (receive(src, d.datum, p) && d.raw) bytes += g_.data[d.datum].bytes;
+        if (receive(src, d.datum, a_.proc[d.from], p) && d.raw) bytes += g_.data[d.datum].bytes;
       }
       ready = std::max(ready, arrival);
     }
@@ -140,7 +142,7 @@ class Simulator {
       std::uint64_t known = s_.end_ns[inst];
       if (a_.proc[brk] != p) {
         known += latency_;
-        receive(inst, loop.condition, p);
+        receive(inst, loop.condition, a_.proc[brk], p);
       }
       st.time = std::max(st.time, known);
       st.pos = 0;

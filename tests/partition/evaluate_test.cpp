@@ -164,5 +164,60 @@ TEST(Evaluate, EvaluatesATracePartitionedByEveryMethod) {
   }
 }
 
+TEST(StepQuotient, SplitsTheCutAndTheSignalsByProcessorPair) {
+  Builder b;
+  const DatumId x = b.datum("x", 100), f = b.datum("f", 40);
+  b.task({{x, M::W}}, 10);              // 0 p0
+  b.task({{x, M::R}, {f, M::CW}}, 10);  // 1 p0
+  b.task({{x, M::R}, {f, M::CW}}, 10);  // 2 p1
+  b.task({{f, M::R}}, 10);              // 3 p0
+  const StepGraph g = b.done();
+  const QuotientGraph q = step_quotient(g, Assignment{2, {0, 0, 1, 0}, {}});
+  EXPECT_EQ(q.load_ns, (std::vector<std::uint64_t>{30, 10}));
+  ASSERT_EQ(q.edges.size(), 2u);
+  EXPECT_EQ(q.edges[0], (QuotientEdge{0, 1, 1, 0, 100, 1}));  // x, one version sent
+  EXPECT_EQ(q.edges[1], (QuotientEdge{1, 0, 1, 0, 40, 1}));   // f
+  EXPECT_THROW(step_quotient(g, Assignment{2, {0, 0, 1}, {}}), Error);
+}
+
+// A loop whose break runs on p0 while p1 runs part of its body: p1 waits for the decision of
+// every iteration, an edge of signals without dependencies.
+TEST(StepQuotient, CountsLoopDecisionsAsSignals) {
+  Builder b;
+  const DatumId y = b.datum("y", 8), cond = b.datum("cond", 1);
+  b.task({{y, M::RW}}, 3);    // 0 p1
+  b.task({{cond, M::W}}, 1);  // 1 p0
+  b.task({{cond, M::R}}, 1);  // 2 p0, the break
+  b.loop(cond, 0, 3, 4);
+  const QuotientGraph q = step_quotient(b.done(), Assignment{2, {1, 0, 0}, {}});
+  ASSERT_EQ(q.edges.size(), 1u);
+  EXPECT_EQ(q.edges[0], (QuotientEdge{0, 1, 0, 0, 0, 4}));
+}
+
+// On random graphs with loops, summed over the pairs: evaluate's cut, the simulator's waits.
+TEST(StepQuotient, SumsToEvaluatesCutAndWaitsOnRandomGraphs) {
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    Trace tr;
+    tr.steps = {testing::random_graph(seed, 40, 6, true)};
+    TraceAssignment a = one_step(3, {});
+    for (TaskId t = 0; t < tr.steps[0].tasks.size(); ++t)
+      a.steps[0].proc.push_back(static_cast<ProcId>((t * 7 + seed) % 3));
+    const StepReport r = evaluate(tr, a, CostModel::ideal()).steps[0];
+    const QuotientGraph q = step_quotient(tr.steps[0], a.steps[0]);
+    std::uint64_t deps = 0, bytes = 0, signals = 0, work = 0;
+    for (const QuotientEdge& e : q.edges) {
+      EXPECT_NE(e.from, e.to);
+      deps += e.deps + e.carried_deps;
+      bytes += e.bytes;
+      signals += e.signals;
+    }
+    for (std::uint64_t l : q.load_ns) work += l;
+    EXPECT_EQ(deps, r.cut_edges) << seed;
+    EXPECT_EQ(bytes, r.cut_bytes) << seed;
+    EXPECT_EQ(signals, r.waits) << seed;
+    EXPECT_EQ(work, r.work_ns) << seed;
+  }
+}
+
 }  // namespace
 }  // namespace tgraph::partition

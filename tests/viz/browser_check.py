@@ -4,7 +4,11 @@
 
 Fails when the page reports a JavaScript error (uncaught exception, console.error, a chart
 that failed to render) or Chromium logs one, when a chart container holds no non-empty SVG
-or canvas, or when fewer charts rendered than the page declared. Saves a PNG screenshot.
+or canvas, or when fewer charts rendered than the page declared. Checks the step graph's
+pan and zoom (a copy of the page with a probe script wheels, clicks the zoom buttons and
+records the SVG's transform each time) and the quotient graph (K processor nodes p0..pK-1,
+K from the page's title, with loads that add up to the step's tasks and to 100 %, and
+edges labelled with bytes and signals). Saves a PNG screenshot.
 
   browser_check.py --tgraph build/release/apps/tgraph --chromium /usr/bin/chromium \
       --screenshot report.png            # runs `tgraph demo` and checks its report
@@ -12,6 +16,7 @@ or canvas, or when fewer charts rendered than the page declared. Saves a PNG scr
 """
 import argparse
 import html.parser
+import json
 import os
 import re
 import subprocess
@@ -71,6 +76,182 @@ class ChartScan(html.parser.HTMLParser):
             if self.stack[i][0] == tag:
                 del self.stack[i:]
                 break
+
+
+class GraphScan(html.parser.HTMLParser):
+    """Collects the Graphviz nodes and edges inside the element with id `container`: for each
+    <g class="node"> or <g class="edge">, its <title> and the texts of its <text> elements."""
+
+    def __init__(self, container):
+        super().__init__()
+        self.container = container
+        self.depth = 0  # open elements inside the container (0: outside)
+        self.items = []  # {"class": "node"|"edge", "title": str, "texts": [str]}
+        self.current = None
+        self.current_depth = 0
+        self.field = None
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if self.depth == 0:
+            if a.get("id") == self.container:
+                self.depth = 1
+            return
+        self.depth += 1
+        if tag == "g" and a.get("class") in ("node", "edge") and self.current is None:
+            self.current = {"class": a["class"], "title": "", "texts": []}
+            self.current_depth = self.depth
+            self.items.append(self.current)
+        elif self.current is not None and tag in ("title", "text"):
+            self.field = tag
+            if tag == "text":
+                self.current["texts"].append("")
+
+    def handle_endtag(self, tag):
+        if self.depth == 0:
+            return
+        if self.current is not None and self.depth == self.current_depth:
+            self.current = None
+        self.field = None
+        self.depth -= 1
+
+    def handle_data(self, data):
+        if self.current is None or self.field is None:
+            return
+        if self.field == "title":
+            self.current["title"] += data
+        else:
+            self.current["texts"][-1] += data
+
+
+# Appended to a copy of the page: after the charts ran, zooms the step graph with the wheel
+# and the buttons (whole graph, reset, +) and records the SVG's CSS transform after each on
+# <html data-probe>.
+PROBE = """<script>
+(function () {
+  var box = document.getElementById('graph-step');
+  var svg = box ? box.querySelector('svg') : null;
+  var p = {ready: box ? (box.dataset.panzoom || '') : 'no #graph-step',
+           inside: !!svg && svg.parentElement === box};
+  function done() { document.documentElement.dataset.probe = JSON.stringify(p); }
+  // Headless Chromium under --virtual-time-budget runs animation frames only at load (two
+  // frames, then none): Panzoom applies each transform in a frame callback, so frames are
+  // driven by timers here, the library's code unchanged.
+  window.requestAnimationFrame = function (cb) {
+    return setTimeout(function () { cb(performance.now()); }, 16);
+  };
+  if (!svg) { done(); return; }
+  var r = box.getBoundingClientRect();
+  // Panzoom applies a transform on the next animation frame: each action waits 200 ms.
+  var steps = [
+    function () { p.start = svg.style.transform; },
+    function () {
+      box.dispatchEvent(new WheelEvent('wheel', {deltaY: -400, clientX: r.left + r.width / 3,
+          clientY: r.top + r.height / 3, bubbles: true, cancelable: true}));
+    },
+    function () { p.wheel = svg.style.transform; document.querySelector('[data-zoom="whole"]').click(); },
+    function () {
+      p.whole = svg.style.transform;
+      p.whole_width = svg.getBoundingClientRect().width;
+      p.box_width = box.getBoundingClientRect().width;
+      document.querySelector('[data-zoom="reset"]').click();
+    },
+    function () { p.reset = svg.style.transform; document.querySelector('[data-zoom="in"]').click(); },
+    function () { p.zoom_in = svg.style.transform; done(); }
+  ];
+  function next(i) {
+    if (i === steps.length) return;
+    setTimeout(function () { steps[i](); next(i + 1); }, 200);
+  }
+  next(0);
+})();
+</script>"""
+
+
+def scale_of(transform):
+    m = re.search(r"scale\(([0-9.eE+-]+)\)", transform or "")
+    return float(m.group(1)) if m else None
+
+
+def check_pan_zoom(binary, report, tmp):
+    """Failures of the step graph's pan and zoom, from a probed copy of the page."""
+    with open(report, encoding="utf-8") as f:
+        page = f.read()
+    at = page.rfind("</body>")
+    if at < 0:
+        return ["the page has no </body>"]
+    probed = os.path.join(tmp, "probed-report.html")
+    with open(probed, "w", encoding="utf-8") as f:
+        f.write(page[:at] + PROBE + page[at:])
+    run = chromium(binary, "--dump-dom", "file://" + probed)
+    scan = ChartScan()
+    scan.feed(run.stdout)
+    raw = scan.root_attrs.get("data-probe")
+    if not raw:
+        return ["pan/zoom probe did not run (chromium exited %d)" % run.returncode]
+    p = json.loads(raw)
+    failures = []
+    if p.get("ready") != "ready":
+        failures.append("pan/zoom not initialised on #graph-step: %r" % p.get("ready"))
+    if not p.get("inside"):
+        failures.append("the step graph's SVG is not directly inside the pan/zoom box #graph-step")
+    start, wheel, whole, reset, zoom_in = (scale_of(p.get(k)) for k in ("start", "wheel", "whole", "reset", "zoom_in"))
+    if start is None or not start > 0:
+        failures.append("the step graph has no initial scale: transform %r" % p.get("start"))
+        return failures
+    if wheel is None or not wheel > start:
+        failures.append("wheel up did not zoom in: %r -> %r" % (p.get("start"), p.get("wheel")))
+    if whole is None or whole > start + 1e-9 or p.get("whole_width", 0) > p.get("box_width", 0) + 1:
+        failures.append("'whole graph' does not fit the graph in the box: %r, %s px wide in %s px"
+                        % (p.get("whole"), p.get("whole_width"), p.get("box_width")))
+    if reset is None or abs(reset - start) > 1e-9:
+        failures.append("'reset' did not go back to the first view: %r, first %r" % (p.get("reset"), p.get("start")))
+    if zoom_in is None or not zoom_in > start:
+        failures.append("the + button did not zoom in: %r" % p.get("zoom_in"))
+    return failures
+
+
+def check_quotient(dom):
+    """Failures of the quotient graph beside the step graph."""
+    title = re.search(r"<h1>[^<]*?, (\d+) threads</h1>", dom)
+    if not title:
+        return ["no '<N> threads' in the page's title"]
+    k = int(title.group(1))
+    scan = GraphScan("graph-quotient")
+    scan.feed(dom)
+    nodes = [i for i in scan.items if i["class"] == "node"]
+    edges = [i for i in scan.items if i["class"] == "edge"]
+    failures = []
+    names = sorted(n["title"] for n in nodes)
+    want = sorted("p%d" % p for p in range(k))
+    if names != want:
+        return ["quotient graph nodes %s, expected %s" % (names, want)]
+    tasks = share = 0.0
+    for n in nodes:
+        t = n["texts"]
+        load = re.fullmatch(r"work [0-9.]+ (ns|µs|ms|s) \(([0-9.]+)%\)", t[1]) if len(t) == 3 else None
+        count = re.fullmatch(r"(\d+) tasks?", t[2]) if len(t) == 3 else None
+        if t[:1] != [n["title"]] or not load or not count:
+            failures.append("quotient node %s labelled %r, expected [name, work (share %%), tasks]"
+                            % (n["title"], t))
+            continue
+        share += float(load.group(2))
+        tasks += int(count.group(1))
+    step_tasks = re.search(r">(\d+) tasks · (\d+) dependencies", dom)
+    if not step_tasks:
+        failures.append("the step graph's title has no task count")
+    elif int(step_tasks.group(1)) != tasks:
+        failures.append("quotient nodes hold %d tasks, the step graph %s" % (tasks, step_tasks.group(1)))
+    if abs(share - 100) > 0.05 * k + 0.1:  # shares rounded to 3 significant digits
+        failures.append("quotient node shares add up to %.2f %%" % share)
+    if k > 1 and not edges:
+        failures.append("the quotient graph has no edge on %d processors" % k)
+    for e in edges:
+        text = " / ".join(e["texts"])
+        if not re.fullmatch(r"\d+ deps?( \(\d+ carried\))? / [0-9.]+ (B|KiB|MiB|GiB) / \d+ signals?", text):
+            failures.append("quotient edge %s labelled %r, expected 'N deps / bytes / N signals'"
+                            % (e["title"], text))
+    return failures
 
 
 def chromium(binary, *args):
@@ -134,6 +315,9 @@ def main():
         if declared is None or declared != rendered:
             failures.append("charts declared %s, rendered %s" % (declared, rendered))
 
+        failures += check_quotient(dom_run.stdout)
+        failures += check_pan_zoom(args.chromium, report, tmp)
+
         shot = chromium(args.chromium, "--hide-scrollbars", "--window-size=1280,4200",
                         "--screenshot=" + os.path.abspath(args.screenshot), url)
         if shot.returncode != 0 or not os.path.exists(args.screenshot) or os.path.getsize(args.screenshot) == 0:
@@ -143,8 +327,8 @@ def main():
             for f in failures:
                 print("FAIL: " + f, file=sys.stderr)
             return 1
-        print("report %s: %d charts rendered, no JavaScript error; screenshot %s" %
-              (report, len(scan.charts), args.screenshot))
+        print("report %s: %d charts rendered, no JavaScript error, step graph pans and zooms, "
+              "quotient graph drawn; screenshot %s" % (report, len(scan.charts), args.screenshot))
         return 0
 
 

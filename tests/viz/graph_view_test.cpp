@@ -258,13 +258,16 @@ TEST(GraphView, LegendListsProcessorsFromP0LeftToRight) {
 TEST(GraphView, CollapsedBars64HasOneNodePerObjectAndLoopWithSummedWork) {
   const StepGraph g = capture_step("bars64", 1);
   ASSERT_GT(g.tasks.size(), 900u);
-  std::map<std::pair<std::string, LoopId>, std::uint64_t> expected;  // key -> work
+  ASSERT_EQ(g.loops.size(), 1u);
+  // key, loop, before (0) or after (1) the loop for tasks outside it -> work
+  std::map<std::tuple<std::string, LoopId, int>, std::uint64_t> expected;
   std::uint64_t total = 0;
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     const Task& task = g.tasks[t];
     const std::string key = task.object == kNoObject ? "k" + std::to_string(task.kind)
                                                      : "o" + std::to_string(task.object);
-    expected[{key, task.loop}] += task.cost_ns * g.runs(t);
+    const int region = task.loop == kNoLoop && t >= g.loops[0].last ? 1 : 0;
+    expected[{key, task.loop, region}] += task.cost_ns * g.runs(t);
     total += task.cost_ns * g.runs(t);
   }
   ViewOptions o;
@@ -311,11 +314,107 @@ TEST(GraphView, CollapsedByKindAndProcessorSumTheWork) {
     EXPECT_EQ(tasks, g.tasks.size()) << to_string(c);
   }
   o.collapse = Collapse::kProcessor;
-  std::set<std::pair<ProcId, LoopId>> want;
-  for (TaskId t = 0; t < g.tasks.size(); ++t) want.insert({a.proc[t], g.tasks[t].loop});
+  std::set<std::tuple<ProcId, LoopId, bool>> want;  // outside the loop: before or after it
+  for (TaskId t = 0; t < g.tasks.size(); ++t)
+    want.insert({a.proc[t], g.tasks[t].loop,
+                 g.tasks[t].loop == kNoLoop && t >= g.loops.at(0).last});
   std::size_t groups = 0;
   for (const ViewNode& n : make_graph_view(g, o).nodes) groups += n.kind == NodeKind::kGroup;
   EXPECT_EQ(groups, want.size());
+}
+
+// body0 has tasks before, inside and after the loop: three nodes (one node for before and
+// after would form a cycle with the loop's node); body1 has none after it.
+TEST(GraphView, CollapsedViewsSplitTheTasksBeforeAndAfterALoop) {
+  const StepGraph g = cw_loop_graph();
+  ViewOptions o;
+  o.collapse = Collapse::kObject;
+  std::set<std::pair<std::string, std::string>> heads;
+  for (const ViewNode& n : make_graph_view(g, o).nodes)
+    if (n.kind == NodeKind::kGroup) heads.insert({n.lines.at(0), n.lines.at(1)});
+  EXPECT_TRUE(heads.count({"body0", "before loop 0"}));
+  EXPECT_TRUE(heads.count({"body0", "after loop 0"}));
+  EXPECT_TRUE(heads.count({"body0", "2 tasks \xC3\x97 3 it."}));
+  EXPECT_TRUE(heads.count({"body1", "before loop 0"}));
+  EXPECT_FALSE(heads.count({"body1", "after loop 0"}));
+}
+
+// Two "integrate" tasks chained through x, then two "sum" readers: collapsed by kind, the
+// chain is a self-loop of the integrate node, the title says so.
+TEST(GraphView, CollapsedViewsCountTheDependenciesTheyHide) {
+  Builder b;
+  b.g.kinds = {"integrate", "sum"};
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{x, M::W}}, 1, 1);
+  b.g.add_task(0, kNoObject, std::vector<Access>{{x, M::RW}}, 1, 2);
+  b.g.add_task(1, kNoObject, std::vector<Access>{{x, M::R}}, 1, 3);
+  b.g.add_task(1, kNoObject, std::vector<Access>{{x, M::R}, {y, M::W}}, 1, 4);
+  const StepGraph g = b.done();
+  ASSERT_EQ(g.edges.size(), 3u);  // 0 -> 1, 1 -> 2, 1 -> 3
+  ViewOptions o;
+  o.collapse = Collapse::kKind;
+  const GraphView v = make_graph_view(g, o);
+  EXPECT_EQ(v.hidden_deps, 1u);
+  EXPECT_EQ(v.deps, 3u);
+  ASSERT_EQ(v.edges.size(), 1u);
+  EXPECT_EQ(v.edges[0].deps, 2u);  // drawn + hidden = all
+  EXPECT_EQ(hidden_deps_note(v),
+            "1 of 3 dependencies join tasks of one node (self-loops, not drawn)");
+  EXPECT_NE(v.title.back().find(hidden_deps_note(v)), std::string::npos) << v.title.back();
+  EXPECT_NE(to_dot(v).find("1 of 3 dependencies join tasks of one node"), std::string::npos);
+  // One node per task: nothing hidden.
+  o.collapse = Collapse::kLoop;
+  EXPECT_EQ(make_graph_view(g, o).hidden_deps, 0u);
+}
+
+// On bars64 collapsed by object, the hidden dependencies are some of those inside one object
+// and loop level (the others go through a datum node and are drawn).
+TEST(GraphView, Bars64CollapsedByObjectHidesTheDependenciesInsideAnObject) {
+  const StepGraph g = capture_step("bars64", 1);
+  ViewOptions o;
+  o.collapse = Collapse::kObject;
+  const GraphView v = make_graph_view(g, o);
+  auto key = [&](TaskId t) {
+    const Task& task = g.tasks[t];
+    return std::make_tuple(task.object, task.object == kNoObject ? task.kind : 0, task.loop,
+                           task.loop == kNoLoop && t >= g.loops.at(0).last);
+  };
+  std::uint64_t inside = 0;
+  for (const auto* edges : {&g.edges, &g.carried_edges})
+    for (const Edge& e : *edges) inside += key(e.from) == key(e.to);
+  EXPECT_GT(v.hidden_deps, 0u);
+  EXPECT_LE(v.hidden_deps, inside);
+  EXPECT_EQ(v.deps, g.edges.size() + g.carried_edges.size());
+  EXPECT_NE(v.title.at(v.title.size() - 1).find(hidden_deps_note(v)), std::string::npos);
+}
+
+TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
+  QuotientGraph q;
+  q.load_ns = {3'000'000, 1'000'000, 0};
+  q.tasks = {30, 10, 0};
+  q.edges = {{0, 1, 4, 2, 2048, 5}, {1, 0, 1, 0, 512, 1}, {2, 0, 0, 0, 0, 3}};
+  const GraphView v = quotient_view(q, "quotient graph, step 1");
+  ASSERT_EQ(v.nodes.size(), 3u);
+  EXPECT_EQ(v.nodes[0].lines, (std::vector<std::string>{"p0", "work 3 ms (75%)", "30 tasks"}));
+  EXPECT_EQ(v.nodes[1].lines, (std::vector<std::string>{"p1", "work 1 ms (25%)", "10 tasks"}));
+  EXPECT_EQ(v.nodes[2].lines, (std::vector<std::string>{"p2", "work 0 ns (0%)", "0 tasks"}));
+  EXPECT_EQ(v.nodes[1].procs, (std::vector<ProcessorShare>{{1, 1'000'000}}));
+  ASSERT_EQ(v.edges.size(), 3u);
+  EXPECT_EQ(v.edges[0].lines,
+            (std::vector<std::string>{"6 deps (2 carried)", "2 KiB", "5 signals"}));
+  EXPECT_EQ(v.edges[1].lines, (std::vector<std::string>{"1 dep", "512 B", "1 signal"}));
+  EXPECT_EQ(v.edges[2].style, EdgeStyle::kOrder);  // loop decisions only
+  EXPECT_DOUBLE_EQ(v.edges[0].width, 6.0);         // the most bytes: the widest
+  EXPECT_DOUBLE_EQ(v.edges[1].width, 1.0 + 5.0 * 512 / 2048);
+  EXPECT_FALSE(v.legend);
+  EXPECT_EQ(v.title,
+            (std::vector<std::string>{
+                "quotient graph, step 1", "3 processors \xC2\xB7 40 tasks \xC2\xB7 work 4 ms",
+                "cut: 7 dependencies \xC2\xB7 2.5 KiB \xC2\xB7 9 signals per execution"}));
+  const std::string svg = render_graph(v, GraphFormat::kSvg);
+  for (const char* text : {">p0<", ">p2<", ">5 signals<", ">work 3 ms (75%)<"})
+    EXPECT_NE(svg.find(text), std::string::npos) << text;
+  EXPECT_EQ(svg.find("legend"), std::string::npos);
 }
 
 TEST(GraphView, Bars64WithoutCollapseIsRefusedWithAHint) {

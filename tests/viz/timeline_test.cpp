@@ -191,6 +191,11 @@ TEST(Report, PageIsSelfContainedWithOneContainerPerChart) {
   EXPECT_NE(html.find("<td>1.77</td>"), std::string::npos);
   EXPECT_EQ(html.find("4.47482"), std::string::npos);
   EXPECT_NE(html.find("<svg"), std::string::npos);  // the step graph
+  // ... in a pan/zoom box bound by the inlined Panzoom, without a quotient graph here.
+  EXPECT_NE(html.find("<div class=\"graph\" id=\"graph-step\"><svg"), std::string::npos);
+  EXPECT_NE(html.find("Panzoom 4.6.2"), std::string::npos);  // the library's banner
+  EXPECT_NE(html.find("Panzoom(svg, {canvas: true"), std::string::npos);
+  EXPECT_EQ(html.find("id=\"graph-quotient\""), std::string::npos);
   EXPECT_EQ(round3(0.0123456), "0.0123");
   EXPECT_EQ(round3(1234.6), "1235");
   EXPECT_EQ(round3(4.47482), "4.47");
@@ -236,6 +241,33 @@ TEST(Report, FromFilesAddsTheComparisonAndReplaysAndFallsBackToStepZero) {
   EXPECT_THROW(report_from_files(trace, "f.tgt", nullptr, 1, (dir / "none.json").string(), {}),
                InputError);
   std::filesystem::remove_all(dir);
+}
+
+TEST(Report, DrawsTheQuotientGraphBesideTheStepGraph) {
+  auto scene = samples::make_scene("fig2", {});
+  capture::Recorder rec(capture::Mode::kCapture);
+  Trace trace;
+  for (int s = 0; s < 2; ++s) {
+    scene->step(rec);
+    trace.steps.push_back(rec.end_step());
+  }
+  Assignment a;
+  a.k = 2;
+  for (TaskId t = 0; t < trace.steps[1].tasks.size(); ++t) a.proc.push_back(t % 2);
+  ReportContent c = report_content(trace, "fig2.tgt", &a, 1, "alternate");
+  EXPECT_EQ(c.graph_step, 1u);
+  set_quotient(c, quotient_graph(trace.steps[1], a), "alternate");
+  const std::string html = report_html(c);
+  const auto step = html.find("id=\"graph-step\""), quotient = html.find("id=\"graph-quotient\"");
+  ASSERT_NE(step, std::string::npos);
+  ASSERT_NE(quotient, std::string::npos);
+  EXPECT_LT(step, quotient);
+  EXPECT_NE(html.find("quotient graph, step 1, alternate on 2 processors"), std::string::npos);
+  for (const char* text : {">p0</text>", ">p1</text>"})
+    EXPECT_NE(html.find(text, quotient), std::string::npos) << text;
+  // The step graph keeps its edge labels as hover text: tooltips, not drawn text.
+  EXPECT_NE(c.graph_caption.find("Hover a node or an edge"), std::string::npos);
+  EXPECT_NE(c.graph_svg.find("xlink:title="), std::string::npos);
 }
 
 TEST(Report, RejectsFilesOfAnotherKind) {

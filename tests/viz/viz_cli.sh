@@ -42,6 +42,16 @@ done
 "$T" viz "$d/b.tgt" --step 1 --collapse object -o "$d/b.svg"
 grep -q '<svg' "$d/b.svg" || fail "b.svg is not an SVG"
 "$T" viz "$d/b.tgt" --step 1 --collapse kind --critical-path -o "$d/b_kind.dot"
+# A collapsed view says how many dependencies it hides as self-loops: on stderr, out of the
+# step's dependencies as `info` counts them, and in the picture's title.
+"$T" viz "$d/b.tgt" --step 1 --collapse object -o "$d/b_obj.svg" 2>"$d/err"
+deps="$("$T" info "$d/b.tgt" --json | python3 -c 'import json,sys; print(json.load(sys.stdin)["per_step"][1]["edges"])')"
+grep -Eq "^tgraph viz: [1-9][0-9]* of $deps dependencies join tasks of one node \(self-loops, not drawn\)\$" "$d/err" \
+  || fail "viz --collapse object does not say what it hides out of $deps: $(cat "$d/err")"
+sed 's/&#45;/-/g' "$d/b_obj.svg" >"$d/b_obj.txt"  # SVG writes '-' as &#45;
+grep -qF "$(sed 's/^tgraph viz: //' "$d/err")" "$d/b_obj.txt" || fail "b_obj.svg's title does not say what it hides"
+"$T" viz "$d/fig2.tgt" --step 1 -o "$d/plain2.dot" 2>"$d/err"
+[ ! -s "$d/err" ] || fail "viz without --collapse printed: $(cat "$d/err")"
 expect_refusal "$d/nb.svg" "$T" viz "$d/b.tgt" --step 1 -o "$d/nb.svg"
 grep -q -- '--collapse' "$d/err" || fail "refusal does not suggest --collapse: $(cat "$d/err")"
 expect_refusal "$d/x.jpeg" "$T" viz "$d/fig2.tgt" --step 1 -o "$d/x.jpeg"

@@ -292,6 +292,7 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
   std::vector<std::map<ProcId, std::uint64_t>> shares;
   std::vector<std::string> names;
   std::vector<LoopId> body;  // Collapse::kLoop: the loop a node stands for
+  std::uint32_t region = 0;  // loops that ended before task t
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     const Task& task = g.tasks[t];
     std::string key, name;
@@ -328,6 +329,15 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
         break;
       case Collapse::kNone:
         break;
+    }
+    // Outside loops, tasks are grouped by the region they run in (before loop 0, after loop
+    // 0, ...): one node for an object's tasks before and after a loop would form a cycle
+    // with its loop node, which dot draws as long arcs across the picture.
+    while (region < g.loops.size() && g.loops[region].last <= t) ++region;
+    if (loop == kNoLoop && o.collapse != Collapse::kLoop && !g.loops.empty()) {
+      key += "r" + std::to_string(region);
+      name += region == 0 ? std::string("\nbefore loop 0")
+                          : "\nafter loop " + std::to_string(region - 1);
     }
     auto [it, fresh] = index.try_emplace({key, loop}, static_cast<std::uint32_t>(v.nodes.size()));
     if (fresh) {
@@ -493,6 +503,7 @@ void build_groups(const StepGraph& g, const ViewOptions& o, const CriticalPath* 
     const bool cross = a && a->proc[e.from] != a->proc[e.to];
     const auto hub = hub_of.find({e.datum, static_cast<int>(e.kind), e.carried, e.to});
     if (hub == hub_of.end()) {
+      if (node_of[e.from] == node_of[e.to]) ++v.hidden_deps;  // a self-loop: not drawn
       add(node_of[e.from], node_of[e.to], e, times, cross, true);
       continue;
     }
@@ -533,6 +544,12 @@ std::string loop_summary(const StepGraph& g, const CriticalPath& cp) {
 }
 
 }  // namespace
+
+std::string hidden_deps_note(const GraphView& v) {
+  return std::to_string(v.hidden_deps) + " of " + std::to_string(v.deps) +
+         (v.deps == 1 ? " dependency joins" : " dependencies join") +
+         " tasks of one node (self-loops, not drawn)";
+}
 
 std::string_view to_string(Collapse c) {
   switch (c) {
@@ -660,9 +677,11 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
     v.title.push_back(std::to_string(a->k) + " processors \xC2\xB7 " + std::to_string(cross) +
                       " dependencies cross processors (red)");
   }
+  v.deps = m.edges;
+  v.edge_labels = o.edge_labels;
   if (o.collapse != Collapse::kNone)
     v.title.push_back("collapsed by " + std::string(to_string(o.collapse)) +
-                      ": work = cost \xC3\x97 runs, edge bytes per step");
+                      ": work = cost \xC3\x97 runs, edge bytes per step; " + hidden_deps_note(v));
   if (o.critical_path)
     v.title.push_back(
         "critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
@@ -685,6 +704,61 @@ GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std
   } catch (const UsageError& e) {
     throw UsageError(trace_name + ": step " + std::to_string(step) + ": " + e.what());
   }
+}
+
+GraphView quotient_view(const QuotientGraph& q, const std::string& title) {
+  GraphView v;
+  v.processors = static_cast<std::uint32_t>(q.load_ns.size());
+  v.collapse = Collapse::kProcessor;
+  v.legend = false;  // every node names its processor
+  v.nodesep = 0.8;   // room for the labels of the edges both ways between two processors
+  std::uint64_t work = 0, tasks = 0, deps = 0, bytes = 0, signals = 0, max_bytes = 0;
+  for (ProcId p = 0; p < v.processors; ++p) {
+    work += q.load_ns[p];
+    tasks += q.tasks[p];
+  }
+  for (ProcId p = 0; p < v.processors; ++p) {
+    ViewNode n;
+    n.id = "p" + std::to_string(p);
+    n.kind = NodeKind::kGroup;
+    n.procs = {{p, q.load_ns[p]}};
+    n.tasks = q.tasks[p];
+    n.work_ns = q.load_ns[p];
+    const double share =
+        work == 0 ? 0.0 : 100.0 * static_cast<double>(q.load_ns[p]) / static_cast<double>(work);
+    n.lines = {"p" + std::to_string(p),
+               "work " + format_ns(static_cast<double>(q.load_ns[p])) + " (" + sig3(share) + "%)",
+               std::to_string(q.tasks[p]) + (q.tasks[p] == 1 ? " task" : " tasks")};
+    v.nodes.push_back(std::move(n));
+  }
+  for (const QuotientEdge& e : q.edges) max_bytes = std::max(max_bytes, e.bytes);
+  for (const QuotientEdge& e : q.edges) {
+    ViewEdge ve;
+    ve.from = e.from;
+    ve.to = e.to;
+    ve.deps = e.deps + e.carried_deps;
+    ve.bytes = e.bytes;
+    ve.style = ve.deps == 0 ? EdgeStyle::kOrder : EdgeStyle::kData;  // only loop decisions
+    // Short lines: labels of the edges both ways between two processors sit side by side.
+    std::string first = std::to_string(ve.deps) + (ve.deps == 1 ? " dep" : " deps");
+    if (e.carried_deps > 0) first += " (" + std::to_string(e.carried_deps) + " carried)";
+    ve.lines = {first, format_bytes(e.bytes),
+                std::to_string(e.signals) + (e.signals == 1 ? " signal" : " signals")};
+    ve.width = max_bytes == 0
+                   ? 1.0
+                   : 1.0 + 5.0 * static_cast<double>(e.bytes) / static_cast<double>(max_bytes);
+    v.edges.push_back(std::move(ve));
+    deps += e.deps + e.carried_deps;
+    bytes += e.bytes;
+    signals += e.signals;
+  }
+  if (!title.empty()) v.title.push_back(title);
+  v.title.push_back(std::to_string(v.processors) + " processors \xC2\xB7 " + std::to_string(tasks) +
+                    " tasks \xC2\xB7 work " + format_ns(static_cast<double>(work)));
+  v.title.push_back("cut: " + std::to_string(deps) + " dependencies \xC2\xB7 " +
+                    format_bytes(bytes) + " \xC2\xB7 " + std::to_string(signals) +
+                    " signals per execution");
+  return v;
 }
 
 }  // namespace tgraph::viz

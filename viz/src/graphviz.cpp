@@ -83,7 +83,9 @@ class Builder {
     agattr(g, AGRAPH, cs("labelloc"), cs("t"));
     agattr(g, AGRAPH, cs("labeljust"), cs("l"));
     agattr(g, AGRAPH, cs("newrank"), cs("true"));
-    agattr(g, AGRAPH, cs("nodesep"), cs("0.25"));
+    char nodesep[32];
+    std::snprintf(nodesep, sizeof nodesep, "%g", v_.nodesep);
+    agattr(g, AGRAPH, cs("nodesep"), nodesep);
     agattr(g, AGRAPH, cs("ranksep"), cs("0.45"));
     agattr(g, AGNODE, cs("shape"), cs("box"));
     agattr(g, AGNODE, cs("style"), cs("rounded,filled"));
@@ -97,7 +99,7 @@ class Builder {
     std::vector<std::string> title = v_.title;
     set(g, "label", label_text(title, "\\l") + "\\l");
 
-    add_legend(g);
+    if (v_.legend) add_legend(g);
     std::vector<Agraph_t*> cluster_of;  // by loop id
     for (const ViewCluster& c : v_.clusters) {
       const std::string name = "cluster_loop" + std::to_string(c.loop);
@@ -128,6 +130,7 @@ class Builder {
  private:
   void style_node(Agnode_t* an, const ViewNode& n) {
     set(an, "label", label_text(n.lines));
+    if (!v_.edge_labels) set(an, "tooltip", label_text(n.lines));  // hover text, not the id
     const std::string fill = node_fill(n);
     switch (n.kind) {
       case NodeKind::kTask:
@@ -184,7 +187,10 @@ class Builder {
   }
 
   void style_edge(Agedge_t* ae, const ViewEdge& e) {
-    if (!e.lines.empty()) set(ae, "label", label_text(e.lines));
+    if (!e.lines.empty()) {
+      // Without drawn labels the text stays reachable: SVG viewers show it on hover.
+      set(ae, v_.edge_labels ? "label" : "tooltip", label_text(e.lines));
+    }
     switch (e.style) {
       case EdgeStyle::kData:
         break;
@@ -210,6 +216,10 @@ class Builder {
     } else if (critical) {
       set(ae, "color", kInkColour);
       set(ae, "penwidth", "4");
+    } else if (e.width > 0) {
+      char width[32];
+      std::snprintf(width, sizeof width, "%.2f", e.width);
+      set(ae, "penwidth", width);
     }
   }
 

@@ -400,7 +400,15 @@ const char* kStyle =
     "text-align:left}dl{display:grid;grid-template-columns:max-content auto;gap:2px 16px}"
     "dt{font-weight:600}dd{margin:0}.charts{display:flex;flex-wrap:wrap;gap:24px}"
     ".graph{overflow:auto;max-height:900px;border:1px solid #ddd}.chart-error{color:#D55E00}"
-    "figcaption{font-size:0.85em;color:#555;max-width:900px}";
+    "figcaption{font-size:0.85em;color:#555;max-width:900px}"
+    ".graphs{display:flex;flex-wrap:wrap;gap:16px;align-items:flex-start}"
+    ".graphs figure{margin:0}.step-figure{flex:3 1 600px;min-width:0}"
+    ".quotient-figure{flex:1 1 300px;min-width:0}"
+    "#graph-step{height:700px;overflow:hidden;background:#fff}"
+    "#graph-step text{text-rendering:geometricPrecision}"
+    "#graph-quotient svg{max-width:100%;height:auto}"
+    ".graph-tools{font-size:0.85em;color:#555;margin-bottom:4px}"
+    ".graph-tools button{font-size:1em;min-width:2.2em;margin-right:4px}";
 
 // First script of the page: records uncaught errors, rejected promises and console.error
 // calls on <html data-js-errors> (what the browser test reads; visible in the inspector).
@@ -432,6 +440,49 @@ const char* kRenderScript = R"js(
         console.error('tgraph chart ' + id + ': ' + err);
       });
   }
+})();
+)js";
+
+// Pan and zoom on the step graph (Panzoom, inlined). The first view shows the whole graph
+// when its labels stay readable (scale >= kReadable), else the left end at the scale that
+// fits the graph's height (readable labels, the rest a drag away). The wheel zooms at the
+// pointer, dragging pans; buttons zoom in and out, go back to the first view ("reset") or
+// show the whole graph ("whole"). Sets data-panzoom="ready" and data-start-scale on
+// #graph-step once bound (what the browser test reads).
+const char* kPanZoomScript = R"js(
+(function () {
+  const box = document.getElementById('graph-step');
+  if (!box) return;
+  const svg = box.querySelector('svg');
+  const kReadable = 0.6;
+  const w = svg.width.baseVal.value, h = svg.height.baseVal.value;  // px
+  const W = box.clientWidth, H = box.clientHeight;
+  const whole = Math.min(W / w, H / h);
+  // Panzoom scales the <svg> about its centre (transform-origin 50% 50%): the translation
+  // that puts its top-left corner at (left, top) of the box at scale s.
+  function at(s, left, top) {
+    return {scale: s, x: (left - (w / 2) * (1 - s)) / s, y: (top - (h / 2) * (1 - s)) / s};
+  }
+  const all = at(whole, (W - whole * w) / 2, (H - whole * h) / 2);
+  const readable = Math.min(1, Math.max(kReadable, H / h));
+  const view = whole >= kReadable ? all
+                                  : at(readable, 8, Math.max(0, (H - readable * h) / 2));
+  const pz = Panzoom(svg, {canvas: true, maxScale: 8, minScale: Math.min(whole, 1) / 2, step: 0.3,
+                           startScale: view.scale, startX: view.x, startY: view.y});
+  box.addEventListener('wheel', function (e) { pz.zoomWithWheel(e); });
+  const actions = {
+    in: function () { pz.zoomIn(); },
+    out: function () { pz.zoomOut(); },
+    reset: function () { pz.reset(); },
+    whole: function () {
+      pz.zoom(all.scale, {force: true});
+      pz.pan(all.x, all.y, {force: true});
+    }
+  };
+  for (const b of document.querySelectorAll('[data-zoom]'))
+    b.addEventListener('click', actions[b.dataset.zoom]);
+  box.dataset.startScale = String(view.scale);
+  box.dataset.panzoom = 'ready';
 })();
 )js";
 
@@ -476,23 +527,40 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
     o.critical_path = true;
     o.max_nodes = 0;
     o.max_edges = 0;
+    o.edge_labels = false;  // on hover: drawn, they overlap on a scene of many objects
     o.title = trace_name + ", step " + std::to_string(step) +
               (assignment
                    ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors"
                    : "");
-    c.graph_svg =
-        inline_svg(render_graph(make_graph_view(trace.steps[step], o), GraphFormat::kSvg));
+    const GraphView view = make_graph_view(trace.steps[step], o);
+    c.graph_step = step;
+    c.graph_svg = inline_svg(render_graph(view, GraphFormat::kSvg));
     c.graph_caption =
         "Step " + std::to_string(step) +
-        " collapsed by object (one node per object and loop level, work = cost × runs), "
+        " collapsed by object (one node per object and loop, and per object before and "
+        "after each loop; work = cost × runs), "
         "coloured by processor" +
         (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
-        "; vermillion edges cross processors; thick black: the critical path. "
-        "Same picture: tgraph viz " +
+        "; vermillion edges cross processors; thick black: the critical path; " +
+        hidden_deps_note(view) +
+        ". Hover a node or an edge for its text (edge labels: data, bytes per step, "
+        "crossings). Same picture with edge labels drawn: tgraph viz " +
         trace_name + " --step " + std::to_string(step) + " --collapse object --critical-path" +
         (assignment ? " --assign A.tga" : "") + " -o g.svg";
   }
   return c;
+}
+
+void set_quotient(ReportContent& c, const QuotientGraph& q, const std::string& method) {
+  const std::string title = "quotient graph, step " + std::to_string(c.graph_step) + ", " + method +
+                            " on " + std::to_string(q.load_ns.size()) + " processors";
+  c.quotient_svg = inline_svg(render_graph(quotient_view(q, title), GraphFormat::kSvg));
+  c.quotient_caption =
+      "The partition seen from the processors: a node per processor with its work (cost × "
+      "runs) and share of the step's work; an arrow p → q for the dependencies from p's tasks "
+      "to q's, their datum bytes (the cut, as in tgraph evaluate) and the signals p sends q in "
+      "one execution of the step (datum versions and loop decisions; summed over the arrows: "
+      "tgraph evaluate's waits). Arrows are wider the more bytes they carry.";
 }
 
 void add_compare_json(ReportContent& c, std::string_view text, const std::string& name) {
@@ -602,16 +670,30 @@ std::string report_html(const ReportContent& c) {
         "id=\"chart-timeline\"></div><figcaption>" +
         escape(caption) + "</figcaption></figure>";
   }
-  if (!c.graph_svg.empty())
-    body += "<h2>Step graph</h2><figure><div class=\"graph\">" + c.graph_svg +
-            "</div><figcaption>" + escape(c.graph_caption) + "</figcaption></figure>";
-  body += "<p><small>Charts: " + escape(std::string(detail::web_asset_versions())) +
-          " (BSD-3-Clause), inlined; the page uses no network.</small></p>";
+  if (!c.graph_svg.empty()) {
+    body += std::string("<h2>Step graph") + (c.quotient_svg.empty() ? "" : " and quotient graph") +
+            "</h2><div class=\"graphs\"><figure class=\"step-figure\"><div "
+            "class=\"graph-tools\"><button data-zoom=\"in\" title=\"zoom in\">+</button>"
+            "<button data-zoom=\"out\" title=\"zoom out\">&minus;</button><button "
+            "data-zoom=\"reset\" title=\"back to the first view\">reset</button><button "
+            "data-zoom=\"whole\" title=\"the whole graph in the box\">whole graph</button> "
+            "wheel: zoom &middot; drag: pan &middot; hover a node or an edge: its text</div><div "
+            "class=\"graph\" "
+            "id=\"graph-step\">" +
+            c.graph_svg + "</div><figcaption>" + escape(c.graph_caption) + "</figcaption></figure>";
+    if (!c.quotient_svg.empty())
+      body += "<figure class=\"quotient-figure\"><div class=\"graph\" id=\"graph-quotient\">" +
+              c.quotient_svg + "</div><figcaption>" + escape(c.quotient_caption) +
+              "</figcaption></figure>";
+    body += "</div>";
+  }
+  body += "<p><small>Charts and pan/zoom: " + escape(std::string(detail::web_asset_versions())) +
+          ", inlined; the page uses no network.</small></p>";
 
   std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
                   escape(c.title) + "</title><style>" + kStyle + "</style><script>" + kErrorHook +
                   "</script>";
-  for (const char* lib : {"vega", "vega-lite", "vega-embed"}) {
+  for (const char* lib : {"vega", "vega-lite", "vega-embed", "panzoom"}) {
     h += "<script>/* ";
     h += lib;
     h += " */\n";
@@ -620,7 +702,9 @@ std::string report_html(const ReportContent& c) {
   }
   h += "</head><body>" + body;
   h += "<script type=\"application/json\" id=\"tgraph-specs\">" + script_json(specs) + "</script>";
-  h += "<script>" + std::string(kRenderScript) + "</script></body></html>\n";
+  h += "<script>" + std::string(kRenderScript) + "</script>";
+  if (!c.graph_svg.empty()) h += "<script>" + std::string(kPanZoomScript) + "</script>";
+  h += "</body></html>\n";
   return h;
 }
 

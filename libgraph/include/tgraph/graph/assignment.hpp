@@ -40,4 +40,31 @@ std::string validate(const StepGraph& g, const Assignment& a, std::uint32_t k);
 /// Tasks of processor `p` in execution order (program order unless `a.order` says otherwise).
 std::vector<TaskId> tasks_of(const Assignment& a, ProcId p);
 
+/// The dependencies of one step that run from tasks on processor `from` to tasks on `to`.
+struct QuotientEdge {
+  ProcId from = 0;
+  ProcId to = 0;
+  std::uint64_t deps = 0;          ///< intra-step dependencies (StepGraph::edges)
+  std::uint64_t carried_deps = 0;  ///< loop-carried ones (StepGraph::carried_edges)
+  std::uint64_t bytes = 0;         ///< datum bytes of both, one datum per dependency
+  /// Datum versions (and loop decisions) `from` sends to `to` in one execution of the step;
+  /// 0 unless a simulation filled it in (partition::step_quotient).
+  std::uint64_t signals = 0;
+  friend bool operator==(const QuotientEdge&, const QuotientEdge&) = default;
+};
+
+/// An assignment's quotient graph of one step: a node per processor, an edge per ordered
+/// pair of processors that dependencies join. Summed over its edges, `deps + carried_deps`
+/// and `bytes` are the cut that `tgraph evaluate` reports.
+struct QuotientGraph {
+  std::vector<std::uint64_t> load_ns;  ///< per processor: sum of cost x runs of its tasks
+  std::vector<std::uint64_t> tasks;    ///< per processor: tasks assigned to it
+  std::vector<QuotientEdge> edges;     ///< from != to, sorted by (from, to)
+};
+
+/// The quotient graph of `g` (edges derived) under `a`, which must fit it (validate).
+///
+///   const QuotientGraph q = quotient_graph(g, a);   // q.load_ns[p], q.edges[i].bytes
+QuotientGraph quotient_graph(const StepGraph& g, const Assignment& a);
+
 }  // namespace tgraph

@@ -61,6 +61,11 @@ std::string report_json(const Report& report, bool per_step = true);
 /// makespan and the quotient graph, five lines.
 std::string report_text(const Report& report);
 
+/// The quotient graph of step `g` under `a` (quotient_graph) with the signals between
+/// processors counted by simulate(): which versions cross does not depend on the cost model
+/// or on timing. Throws tgraph::Error when `a` does not fit `g`.
+QuotientGraph step_quotient(const StepGraph& g, const Assignment& a);
+
 /// Checks that `a` fits `trace`; throws InputError naming `a_name` otherwise.
 void check_fits(const Trace& trace, const TraceAssignment& a, const std::string& a_name);
 

@@ -20,6 +20,9 @@ struct Schedule {
   std::vector<std::uint64_t> finish_ns;   ///< per processor: end of its last task
   std::uint64_t signals = 0;     ///< datum versions (and loop decisions) sent to other processors
   std::uint64_t waits = 0;       ///< (version, receiving processor) pairs
+  /// k x k, [from * k + to]: the waits of processor `to` for versions sent by `from`
+  /// (summed: `waits`); what the report's quotient graph calls the signals from -> to.
+  std::vector<std::uint64_t> waits_between;
   std::uint64_t transfer_bytes = 0;  ///< bytes read from another processor's writes
   std::vector<std::uint64_t> first_instance;  ///< per task, plus the total at the end
   std::vector<std::uint64_t> start_ns;        ///< per instance

@@ -16,7 +16,8 @@
 
 namespace tgraph::viz {
 
-/// How tasks are aggregated into nodes.
+/// How tasks are aggregated into nodes. Object, kind and processor groups are made per loop
+/// body and, outside loops, per region between loops (before loop 0, after loop 0, ...).
 enum class Collapse : std::uint8_t {
   kNone = 0,       ///< one node per task (+ signal, wait and reducer nodes with an assignment)
   kObject = 1,     ///< one node per object and loop level (shared tasks: per kind)
@@ -78,6 +79,7 @@ struct ViewEdge {
   std::uint64_t bytes = 0;       ///< single edge: datum bytes; aggregate: bytes per step
   std::uint64_t cross_deps = 0;  ///< of `deps`, how many join different processors
   std::uint32_t critical_hits = 0;
+  double width = 0;  ///< stroke width in points (0: by style, crossing and critical path)
 };
 
 /// A loop body drawn as a cluster.
@@ -97,6 +99,9 @@ struct ViewOptions {
   /// 11,206 task-level edges take minutes), so large pictures are refused before layout.
   std::size_t max_edges = 4000;
   std::string title;  ///< first line of the graph label
+  /// false: edge labels become tooltips (shown on hover in SVG) and dot's layout stays
+  /// compact, for large collapsed graphs where labels would overlap.
+  bool edge_labels = true;
 };
 
 /// The picture of one step.
@@ -114,6 +119,12 @@ struct GraphView {
   std::vector<ViewNode> nodes;
   std::vector<ViewEdge> edges;
   std::vector<ViewCluster> clusters;
+  /// Collapsed views: dependencies whose two tasks fall in one node (self-loops, not drawn).
+  std::uint64_t hidden_deps = 0;
+  std::uint64_t deps = 0;   ///< dependencies of the step (intra-step + loop-carried)
+  bool edge_labels = true;  ///< ViewOptions::edge_labels
+  bool legend = true;       ///< a legend cluster (processors, shapes, strokes)
+  double nodesep = 0.25;    ///< inches between neighbours of one rank (dot's nodesep)
 };
 
 /// Builds the picture of `g` (edges derived). Throws UsageError when the assignment does
@@ -126,6 +137,16 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& options);
 /// errors are prefixed with "<trace_name>: step S: ".
 GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std::size_t step,
                           const TraceAssignment* assignment, ViewOptions options);
+
+/// The picture of an assignment's quotient graph: a node per processor with its work, task
+/// count and share of the step's work; an edge per ordered pair of processors with its
+/// dependencies, cut bytes and signals, wider the more bytes it carries. `title` is the
+/// first line of the label.
+GraphView quotient_view(const QuotientGraph& q, const std::string& title);
+
+/// "56 of 252 dependencies join tasks of one node (self-loops, not drawn)": what a
+/// collapsed view leaves out (its title says it; `tgraph viz` prints it too).
+std::string hidden_deps_note(const GraphView& v);
 
 /// "96 B", "1.5 KiB", "2.25 MiB".
 std::string format_bytes(std::uint64_t bytes);

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The HTML report of `tgraph report` and `tgraph demo`: one self-contained page (Vega-Lite,
-// Vega and Vega-Embed inlined, no network) with the scene, the method x K table, speed-up
-// charts, per-step partition time and migrations, the replay timeline and the step graph.
+// Vega, Vega-Embed and Panzoom inlined, no network) with the scene, the method x K table,
+// speed-up charts, per-step partition time and migrations, the replay timeline, the step
+// graph (pan and zoom) and the partition's quotient graph.
 #pragma once
 
 #include <cstdint>
@@ -59,6 +60,9 @@ struct ReportContent {
   std::string timeline_caption;
   std::string graph_svg;  ///< the step graph (Graphviz SVG), empty: none
   std::string graph_caption;
+  std::size_t graph_step = 0;  ///< the step it shows
+  std::string quotient_svg;    ///< the assignment's quotient graph of that step, empty: none
+  std::string quotient_caption;
   std::vector<std::string> notes;  ///< paragraphs under the title
 };
 
@@ -67,6 +71,10 @@ struct ReportContent {
 ReportContent report_content(const Trace& trace, const std::string& trace_name,
                              const Assignment* assignment, std::size_t step,
                              const std::string& assignment_name = {});
+
+/// Draws `q`, the quotient graph of the step graph's assignment (partition::step_quotient
+/// of step `c.graph_step`), beside the step graph; `method` names the assignment.
+void set_quotient(ReportContent& c, const QuotientGraph& q, const std::string& method);
 
 /// Adds the rows (and per-step series) of `tgraph compare --json` text; throws InputError
 /// naming `name` when the text is not such a comparison.
