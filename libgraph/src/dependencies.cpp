@@ -20,7 +20,10 @@
 // A datum's edges depend only on its own access sequence, so the derivation runs datum by
 // datum over the accesses grouped by datum (derive_datum), which the incremental
 // EdgeDeriver shares.
+#include <sys/mman.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -92,17 +95,24 @@ void apply_access(DatumState& s, TaskId id, Access a, EdgeSink& sink) {
   }
 }
 
-bool edge_less(const Edge& a, const Edge& b) {
-  if (a.to != b.to) return a.to < b.to;
-  if (a.from != b.from) return a.from < b.from;
-  if (a.datum != b.datum) return a.datum < b.datum;
-  return a.kind < b.kind;
+void advise_huge_pages(void* p, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
+  const auto begin = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+  const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
+  if (end >= begin + 2 * kHuge)
+    ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint only
+#else
+  (void)p;
+  (void)bytes;
+#endif
 }
 
 void group_accesses(const StepGraph& g, AccessesByDatum& out) {
   out.begin.assign(g.data.size() + 1, 0);
   for (const Access& a : g.accesses) ++out.begin[a.datum + 1];
   for (std::size_t d = 0; d < g.data.size(); ++d) out.begin[d + 1] += out.begin[d];
+  reserve_huge(out.entries, g.accesses.size());
   out.entries.resize(g.accesses.size());
   // Each datum's next free entry; begin[d] again once every access is placed.
   std::vector<std::uint32_t> fill(out.begin.begin(), out.begin.end() - 1);
@@ -147,14 +157,14 @@ void derive_datum(const StepGraph& g, DatumId d, const AccessEntry* first, const
   main.out = &edges;
   main.max_edges = max_edges;
   for (const AccessEntry* i = first; i < last;) {
-    if (i->loop == kNoLoop) {
-      apply_access(state, i->task, {d, i->mode}, main);
+    if (i->loop() == kNoLoop) {
+      apply_access(state, i->task, {d, i->mode()}, main);
       ++i;
       continue;
     }
     const AccessEntry* j = i;
-    while (j < last && j->loop == i->loop) ++j;
-    for (const AccessEntry* k = i; k < j; ++k) apply_access(state, k->task, {d, k->mode}, main);
+    while (j < last && j->loop() == i->loop()) ++j;
+    for (const AccessEntry* k = i; k < j; ++k) apply_access(state, k->task, {d, k->mode()}, main);
     // Second pass over the body from the end-of-body state: edges from a first-pass task
     // to a second-pass task are the loop-carried ones.
     second_state.writers.assign(state.writers.begin(), state.writers.end());
@@ -166,10 +176,10 @@ void derive_datum(const StepGraph& g, DatumId d, const AccessEntry* first, const
     second.out = &carried;
     second.max_edges = max_edges;
     second.offset = n;
-    second.body_first = g.loops[i->loop].first;
-    second.body_last = g.loops[i->loop].last;
+    second.body_first = g.loops[i->loop()].first;
+    second.body_last = g.loops[i->loop()].last;
     for (const AccessEntry* k = i; k < j; ++k)
-      apply_access(second_state, k->task + n, {d, k->mode}, second);
+      apply_access(second_state, k->task + n, {d, k->mode()}, second);
     i = j;
   }
   sort_unique_tail(edges, edges_at);
@@ -180,15 +190,22 @@ void assemble_by_target(const std::vector<Edge>& by_datum, std::size_t tasks,
                         std::vector<Edge>& out) {
   std::vector<std::uint32_t> begin(tasks + 1, 0);
   for (const Edge& e : by_datum) ++begin[e.to + 1];
+  assemble_counted(by_datum, begin, out);
+}
+
+void assemble_counted(const std::vector<Edge>& by_datum, std::vector<std::uint32_t>& begin,
+                      std::vector<Edge>& out) {
+  const std::size_t tasks = begin.size() - 1;
   for (std::size_t t = 0; t < tasks; ++t) begin[t + 1] += begin[t];
+  reserve_huge(out, by_datum.size());
   out.resize(by_datum.size());
-  {
-    std::vector<std::uint32_t> fill(begin.begin(), begin.end() - 1);
-    for (const Edge& e : by_datum) out[fill[e.to]++] = e;
-  }
+  // begin[t] is target t's next free slot; after the scatter it is where t + 1 starts.
+  for (const Edge& e : by_datum) out[begin[e.to]++] = e;
+  std::uint32_t from = 0;
   for (std::size_t t = 0; t < tasks; ++t) {
-    const auto b = out.begin() + begin[t], e = out.begin() + begin[t + 1];
+    const auto b = out.begin() + from, e = out.begin() + begin[t];
     if (e - b > 1 && !std::is_sorted(b, e, edge_less)) std::sort(b, e, edge_less);
+    from = begin[t];
   }
 }
 
@@ -219,19 +236,27 @@ void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
   detail::AccessesByDatum by_datum;
   detail::group_accesses(*this, by_datum);
   std::vector<Edge> intra, carried;
-  intra.reserve(accesses.size());
+  // Most steps have one to two edges per access: reserved (address space only) so that
+  // the list rarely grows by copying.
+  detail::reserve_huge(intra, 2 * accesses.size() + 16);
   detail::DatumState state, second_state;
+  // Edges per target, counted while each datum's edges are still in cache.
+  std::vector<std::uint32_t> intra_begin(tasks.size() + 1, 0), carried_begin(tasks.size() + 1, 0);
   const detail::AccessEntry* entries = by_datum.entries.data();
   for (DatumId d = 0; d < data.size(); ++d) {
     const std::uint32_t b = by_datum.begin[d], e = by_datum.begin[d + 1];
-    if (b != e)
-      detail::derive_datum(*this, d, entries + b, entries + e, intra, carried, state,
-                           second_state, max_edges);
+    if (b == e) continue;
+    const std::size_t intra_at = intra.size(), carried_at = carried.size();
+    detail::derive_datum(*this, d, entries + b, entries + e, intra, carried, state, second_state,
+                         max_edges);
+    for (std::size_t i = intra_at; i < intra.size(); ++i) ++intra_begin[intra[i].to + 1];
+    for (std::size_t i = carried_at; i < carried.size(); ++i) ++carried_begin[carried[i].to + 1];
   }
   by_datum = {};  // released before the edges are assembled
-  detail::assemble_by_target(intra, tasks.size(), edges);
+  detail::assemble_counted(intra, intra_begin, edges);
   intra = {};
-  detail::assemble_by_target(carried, tasks.size(), carried_edges);
+  intra_begin = {};
+  detail::assemble_counted(carried, carried_begin, carried_edges);
 }
 
 }  // namespace tgraph

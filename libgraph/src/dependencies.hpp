@@ -39,7 +39,24 @@ struct EdgeSink {
 void apply_access(DatumState& s, TaskId id, Access a, EdgeSink& sink);
 
 /// The order of StepGraph::edges: by target, source, datum, then kind.
-bool edge_less(const Edge& a, const Edge& b);
+inline bool edge_less(const Edge& a, const Edge& b) {
+  if (a.to != b.to) return a.to < b.to;
+  if (a.from != b.from) return a.from < b.from;
+  if (a.datum != b.datum) return a.datum < b.datum;
+  return a.kind < b.kind;
+}
+
+/// Asks the kernel to back [p, p + bytes) with huge pages when it spans several (Linux
+/// MADV_HUGEPAGE; a hint, ignored elsewhere or when refused). Large arrays filled once
+/// then take one page fault per 2 MiB instead of one per 4 KiB.
+void advise_huge_pages(void* p, std::size_t bytes);
+
+/// v.reserve(n), the reserved range advised as huge pages before anything touches it.
+template <class T>
+void reserve_huge(std::vector<T>& v, std::size_t n) {
+  v.reserve(n);
+  advise_huge_pages(v.data(), v.capacity() * sizeof(T));
+}
 
 /// `g`'s accesses grouped by datum (a counting sort: linear in tasks, data and accesses).
 void group_accesses(const StepGraph& g, AccessesByDatum& out);
@@ -59,5 +76,9 @@ void derive_datum(const StepGraph& g, DatumId d, const AccessEntry* first, const
 /// datum and kind (already in order when they come from one datum).
 void assemble_by_target(const std::vector<Edge>& by_datum, std::size_t tasks,
                         std::vector<Edge>& out);
+/// The same with the edges per target already counted: `begin[t + 1]` holds target t's
+/// count on entry (begin has tasks + 1 entries; it is consumed).
+void assemble_counted(const std::vector<Edge>& by_datum, std::vector<std::uint32_t>& begin,
+                      std::vector<Edge>& out);
 
 }  // namespace tgraph::detail

@@ -135,9 +135,9 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
         for (std::ptrdiff_t i = 0; same && i < ne - nb; ++i) {
           const Entry& x = nb[i];
           const Entry& y = ob[i];
-          same = old_of[x.task] == y.task && x.mode == y.mode &&
-                 (x.loop == kNoLoop) == (y.loop == kNoLoop) &&
-                 (i == 0 || (x.loop == nb[i - 1].loop) == (y.loop == ob[i - 1].loop));
+          same = old_of[x.task] == y.task && x.mode() == y.mode() &&
+                 (x.loop() == kNoLoop) == (y.loop() == kNoLoop) &&
+                 (i == 0 || (x.loop() == nb[i - 1].loop()) == (y.loop() == ob[i - 1].loop()));
         }
       }
       if (same) {

@@ -11,11 +11,21 @@
 namespace tgraph {
 
 namespace detail {
-/// One access seen from its datum: the task, its mode, the task's loop.
+/// One access seen from its datum: the task, its mode, the task's loop (8 bytes: the loop
+/// id and the mode share a word; a step has far fewer than 2^30 loops).
 struct AccessEntry {
   TaskId task = 0;
-  AccessMode mode = AccessMode::R;
-  LoopId loop = kNoLoop;
+  std::uint32_t loop_mode = kNoLoopBits << 2;  ///< loop id (kNoLoopBits for none) << 2 | mode
+  static constexpr std::uint32_t kNoLoopBits = (1u << 30) - 1;
+  AccessEntry() = default;
+  AccessEntry(TaskId t, AccessMode m, LoopId l)
+      : task(t),
+        loop_mode(((l == kNoLoop ? kNoLoopBits : l) << 2) | static_cast<std::uint32_t>(m)) {}
+  AccessMode mode() const { return static_cast<AccessMode>(loop_mode & 3u); }
+  LoopId loop() const {
+    const std::uint32_t l = loop_mode >> 2;
+    return l == kNoLoopBits ? kNoLoop : l;
+  }
 };
 /// A step's accesses grouped by datum, each datum's in program order (CSR: the entries of
 /// datum d are [begin[d], begin[d + 1])).
