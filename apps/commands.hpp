@@ -57,6 +57,7 @@ void add_info(CLI::App& app);
 void add_export(CLI::App& app);
 void add_diff(CLI::App& app);
 void add_capture(CLI::App& app);
+void add_generate(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_experiment(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
@@ -74,6 +75,7 @@ inline void add_all_verbs(CLI::App& app) {
   add_demo(app);
   add_experiment(app);
   add_capture(app);
+  add_generate(app);
   add_info(app);
   add_export(app);
   add_diff(app);

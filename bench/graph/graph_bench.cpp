@@ -3,10 +3,14 @@
 //
 //   graph_bench --benchmark_filter=DeriveEdges
 //
-//  * DeriveEdges/tasks:N: StepGraph::derive_edges on a synthetic physics-like step of about
-//    N tasks (10^3..10^6): per object a force task outside the solver loop and five tasks
-//    in a CG-like loop with two global dot products, plus one contact task per four objects.
-//    Counters: accesses_per_s and tasks_per_s (throughput), edges_per_task.
+//  * DeriveEdges/tasks:N: StepGraph::derive_edges on a generated solver step (generate_step,
+//    pattern domain) of about N tasks (10^3..10^7): per object a force task outside the
+//    solver loop and five tasks in a CG-like loop with two global dot products, plus one
+//    contact task per four objects. Counters: accesses_per_s and tasks_per_s (throughput),
+//    edges_per_task. GeneratedEdges/<stencil|random>/tasks:N: the same on Task Bench's
+//    shapes; IncrementalEdges/tasks:N: EdgeDeriver::derive on a step of unchanged structure
+//    (every datum's edges carried over); Metrics/tasks:N: compute_metrics;
+//    GeneratedTrace/<encode|decode>/tasks:N: a one-step trace of the solver step (up to 10^6).
 //  * TraceEncode / TraceDecode/<scene>/<reuse|full>: encode_trace and read_trace_bytes (edges
 //    derived, as every reader does) in memory, on a trace captured from a scene, with steps
 //    of repeated structure stored as reference frames (reuse) or every step as a full frame
@@ -25,6 +29,9 @@
 
 #include "bench_main.hpp"
 #include "tgraph/capture/recorder.hpp"
+#include "tgraph/graph/generate.hpp"
+#include "tgraph/graph/incremental.hpp"
+#include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/samples/scene.hpp"
@@ -34,87 +41,22 @@ namespace {
 using namespace tgraph;
 using bench::Size;
 
-/// About `tasks` tasks: objects * 6 + objects / 4 contacts + 3 shared tasks. Each global sum
-/// (CW by every object) has one reader, whose scalar the objects then read: edges stay
-/// linear in the tasks (a sum read by every object directly gives writers x readers edges).
-StepGraph physics_like(std::uint32_t tasks) {
-  const std::uint32_t objects = std::max<std::uint32_t>(1, tasks * 4 / 25);
-  StepGraph g;
-  const KindId kf = g.intern_kind("addForce"), kc = g.intern_kind("contact"),
-               kd = g.intern_kind("addDForce"), kpq = g.intern_kind("dotPQ"),
-               ks = g.intern_kind("cgScalars"), ku = g.intern_kind("cgUpdate"),
-               krr = g.intern_kind("dotRR"), kres = g.intern_kind("residual"),
-               kdir = g.intern_kind("cgDirection"), kb = g.intern_kind("loop.break");
-  std::vector<DatumId> x, f, p, q, r;
-  g.objects.reserve(objects);
-  g.data.reserve(objects * 5 + 5);
-  for (std::uint32_t o = 0; o < objects; ++o) {
-    const std::string name = "body" + std::to_string(o);
-    g.objects.push_back({name});
-    for (auto* v : {&x, &f, &p, &q, &r}) {
-      v->push_back(static_cast<DatumId>(g.data.size()));
-      g.data.push_back({name + ".v" + std::to_string(v->size()), o, 6144});
-    }
+/// A generated step of about `tasks` tasks (edges not derived), kept while the same pattern
+/// and size are asked for: Google Benchmark calls a benchmark function several times per
+/// repetition. One step at a time (a 10^7-task step holds a few GB).
+StepGraph& generated(Pattern pattern, std::int64_t tasks) {
+  static std::pair<Pattern, std::int64_t> key{Pattern::kTrivial, 0};
+  static StepGraph cached;
+  if (key != std::pair{pattern, tasks}) {
+    cached = {};
+    cached = generate_step({.tasks = static_cast<std::uint64_t>(tasks), .pattern = pattern});
+    key = {pattern, tasks};
   }
-  const auto pq = static_cast<DatumId>(g.data.size());
-  const DatumId alpha = pq + 1, rr = pq + 2, beta = pq + 3, cond = pq + 4;
-  for (const char* n : {"pq", "alpha", "rr", "beta", "cond"}) g.data.push_back({n, kNoObject, 8});
-  StableKey key = 1;
-  auto add = [&](KindId k, ObjectId o, std::initializer_list<Access> acc, bool in_loop) {
-    const std::vector<Access> v(acc);
-    const TaskId t = g.add_task(k, o, v, 1000, key++);
-    if (in_loop) g.tasks[t].loop = 0;
-  };
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(kf, o, {{x[o], AccessMode::R}, {f[o], AccessMode::CW}}, false);
-  for (std::uint32_t o = 0; o + 1 < objects; o += 4)
-    add(kc, o,
-        {{x[o], AccessMode::R},
-         {x[o + 1], AccessMode::R},
-         {f[o], AccessMode::CW},
-         {f[o + 1], AccessMode::CW}},
-        false);
-  Loop loop;
-  loop.condition = cond;
-  loop.first = static_cast<TaskId>(g.tasks.size());
-  loop.iterations = 25;
-  loop.max_iterations = 200;
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(kd, o, {{f[o], AccessMode::R}, {p[o], AccessMode::R}, {q[o], AccessMode::W}}, true);
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(kpq, o, {{p[o], AccessMode::R}, {q[o], AccessMode::R}, {pq, AccessMode::CW}}, true);
-  add(ks, kNoObject, {{pq, AccessMode::R}, {rr, AccessMode::R}, {alpha, AccessMode::W}}, true);
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(ku, o,
-        {{alpha, AccessMode::R},
-         {q[o], AccessMode::R},
-         {x[o], AccessMode::RW},
-         {r[o], AccessMode::RW}},
-        true);
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(krr, o, {{r[o], AccessMode::R}, {rr, AccessMode::CW}}, true);
-  add(kres, kNoObject, {{rr, AccessMode::R}, {beta, AccessMode::W}, {cond, AccessMode::W}}, true);
-  for (std::uint32_t o = 0; o < objects; ++o)
-    add(kdir, o, {{r[o], AccessMode::R}, {beta, AccessMode::R}, {p[o], AccessMode::RW}}, true);
-  add(kb, kNoObject, {{cond, AccessMode::R}}, true);
-  loop.last = static_cast<TaskId>(g.tasks.size());
-  g.loops.push_back(loop);
-  return g;
+  return cached;
 }
 
-void BM_DeriveEdges(benchmark::State& state) {
-  // Built once per size: Google Benchmark calls this function several times per repetition.
-  static std::map<std::int64_t, StepGraph> graphs;
-  auto found = graphs.find(state.range(0));
-  if (found == graphs.end())
-    found = graphs.emplace(state.range(0), physics_like(static_cast<std::uint32_t>(state.range(0))))
-                .first;
-  StepGraph& g = found->second;
-  for (auto _ : state) {
-    g.derive_edges();
-    benchmark::DoNotOptimize(g.edges.data());
-    benchmark::ClobberMemory();
-  }
+/// Throughput counters of one pass over a step per iteration.
+void step_counters(benchmark::State& state, const StepGraph& g) {
   const auto it = static_cast<double>(state.iterations());
   const auto tasks = static_cast<double>(g.tasks.size());
   state.counters["tasks"] = tasks;
@@ -123,6 +65,76 @@ void BM_DeriveEdges(benchmark::State& state) {
   state.counters["tasks_per_s"] = benchmark::Counter(it * tasks, benchmark::Counter::kIsRate);
   state.counters["edges_per_task"] =
       static_cast<double>(g.edges.size() + g.carried_edges.size()) / tasks;
+}
+
+void derive_edges(benchmark::State& state, Pattern pattern) {
+  StepGraph& g = generated(pattern, state.range(0));
+  for (auto _ : state) {
+    g.derive_edges();
+    benchmark::DoNotOptimize(g.edges.data());
+    benchmark::ClobberMemory();
+  }
+  step_counters(state, g);
+}
+
+// The scaled solver step (pattern domain): the case the engine produces.
+void BM_DeriveEdges(benchmark::State& state) { derive_edges(state, Pattern::kDomain); }
+
+// Task Bench's stencil and random shapes.
+void BM_GeneratedEdges(benchmark::State& state, Pattern pattern) { derive_edges(state, pattern); }
+
+// EdgeDeriver::derive on a step of the same structure as the previous one (every datum's
+// edges carried over, renumbered by stable key), the solver step.
+void BM_IncrementalEdges(benchmark::State& state) {
+  StepGraph& g = generated(Pattern::kDomain, state.range(0));
+  g.derive_edges();
+  EdgeDeriver deriver;
+  deriver.seed(g);
+  StepGraph next = g;
+  for (auto _ : state) {
+    const EdgeUpdate u = deriver.derive(next);
+    benchmark::DoNotOptimize(u.edges);
+  }
+  step_counters(state, next);
+}
+
+// encode_trace and read_trace_bytes (edges derived) of a one-step trace of the solver step.
+void BM_GeneratedTrace(benchmark::State& state, bool decode) {
+  Trace t;
+  t.steps.push_back(std::move(generated(Pattern::kDomain, state.range(0))));
+  t.steps[0].derive_edges();
+  std::size_t bytes = 0;
+  if (decode) {
+    const std::vector<std::uint8_t> b = encode_trace(t);
+    bytes = b.size();
+    for (auto _ : state) {
+      const Trace back = read_trace_bytes(b, "generated");
+      benchmark::DoNotOptimize(back.steps.data());
+    }
+  } else {
+    for (auto _ : state) {
+      const std::vector<std::uint8_t> b = encode_trace(t);
+      bytes = b.size();
+      benchmark::DoNotOptimize(b.data());
+    }
+  }
+  step_counters(state, t.steps[0]);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) *
+                          static_cast<std::int64_t>(bytes));
+  state.counters["bytes_per_task"] =
+      static_cast<double>(bytes) / static_cast<double>(t.steps[0].tasks.size());
+  generated(Pattern::kDomain, state.range(0)) = std::move(t.steps[0]);  // back to the cache
+}
+
+// compute_metrics (work, span with the loop unrolled, per kind), the solver step.
+void BM_Metrics(benchmark::State& state) {
+  StepGraph& g = generated(Pattern::kDomain, state.range(0));
+  g.derive_edges();
+  for (auto _ : state) {
+    const Metrics m = compute_metrics(g);
+    benchmark::DoNotOptimize(m.span_ns);
+  }
+  step_counters(state, g);
 }
 
 // ---- traces ---------------------------------------------------------------------------
@@ -212,13 +224,30 @@ void BM_TraceReadFile(benchmark::State& state, const std::string& scene) {
 void register_all(Size size) {
   g_steps_bars64 = bench::by_size(size, 2, 5, 10);
   g_steps_falling = bench::by_size(size, 50, 100, 100);
-  auto* derive = benchmark::RegisterBenchmark("BM_DeriveEdges", BM_DeriveEdges)
-                     ->ArgName("tasks")
-                     ->Unit(benchmark::kMicrosecond);
-  for (int n : bench::by_size<std::vector<int>>(size, {1000}, {1000, 100000},
-                                                {1000, 10000, 100000, 1000000}))
-    derive->Arg(n);
-  bench::timed(derive, size, 0.5);
+  // 10^7 only in full runs (a few GB of memory and seconds per pass).
+  const auto sizes = bench::by_size<std::vector<std::int64_t>>(
+      size, {1000}, {1000, 100000}, {1000, 10000, 100000, 1000000, 10000000});
+  const auto scaled = [&](benchmark::internal::Benchmark* b) {
+    b->ArgName("tasks")->Unit(benchmark::kMicrosecond);
+    for (const std::int64_t n : sizes) b->Arg(n);
+    bench::timed(b, size, 0.5);
+  };
+  scaled(benchmark::RegisterBenchmark("BM_DeriveEdges", BM_DeriveEdges));
+  for (const Pattern p : {Pattern::kStencil, Pattern::kRandom})
+    scaled(benchmark::RegisterBenchmark(
+        ("BM_GeneratedEdges/" + std::string(to_string(p))).c_str(), BM_GeneratedEdges, p));
+  scaled(benchmark::RegisterBenchmark("BM_IncrementalEdges", BM_IncrementalEdges));
+  scaled(benchmark::RegisterBenchmark("BM_Metrics", BM_Metrics));
+  // Encoded and decoded copies beside the step: up to 10^6 tasks.
+  for (const bool decode : {false, true}) {
+    auto* b = benchmark::RegisterBenchmark(decode ? "BM_GeneratedTrace/decode" : "BM_GeneratedTrace/encode",
+                                           BM_GeneratedTrace, decode)
+                  ->ArgName("tasks")
+                  ->Unit(benchmark::kMillisecond);
+    for (const std::int64_t n : sizes)
+      if (n <= 1000000) b->Arg(n);
+    bench::timed(b, size, 0.5);
+  }
   for (const std::string scene : {"bars64", "falling"}) {
     for (const bool reuse : {true, false}) {
       const std::string suffix = scene + (reuse ? "/reuse" : "/full");

@@ -8,7 +8,8 @@
 //    iterations with per-bar matrix products and global dot products) under each policy.
 //  * TaskOverhead/<policy>/threads:N: the same step with empty bodies (no spin, no data):
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
-//    worksteal, barrier, and starpu when the build has StarPU.
+//    worksteal, barrier, and starpu when the build has StarPU; per step, the signals
+//    published, the waits that blocked and those that parked.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -163,7 +164,17 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   const StepStats first = ex->run_step(g, &a, w);
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : first.threads) instances += c.tasks;
-  for (auto _ : state) ex->run_step(g, &a, w);
+  std::uint64_t signals = 0, blocked = 0, parks = 0;
+  for (auto _ : state) {
+    const StepStats s = ex->run_step(g, &a, w);
+    signals += s.signals();
+    blocked += s.blocked_waits();
+    parks += s.parks();
+  }
+  const auto steps = static_cast<double>(state.iterations());
+  state.counters["signals_per_step"] = static_cast<double>(signals) / steps;
+  state.counters["blocked_per_step"] = static_cast<double>(blocked) / steps;
+  state.counters["parks_per_step"] = static_cast<double>(parks) / steps;
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * instances));
   state.counters["ns_per_task"] =
       benchmark::Counter(static_cast<double>(state.iterations() * instances),

@@ -16,7 +16,14 @@
 // Loop bodies are processed once for intra-iteration edges, then a second time from the
 // state at the end of the body: edges from a first-pass task to a second-pass task are the
 // loop-carried edges (iteration i -> i + 1).
+//
+// A datum's edges depend only on its own access sequence, so the derivation runs datum by
+// datum over the accesses grouped by datum (derive_datum), which the incremental
+// EdgeDeriver shares.
+#include <sys/mman.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -88,61 +95,121 @@ void apply_access(DatumState& s, TaskId id, Access a, EdgeSink& sink) {
   }
 }
 
-bool edge_less(const Edge& a, const Edge& b) {
-  if (a.to != b.to) return a.to < b.to;
-  if (a.from != b.from) return a.from < b.from;
-  if (a.datum != b.datum) return a.datum < b.datum;
-  return a.kind < b.kind;
+void advise_huge_pages(void* p, std::size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
+  const auto begin = (reinterpret_cast<std::uintptr_t>(p) + kHuge - 1) & ~(kHuge - 1);
+  const auto end = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kHuge - 1);
+  if (end >= begin + 2 * kHuge)
+    ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint only
+#else
+  (void)p;
+  (void)bytes;
+#endif
 }
 
-}  // namespace detail
+void group_accesses(const StepGraph& g, AccessesByDatum& out) {
+  out.begin.assign(g.data.size() + 1, 0);
+  for (const Access& a : g.accesses) ++out.begin[a.datum + 1];
+  for (std::size_t d = 0; d < g.data.size(); ++d) out.begin[d + 1] += out.begin[d];
+  reserve_huge(out.entries, g.accesses.size());
+  out.entries.resize(g.accesses.size());
+  // Each datum's next free entry; begin[d] again once every access is placed.
+  std::vector<std::uint32_t> fill(out.begin.begin(), out.begin.end() - 1);
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  for (TaskId t = 0; t < n; ++t) {
+    const Task& task = g.tasks[t];
+    const Access* a = g.accesses.data() + task.access_begin;
+    for (std::uint32_t i = 0; i < task.access_count; ++i)
+      out.entries[fill[a[i].datum]++] = {t, a[i].mode, task.loop};
+  }
+}
 
 namespace {
 
-using detail::DatumState;
-using detail::EdgeSink;
+void clear(DatumState& s) {
+  s.writers.clear();
+  s.readers.clear();
+  s.group_preds.clear();
+  s.group_kind = EdgeKind::WAW;
+  s.cw_group = false;
+}
 
-class Extractor {
- public:
-  Extractor(const StepGraph& g, std::vector<Edge>& out, std::size_t max_edges)
-      : g_(g), state_(g.data.size()) {
-    sink_.out = &out;
-    sink_.max_edges = max_edges;
-  }
-
-  // Second-pass mode (see EdgeSink).
-  void set_pass(TaskId offset, TaskId body_first, TaskId body_last) {
-    sink_.offset = offset;
-    sink_.body_first = body_first;
-    sink_.body_last = body_last;
-  }
-
-  void process(TaskId t) {
-    const TaskId id = t + sink_.offset;
-    for (const Access& a : g_.accesses_of(t)) detail::apply_access(state_[a.datum], id, a, sink_);
-  }
-
-  std::vector<DatumState>& state() { return state_; }
-
- private:
-  const StepGraph& g_;
-  std::vector<DatumState> state_;
-  EdgeSink sink_;
-};
-
-void sort_unique(std::vector<Edge>& edges) {
-  // The kind breaks ties so that of duplicate (from, to, datum) triples emitted with two
-  // kinds (a task both reading and cumulatively writing a datum that a later RW task
-  // updates) the same one is kept whatever order the edges were emitted in.
-  std::sort(edges.begin(), edges.end(), detail::edge_less);
-  edges.erase(std::unique(edges.begin(), edges.end(),
-                          [](const Edge& a, const Edge& b) {
-                            return a.from == b.from && a.to == b.to && a.datum == b.datum;
-                          }),
-              edges.end());
+// Sorts [from, end) of `v` by edge_less (a datum's edges come out of the state machine
+// almost sorted: skipped when they already are) and removes repeated (from, to) pairs.
+void sort_unique_tail(std::vector<Edge>& v, std::size_t from) {
+  const auto b = v.begin() + static_cast<std::ptrdiff_t>(from);
+  if (!std::is_sorted(b, v.end(), edge_less)) std::sort(b, v.end(), edge_less);
+  v.erase(std::unique(b, v.end(),
+                      [](const Edge& x, const Edge& y) { return x.from == y.from && x.to == y.to; }),
+          v.end());
 }
 
 }  // namespace
+
+void derive_datum(const StepGraph& g, DatumId d, const AccessEntry* first, const AccessEntry* last,
+                  std::vector<Edge>& edges, std::vector<Edge>& carried, DatumState& state,
+                  DatumState& second_state, std::size_t max_edges) {
+  const std::size_t edges_at = edges.size(), carried_at = carried.size();
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  clear(state);
+  EdgeSink main;
+  main.out = &edges;
+  main.max_edges = max_edges;
+  for (const AccessEntry* i = first; i < last;) {
+    if (i->loop() == kNoLoop) {
+      apply_access(state, i->task, {d, i->mode()}, main);
+      ++i;
+      continue;
+    }
+    const AccessEntry* j = i;
+    while (j < last && j->loop() == i->loop()) ++j;
+    for (const AccessEntry* k = i; k < j; ++k) apply_access(state, k->task, {d, k->mode()}, main);
+    // Second pass over the body from the end-of-body state: edges from a first-pass task
+    // to a second-pass task are the loop-carried ones.
+    second_state.writers.assign(state.writers.begin(), state.writers.end());
+    second_state.readers.assign(state.readers.begin(), state.readers.end());
+    second_state.group_preds.assign(state.group_preds.begin(), state.group_preds.end());
+    second_state.group_kind = state.group_kind;
+    second_state.cw_group = state.cw_group;
+    EdgeSink second;
+    second.out = &carried;
+    second.max_edges = max_edges;
+    second.offset = n;
+    second.body_first = g.loops[i->loop()].first;
+    second.body_last = g.loops[i->loop()].last;
+    for (const AccessEntry* k = i; k < j; ++k)
+      apply_access(second_state, k->task + n, {d, k->mode()}, second);
+    i = j;
+  }
+  sort_unique_tail(edges, edges_at);
+  sort_unique_tail(carried, carried_at);
+}
+
+void assemble_by_target(const std::vector<Edge>& by_datum, std::size_t tasks,
+                        std::vector<Edge>& out) {
+  std::vector<std::uint32_t> begin(tasks + 1, 0);
+  for (const Edge& e : by_datum) ++begin[e.to + 1];
+  assemble_counted(by_datum, begin, out);
+}
+
+void assemble_counted(const std::vector<Edge>& by_datum, std::vector<std::uint32_t>& begin,
+                      std::vector<Edge>& out) {
+  const std::size_t tasks = begin.size() - 1;
+  for (std::size_t t = 0; t < tasks; ++t) begin[t + 1] += begin[t];
+  reserve_huge(out, by_datum.size());
+  out.resize(by_datum.size());
+  // begin[t] is target t's next free slot; after the scatter it is where t + 1 starts.
+  for (const Edge& e : by_datum) out[begin[e.to]++] = e;
+  std::uint32_t from = 0;
+  for (std::size_t t = 0; t < tasks; ++t) {
+    const auto b = out.begin() + from, e = out.begin() + begin[t];
+    if (e - b > 1 && !std::is_sorted(b, e, edge_less)) std::sort(b, e, edge_less);
+    from = begin[t];
+  }
+}
+
+}  // namespace detail
 
 void StepGraph::derive_edges() { derive_edges(std::numeric_limits<std::size_t>::max()); }
 
@@ -161,36 +228,35 @@ bool StepGraph::derive_edges(std::size_t max_edges) {
   return true;
 }
 
+// Datum by datum (each datum's edges depend on its own access sequence only): the accesses
+// grouped by datum, one state machine run per datum over its sequence, then the edges put
+// in target order. Every pass is linear in tasks, data, accesses and edges, and works on
+// contiguous arrays (the state machine's scratch is reused from datum to datum).
 void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
-  Extractor main(*this, edges, max_edges);
-  std::size_t next_loop = 0;
-  const auto n = static_cast<TaskId>(tasks.size());
-  for (TaskId t = 0; t < n;) {
-    if (next_loop < loops.size() && loops[next_loop].first == t) {
-      const Loop& loop = loops[next_loop++];
-      for (TaskId u = loop.first; u < loop.last; ++u) main.process(u);
-      // Second pass over the body from the end-of-body state, on a copy of the states of
-      // the data the body touches (the others cannot produce carried edges). Each datum's
-      // state is copied once: a scalar every object reads would otherwise copy its reader
-      // list once per access, quadratic in the objects.
-      Extractor second(*this, carried_edges, max_edges);
-      std::vector<char> copied(data.size(), 0);
-      for (TaskId u = loop.first; u < loop.last; ++u)
-        for (const Access& a : accesses_of(u))
-          if (!copied[a.datum]) {
-            copied[a.datum] = 1;
-            second.state()[a.datum] = main.state()[a.datum];
-          }
-      second.set_pass(n, loop.first, loop.last);
-      for (TaskId u = loop.first; u < loop.last; ++u) second.process(u);
-      t = loop.last;
-      continue;
-    }
-    main.process(t);
-    ++t;
+  detail::AccessesByDatum by_datum;
+  detail::group_accesses(*this, by_datum);
+  std::vector<Edge> intra, carried;
+  // Most steps have one to two edges per access: reserved (address space only) so that
+  // the list rarely grows by copying.
+  detail::reserve_huge(intra, 2 * accesses.size() + 16);
+  detail::DatumState state, second_state;
+  // Edges per target, counted while each datum's edges are still in cache.
+  std::vector<std::uint32_t> intra_begin(tasks.size() + 1, 0), carried_begin(tasks.size() + 1, 0);
+  const detail::AccessEntry* entries = by_datum.entries.data();
+  for (DatumId d = 0; d < data.size(); ++d) {
+    const std::uint32_t b = by_datum.begin[d], e = by_datum.begin[d + 1];
+    if (b == e) continue;
+    const std::size_t intra_at = intra.size(), carried_at = carried.size();
+    detail::derive_datum(*this, d, entries + b, entries + e, intra, carried, state, second_state,
+                         max_edges);
+    for (std::size_t i = intra_at; i < intra.size(); ++i) ++intra_begin[intra[i].to + 1];
+    for (std::size_t i = carried_at; i < carried.size(); ++i) ++carried_begin[carried[i].to + 1];
   }
-  sort_unique(edges);
-  sort_unique(carried_edges);
+  by_datum = {};  // released before the edges are assembled
+  detail::assemble_counted(intra, intra_begin, edges);
+  intra = {};
+  intra_begin = {};
+  detail::assemble_counted(carried, carried_begin, carried_edges);
 }
 
 }  // namespace tgraph

@@ -17,75 +17,6 @@ std::int64_t now_ns() {
       .count();
 }
 
-// The edges of one datum from its access sequence [first, last) (program order), as
-// StepGraph::derive_edges() finds them: loop bodies get their second pass over the same
-// accesses from the end-of-body state. Appends to `edges` / `carried`, each sorted and
-// without duplicates.
-// `state` and `second_state` are scratch (their buffers are reused from datum to datum).
-template <class Entry>
-void derive_datum(const StepGraph& g, DatumId d, const Entry* first, const Entry* last,
-                  std::vector<Edge>& edges, std::vector<Edge>& carried,
-                  detail::DatumState& state, detail::DatumState& second_state) {
-  const std::size_t edges_at = edges.size(), carried_at = carried.size();
-  const auto n = static_cast<TaskId>(g.tasks.size());
-  auto clear = [](detail::DatumState& s) {
-    s.writers.clear();
-    s.readers.clear();
-    s.group_preds.clear();
-    s.group_kind = EdgeKind::WAW;
-    s.cw_group = false;
-  };
-  clear(state);
-  detail::EdgeSink main;
-  main.out = &edges;
-  for (const Entry* i = first; i < last;) {
-    if (i->loop == kNoLoop) {
-      detail::apply_access(state, i->task, {d, i->mode}, main);
-      ++i;
-      continue;
-    }
-    const Entry* j = i;
-    while (j < last && j->loop == i->loop) ++j;
-    for (const Entry* k = i; k < j; ++k) detail::apply_access(state, k->task, {d, k->mode}, main);
-    second_state.writers.assign(state.writers.begin(), state.writers.end());
-    second_state.readers.assign(state.readers.begin(), state.readers.end());
-    second_state.group_preds.assign(state.group_preds.begin(), state.group_preds.end());
-    second_state.group_kind = state.group_kind;
-    second_state.cw_group = state.cw_group;
-    detail::EdgeSink second;
-    second.out = &carried;
-    second.offset = n;
-    second.body_first = g.loops[i->loop].first;
-    second.body_last = g.loops[i->loop].last;
-    for (const Entry* k = i; k < j; ++k)
-      detail::apply_access(second_state, k->task + n, {d, k->mode}, second);
-    i = j;
-  }
-  auto sort_unique = [](std::vector<Edge>& v, std::size_t from) {
-    const auto b = v.begin() + static_cast<std::ptrdiff_t>(from);
-    std::sort(b, v.end(), detail::edge_less);
-    v.erase(std::unique(b, v.end(),
-                        [](const Edge& x, const Edge& y) { return x.from == y.from && x.to == y.to; }),
-            v.end());
-  };
-  sort_unique(edges, edges_at);
-  sort_unique(carried, carried_at);
-}
-
-// `by_datum` (edges grouped by datum) in StepGraph order: counting sort by target, then
-// each target's few edges by source, datum and kind.
-void assemble(const std::vector<Edge>& by_datum, std::size_t n, std::vector<Edge>& out) {
-  std::vector<std::uint32_t> begin(n + 1, 0);
-  for (const Edge& e : by_datum) ++begin[e.to + 1];
-  for (std::size_t t = 0; t < n; ++t) begin[t + 1] += begin[t];
-  out.resize(by_datum.size());
-  std::vector<std::uint32_t> fill(begin.begin(), begin.end() - 1);
-  for (const Edge& e : by_datum) out[fill[e.to]++] = e;
-  for (std::size_t t = 0; t < n; ++t)
-    if (begin[t + 1] - begin[t] > 1)
-      std::sort(out.begin() + begin[t], out.begin() + begin[t + 1], detail::edge_less);
-}
-
 // Edges grouped by datum (stable), with the group offsets.
 void group_edges(const std::vector<Edge>& edges, std::size_t n_data,
                  std::vector<std::uint32_t>& begin, std::vector<Edge>& out) {
@@ -126,16 +57,6 @@ TaskId EdgeDeriver::KeyTable::find(StableKey k) const {
   }
 }
 
-void EdgeDeriver::group_accesses(const StepGraph& g, ByDatum& out) {
-  out.begin.assign(g.data.size() + 1, 0);
-  for (const Access& a : g.accesses) ++out.begin[a.datum + 1];
-  for (std::size_t d = 0; d < g.data.size(); ++d) out.begin[d + 1] += out.begin[d];
-  out.entries.resize(g.accesses.size());
-  std::vector<std::uint32_t> fill(out.begin.begin(), out.begin.end() - 1);
-  for (TaskId t = 0; t < g.tasks.size(); ++t)
-    for (const Access& a : g.accesses_of(t)) out.entries[fill[a.datum]++] = {t, a.mode, g.tasks[t].loop};
-}
-
 void EdgeDeriver::reset() {
   have_previous_ = false;
   previous_task_ = {};
@@ -160,7 +81,7 @@ void EdgeDeriver::remember(const StepGraph& g, ByDatum&& accesses, bool keyed) {
 
 void EdgeDeriver::seed(const StepGraph& g) {
   ByDatum acc;
-  group_accesses(g, acc);
+  detail::group_accesses(g, acc);
   const bool keyed = current_task_.build(g);
   remember(g, std::move(acc), keyed);
   group_edges(g.edges, g.data.size(), edge_begin_, edges_by_datum_);
@@ -171,7 +92,7 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
   const std::int64_t t0 = now_ns();
   EdgeUpdate u;
   ByDatum cur;
-  group_accesses(g, cur);
+  detail::group_accesses(g, cur);
   const auto n = static_cast<TaskId>(g.tasks.size());
   // New task -> previous task, by stable key; every key must name one task in each step.
   std::vector<TaskId> old_of(n, kNoTask);
@@ -214,9 +135,9 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
         for (std::ptrdiff_t i = 0; same && i < ne - nb; ++i) {
           const Entry& x = nb[i];
           const Entry& y = ob[i];
-          same = old_of[x.task] == y.task && x.mode == y.mode &&
-                 (x.loop == kNoLoop) == (y.loop == kNoLoop) &&
-                 (i == 0 || (x.loop == nb[i - 1].loop) == (y.loop == ob[i - 1].loop));
+          same = old_of[x.task] == y.task && x.mode() == y.mode() &&
+                 (x.loop() == kNoLoop) == (y.loop() == kNoLoop) &&
+                 (i == 0 || (x.loop() == nb[i - 1].loop()) == (y.loop() == ob[i - 1].loop()));
         }
       }
       if (same) {
@@ -233,15 +154,15 @@ EdgeUpdate EdgeDeriver::derive(StepGraph& g) {
         ++u.data_reused;
       } else {
         thread_local detail::DatumState state, second_state;  // buffers kept between data
-        derive_datum(g, d, nb, ne, edges, carried, state, second_state);
+        detail::derive_datum(g, d, nb, ne, edges, carried, state, second_state);
         ++u.data_rederived;
       }
     }
     edge_begin[d + 1] = static_cast<std::uint32_t>(edges.size());
     carried_begin[d + 1] = static_cast<std::uint32_t>(carried.size());
   }
-  assemble(edges, n, g.edges);
-  assemble(carried, n, g.carried_edges);
+  detail::assemble_by_target(edges, n, g.edges);
+  detail::assemble_by_target(carried, n, g.carried_edges);
   u.edges = g.edges.size() + g.carried_edges.size();
   remember(g, std::move(cur), keyed);
   edge_begin_ = std::move(edge_begin);

@@ -47,7 +47,9 @@ std::vector<std::uint64_t> earliest_finish(const StepGraph& g) {
     if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
       const Loop& loop = g.loops[next_loop++];
       std::uint64_t gate = 0;
-      prev.assign(n, 0);
+      // Indexed by task id, read for the body's tasks only: sized once, not cleared per loop
+      // (a loop's carried edges come from its own body, written before they are read).
+      if (prev.size() != n) prev.assign(n, 0);
       for (std::uint32_t it = 0; it < loop.iterations; ++it) {
         if (it > 0) {
           std::copy(finish.begin() + loop.first, finish.begin() + loop.last, prev.begin() + loop.first);
@@ -71,10 +73,13 @@ Metrics compute_metrics(const StepGraph& g) {
   m.data = g.data.size();
   m.loops = g.loops.size();
   for (const Loop& l : g.loops) m.loop_iterations += l.iterations;
+  std::vector<std::uint64_t> per_kind(g.kinds.size(), 0);  // by kind id, named once below
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     m.work_ns += g.tasks[t].cost_ns * g.runs(t);
-    ++m.per_kind[g.kind_name(t)];
+    ++per_kind[g.tasks[t].kind];
   }
+  for (KindId k = 0; k < per_kind.size(); ++k)
+    if (per_kind[k] != 0) m.per_kind[g.kinds[k]] += per_kind[k];
   const auto finish = earliest_finish(g);
   for (auto f : finish) m.span_ns = std::max(m.span_ns, f);
   m.parallelism = m.span_ns == 0 ? 0.0 : static_cast<double>(m.work_ns) / static_cast<double>(m.span_ns);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <string>
+#include <string_view>
 
 #include "common.hpp"
 #include "tgraph/graph/error.hpp"
@@ -133,6 +134,37 @@ ReduceScope Executor::reduce_scope() const {
 
 namespace {
 
+/// The plan cache's key of a step's structure: what same_structure() compares (which
+/// confirms every hit), hashed word by word. StepGraph::structural_hash() hashes byte by
+/// byte for the files that store it (one dependent multiply per byte: tens of microseconds
+/// per step for a bars64-sized step, paid on every run_step); this key is never stored.
+std::uint64_t structure_key(const StepGraph& g) {
+  std::uint64_t h = 0x243f6a8885a308d3ull ^ g.tasks.size();
+  auto mix = [&h](std::uint64_t v) {
+    h = (h ^ v) * 0x9e3779b97f4a7c15ull;
+    h ^= h >> 29;
+  };
+  const std::hash<std::string_view> text;
+  for (const auto& k : g.kinds) mix(text(k));
+  for (const auto& o : g.objects) mix(text(o.name));
+  for (const auto& d : g.data) {
+    mix(text(d.name));
+    mix((static_cast<std::uint64_t>(d.object) << 32) ^ d.bytes);
+  }
+  for (const Task& t : g.tasks) {
+    mix((static_cast<std::uint64_t>(t.kind) << 32) | t.object);
+    mix((static_cast<std::uint64_t>(t.access_count) << 32) | t.loop);
+    mix(t.key);
+  }
+  for (const Access& a : g.accesses)
+    mix((static_cast<std::uint64_t>(a.datum) << 8) | static_cast<std::uint64_t>(a.mode));
+  for (const Loop& l : g.loops) {
+    mix((static_cast<std::uint64_t>(l.condition) << 32) | l.max_iterations);
+    mix((static_cast<std::uint64_t>(l.first) << 32) | l.last);
+  }
+  return h;
+}
+
 std::uint64_t hash_assignment(const Assignment& a) {
   std::uint64_t h = 1469598103934665603ull ^ a.k;
   auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
@@ -180,7 +212,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
   const CwMode mode = cw_mode();
   const ReduceScope scope = reduce_scope();
   const std::vector<bool>* reducible = w.reducible();
-  std::uint64_t key = g.structural_hash() * 31 + static_cast<std::uint64_t>(mode) * 7 +
+  std::uint64_t key = structure_key(g) * 31 + static_cast<std::uint64_t>(mode) * 7 +
                       static_cast<std::uint64_t>(scope);
   if (use_assignment) key ^= hash_assignment(*a) * 0x9e3779b97f4a7c15ull;
   if (reducible != nullptr) key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;

@@ -50,16 +50,21 @@ struct WaitPoint {
 
 enum class OpKind : std::uint8_t { kTask, kLoopBegin, kLoopEnd };
 
-struct Op {
+// One op of a processor's program: 32 bytes, aligned, so that a record never straddles two
+// cache lines and the hot loop indexes ops with a shift. Everything the loop needs for a
+// task is here (its original id too), not in the exec graph's arrays.
+struct alignas(32) Op {
   OpKind kind = OpKind::kTask;
   bool signal = false;    // publish done[task] after running
   bool is_break = false;  // evaluate and publish the loop decision after running
   TaskId task = 0;
   LoopId loop = kNoLoop;
   std::uint32_t wait_begin = 0, wait_end = 0;
-  std::uint32_t jump = 0;  // kLoopEnd: first op of the body
+  std::uint32_t jump = 0;       // kLoopEnd: first op of the body
+  TaskId origin = kNoTask;      // kTask: the original task (ExecGraph::origin)
   friend bool operator==(const Op&, const Op&) = default;
 };
+static_assert(sizeof(Op) == 32);
 
 struct ProcPlan {
   std::vector<Op> ops;
@@ -158,18 +163,18 @@ void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide, 
       const LoopId l = g.tasks[t].loop;
       if (l == kNoLoop) {
         plan.pos[t] = static_cast<std::int64_t>(ops.size());
-        ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0});
+        ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0, x.origin[t]});
         continue;
       }
       if (opened[l]) continue;
       opened[l] = true;
-      ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0});
+      ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0, kNoTask});
       const auto body = static_cast<std::uint32_t>(ops.size());
       for (TaskId u : in_loop[l]) {
         plan.pos[u] = static_cast<std::int64_t>(ops.size());
-        ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0});
+        ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0, x.origin[u]});
       }
-      ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body});
+      ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body, kNoTask});
     }
   }
 }
@@ -793,7 +798,8 @@ class PartitionExecutor final : public Executor {
     for (std::size_t l = 0; l < plan_->loops; ++l) parking_.poke(loop_[l].v);
   }
 
-  // Waits until ok(c); false when the step is aborting.
+  // Waits until ok(c); false when the step is aborting. The check that holds at once is
+  // inlined into the hot loop; blocking is out of line (block()).
   // `kind`/`id`: what is waited for, for the watchdog's report (1: task id's completion,
   // 2: loop id's decision, 3: the first-touch barrier).
   template <class Ok>
@@ -802,28 +808,37 @@ class PartitionExecutor final : public Executor {
     ++tc.waits;
     // acquire: pairs with the signaller's store; its writes are visible to our task.
     value = c.load(std::memory_order_acquire);
-    if (!ok(value)) {
-      Slot& slot = counters_[thread];
-      // relaxed: read by the watchdog for its report only.
-      slot.at_task.store(task, std::memory_order_relaxed);
-      slot.wait_id.store(id, std::memory_order_relaxed);
-      slot.wait_kind.store(kind, std::memory_order_relaxed);
-      bool parked = false;
-      std::int64_t waited = 0;
-      const std::int64_t t0 = observers_.empty() ? 0 : now_ns();
-      value = parking_.wait(c, ok, abort_, parked, waited);
-      // relaxed: as above; progress is only compared between two samples.
-      slot.wait_kind.store(0, std::memory_order_relaxed);
-      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
-                          std::memory_order_relaxed);
-      ++tc.blocked_waits;
-      tc.parks += parked ? 1 : 0;
-      tc.wait_ns += waited;
-      if (!observers_.empty())
-        for (Observer* o : observers_) o->on_wait(thread, task, t0, t0 + waited, parked);
-    }
+    if (!ok(value)) [[unlikely]]
+      value = block(c, ok, thread, task, tc, kind, id);
     // relaxed: a hint; when set, no task runs after this point, so nothing depends on it.
     return !abort_.load(std::memory_order_relaxed);
+  }
+
+  // The blocking part of wait(): spin, then park; returns the value that satisfied ok (or
+  // the last one read when aborting).
+  template <class Ok>
+  [[gnu::noinline]] std::uint64_t block(std::atomic<std::uint64_t>& c, Ok ok,
+                                        std::uint32_t thread, TaskId task, ThreadCounters& tc,
+                                        std::uint32_t kind, std::uint32_t id) {
+    Slot& slot = counters_[thread];
+    // relaxed: read by the watchdog for its report only.
+    slot.at_task.store(task, std::memory_order_relaxed);
+    slot.wait_id.store(id, std::memory_order_relaxed);
+    slot.wait_kind.store(kind, std::memory_order_relaxed);
+    bool parked = false;
+    std::int64_t waited = 0;
+    const std::int64_t t0 = observers_.empty() ? 0 : now_ns();
+    const std::uint64_t value = parking_.wait(c, ok, abort_, parked, waited);
+    // relaxed: as above; progress is only compared between two samples.
+    slot.wait_kind.store(0, std::memory_order_relaxed);
+    slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
+                        std::memory_order_relaxed);
+    ++tc.blocked_waits;
+    tc.parks += parked ? 1 : 0;
+    tc.wait_ns += waited;
+    if (!observers_.empty())
+      for (Observer* o : observers_) o->on_wait(thread, task, t0, t0 + waited, parked);
+    return value;
   }
 
   // ExecOptions::test_lose_signal: the task's completion is never published.
@@ -898,6 +913,8 @@ class PartitionExecutor final : public Executor {
     const std::uint32_t stride = observe_stride_;
     const bool watch = watchdog_ != nullptr;
     Slot& slot = counters_[p];
+    // Kept in registers in the loop (tc escapes into wait()), added to tc at the end.
+    std::uint64_t tasks = 0, signals = 0;
     try {
       if (fresh_) {
         // A failed allocation still arrives at the barrier below (the others would wait
@@ -920,8 +937,11 @@ class PartitionExecutor final : public Executor {
       }
       std::uint32_t iter = 0;
       std::uint64_t v = 0;
-      for (std::size_t pc = 0; pc < pp.ops.size();) {
-        const Op& op = pp.ops[pc];
+      const Op* const ops = pp.ops.data();
+      const WaitPoint* const waits = pp.waits.data();
+      const std::size_t n_ops = pp.ops.size();
+      for (std::size_t pc = 0; pc < n_ops;) {
+        const Op& op = ops[pc];
         switch (op.kind) {
           case OpKind::kLoopBegin:
             iter = 0;
@@ -945,7 +965,7 @@ class PartitionExecutor final : public Executor {
           }
           case OpKind::kTask: {
             for (auto i = op.wait_begin; i < op.wait_end; ++i) {
-              const WaitPoint& wp = pp.waits[i];
+              const WaitPoint& wp = waits[i];
               std::uint64_t target = E + 1;
               switch (wp.kind) {
                 case WaitKind::kOnce:
@@ -979,22 +999,22 @@ class PartitionExecutor final : public Executor {
             if (observe && detail::sampled(iter, stride))
               detail::notify_begin(observers_, p, op.task, iter);
             if (watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // relaxed: report
-            w.run(TaskRun{&x, op.task, x.origin[op.task], iter, p});
+            w.run(TaskRun{&x, op.task, op.origin, iter, p});
             if (observe && detail::sampled(iter, stride))
               detail::notify_end(observers_, p, op.task, iter);
             if (watch)  // relaxed: compared between two samples of the watchdog only
               slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
                                   std::memory_order_relaxed);
-            ++tc.tasks;
+            ++tasks;
             if (op.signal) {
               parking_.signal(done_[op.task].v, E + iter + 1);
-              ++tc.signals;
+              ++signals;
             }
             if (op.is_break) {
               const bool stop = detail::leave_loop(x, op.loop, iter, w);
               parking_.signal(loop_[op.loop].v,
                               E | (static_cast<std::uint64_t>(iter + 1) << 1) | (stop ? 1u : 0u));
-              ++tc.signals;
+              ++signals;
             }
             ++pc;
             break;
@@ -1005,6 +1025,8 @@ class PartitionExecutor final : public Executor {
       fail(std::current_exception());
     }
   out:
+    tc.tasks += tasks;
+    tc.signals += signals;
     counters_[p].c = tc;
   }
 

@@ -10,6 +10,31 @@
 
 namespace tgraph {
 
+namespace detail {
+/// One access seen from its datum: the task, its mode, the task's loop (8 bytes: the loop
+/// id and the mode share a word; a step has far fewer than 2^30 loops).
+struct AccessEntry {
+  TaskId task = 0;
+  std::uint32_t loop_mode = kNoLoopBits << 2;  ///< loop id (kNoLoopBits for none) << 2 | mode
+  static constexpr std::uint32_t kNoLoopBits = (1u << 30) - 1;
+  AccessEntry() = default;
+  AccessEntry(TaskId t, AccessMode m, LoopId l)
+      : task(t),
+        loop_mode(((l == kNoLoop ? kNoLoopBits : l) << 2) | static_cast<std::uint32_t>(m)) {}
+  AccessMode mode() const { return static_cast<AccessMode>(loop_mode & 3u); }
+  LoopId loop() const {
+    const std::uint32_t l = loop_mode >> 2;
+    return l == kNoLoopBits ? kNoLoop : l;
+  }
+};
+/// A step's accesses grouped by datum, each datum's in program order (CSR: the entries of
+/// datum d are [begin[d], begin[d + 1])).
+struct AccessesByDatum {
+  std::vector<std::uint32_t> begin;
+  std::vector<AccessEntry> entries;
+};
+}  // namespace detail
+
 /// What EdgeDeriver::derive did for one step.
 struct EdgeUpdate {
   /// False when the step was derived from scratch (first step, or stable keys that do not
@@ -48,16 +73,8 @@ class EdgeDeriver {
   void reset();
 
  private:
-  struct Entry {
-    TaskId task = 0;
-    AccessMode mode = AccessMode::R;
-    LoopId loop = kNoLoop;
-  };
-  // Accesses grouped by datum, in program order (CSR).
-  struct ByDatum {
-    std::vector<std::uint32_t> begin;
-    std::vector<Entry> entries;
-  };
+  using Entry = detail::AccessEntry;
+  using ByDatum = detail::AccessesByDatum;
   // Task by stable key: open addressing, linear probing (keys are hashes already).
   class KeyTable {
    public:
@@ -71,7 +88,6 @@ class EdgeDeriver {
     std::vector<TaskId> tasks_;  // kNoTask: empty slot
     std::size_t mask_ = 0;
   };
-  static void group_accesses(const StepGraph& g, ByDatum& out);
   void remember(const StepGraph& g, ByDatum&& accesses, bool keyed);
 
   bool have_previous_ = false;
