@@ -464,6 +464,35 @@ class SceneBuilder {
     if (!collide_) b.surface.clear();
   }
 
+  // split=N (or --split): the object's internal force field as up to N fields over
+  // consecutive runs of its elements or springs, each a task of its own (cumulative writes
+  // into the object's force vectors), so one big object no longer serialises its force and
+  // CG products. Run one after the other, the fields add the same terms into every node in
+  // the same order as the whole field (FEM: runs of whole element batches).
+  int split_of(Directive& d) {
+    const int split = d.integer("split", 1, 1, 1024);
+    if (options_.split) {
+      if (*options_.split < 1 || *options_.split > 1024) throw UsageError("--split must be in [1, 1024]");
+      return *options_.split;
+    }
+    return split;
+  }
+
+  // `units` in order, cut into up to `split` consecutive runs; make(name, run) builds a field.
+  template <class Unit, class Make>
+  void add_split_fields(const std::string& name, const std::vector<Unit>& units, int split, Make make) {
+    const std::size_t per = (units.size() + static_cast<std::size_t>(split) - 1) / static_cast<std::size_t>(split);
+    if (split <= 1 || per >= units.size()) {
+      scene_->add_force_field(make(name, units.begin(), units.end()));
+      return;
+    }
+    int block = 0;
+    for (std::size_t start = 0; start < units.size(); start += per, ++block)
+      scene_->add_force_field(make(name + "[" + std::to_string(block) + "]",
+                                   units.begin() + static_cast<std::ptrdiff_t>(start),
+                                   units.begin() + static_cast<std::ptrdiff_t>(std::min(units.size(), start + per))));
+  }
+
   std::vector<Index> fixed_nodes(Directive& d, const StateVec& x, const std::string& spec) {
     std::vector<Index> out;
     if (spec.empty() || spec == "none") return out;
@@ -621,6 +650,7 @@ class SceneBuilder {
       k = d.positive("stiffness");
     }
     const std::string fix = d.text("fix", "none");
+    const int split = split_of(d);
     const HexMesh proto = detail::make_hex_grid(nodes, size, Vec3::Zero(), shape);
     if (proto.elements.empty()) d.fail("the shape contains no element (use more nodes)");
     const std::vector<Spring> springs = fem ? std::vector<Spring>{} : detail::grid_springs(proto, k);
@@ -654,10 +684,20 @@ class SceneBuilder {
       instance_common(d, *pb, proto.spacing.minCoeff(), first);
       first = false;
       add_gravity(*pb);
-      if (fem)
+      if (fem && split > 1) {
+        const HexFemForceField whole(inst + ".fem", pb, proto.elements, mat);
+        add_split_fields(inst + ".fem", whole.element_batches(), split, [&](const std::string& n, auto first, auto last) {
+          std::vector<std::array<Index, 8>> elements;
+          for (auto it = first; it != last; ++it) elements.insert(elements.end(), it->begin(), it->end());
+          return std::make_unique<HexFemForceField>(n, pb, std::move(elements), mat, &whole);
+        });
+      } else if (fem) {
         scene_->add_force_field(std::make_unique<HexFemForceField>(inst + ".fem", pb, proto.elements, mat));
-      else
-        scene_->add_force_field(std::make_unique<SpringForceField>(inst + ".springs", pb, nullptr, springs));
+      } else {
+        add_split_fields(inst + ".springs", springs, split, [&](const std::string& n, auto first, auto last) {
+          return std::make_unique<SpringForceField>(n, pb, nullptr, std::vector<Spring>(first, last));
+        });
+      }
       add_fix(*pb, fixed_nodes(d, x, fix));
     }
   }
@@ -751,6 +791,7 @@ class SceneBuilder {
     if (kb > 0.0)
       for (Index i = 0; i + 2 < n; ++i) springs.push_back({i, i + 2, (proto.col(i + 2) - proto.col(i)).norm(), kb});
     const std::string fix = d.text("fix", "none");
+    const int split = split_of(d);
     bool first = true;
     for (const auto& [inst, c] : instances(d, name, center)) {
       check_new_name(d, inst);
@@ -763,7 +804,9 @@ class SceneBuilder {
       instance_common(d, b, seg, first);
       first = false;
       add_gravity(b);
-      scene_->add_force_field(std::make_unique<SpringForceField>(inst + ".springs", &b, nullptr, springs));
+      add_split_fields(inst + ".springs", springs, split, [&](const std::string& fn, auto first, auto last) {
+        return std::make_unique<SpringForceField>(fn, &b, nullptr, std::vector<Spring>(first, last));
+      });
       add_fix(b, fixed_nodes(d, x, fix));
     }
   }
