@@ -142,6 +142,9 @@ TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {
   o.threads = "1,2,16";
   const ExperimentPlan p = plan_experiment(o, 4);
   EXPECT_EQ(p.scenes[0].scene, "falling64");
+  o.quick = true;  // the small scene, up to its first contacts
+  EXPECT_EQ(plan_experiment(o, 4).scenes[0].scene, "falling");
+  o.quick = false;
   EXPECT_EQ(p.series_methods, (std::vector<std::string>{"sticky", "metis", "metis-relabel"}));
   EXPECT_EQ(p.series_threads, 2u);
   o.threads = "8,16";  // nothing measured: predictions only, no per-step runs
