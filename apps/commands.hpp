@@ -64,6 +64,8 @@ void add_validate(CLI::App& app);         // validate (live vs replay vs simulat
 void add_viz_verbs(CLI::App& app);        // viz, then add_timeline and add_report
 void add_timeline(CLI::App& app);
 void add_report(CLI::App& app);
+void add_simulate(CLI::App& app);         // simulate (builtin or SimGrid)
+void add_platform(CLI::App& app);         // platform (SimGrid platform file)
 
 /// Every verb, in the order `tgraph --help` lists them (main() and the command-line fuzz
 /// target register the same set).
@@ -75,6 +77,8 @@ inline void add_all_verbs(CLI::App& app) {
   add_export(app);
   add_diff(app);
   add_partition_verbs(app);
+  add_simulate(app);
+  add_platform(app);
   add_replay_verbs(app);
   add_validate(app);
   add_viz_verbs(app);

@@ -6,6 +6,10 @@
 //  * StickyReuse/<graph>/k:K: sticky on an unchanged step given its own previous assignment
 //    (the path the paper relies on while the structure repeats).
 //  * Simulate/<graph>/k:K: the simulator on owner's assignment (items: task instances).
+//  * SimulateCluster/stencil:<tasks>/<engine>/nodes:N: `tgraph simulate` on a generated
+//    stencil step (rows of 1,024 tasks, each reading its three neighbours of the previous
+//    row, 10-50 us, 4 KiB per datum), column c on processor c of N x 16 cores (1,024
+//    processors: 64 nodes x 16 cores at N = 64); builtin against SimGrid (when built).
 //
 // Graphs: step 3 of the scenes bars64, cloth128, falling and torso (captured at start-up,
 // edges derived), `synthetic` (a bars-like step: 64 objects with per-object chains in a
@@ -20,6 +24,7 @@
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/stg.hpp"
+#include "tgraph/partition/simulation.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/samples/scene.hpp"
@@ -136,7 +141,62 @@ void BM_Simulate(benchmark::State& state, const std::string& name) {
   state.SetItemsProcessed(static_cast<std::int64_t>(instances) * state.iterations());
 }
 
+// `rows` rows of `width` tasks; task (r, c) writes its datum and reads those of (r - 1,
+// c - 1..c + 1). Costs 10-50 us from a fixed pseudo-random sequence.
+StepGraph stencil(int width, int rows) {
+  StepGraph g;
+  g.kinds = {"op"};
+  std::uint64_t seed = 12345;
+  StableKey key = 1;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < width; ++c) {
+      std::string name = "v";
+      name += std::to_string(r * width + c);
+      g.data.push_back({name, kNoObject, 4096});
+      std::vector<Access> acc{{static_cast<DatumId>(g.data.size() - 1), AccessMode::W}};
+      for (int dc = -1; dc <= 1 && r > 0; ++dc)
+        if (c + dc >= 0 && c + dc < width)
+          acc.push_back({static_cast<DatumId>((r - 1) * width + c + dc), AccessMode::R});
+      seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+      g.add_task(0, kNoObject, acc, 10000 + (seed >> 33) % 40001, key++);
+    }
+  g.derive_edges();
+  return g;
+}
+
+void BM_SimulateCluster(benchmark::State& state, int rows, SimulationEngine engine) {
+  constexpr int kWidth = 1024;
+  constexpr std::uint32_t kCores = 16;
+  Trace trace;
+  trace.steps = {stencil(kWidth, rows)};
+  TraceAssignment a;
+  a.k = kWidth;
+  a.steps.push_back({kWidth, {}, {}});
+  for (std::size_t t = 0; t < trace.steps[0].tasks.size(); ++t)
+    a.steps[0].proc.push_back(static_cast<ProcId>(t % kWidth));
+  SimulatedPlatform p;
+  p.cluster = ClusterShape{static_cast<std::uint32_t>(state.range(0)), kCores};
+  p.model = CostModel::defaults();
+  std::uint64_t makespan = 0;
+  for (auto _ : state) makespan = simulate_trace(trace, a, engine, p).makespan_ns;
+  state.counters["makespan_ms"] = static_cast<double>(makespan) / 1e6;
+  state.SetItemsProcessed(static_cast<std::int64_t>(trace.steps[0].tasks.size()) * state.iterations());
+}
+
 void register_all(bench::Size size) {
+  const int rows = bench::by_size(size, 2, 20, 100);
+  for (SimulationEngine e : {SimulationEngine::builtin, SimulationEngine::simgrid}) {
+    if (e == SimulationEngine::simgrid && !simgrid_available()) continue;
+    auto* b = benchmark::RegisterBenchmark(
+                  ("BM_SimulateCluster/stencil:" + std::to_string(rows * 1024) + "/" + to_string(e))
+                      .c_str(),
+                  BM_SimulateCluster, rows, e)
+                  ->ArgName("nodes")
+                  ->Unit(benchmark::kMillisecond)
+                  ->UseRealTime();  // SimGrid runs in a child process
+    b->Arg(64)->Arg(1024);
+    bench::timed(b, size, 0.05);
+  }
   std::vector<std::string> graphs = {"bars64", "cloth128", "falling", "torso", "synthetic"};
   if (std::getenv("TGRAPH_BENCH_STG") != nullptr) graphs.push_back("stg");
   if (size == bench::Size::kSmoke) graphs = {"synthetic"};

@@ -13,11 +13,11 @@
 
 namespace tgraph::partition {
 
-CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal"}; }
+CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal", 0.0, 0.0}; }
 
 // Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
 // servers (`tgraph calibrate` measures it) and 0.05 ns/byte (20 GB/s cross-core).
-CostModel CostModel::defaults() { return CostModel{100.0, 0.05, "default"}; }
+CostModel CostModel::defaults() { return CostModel{}; }
 
 std::string default_calibration_path() {
   if (const char* xdg = std::getenv("XDG_CONFIG_HOME"); xdg != nullptr && *xdg != '\0')
@@ -86,6 +86,9 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   CostModel m;
   m.sync_latency_ns = number("sync_latency_ns");
   m.per_byte_ns = number("per_byte_ns");
+  // Inter-node fields are optional: files written before they existed keep their meaning.
+  if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
+  if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
   m.source = name;
   return m;
 }

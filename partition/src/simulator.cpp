@@ -7,40 +7,18 @@
 #include <unordered_set>
 
 #include "tgraph/graph/error.hpp"
+#include "schedule_program.hpp"
 
 namespace tgraph::partition {
 
 namespace {
 
-constexpr std::uint64_t kUnknown = std::numeric_limits<std::uint64_t>::max();
+using detail::Dep;
+using detail::Item;
+constexpr std::uint64_t kUnknown = detail::kNoInstance;
 
-struct Dep {
-  TaskId from;
-  DatumId datum;
-  bool raw;
-  bool carried;
-};
-
-// One thing a processor runs: a task outside loops, or its share of one loop's body.
-struct Item {
-  TaskId task = kNoTask;
-  LoopId loop = kNoLoop;
-  std::vector<TaskId> body;
-};
-
-struct SyncKey {
-  std::uint64_t instance;
-  std::uint32_t datum;
-  std::uint32_t proc;
-  friend bool operator==(const SyncKey&, const SyncKey&) = default;
-};
-struct SyncKeyHash {
-  std::size_t operator()(const SyncKey& k) const {
-    std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
-    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    return static_cast<std::size_t>(h);
-  }
-};
+using SyncKey = detail::VersionOnProc;
+using SyncKeyHash = detail::VersionOnProcHash;
 
 void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
@@ -51,42 +29,12 @@ class Simulator {
   Simulator(const StepGraph& g, const Assignment& a, const CostModel& m)
       : g_(g), a_(a), k_(a.k), latency_(static_cast<std::uint64_t>(std::llround(m.sync_latency_ns))),
         per_byte_(m.per_byte_ns) {
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    s_.first_instance.resize(n + 1);
-    std::uint64_t total = 0;
-    for (TaskId t = 0; t < n; ++t) {
-      s_.first_instance[t] = total;
-      total += g.runs(t);
-    }
-    s_.first_instance[n] = total;
+    s_.first_instance = detail::first_instances(g);
+    const std::uint64_t total = s_.first_instance.back();
     s_.start_ns.assign(total, 0);
     s_.end_ns.assign(total, kUnknown);
-    deps_.resize(n);
-    for (const Edge& e : g.edges)
-      if (e.from != e.to) deps_[e.to].push_back({e.from, e.datum, e.kind == EdgeKind::RAW, false});
-    for (const Edge& e : g.carried_edges)
-      deps_[e.to].push_back({e.from, e.datum, e.kind == EdgeKind::RAW, true});
-
-    items_.resize(k_);
-    std::vector<std::vector<std::size_t>> block(k_, std::vector<std::size_t>(g.loops.size(), SIZE_MAX));
-    auto place = [&](ProcId p, TaskId t) {
-      const LoopId l = g.tasks[t].loop;
-      if (l == kNoLoop) {
-        items_[p].push_back({t, kNoLoop, {}});
-        return;
-      }
-      if (block[p][l] == SIZE_MAX) {
-        block[p][l] = items_[p].size();
-        items_[p].push_back({kNoTask, l, {}});
-      }
-      items_[p][block[p][l]].body.push_back(t);
-    };
-    if (a.order.empty()) {
-      for (TaskId t = 0; t < n; ++t) place(a.proc[t], t);
-    } else {
-      for (ProcId p = 0; p < k_; ++p)
-        for (TaskId t : a.order[p]) place(p, t);
-    }
+    deps_ = detail::dependencies(g);
+    items_ = detail::programs(g, a);
     state_.resize(k_);
     // The step's serial host work (StepGraph::host_ns) runs before any of its tasks.
     for (State& st : state_) st.time = g_.host_ns;
@@ -102,12 +50,7 @@ class Simulator {
     }
     for (ProcId p = 0; p < k_; ++p)
       if (state_[p].item < items_[p].size()) {
-        const Item& it = items_[p][state_[p].item];
-        const TaskId t = it.task != kNoTask ? it.task
-                         : state_[p].pos < it.body.size() ? it.body[state_[p].pos]
-                                                          : g_.loops[it.loop].last - 1;
-        throw Error("assignment order deadlocks: processor " + std::to_string(p) +
-                    " waits forever before task " + std::to_string(t));
+        throw Error(detail::deadlock_message(g_, items_[p][state_[p].item], state_[p].pos, p));
       }
     for (ProcId p = 0; p < k_; ++p) {
       s_.finish_ns[p] = state_[p].time;
@@ -126,11 +69,7 @@ class Simulator {
 
   // Instance that dependency `d` of iteration `i` of a task refers to; kUnknown for none.
   std::uint64_t source(const Dep& d, TaskId t, std::uint32_t i) const {
-    const LoopId lu = g_.tasks[d.from].loop;
-    if (d.carried) return i == 0 ? kUnknown : s_.first_instance[d.from] + i - 1;
-    if (lu != kNoLoop && lu == g_.tasks[t].loop) return s_.first_instance[d.from] + i;
-    const std::uint64_t runs = g_.runs(d.from);
-    return runs == 0 ? kUnknown : s_.first_instance[d.from] + runs - 1;
+    return detail::dependency_source(g_, s_.first_instance, d, t, i);
   }
 
   // Records that processor p receives (instance, datum) from another processor; returns

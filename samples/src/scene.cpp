@@ -441,6 +441,9 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
     b.add_mdx = rec.kind("addMDx");
     b.cg_update = rec.kind("cgUpdate");
     b.cg_scalars = rec.kind("cgScalars");
+    b.update_proxy = rec.kind("updateProxy");
+    b.collide_pair = rec.kind("collidePair");
+    b.collide_floor = rec.kind("collideFloor");
     b.body_object.resize(n);
     b.body_vec.assign(n, {});
     for (auto& ids : b.body_vec) ids.fill(kNoDatum);
@@ -452,7 +455,7 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
     host_start = std::chrono::steady_clock::now();
   }
 
-  // Collision detection: sequential, outside the task graph.
+  // Collision detection, host part: the contact sets the last step's tasks found, merged.
   if (collision_.enabled) detail::detect_collisions(*this, m);
 
   // Collision groups: connected components of the interactions.
@@ -498,11 +501,22 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
     g.solver = slot.get();
   }
 
-  // The shape of this step: every interaction field, then each body's group.
+  // The detection tasks this step records for the next one.
+  const bool detect_in_graph = collision_.enabled && collision_.in_graph;
+  if (detect_in_graph) detail::plan_detection(*this, m);
+
+  // The shape of this step: every interaction field, then each body's group, then the
+  // narrow-phase tasks (their slots).
   std::vector<const void*> shape(interactions.begin(), interactions.end());
   shape.push_back(nullptr);
   for (std::size_t i = 0; i < n; ++i)
     shape.push_back(m.groups[static_cast<std::size_t>(m.body_group[i])].solver);
+  if (detect_in_graph) {
+    shape.push_back(nullptr);
+    for (const auto& key : m.collide.planned_pairs) shape.push_back(m.collide.pair_slots.at(key).get());
+    shape.push_back(nullptr);
+    for (int f : m.collide.planned_floors) shape.push_back(m.collide.floor_slots[static_cast<std::size_t>(f)].get());
+  }
   const bool reuse = allow_reuse && b.rec == &rec && shape == m.recorded_shape;
   if (!reuse) m.recorded_shape = std::move(shape);
   stats_ = StepStats{};
@@ -510,6 +524,9 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
   stats_.interactions = static_cast<std::uint32_t>(interactions.size());
   stats_.contact_fields = static_cast<std::uint32_t>(m.contacts.size());
   for (const auto& [key, cf] : m.contacts) stats_.contact_pairs += cf->pairs().size();
+  if (detect_in_graph)
+    stats_.narrow_tasks = static_cast<std::uint32_t>(m.collide.planned_pairs.size() + m.collide.planned_floors.size());
+  stats_.host_narrow = m.collide.host_narrow;
   time_ += solver_.dt;
   ++steps_run_;
   if (reuse) return false;
@@ -531,6 +548,7 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
   contact_set.erase(std::unique(contact_set.begin(), contact_set.end()), contact_set.end());
   if (solver_.integrator == Integrator::kImplicitEuler)
     for (Group& g : m.groups) stepper.declare_solver(*g.solver);
+  if (detect_in_graph) detail::declare_detection(*this, m, rec);
   ObjectId max_object = 0;
   for (const auto& [obj, body] : b.object_body) max_object = std::max(max_object, obj);
   std::vector<std::uint32_t> group_of(static_cast<std::size_t>(max_object) + 1, 0);
@@ -544,6 +562,7 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
       case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;
     }
   }
+  if (detect_in_graph) detail::record_detection(*this, m, rec, [&stepper](int i) { return stepper.vec(i, VecId::kX); });
   if (rec.mode() != capture::Mode::kDeferred) detail::check_divergence(*this, m);
   return true;
 }
@@ -562,6 +581,12 @@ StepStats Scene::last_stats() const {
 std::vector<const ContactForceField*> Scene::contact_fields() const {
   std::vector<const ContactForceField*> out;
   for (const auto& [key, cf] : impl_->contacts) out.push_back(cf.get());
+  return out;
+}
+
+std::vector<const FloorContactForceField*> Scene::floor_fields() const {
+  std::vector<const FloorContactForceField*> out;
+  for (const auto& ff : impl_->floors) out.push_back(ff.get());
   return out;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -16,6 +17,43 @@
 namespace tgraph::samples::detail {
 
 inline constexpr DatumId kNoDatum = std::numeric_limits<DatumId>::max();
+
+/// A body's collision proxy: the world positions of its surface points and their bounds.
+/// Its updateProxy task writes it at the end of a step (from the positions the step left);
+/// the narrow-phase tasks of the same step read it.
+struct CollisionProxy {
+  std::vector<Vec3> points;         // by surface point, storage fixed when the scene finalizes
+  Eigen::AlignedBox3d box;          // bounds of `points` (empty without a surface)
+  double motion = 0.0;              // largest point displacement since the previous update
+  bool filled = false;              // updated at least once (`motion` is meaningful)
+  std::uint64_t epoch = 0;          // CollisionState::epoch it was updated for (0: never)
+};
+
+/// What one narrow-phase task found: a body pair's contact pairs, or a body's points near the
+/// floor. Addresses are stable for the scene's life (kept programs point at them).
+struct ContactSlot {
+  std::vector<ContactPair> pairs;   // body pair: in the sequential detection's order
+  std::vector<Index> floor_points;  // floor: surface points near the plane, in surface order
+  std::uint64_t epoch = 0;          // CollisionState::epoch it was computed for (0: never)
+};
+
+/// Collision detection split between the step graph and the host. The tasks a step records
+/// (proxies, then one narrow phase per planned body pair and per planned floor contact) run at
+/// its end and find the contacts of the next step; the next step's host merge takes their
+/// results, in a fixed order, and runs on the host only the narrow phases no task covered.
+struct CollisionState {
+  /// Epoch the tasks of the last recorded or reused program stamp their results with (0: the
+  /// last program had none). The host sets it before the program runs; tasks read it.
+  std::uint64_t epoch = 0;
+  std::uint64_t next_epoch = 1;
+  std::vector<CollisionProxy> proxies;                                   // by body
+  std::map<std::pair<int, int>, std::unique_ptr<ContactSlot>> pair_slots;  // by body pair
+  std::vector<std::unique_ptr<ContactSlot>> floor_slots;                 // by Impl::floors
+  std::vector<char> may_collide;       // by body: has a surface, not fixed everywhere
+  std::vector<std::pair<int, int>> planned_pairs;  // narrow-phase tasks of this step, in order
+  std::vector<int> planned_floors;                 // floor-phase tasks (Impl::floors indices)
+  std::uint32_t host_narrow = 0;  // narrow phases the last merge ran on the host
+};
 
 /// Scalars and ids of one CG solver instance (one per collision group, or one shared).
 /// Task bodies reference these fields, so an instance lives as long as the scene.
@@ -46,12 +84,16 @@ struct Binding {
   std::uint64_t generation = 0;
   KindId reset_force = 0, add_force = 0, add_dforce = 0, project = 0, update_velocity = 0,
          update_position = 0, compute_rhs = 0, dot = 0, cg_init = 0, cg_start = 0,
-         cg_direction = 0, add_mdx = 0, cg_update = 0, cg_scalars = 0;
+         cg_direction = 0, add_mdx = 0, cg_update = 0, cg_scalars = 0, update_proxy = 0,
+         collide_pair = 0, collide_floor = 0;
   std::vector<ObjectId> body_object;                        // per body index
   std::vector<std::array<DatumId, kVecCount>> body_vec;     // per body index
   std::unordered_map<std::string, ObjectId> field_object;   // interaction fields
   std::unordered_map<std::string, DatumId> field_state;     // fields with cached state
   std::unordered_map<ObjectId, int> object_body;            // object -> a body (for groups)
+  std::vector<DatumId> body_proxy;                          // per body index (kNoDatum: none yet)
+  std::map<std::pair<int, int>, DatumId> pair_contacts;     // per body pair: its contact set
+  std::vector<DatumId> floor_contacts;                      // per Impl::floors index
 };
 
 /// A force field with its recorder ids, resolved once per step.
@@ -97,6 +139,7 @@ struct Scene::Impl {
   std::vector<ForceField*> interactions;  // permanent interaction fields
   std::vector<std::unique_ptr<FloorContactForceField>> floors;
   std::map<std::pair<int, int>, std::unique_ptr<ContactForceField>> contacts;
+  detail::CollisionState collide;
   std::map<std::string, std::unique_ptr<detail::GroupSolver>> solvers;
   std::vector<detail::Group> groups;
   std::vector<int> body_group;
@@ -108,8 +151,21 @@ struct Scene::Impl {
 };
 
 namespace detail {
-/// Collision detection: updates the floor points and creates/removes contact fields.
+/// Host part of collision detection at the start of a step: takes the contact sets the last
+/// step's tasks found (computing on the host what no task covered), then updates the floor
+/// points and creates/removes contact fields in the sequential detection's order.
 void detect_collisions(Scene& scene, Scene::Impl& impl);
+/// Chooses the narrow-phase tasks this step records (CollisionState::planned_*): body pairs and
+/// floor contacts whose bounds, grown by twice the motion of the last step, are within reach.
+void plan_detection(Scene& scene, Scene::Impl& impl);
+/// Declares the interaction objects of the planned body pairs (before the step's contact set
+/// and groups are set, so that every object has a group).
+void declare_detection(Scene& scene, Scene::Impl& impl, capture::Recorder& rec);
+/// Records the detection tasks at the end of the step: updateProxy per body (reads its x),
+/// collidePair per planned pair and collideFloor per planned floor contact (read proxies,
+/// write the contact set). `x_of(body)` is the datum of a body's positions.
+void record_detection(Scene& scene, Scene::Impl& impl, capture::Recorder& rec,
+                      const std::function<DatumId(int)>& x_of);
 /// Divergence checks of the state the last executed step left (samples/src/divergence.cpp):
 /// throws DivergenceError; the first call records the reference energies.
 void check_divergence(const Scene& scene, Scene::Impl& impl);

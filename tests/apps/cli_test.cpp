@@ -192,4 +192,43 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
   EXPECT_NE(html.find("worksteal"), std::string::npos);
 }
 
+TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
+  ASSERT_EQ(run("partition f.tgt -m metis -k 4 -o f.tga").code, 0);
+  const Result b = run("simulate f.tgt f.tga --engine builtin --json");
+  ASSERT_EQ(b.code, 0) << b.err;
+  const auto jb = nlohmann::json::parse(b.out);
+  EXPECT_EQ(jb["engine"], "builtin");
+  EXPECT_EQ(jb["per_step"].size(), 3u);
+  for (const char* bad : {"--cluster 4", "--cluster 0x4", "--cluster 1x3"}) {
+    const Result r = run(std::string("simulate f.tgt f.tga --engine simgrid ") + bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_TRUE(one_line(r.err)) << bad << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << bad;
+  }
+#ifdef TGRAPH_HAVE_SIMGRID
+  const Result s = run("simulate f.tgt f.tga --engine simgrid --cluster 2x2 --json");
+  ASSERT_EQ(s.code, 0) << s.err;
+  EXPECT_TRUE(one_line(s.out)) << s.out;
+  const auto js = nlohmann::json::parse(s.out);
+  EXPECT_EQ(js["engine"], "simgrid");
+  ASSERT_EQ(js["per_step"].size(), 3u);
+  std::uint64_t sum = 0;
+  for (const auto& st : js["per_step"]) sum += st["makespan_ns"].get<std::uint64_t>();
+  EXPECT_EQ(js["makespan_ns"].get<std::uint64_t>(), sum);
+  ASSERT_EQ(run("platform --nodes 2 --cores 2 -o p.xml").code, 0);
+  const Result p = run("simulate f.tgt f.tga --engine simgrid --platform p.xml --json");
+  ASSERT_EQ(p.code, 0) << p.err;
+  EXPECT_EQ(nlohmann::json::parse(p.out)["makespan_ns"], js["makespan_ns"]);
+  std::ofstream(dir_ / "bad.xml") << "<platform version=";
+  for (const char* bad : {"--platform bad.xml", "--platform none.xml"}) {
+    const Result r = run(std::string("simulate f.tgt f.tga --engine simgrid ") + bad + " --json");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_TRUE(one_line(r.err)) << bad << ": " << r.err;
+    EXPECT_NE(r.err.find(".xml"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << bad << ": " << r.out;
+  }
+#endif
+}
+
 }  // namespace

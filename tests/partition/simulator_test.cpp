@@ -14,7 +14,13 @@ namespace {
 using testing::Builder;
 using testing::M;
 
-CostModel model(double latency, double per_byte) { return CostModel{latency, per_byte, "test"}; }
+CostModel model(double latency, double per_byte) {
+  CostModel m;
+  m.sync_latency_ns = latency;
+  m.per_byte_ns = per_byte;
+  m.source = "test";
+  return m;
+}
 
 Assignment assign(std::uint32_t k, std::vector<ProcId> proc) {
   Assignment a;

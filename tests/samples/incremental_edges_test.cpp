@@ -16,6 +16,7 @@ TEST(IncrementalEdges, EqualFromScratchOnEveryStepOfFalling) {
   capture::Recorder rec(capture::Mode::kCapture);
   ASSERT_EQ(s->default_steps(), 300);
   std::vector<Contact> prev;
+  std::vector<ObjectId> prev_narrow;
   int changes = 0, merged_or_split = 0;
   std::size_t prev_loops = 0;
   for (int k = 0; k < s->default_steps(); ++k) {
@@ -28,8 +29,15 @@ TEST(IncrementalEdges, EqualFromScratchOnEveryStepOfFalling) {
     ASSERT_EQ(g.carried_edges, reference.carried_edges) << "step " << k;
     EXPECT_EQ(u.incremental, k > 0) << "step " << k;
     EXPECT_EQ(u.edges, g.edges.size() + g.carried_edges.size());
-    if (k > 0 && g.contacts != prev) {
-      ++changes;
+    // The narrow-phase tasks of collision detection (one per body pair the broad phase keeps)
+    // change the structure too, a step or more before the contacts they find.
+    std::vector<ObjectId> narrow;
+    for (TaskId t = 0; t < g.tasks.size(); ++t)
+      if (g.kind_name(t) == "collidePair" || g.kind_name(t) == "collideFloor") narrow.push_back(g.tasks[t].object);
+    const bool narrow_changed = k > 0 && narrow != prev_narrow;
+    prev_narrow = std::move(narrow);
+    if (k > 0 && (g.contacts != prev || narrow_changed)) {
+      if (g.contacts != prev) ++changes;
       if (g.loops.size() != prev_loops) ++merged_or_split;
       // Only the data of the bodies the change touched are derived again.
       EXPECT_GT(u.data_rederived, 0u) << "step " << k;

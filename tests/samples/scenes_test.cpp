@@ -60,8 +60,9 @@ TEST(Scenes, Bars64HasSixtyFourIdenticalBarsInOneCgLoop) {
 }
 
 TEST(Scenes, FallingRecordsItsCollisionDetectionAsTheStepsHostTime) {
-  // Collision detection runs on the engine's thread before the step's tasks, outside the
-  // graph: each step carries its duration, which replays and the simulator pay.
+  // The host part of collision detection (merging contact sets, collision groups) runs on the
+  // engine's thread before the step's tasks: each step carries its duration, which replays and
+  // the simulator pay.
   auto s = make_scene("falling");
   capture::Recorder rec(capture::Mode::kCapture);
   for (int k = 0; k < 3; ++k) {

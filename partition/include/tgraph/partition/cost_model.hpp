@@ -20,6 +20,13 @@ struct CostModel {
   double per_byte_ns = 0.05;
   /// Where the constants come from ("default", "ideal" or the calibration file's path).
   std::string source = "default";
+  /// One-way MPI message latency between two nodes (ns): the inter-node links of a
+  /// simulated platform (`tgraph platform`, `simulate --engine simgrid`). Calibration files
+  /// without "mpi_latency_ns" get the default, 1500 ns (`tgraph calibrate --mpi`: not yet).
+  double mpi_latency_ns = 1500.0;
+  /// Cost per byte (ns) of an MPI message between two nodes (1 / bandwidth): default 0.08
+  /// (12.5 GB/s, a 100 Gb/s InfiniBand EDR link), from "mpi_per_byte_ns" when present.
+  double mpi_per_byte_ns = 0.08;
 
   /// Zero synchronisation and transfer cost: pure precedence and load.
   static CostModel ideal();

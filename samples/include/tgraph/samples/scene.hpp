@@ -19,12 +19,16 @@
 
 namespace tgraph::samples {
 
-/// Collision detection settings. Detection is sequential and outside the task graph: a
-/// bounding-box broad phase between bodies, then a proximity narrow phase between surface
-/// points (spheres of radius Body::contact_radius) of the two bodies, and between surface
-/// points and the floor plane.
+/// Collision detection settings. Detection is a bounding-box broad phase between bodies, then
+/// a proximity narrow phase between surface points (spheres of radius Body::contact_radius) of
+/// the two bodies, and between surface points and the floor plane. The proxies (surface points
+/// and bounds) and the narrow phases are tasks at the end of each step's graph, whose results
+/// the next step's host work merges in a fixed order (the same contacts as a sequential pass).
 struct CollisionSettings {
   bool enabled = false;
+  /// false: the whole detection runs sequentially on the host at the start of each step (the
+  /// reference the in-graph detection is tested against; same contacts, same physics).
+  bool in_graph = true;
   double alarm_distance = 0.01;  ///< a pair is kept while d < ra + rb + alarm_distance
   double stiffness = 1e4;        ///< penalty stiffness of one contact pair (N/m)
   double damping = 0.0;          ///< normal damping of one contact pair (N s/m)
@@ -55,6 +59,8 @@ struct StepStats {
   std::uint32_t interactions = 0;    ///< interacting body pairs (permanent + contacts)
   std::uint32_t contact_fields = 0;  ///< penalty contact interactions alive
   std::uint64_t contact_pairs = 0;   ///< point pairs in those interactions
+  std::uint32_t narrow_tasks = 0;    ///< narrow-phase tasks recorded (body pairs and floor)
+  std::uint32_t host_narrow = 0;     ///< narrow phases the host ran (no task of the last step had)
   std::uint32_t cg_iterations = 0;   ///< max CG iterations over the groups (implicit)
   double cg_residual = 0.0;          ///< max relative residual |r|/|b| reached
 };
@@ -98,8 +104,9 @@ class Scene {
   int default_steps() const { return default_steps_; }
   void set_default_steps(int steps) { default_steps_ = steps; }
 
-  /// Runs one time step: collision detection (sequential, unrecorded), then
-  /// rec.begin_step(), the contact set, and every solver's tasks. The step is left open.
+  /// Runs one time step: the host part of collision detection (merging the contact sets the
+  /// last step's detection tasks found), then rec.begin_step(), the contact set, every
+  /// solver's tasks, and the detection tasks for the next step. The step is left open.
   void step(capture::Recorder& rec);
   /// For live runs that keep the program of the last step recorded into `rec` (deferred
   /// mode): runs collision detection; when the step's interactions and collision groups
@@ -124,6 +131,8 @@ class Scene {
   const std::vector<std::unique_ptr<FixedConstraint>>& constraints() const { return constraints_; }
   /// Penalty contact interactions alive now.
   std::vector<const ContactForceField*> contact_fields() const;
+  /// Floor contact fields (one per body with a surface when the scene has a floor).
+  std::vector<const FloorContactForceField*> floor_fields() const;
   /// Kinetic energy of all bodies.
   double kinetic_energy() const;
   /// Potential energy of all force fields, contacts included (at the current positions).

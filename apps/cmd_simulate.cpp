@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// `tgraph simulate T.tgt A.tga --engine builtin|simgrid (--platform P.xml | --cluster NxC)`:
+// the predicted makespan of every step, from the built-in simulator or SimGrid.
+#include <iostream>
+
+#include "commands.hpp"
+#include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/partition/simulation.hpp"
+
+namespace tgraph::app {
+
+namespace tp = tgraph::partition;
+
+void add_simulate(CLI::App& app) {
+  struct Flags {
+    std::string engine = "builtin", platform, cluster, model = "calibrated", calibration;
+    std::string intra_node = "reader";
+  };
+  auto a = std::make_shared<Args>();
+  auto f = std::make_shared<Flags>();
+  auto* cmd = app.add_subcommand(
+      "simulate", "Predict each step's makespan of an assignment: built-in simulator or SimGrid");
+  cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
+  cmd->add_option("assignment", a->assignment, "Assignment file (.tga)")->required();
+  cmd->add_option("--engine", f->engine, "builtin (default; one machine) or simgrid")
+      ->check(CLI::IsMember({"builtin", "simgrid"}));
+  auto* platform =
+      cmd->add_option("--platform", f->platform, "SimGrid platform file (tgraph platform -o)");
+  cmd->add_option("--cluster", f->cluster,
+                  "N nodes x C cores (e.g. 64x16): processor p on core p % C of node p / C")
+      ->excludes(platform);
+  cmd->add_option("--intra-node", f->intra_node,
+                  "simgrid, bytes between two cores of a node: reader (default; the reading core "
+                  "spends size / loopback bandwidth) or link (the loopback link carries them)")
+      ->check(CLI::IsMember({"reader", "link"}));
+  cmd->add_option("--model", f->model, "Cost model: calibrated (default) or ideal (free syncs)")
+      ->check(CLI::IsMember({"ideal", "calibrated"}));
+  cmd->add_option("--calibration", f->calibration,
+                  "Calibration file (default: " + tp::default_calibration_path() + " if present)");
+  cmd->add_flag("--json", a->json, "Print one JSON object");
+  cmd->callback([a, f] {
+    tp::SimulatedPlatform p;
+    p.model = tp::select_cost_model(f->model, f->calibration);
+    if (!f->cluster.empty()) p.cluster = tp::parse_cluster(f->cluster, "--cluster");
+    p.file = f->platform;
+    p.intra_node =
+        f->intra_node == "link" ? tp::IntraNodeTransfer::link : tp::IntraNodeTransfer::reader;
+    const tp::SimulationEngine engine =
+        f->engine == "simgrid" ? tp::SimulationEngine::simgrid : tp::SimulationEngine::builtin;
+    if (engine == tp::SimulationEngine::builtin && !p.file.empty())
+      throw UsageError("--platform: the builtin engine has no platform model (use --engine simgrid)");
+    const Trace trace = read_trace(a->input);
+    const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
+    const tp::Prediction r = tp::simulate_trace(trace, as, engine, p);
+    std::cout << (a->json ? tp::prediction_json(r) + "\n" : tp::prediction_text(r));
+  });
+}
+
+void add_platform(CLI::App& app) {
+  struct Flags {
+    std::uint64_t nodes = 1, cores = 1;
+    std::string calibration;
+  };
+  auto a = std::make_shared<Args>();
+  auto f = std::make_shared<Flags>();
+  auto* cmd = app.add_subcommand(
+      "platform", "Write a SimGrid platform file: a cluster whose links follow the calibration");
+  cmd->add_option("--nodes", f->nodes, "Nodes of the cluster")->required();
+  cmd->add_option("--cores", f->cores, "Cores per node")->required();
+  cmd->add_option("--calibration", f->calibration,
+                  "Calibration file (default: " + tp::default_calibration_path() + " if present)");
+  cmd->add_option("-o,--output", a->output, "Platform file to write (.xml)")->required();
+  cmd->callback([a, f] {
+    const tp::ClusterShape c = tp::cluster_shape(f->nodes, f->cores);
+    const tp::CostModel m = tp::select_cost_model("calibrated", f->calibration);
+    write_file_atomic(a->output, tp::platform_xml(c, m));
+    std::cout << "wrote " << a->output << ": " << c.nodes << " nodes x " << c.cores
+              << " cores, costs from " << m.source << "\n";
+  });
+}
+
+}  // namespace tgraph::app

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// Simulated clusters: the `--cluster NxC` shape and the SimGrid platform file of
+// `tgraph platform` (a cluster zone whose links follow the cost model).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::partition {
+
+/// N identical nodes of C cores each. Processor p of an assignment runs on core p % C of
+/// node p / C.
+///
+///   ClusterShape c = parse_cluster("64x16", "--cluster");   // c.nodes 64, c.cores 16
+struct ClusterShape {
+  std::uint32_t nodes = 1;
+  std::uint32_t cores = 1;
+  /// Processors the cluster holds (nodes x cores).
+  std::uint64_t processors() const { return std::uint64_t{nodes} * cores; }
+};
+
+/// Largest node count and core count accepted (a platform of 2^20 hosts is far beyond
+/// what SimGrid simulates in minutes).
+inline constexpr std::uint32_t kMaxNodes = 1u << 20;
+inline constexpr std::uint32_t kMaxCores = 4096;
+
+/// Parses "NxC" (1 <= N <= kMaxNodes, 1 <= C <= kMaxCores); throws UsageError naming `flag`.
+ClusterShape parse_cluster(std::string_view text, std::string_view flag);
+/// Checks a shape given as two numbers (`tgraph platform --nodes N --cores C`); throws
+/// UsageError naming the flag out of range.
+ClusterShape cluster_shape(std::uint64_t nodes, std::uint64_t cores);
+
+/// The SimGrid platform (XML, DTD 4.1) of cluster `c` whose costs follow `m`:
+/// * hosts `node-0` ... `node-(N-1)`, C cores each at 1 Gflop/s (one flop = one ns of a
+///   task's measured cost);
+/// * inside a node, a loopback link of latency `m.sync_latency_ns` and bandwidth
+///   1 / `m.per_byte_ns` (shared by nobody: SimGrid's cluster loopback is a fat pipe);
+/// * between nodes, each node's private link (split duplex) of latency
+///   `m.mpi_latency_ns / 2` and bandwidth 1 / `m.mpi_per_byte_ns`, no backbone: a message
+///   crosses two links, latency `m.mpi_latency_ns`, and shares its nodes' links only;
+/// * the network model that makes a transfer cost exactly latency + size / bandwidth
+///   (CM02, no cross traffic, no TCP window bound).
+/// A per-byte cost of 0 becomes a bandwidth of 1e18 B/s (SimGrid needs a finite one).
+std::string platform_xml(const ClusterShape& c, const CostModel& m);
+
+/// The SimGrid configuration the engine and platform_xml() set, as "key:value" items.
+inline constexpr std::string_view kSimgridNetworkConfig[] = {
+    "network/model:CM02", "network/crosstraffic:0", "network/TCP-gamma:0"};
+
+}  // namespace tgraph::partition

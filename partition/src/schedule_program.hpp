@@ -1,0 +1,76 @@
+// SPDX-License-Identifier: MIT
+// What both schedule simulators (built-in and SimGrid) run: each processor's program of
+// tasks and loop blocks, each task's dependencies, and which instance a dependency names.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+
+namespace tgraph::partition::detail {
+
+/// An instance index that names no instance (the dependency has no source this iteration).
+inline constexpr std::uint64_t kNoInstance = std::numeric_limits<std::uint64_t>::max();
+
+/// One dependency of a task: intra-step edge or loop-carried edge (from iteration i - 1).
+struct Dep {
+  TaskId from;
+  DatumId datum;
+  bool raw;
+  bool carried;
+};
+
+/// One thing a processor runs: a task outside loops, or its share of one loop's body
+/// (paper section 3.3: the body is partitioned once, loop control replicated).
+struct Item {
+  TaskId task = kNoTask;
+  LoopId loop = kNoLoop;
+  std::vector<TaskId> body;
+};
+
+/// A datum version (the instance that wrote it) known on a processor: what both simulators
+/// count once (a wait, a transfer's bytes).
+struct VersionOnProc {
+  std::uint64_t instance;
+  std::uint32_t datum;
+  std::uint32_t proc;
+  friend bool operator==(const VersionOnProc&, const VersionOnProc&) = default;
+};
+struct VersionOnProcHash {
+  std::size_t operator()(const VersionOnProc& k) const {
+    std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
+    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+/// Per task, the first of its instances (iteration i of task t is `first[t] + i`), plus the
+/// total number of instances at the end.
+std::vector<std::uint64_t> first_instances(const StepGraph& g);
+/// Per task, its dependencies (self edges dropped, loop-carried edges marked).
+std::vector<std::vector<Dep>> dependencies(const StepGraph& g);
+/// Per processor, its items in `a.order[p]` or program order; a processor's loop tasks form
+/// one block placed where its first loop task appears.
+std::vector<std::vector<Item>> programs(const StepGraph& g, const Assignment& a);
+
+/// The error text of a processor stuck at position `pos` of item `it` (the task it waits to
+/// run, or the loop's break task at the end of an iteration).
+std::string deadlock_message(const StepGraph& g, const Item& it, std::size_t pos, ProcId p);
+
+/// The instance that dependency `d` of iteration `i` of task `t` refers to (kNoInstance for
+/// none): iteration i - 1 for a loop-carried edge, iteration i within one loop body, else the
+/// source's last run.
+inline std::uint64_t dependency_source(const StepGraph& g, const std::vector<std::uint64_t>& first,
+                                       const Dep& d, TaskId t, std::uint32_t i) {
+  const LoopId lu = g.tasks[d.from].loop;
+  if (d.carried) return i == 0 ? kNoInstance : first[d.from] + i - 1;
+  if (lu != kNoLoop && lu == g.tasks[t].loop) return first[d.from] + i;
+  const std::uint64_t runs = g.runs(d.from);
+  return runs == 0 ? kNoInstance : first[d.from] + runs - 1;
+}
+
+}  // namespace tgraph::partition::detail

@@ -1,0 +1,639 @@
+// SPDX-License-Identifier: MIT
+// The SimGrid engine of `tgraph simulate`: every step of a trace as SimGrid s4u activities
+// (one Exec per task instance on its processor's host, one Comm per datum version and
+// receiving processor on the platform's links), created when they become ready.
+//
+// Why a child process: SimGrid 3.32 allows one engine per process (a second one keeps the
+// first one's clock and models) and ends the process on some malformed platform files; the
+// child runs the simulation with its output sent to a temporary file, and hands the
+// per-step results back through a pipe.
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <deque>
+#include <simgrid/s4u.hpp>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "schedule_program.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/partition/simulation.hpp"
+
+namespace tgraph::partition::detail {
+
+namespace {
+
+namespace sg = simgrid::s4u;
+
+/// When a finished instance (task t, iteration i) sends to a processor: every iteration
+/// (same loop body), all but the last (loop-carried edge to iteration i + 1), or only the
+/// last run (a reader after the loop, or outside any loop).
+enum class When : std::uint8_t { every, not_last, last };
+
+/// One outgoing dependency of a task towards another processor.
+struct Out {
+  ProcId to;
+  DatumId datum;
+  bool raw;
+  When when;
+};
+
+enum class Kind : std::uint8_t { host, exec, comm };
+
+/// An activity in flight and what its completion means.
+struct InFlight {
+  sg::ActivityPtr activity;
+  Kind kind;
+  TaskId task;
+  std::uint32_t iteration;
+  ProcId proc;  ///< exec: where it runs
+  std::vector<ProcId> receivers;  ///< comm: the processors that know the instance on arrival
+};
+
+/// Runs the steps of a trace one after the other on the given hosts (host of processor p);
+/// `read_ns_per_byte[p]`: what reading a byte written by another core of its node costs
+/// processor p (its host's loopback link) when the reader pays for transfers in a node.
+class Driver {
+ public:
+  Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts,
+         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node)
+      : trace_(trace), a_(a), hosts_(std::move(hosts)), read_ns_per_byte_(std::move(read_ns_per_byte)),
+        reader_pays_(intra_node == IntraNodeTransfer::reader),
+        steps_(std::min(trace.steps.size(), a.steps.size())) {}
+
+  /// Starts step 0; the engine's run() does the rest through on_completion().
+  void start() {
+    begin_step(0);
+    while (step_ < steps_ && finished_ == k_ && outstanding_ == 0) end_step();
+  }
+
+  void on_completion(const sg::Activity& activity) {
+    const auto found = live_.find(&activity);
+    if (found == live_.end()) return;
+    InFlight f = std::move(found->second);
+    // The engine still uses the activity after this callback: keep it alive until the
+    // clock moves on (on_time_advance()).
+    graveyard_.push_back(f.activity);
+    live_.erase(found);
+    --outstanding_;
+    switch (f.kind) {
+      case Kind::host:
+        for (ProcId p = 0; p < k_; ++p) wake_proc(p);
+        break;
+      case Kind::exec:
+        state_[f.proc].running = false;
+        step_forward(f.proc);
+        finish_instance(f.task, f.iteration, f.proc);
+        wake_proc(f.proc);
+        break;
+      case Kind::comm:
+        for (ProcId q : f.receivers) {
+          const std::uint64_t key = (first_[f.task] + f.iteration) * k_ + q;
+          arrived_.insert(key);
+          wake(key);
+        }
+        break;
+    }
+    drain();
+    while (step_ < steps_ && finished_ == k_ && outstanding_ == 0) end_step();
+  }
+
+  void on_time_advance() { graveyard_.clear(); }
+
+  bool done() const { return step_ >= steps_; }
+  const std::vector<StepPrediction>& results() const { return results_; }
+
+  /// Why the simulation stopped before the end (a processor that waits forever).
+  std::string stuck() const {
+    for (ProcId p = 0; p < k_; ++p)
+      if (!state_[p].finished)
+        return "step " + std::to_string(step_) + ": " +
+               deadlock_message(*g_, items_[p][state_[p].item], state_[p].pos, p);
+    return "step " + std::to_string(step_) + ": the simulation stopped early";
+  }
+
+ private:
+  struct State {
+    std::size_t item = 0;
+    std::uint32_t iter = 0;
+    std::size_t pos = 0;
+    bool running = false;
+    bool finished = false;
+    bool queued = false;
+  };
+
+  void begin_step(std::size_t s) {
+    step_ = s;
+    if (s >= steps_) return;
+    g_ = &trace_.steps[s];
+    pa_ = &a_.steps[s];
+    k_ = pa_->k;
+    first_ = first_instances(*g_);
+    deps_ = dependencies(*g_);
+    items_ = programs(*g_, *pa_);
+    build_outs();
+    done_.assign(first_.back(), 0);
+    arrived_.clear();
+    received_.clear();
+    waiters_.clear();
+    state_.assign(k_, State{});
+    finished_ = 0;
+    current_ = {};
+    start_ = sg::Engine::get_clock();
+    // The step's serial host work (StepGraph::host_ns) runs on processor 0's core before
+    // any task, as in the built-in simulator.
+    if (g_->host_ns > 0) {
+      sg::ExecPtr x = sg::Exec::init();
+      x->set_flops_amount(static_cast<double>(g_->host_ns));
+      x->set_host(hosts_[0]);
+      track(x, Kind::host, kNoTask, 0, 0);
+      x->start();
+    } else {
+      for (ProcId p = 0; p < k_; ++p) wake_proc(p);
+      drain();
+    }
+  }
+
+  void end_step() {
+    current_.makespan_ns =
+        static_cast<std::uint64_t>(std::llround((sg::Engine::get_clock() - start_) * 1e9));
+    results_.push_back(current_);
+    begin_step(step_ + 1);
+  }
+
+  // Per task, its dependencies towards other processors (and, for a loop's break task, the
+  // decision every other processor running part of the body waits for), by receiver.
+  void build_outs() {
+    const auto n = static_cast<TaskId>(g_->tasks.size());
+    outs_.assign(n, {});
+    for (TaskId u = 0; u < n; ++u) {
+      const ProcId pu = pa_->proc[u];
+      const LoopId lu = g_->tasks[u].loop;
+      for (const Dep& d : deps_[u]) {
+        if (pa_->proc[d.from] == pu) continue;
+        const LoopId lf = g_->tasks[d.from].loop;
+        const When when = d.carried                       ? When::not_last
+                          : lf != kNoLoop && lf == lu     ? When::every
+                                                          : When::last;
+        if (g_->runs(u) == 0) continue;  // a reader that never runs waits for nothing
+        outs_[d.from].push_back({pu, d.datum, d.raw, when});
+      }
+    }
+    for (LoopId l = 0; l < g_->loops.size(); ++l) {
+      const Loop& loop = g_->loops[l];
+      if (loop.iterations == 0) continue;
+      const TaskId brk = loop.last - 1;
+      for (ProcId p = 0; p < k_; ++p) {
+        if (p == pa_->proc[brk]) continue;
+        const bool holds = std::any_of(items_[p].begin(), items_[p].end(),
+                                       [&](const Item& it) { return it.loop == l; });
+        if (holds) outs_[brk].push_back({p, loop.condition, false, When::every});
+      }
+    }
+    for (auto& o : outs_)
+      std::stable_sort(o.begin(), o.end(), [](const Out& x, const Out& y) { return x.to < y.to; });
+  }
+
+  void track(const sg::ActivityPtr& act, Kind kind, TaskId t, std::uint32_t i, ProcId p) {
+    live_.emplace(act.get(), InFlight{act, kind, t, i, p, {}});
+    ++outstanding_;
+  }
+
+  void wake_proc(ProcId p) {
+    if (state_[p].queued) return;
+    state_[p].queued = true;
+    ready_.push_back(p);
+  }
+
+  void wake(std::uint64_t key) {
+    const auto w = waiters_.find(key);
+    if (w == waiters_.end()) return;
+    for (ProcId p : w->second) wake_proc(p);
+    waiters_.erase(w);
+  }
+
+  void drain() {
+    while (!ready_.empty()) {
+      const ProcId p = ready_.front();
+      ready_.pop_front();
+      state_[p].queued = false;
+      advance(p);
+    }
+  }
+
+  // Whether instance `inst` (run on processor `owner`) is known on processor p: finished
+  // when local, its transfer arrived when not. Registers p as a waiter when not.
+  bool known(std::uint64_t inst, ProcId owner, ProcId p) {
+    const std::uint64_t key = inst * k_ + p;
+    if (owner == p ? done_[inst] != 0 : arrived_.count(key) != 0) return true;
+    waiters_[key].push_back(p);
+    return false;
+  }
+
+  bool ready(ProcId p, TaskId t, std::uint32_t i) {
+    for (const Dep& d : deps_[t]) {
+      const std::uint64_t src = dependency_source(*g_, first_, d, t, i);
+      if (src != kNoInstance && !known(src, pa_->proc[d.from], p)) return false;
+    }
+    return true;
+  }
+
+  // Inside a node, when the reader pays: the bytes of the datum versions task t (iteration
+  // i) is the first on p to receive, at p's loopback cost per byte (the built-in
+  // simulator's rule: once per version and processor, reads only).
+  std::uint64_t read_cost(ProcId p, TaskId t, std::uint32_t i) {
+    if (!reader_pays_) return 0;
+    std::uint64_t bytes = 0;
+    for (const Dep& d : deps_[t]) {
+      const ProcId from = pa_->proc[d.from];
+      if (from == p || hosts_[from] != hosts_[p]) continue;
+      const std::uint64_t src = dependency_source(*g_, first_, d, t, i);
+      if (src == kNoInstance) continue;
+      if (received_.insert({src, d.datum, p}).second && d.raw) bytes += g_->data[d.datum].bytes;
+    }
+    current_.bytes += bytes;
+    return static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * read_ns_per_byte_[p]));
+  }
+
+  void step_forward(ProcId p) {
+    State& st = state_[p];
+    if (items_[p][st.item].task != kNoTask)
+      ++st.item;
+    else
+      ++st.pos;
+  }
+
+  // Runs processor p as far as it can without waiting for the simulated time to move.
+  void advance(ProcId p) {
+    State& st = state_[p];
+    if (st.running || st.finished) return;
+    while (st.item < items_[p].size()) {
+      const Item& it = items_[p][st.item];
+      const bool loop_task =
+          it.task == kNoTask && g_->loops[it.loop].iterations > 0 && st.pos < it.body.size();
+      if (it.task != kNoTask || loop_task) {
+        const TaskId t = it.task != kNoTask ? it.task : it.body[st.pos];
+        const std::uint32_t i = it.task != kNoTask ? 0 : st.iter;
+        if (!ready(p, t, i)) return;
+        const std::uint64_t cost = g_->tasks[t].cost_ns + read_cost(p, t, i);
+        if (cost == 0) {  // nothing to simulate: it finishes when it starts
+          step_forward(p);
+          finish_instance(t, i, p);
+          continue;
+        }
+        sg::ExecPtr x = sg::Exec::init();
+        x->set_flops_amount(static_cast<double>(cost));
+        x->set_host(hosts_[p]);
+        track(x, Kind::exec, t, i, p);
+        st.running = true;
+        x->start();
+        return;
+      }
+      const Loop& loop = g_->loops[it.loop];
+      if (loop.iterations == 0) {
+        ++st.item;
+        continue;
+      }
+      // End of an iteration: loop control needs the break task's decision (section 3.3).
+      const TaskId brk = loop.last - 1;
+      if (!known(first_[brk] + st.iter, pa_->proc[brk], p)) return;
+      st.pos = 0;
+      if (++st.iter == loop.iterations) {
+        st.iter = 0;
+        ++st.item;
+      }
+    }
+    st.finished = true;
+    ++finished_;
+  }
+
+  // Instance (t, i) finished on processor `owner`: its local readers may go on, and its
+  // data (and loop decision) leave for every other processor that reads them.
+  void finish_instance(TaskId t, std::uint32_t i, ProcId owner) {
+    const std::uint64_t inst = first_[t] + i;
+    done_[inst] = 1;
+    wake(inst * k_ + owner);
+    const std::uint64_t runs = g_->runs(t);
+    const std::vector<Out>& outs = outs_[t];
+    // Receivers in the owner's node get one transfer each; another node gets one message
+    // for all its receivers (outs are sorted by processor, a node's processors contiguous).
+    auto same_group = [&](const Out& x, const Out& y) {
+      return hosts_[x.to] == hosts_[owner] ? x.to == y.to : hosts_[x.to] == hosts_[y.to];
+    };
+    for (std::size_t b = 0; b < outs.size();) {
+      std::size_t e = b;
+      std::uint64_t bytes = 0;
+      sent_.clear();
+      receivers_.clear();
+      for (; e < outs.size() && same_group(outs[e], outs[b]); ++e) {
+        const Out& o = outs[e];
+        const bool applies = o.when == When::every ||
+                             (o.when == When::not_last ? i + 1 < runs : i + 1 == runs);
+        if (!applies) continue;
+        if (receivers_.empty() || receivers_.back() != o.to) receivers_.push_back(o.to);
+        // Each datum version is sent once per receiving processor or node (reads only).
+        if (o.raw && std::find(sent_.begin(), sent_.end(), o.datum) == sent_.end()) {
+          sent_.push_back(o.datum);
+          bytes += g_->data[o.datum].bytes;
+        }
+      }
+      // The reader pays for the bytes inside a node (read_cost): the link carries the signal.
+      if (!receivers_.empty())
+        send(t, i, owner, reader_pays_ && hosts_[owner] == hosts_[outs[b].to] ? 0 : bytes);
+      b = e;
+    }
+  }
+
+  // One transfer of instance (t, i) from processor `from` to receivers_ (one node).
+  void send(TaskId t, std::uint32_t i, ProcId from, std::uint64_t bytes) {
+    const ProcId to = receivers_.front();
+    sg::CommPtr c = sg::Comm::sendto_init(hosts_[from], hosts_[to]);
+    c->set_payload_size(bytes);
+    live_.emplace(c.get(), InFlight{c, Kind::comm, t, i, to, receivers_});
+    ++outstanding_;
+    ++current_.messages;
+    current_.bytes += bytes;
+    if (hosts_[from] != hosts_[to]) {
+      ++current_.inter_node_messages;
+      current_.inter_node_bytes += bytes;
+    }
+    c->start();
+  }
+
+  const Trace& trace_;
+  const TraceAssignment& a_;
+  const std::vector<sg::Host*> hosts_;
+  const std::vector<double> read_ns_per_byte_;
+  const bool reader_pays_;
+  const std::size_t steps_;
+  std::size_t step_ = 0;
+  const StepGraph* g_ = nullptr;
+  const Assignment* pa_ = nullptr;
+  std::uint64_t k_ = 1;
+  std::vector<std::uint64_t> first_;
+  std::vector<std::vector<Dep>> deps_;
+  std::vector<std::vector<Item>> items_;
+  std::vector<std::vector<Out>> outs_;
+  std::vector<std::uint8_t> done_;
+  std::unordered_set<std::uint64_t> arrived_;
+  std::unordered_set<VersionOnProc, VersionOnProcHash> received_;  // the reader paid
+  std::unordered_map<std::uint64_t, std::vector<ProcId>> waiters_;
+  std::vector<State> state_;
+  std::deque<ProcId> ready_;
+  std::vector<DatumId> sent_;
+  std::vector<ProcId> receivers_;
+  std::uint32_t finished_ = 0;
+  std::uint64_t outstanding_ = 0;
+  double start_ = 0;
+  StepPrediction current_;
+  std::vector<StepPrediction> results_;
+  std::unordered_map<const sg::Activity*, InFlight> live_;
+  std::vector<sg::ActivityPtr> graveyard_;
+};
+
+// Host names compared as text with digit runs compared as numbers (node-2 < node-10).
+bool natural_less(const std::string& a, const std::string& b) {
+  std::size_t i = 0, j = 0;
+  while (i < a.size() && j < b.size()) {
+    const bool da = std::isdigit(static_cast<unsigned char>(a[i])) != 0;
+    const bool db = std::isdigit(static_cast<unsigned char>(b[j])) != 0;
+    if (da && db) {
+      std::size_t ie = i, je = j;
+      while (ie < a.size() && std::isdigit(static_cast<unsigned char>(a[ie]))) ++ie;
+      while (je < b.size() && std::isdigit(static_cast<unsigned char>(b[je]))) ++je;
+      const std::string na = a.substr(i, ie - i), nb = b.substr(j, je - j);
+      const auto za = na.find_first_not_of('0'), zb = nb.find_first_not_of('0');
+      const std::string ta = za == std::string::npos ? "" : na.substr(za);
+      const std::string tb = zb == std::string::npos ? "" : nb.substr(zb);
+      if (ta.size() != tb.size()) return ta.size() < tb.size();
+      if (ta != tb) return ta < tb;
+      i = ie;
+      j = je;
+    } else {
+      if (a[i] != b[j]) return a[i] < b[j];
+      ++i;
+      ++j;
+    }
+  }
+  return a.size() - i < b.size() - j;
+}
+
+// What the child hands back: a tag byte, then the payload.
+constexpr char kLoaded = 'L', kResult = 'R', kInputError = 'I', kFailure = 'F';
+
+void write_all(int fd, const void* data, std::size_t n) {
+  const char* p = static_cast<const char*>(data);
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w <= 0) return;
+    p += w;
+    n -= static_cast<std::size_t>(w);
+  }
+}
+
+void send_message(int fd, char tag, const std::string& text) {
+  write_all(fd, &tag, 1);
+  write_all(fd, text.data(), text.size());
+}
+
+// The child: loads the platform, maps processors to hosts, simulates, writes the results.
+[[noreturn]] void child(int fd, const Trace& trace, const TraceAssignment& a,
+                        const SimulatedPlatform& platform) {
+  int code = 0;
+  try {
+    std::string file = platform.file;
+    std::string temp;
+    if (file.empty()) {
+      char name[] = "/tmp/tgraph-platform-XXXXXX";
+      const int tfd = ::mkstemp(name);
+      if (tfd < 0) throw std::runtime_error("cannot create a temporary platform file");
+      ::close(tfd);
+      temp = name;
+      write_file_atomic(temp, platform_xml(*platform.cluster, platform.model));
+      file = temp;
+    }
+    std::vector<std::string> args = {"tgraph-simulate", "--log=root.thresh:critical"};
+    std::vector<char*> argv;
+    for (std::string& s : args) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    int argc = static_cast<int>(args.size());
+    sg::Engine engine(&argc, argv.data());
+    for (std::string_view item : kSimgridNetworkConfig) sg::Engine::set_config(std::string(item));
+    try {
+      engine.load_platform(file);
+    } catch (const std::exception& e) {
+      if (!temp.empty()) ::unlink(temp.c_str());
+      send_message(fd, kInputError, "SimGrid cannot load this platform (" + std::string(e.what()) + ")");
+      ::_exit(0);
+    }
+    if (!temp.empty()) ::unlink(temp.c_str());
+    write_all(fd, &kLoaded, 1);
+
+    std::vector<sg::Host*> all = engine.get_all_hosts();
+    std::sort(all.begin(), all.end(), [](const sg::Host* x, const sg::Host* y) {
+      return natural_less(x->get_name(), y->get_name());
+    });
+    std::vector<sg::Host*> proc_hosts;
+    std::uint64_t cores = 0;
+    for (sg::Host* h : all) {
+      const int c = h->get_core_count();
+      cores += static_cast<std::uint64_t>(std::max(c, 0));
+      for (int i = 0; i < c && proc_hosts.size() < a.k; ++i) proc_hosts.push_back(h);
+    }
+    if (proc_hosts.size() < a.k) {
+      send_message(fd, kInputError,
+                   "the assignment has " + std::to_string(a.k) + " processors, the platform " +
+                       (platform.file.empty() ? std::string("cluster") : platform.file) +
+                       " only " + std::to_string(cores) + " cores on " +
+                       std::to_string(all.size()) + " hosts");
+      ::_exit(0);
+    }
+    // A host's loopback link (its route to itself) prices a byte read from another core.
+    std::vector<double> read_ns_per_byte;
+    for (const sg::Host* h : proc_hosts) {
+      std::vector<sg::Link*> links;
+      double latency = 0;
+      h->route_to(h, links, &latency);
+      double bandwidth = 0;
+      for (const sg::Link* l : links)
+        bandwidth = bandwidth == 0 ? l->get_bandwidth() : std::min(bandwidth, l->get_bandwidth());
+      read_ns_per_byte.push_back(bandwidth > 0 ? 1e9 / bandwidth : 0.0);
+    }
+    Driver driver(trace, a, proc_hosts, std::move(read_ns_per_byte), platform.intra_node);
+    sg::Activity::on_completion_cb([&](const sg::Activity& act) { driver.on_completion(act); });
+    sg::Engine::on_time_advance_cb([&](double) { driver.on_time_advance(); });
+    driver.start();
+    engine.run();
+    if (!driver.done()) {
+      send_message(fd, kInputError, driver.stuck());
+      ::_exit(0);
+    }
+    const std::uint64_t header[2] = {all.size(), cores};
+    write_all(fd, &kResult, 1);
+    write_all(fd, header, sizeof header);
+    for (const StepPrediction& s : driver.results()) {
+      const std::uint64_t v[5] = {s.makespan_ns, s.messages, s.bytes, s.inter_node_messages,
+                                  s.inter_node_bytes};
+      write_all(fd, v, sizeof v);
+    }
+  } catch (const std::exception& e) {
+    send_message(fd, kFailure, e.what());
+  } catch (...) {
+    send_message(fd, kFailure, "SimGrid failed");
+    code = 1;
+  }
+  ::_exit(code);
+}
+
+// The last non-empty line SimGrid wrote (its reason when it ended the child).
+std::string last_line(std::FILE* f) {
+  std::string text, line;
+  std::fflush(f);
+  std::rewind(f);
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  std::size_t end = text.find_last_not_of(" \n\r\t");
+  if (end == std::string::npos) return "";
+  const std::size_t begin = text.rfind('\n', end);
+  return text.substr(begin == std::string::npos ? 0 : begin + 1, end + 1 - (begin == std::string::npos ? 0 : begin + 1));
+}
+
+// One line: SimGrid's messages may span several.
+std::string one_line(std::string text) {
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
+
+}  // namespace
+
+Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
+                           const SimulatedPlatform& platform) {
+  if (!platform.file.empty()) (void)read_file_bytes(platform.file);  // missing: InputError
+  int fds[2];
+  if (::pipe(fds) != 0) throw std::runtime_error("simulate: cannot create a pipe");
+  std::FILE* log = std::tmpfile();
+  std::fflush(stdout);
+  std::fflush(stderr);
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]);
+    ::close(fds[1]);
+    if (log) std::fclose(log);
+    throw std::runtime_error("simulate: cannot start the SimGrid process");
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    // SimGrid's own messages never reach tgraph's stdout (--json stays one object).
+    const int out = log ? ::fileno(log) : ::open("/dev/null", O_WRONLY);
+    ::dup2(out, STDOUT_FILENO);
+    ::dup2(out, STDERR_FILENO);
+    child(fds[1], trace, a, platform);
+  }
+  ::close(fds[1]);
+  std::string got;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n > 0) {
+      got.append(buf, static_cast<std::size_t>(n));
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    break;
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  const std::string said = log ? one_line(last_line(log)) : "";
+  if (log) std::fclose(log);
+  const std::string where = platform.file.empty() ? "the cluster platform" : platform.file;
+  const bool loaded = !got.empty() && got[0] == kLoaded;
+  const std::string rest = loaded ? got.substr(1) : got;
+  if (!rest.empty() && rest[0] == kInputError) {
+    if (!loaded && !platform.file.empty())
+      throw InputError(platform.file, std::nullopt, one_line(rest.substr(1)));
+    throw Error(one_line(rest.substr(1)));
+  }
+  if (!rest.empty() && rest[0] == kFailure) throw std::runtime_error("simgrid: " + one_line(rest.substr(1)));
+  const std::size_t step_bytes = 5 * sizeof(std::uint64_t);
+  if (rest.empty() || rest[0] != kResult || rest.size() < 1 + 2 * sizeof(std::uint64_t) ||
+      (rest.size() - 1 - 2 * sizeof(std::uint64_t)) % step_bytes != 0) {
+    const std::string why = "SimGrid ended " +
+                            (WIFSIGNALED(status) ? "with signal " + std::to_string(WTERMSIG(status))
+                                                 : "with status " + std::to_string(WEXITSTATUS(status))) +
+                            (said.empty() ? "" : ": " + said);
+    if (!loaded && !platform.file.empty())
+      throw InputError(platform.file, std::nullopt, "SimGrid cannot load this platform (" + why + ")");
+    throw std::runtime_error("simulate on " + where + ": " + why);
+  }
+  Prediction r;
+  r.engine = SimulationEngine::simgrid;
+  r.k = a.k;
+  std::uint64_t header[2];
+  std::memcpy(header, rest.data() + 1, sizeof header);
+  r.hosts = static_cast<std::uint32_t>(header[0]);
+  r.cores = header[1];
+  r.platform = platform.file.empty() ? std::to_string(platform.cluster->nodes) + "x" +
+                                           std::to_string(platform.cluster->cores)
+                                     : platform.file;
+  for (std::size_t at = 1 + sizeof header; at + step_bytes <= rest.size(); at += step_bytes) {
+    std::uint64_t v[5];
+    std::memcpy(v, rest.data() + at, sizeof v);
+    r.steps.push_back({v[0], v[1], v[2], v[3], v[4]});
+  }
+  return r;
+}
+
+}  // namespace tgraph::partition::detail
