@@ -41,6 +41,10 @@ void add_capture(CLI::App& app) {
   cmd->add_option("--coupling", a->policy,
                   "Solver sharing: groups (one CG per collision group) or shared")
       ->check(CLI::IsMember({"groups", "shared"}));
+  cmd->add_option("--cost-passes", o->cost_passes,
+                  "Time every task body this many times from the same state (its written data "
+                  "restored between passes) and keep the median (default 1)")
+      ->check(CLI::Range(1u, 1000u));
   cmd->add_flag("--no-capture", o->no_capture,
                 "Run the same steps uninstrumented (Mode::kOff), write nothing");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
@@ -49,9 +53,7 @@ void add_capture(CLI::App& app) {
       o->scene_options.coupling =
           a->policy == "groups" ? samples::Coupling::kGroups : samples::Coupling::kShared;
     o->progress = isatty(STDERR_FILENO) != 0;
-    o->warn = [](const std::string& w) {
-      std::fprintf(stderr, "tgraph: warning: %s\n", w.c_str());
-    };
+    o->warn = warn;
     // A file size limit (RLIMIT_FSIZE) then fails the write with EFBIG instead of killing us.
     ::signal(SIGXFSZ, SIG_IGN);
     const samples::CaptureRun r = samples::capture_scene(*o);

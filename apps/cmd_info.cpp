@@ -14,8 +14,12 @@ void add_info(CLI::App& app) {
   cmd->add_option("trace", o->input, "Trace file (.tgt)")->required();
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->add_flag("--recover", o->recover, "Read the complete steps of an interrupted capture");
-  cmd->callback([o] {
-    const TraceSummary s = summarize_trace(read_trace(o->input, {.recover = o->recover}));
+  auto summary = std::make_shared<SummaryOptions>();
+  cmd->add_flag("--unit-cost", summary->unit_cost,
+                "Also the work and span in tasks (every task costs 1; loops unrolled)");
+  cmd->callback([o, summary] {
+    const TraceSummary s =
+        summarize_trace(read_trace(o->input, {.recover = o->recover}), *summary);
     std::cout << (o->json ? trace_summary_json(s, o->input) + "\n"
                           : trace_summary_text(s, o->input));
   });

@@ -74,6 +74,7 @@ void add_partition_verbs(CLI::App& app) {
     const Trace trace = read_trace(a->input);
     if (a->k == 0) throw UsageError("-k: expected at least 1");
     const auto r = tp::partition_trace(trace, a->method, a->k, n->options());
+    for (const std::string& w : r.warnings) warn(w);
     if (!a->output.empty()) tp::write_assignment(a->output, r.assignment, trace);
     std::cout << (a->json ? tp::partition_json(r, a->output) + "\n"
                           : tp::partition_text(r, a->output));

@@ -44,6 +44,11 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
       ->each([&exec](const std::string& cw) {
         exec.cw = cw == "serialize" ? tr::CwMode::kSerialize : tr::CwMode::kReduce;
       });
+  cmd->add_option_function<std::string>(
+      "--barrier-rule",
+      [&exec](const std::string& r) { exec.barrier_rule = tr::barrier_rule_flag(r, "--barrier-rule"); },
+      "Barrier policy's phases: level (default; one per dependency level) or operation (one "
+      "per run of same-kind tasks in program order, the paper's rule)");
   cmd->add_option("--starpu-sched", exec.starpu_sched,
                   "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
   cmd->add_flag_callback(
@@ -56,22 +61,33 @@ void replay(const Args& a, tr::ReplayOptions& o, const tp::NamedOptions& model) 
   o.policy = tr::policy_flag(a.policy.empty() ? "partition" : a.policy, "--policy");
   std::optional<TraceAssignment> as;
   std::vector<std::uint64_t> predicted;
+  tp::PartitionNotes notes;
   if (o.policy == tr::Policy::kPartition) {
-    as = tp::load_or_partition(trace, a.input, a.assignment, a.method, o.exec.threads);
+    as = tp::load_or_partition(trace, a.input, a.assignment, a.method, o.exec.threads, &notes);
+    for (const std::string& w : notes.warnings) warn(w);
     predicted = tp::predicted_makespans(trace, *as, model.cost_model());
   } else if (!a.assignment.empty()) {
     throw UsageError("an assignment file is only used by --policy partition");
   }
   tr::TimelineObserver timeline;
   const bool observe = !a.timeline.empty() || !a.chrome.empty();
-  const tr::ReplayResult r = tr::replay_trace(
+  tr::ReplayResult r = tr::replay_trace(
       trace, as ? &*as : nullptr, o, as ? &predicted : nullptr, observe ? &timeline : nullptr);
+  r.warnings = notes.warnings;
   if (!a.timeline.empty()) write_file_atomic(a.timeline, timeline.to_json());
   if (!a.chrome.empty())
     write_file_atomic(a.chrome,
                       viz::chrome_trace(viz::parse_timeline(timeline.to_json(), a.chrome)));
-  std::string label = a.assignment;  // where the assignment came from
-  if (as && label.empty()) label = a.method + " (computed)";
+  // Where the assignment came from: the file, or the strategy that placed the steps, and why
+  // that one when the user named none or the named one fell back.
+  std::string label = a.assignment;
+  if (as && label.empty()) {
+    label = notes.placed_by + " (computed";
+    if (a.method.empty())
+      label += notes.method == "owner" ? ", default" : ", default for a trace without objects";
+    if (notes.placed_by != notes.method) label += ", fallback of " + notes.method;
+    label += ")";
+  }
   std::cout << (a.json ? tr::to_json(r, a.input, label) + "\n" : tr::to_text(r, a.input, o.repeat));
 }
 
@@ -102,7 +118,6 @@ void add_replay_verbs(CLI::App& app) {
   auto a = std::make_shared<Args>();
   auto o = std::make_shared<tr::ReplayOptions>();
   auto model = std::make_shared<tp::NamedOptions>();
-  a->method = "owner";
   auto* cmd =
       app.add_subcommand("replay", "Replay a trace's steps on real threads (synthetic bodies)");
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
@@ -112,7 +127,8 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_option("--policy", a->policy,
                   "partition (default), worksteal, barrier, starpu or sequential");
   cmd->add_option("--method", a->method,
-                  "Strategy used when no assignment file is given (default owner)");
+                  "Strategy used when no assignment file is given (default: owner when the "
+                  "trace's tasks work on objects, else list)");
   cmd->add_option("--steps", o->steps, "Steps to replay (default: all)");
   cmd->add_option("--first-step", o->first_step, "First step replayed");
   cmd->add_option("--repeat", o->repeat, "Timed passes (medians reported; default 3)");

@@ -44,6 +44,8 @@ struct Args {
   bool json = false, recover = false;
 };
 
+/// Prints "tgraph: warning: TEXT" on stderr (what the user should know; not an error).
+inline void warn(const std::string& text) { std::cerr << "tgraph: warning: " << text << '\n'; }
 /// Prints a JSON object on stdout (one line, as `--json` promises).
 inline void print_json(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 /// Threads a verb uses by default: all hardware threads (at least 1).

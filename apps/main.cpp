@@ -6,12 +6,13 @@
 #include <new>
 
 #include "commands.hpp"
+#include "tgraph/version.hpp"
 
 int main(int argc, char** argv) {
   using namespace tgraph::app;
   CLI::App app{
       "tgraph: capture, partition, evaluate and replay task graphs of physics simulations"};
-  app.set_version_flag("--version", std::string("tgraph ") + TGRAPH_VERSION);
+  app.set_version_flag("--version", "tgraph " + std::string(tgraph::kVersionString));
   app.require_subcommand(0, 1);
   add_all_verbs(app);
   try {

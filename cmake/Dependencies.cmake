@@ -1,6 +1,19 @@
 # SPDX-License-Identifier: MIT
 # Every dependency comes from a Debian package; none is vendored.
 find_package(PkgConfig REQUIRED)
+
+# tgraph_pkg_config(NAME [OPTIONAL] MODULES m...): pkg_check_modules with a GLOBAL imported
+# target PkgConfig::NAME, whose pkg-config modules are remembered: the installed package
+# config (cmake/Install.cmake) finds the same target again for the libraries that link it.
+macro(tgraph_pkg_config name)
+  cmake_parse_arguments(_tgraph_pc "OPTIONAL" "" "MODULES" ${ARGN})
+  if(_tgraph_pc_OPTIONAL)
+    pkg_check_modules(${name} QUIET IMPORTED_TARGET GLOBAL ${_tgraph_pc_MODULES})
+  else()
+    pkg_check_modules(${name} REQUIRED IMPORTED_TARGET GLOBAL ${_tgraph_pc_MODULES})
+  endif()
+  set_property(GLOBAL PROPERTY TGRAPH_PKG_CONFIG_${name} "${_tgraph_pc_MODULES}")
+endmacro()
 find_package(Threads REQUIRED)
 find_package(ZLIB REQUIRED)
 find_package(Eigen3 3.4 REQUIRED CONFIG)
@@ -8,8 +21,8 @@ find_package(nlohmann_json 3.10 REQUIRED CONFIG)
 find_package(CLI11 REQUIRED CONFIG)
 find_package(TBB REQUIRED CONFIG)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
-pkg_check_modules(HWLOC REQUIRED IMPORTED_TARGET hwloc)
-pkg_check_modules(GRAPHVIZ REQUIRED IMPORTED_TARGET libcgraph libgvc)
+tgraph_pkg_config(HWLOC MODULES hwloc)
+tgraph_pkg_config(GRAPHVIZ MODULES libcgraph libgvc)
 
 # METIS 5.1 ships neither pkg-config nor CMake files.
 find_path(METIS_INCLUDE_DIR metis.h PATHS /usr/include NO_DEFAULT_PATH REQUIRED)

@@ -1,78 +1,190 @@
 # SPDX-License-Identifier: MIT
-# `cmake --install`: headers, static libraries, the `tgraph` binary, the CMake package
-# (find_package(tgraph) -> tgraph::graph, tgraph::capture, tgraph::partition, tgraph::replay,
-# tgraph::viz, tgraph::samples, tgraph::experiment, as built) and tgraph.pc for pkg-config users of the capture API.
+# `cmake --install`: headers, static libraries, the `tgraph` binary, the CMake package with one
+# component per library (find_package(tgraph COMPONENTS capture) -> tgraph::capture and
+# tgraph::graph, finding only their dependencies; without COMPONENTS: every component built)
+# and tgraph.pc for pkg-config users of the capture API.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(TGRAPH_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/tgraph"
     CACHE STRING "Where the CMake package files go (relative to the prefix)")
 
-# Library targets and their folders, in dependency order. tgraph_options carries C++20 to
-# consumers; tgraph_metis and tgraph_scotch are the link-only dependencies of the static
-# partition library.
-set(_tgraph_exported tgraph_options)
+# How the package config finds again each imported target that a library links. The libraries
+# are static, so their private dependencies are link dependencies of the consumer: every
+# imported target in a link interface must be listed here (configuration stops otherwise).
+set(_tgraph_find_Threads::Threads "find_package(Threads QUIET)\nset(_ok \${Threads_FOUND})")
+set(_tgraph_find_ZLIB::ZLIB "find_package(ZLIB QUIET)\nset(_ok \${ZLIB_FOUND})")
+set(_tgraph_find_nlohmann_json::nlohmann_json
+    "find_package(nlohmann_json 3.10 QUIET CONFIG)\nset(_ok \${nlohmann_json_FOUND})")
+set(_tgraph_find_TBB::tbb "find_package(TBB QUIET CONFIG)\nset(_ok \${TBB_FOUND})")
+set(_tgraph_find_OpenMP::OpenMP_CXX
+    "find_package(OpenMP QUIET COMPONENTS CXX)\nset(_ok \${OpenMP_CXX_FOUND})")
+set(_tgraph_find_Eigen3::Eigen "find_package(Eigen3 3.4 QUIET CONFIG)\nset(_ok \${Eigen3_FOUND})")
+set(_tgraph_find_MPI::MPI_CXX "find_package(MPI QUIET COMPONENTS CXX)\nset(_ok \${MPI_CXX_FOUND})")
+# What to install to get them (the message of a failed find_package(tgraph)).
+set(_tgraph_debian_Threads::Threads "libc6-dev")
+set(_tgraph_debian_ZLIB::ZLIB "zlib1g-dev")
+set(_tgraph_debian_nlohmann_json::nlohmann_json "nlohmann-json3-dev")
+set(_tgraph_debian_TBB::tbb "libtbb-dev")
+set(_tgraph_debian_OpenMP::OpenMP_CXX "g++ (libgomp)")
+set(_tgraph_debian_Eigen3::Eigen "libeigen3-dev")
+set(_tgraph_debian_MPI::MPI_CXX "libopenmpi-dev")
+set(_tgraph_debian_PkgConfig::HWLOC "libhwloc-dev")
+set(_tgraph_debian_PkgConfig::STARPU "libstarpu-dev")
+set(_tgraph_debian_PkgConfig::GRAPHVIZ "libgraphviz-dev")
+set(_tgraph_debian_PkgConfig::CAIRO "libcairo2-dev")
+set(_tgraph_debian_PkgConfig::SIMGRID "libsimgrid-dev")
+
+# The modules, as library targets tgraph_<module> in folder <folder>, in dependency order.
 set(_tgraph_modules "")
 foreach(pair graph:libgraph capture:capture partition:partition replay:replay viz:viz
-             samples:samples experiment:experiment)
+             samples:samples measure:measure mpi:mpi experiment:experiment)
   string(REPLACE ":" ";" pair "${pair}")
   list(GET pair 0 module)
   list(GET pair 1 folder)
-  if(NOT TARGET tgraph_${module})
-    continue()
+  if(TARGET tgraph_${module})
+    list(APPEND _tgraph_modules ${module})
+    set(_tgraph_folder_${module} ${folder})
   endif()
-  list(APPEND _tgraph_modules ${module})
-  list(APPEND _tgraph_exported tgraph_${module})
+endforeach()
+
+# _tgraph_component_dependencies(MODULE): what the component's targets link, split into the
+# components they need (_tgraph_needs_<module>) and the imported targets of other packages
+# (_tgraph_imports_<module>). tgraph_options goes with graph; tgraph_metis and tgraph_scotch
+# (interface targets naming Debian's libraries) go with partition.
+function(_tgraph_component_dependencies module)
+  set(targets tgraph_${module})
+  if(module STREQUAL "graph")
+    list(APPEND targets tgraph_options)
+  elseif(module STREQUAL "partition")
+    list(APPEND targets tgraph_metis tgraph_scotch)
+  endif()
+  set(needs "")
+  set(imports "")
+  foreach(target IN LISTS targets)
+    get_target_property(type ${target} TYPE)
+    if(type STREQUAL "INTERFACE_LIBRARY")
+      get_target_property(links ${target} INTERFACE_LINK_LIBRARIES)
+    else()
+      get_target_property(links ${target} LINK_LIBRARIES)
+    endif()
+    foreach(link IN LISTS links)
+      if(NOT link MATCHES "([A-Za-z0-9_]+::[A-Za-z0-9_]+)")
+        continue()  # a library file, or nothing
+      endif()
+      set(link "${CMAKE_MATCH_1}")
+      if(link MATCHES "^tgraph::(.*)$")
+        if(CMAKE_MATCH_1 IN_LIST _tgraph_modules AND NOT CMAKE_MATCH_1 STREQUAL module)
+          list(APPEND needs ${CMAKE_MATCH_1})
+        endif()
+        continue()  # options, metis, scotch: in this component's export set
+      endif()
+      if(NOT DEFINED _tgraph_find_${link} AND NOT link MATCHES "^PkgConfig::")
+        message(FATAL_ERROR "cmake/Install.cmake: tgraph_${module} links ${link}; say how the "
+                            "package config finds it again (_tgraph_find_${link})")
+      endif()
+      list(APPEND imports ${link})
+    endforeach()
+  endforeach()
+  list(REMOVE_DUPLICATES needs)
+  list(REMOVE_DUPLICATES imports)
+  set(_tgraph_needs_${module} "${needs}" PARENT_SCOPE)
+  set(_tgraph_imports_${module} "${imports}" PARENT_SCOPE)
+endfunction()
+
+set(TGRAPH_PACKAGE_COMPONENTS "")
+set(_tgraph_emitted "")
+set(_tgraph_before "")
+foreach(module IN LISTS _tgraph_modules)
+  _tgraph_component_dependencies(${module})
+  foreach(need IN LISTS _tgraph_needs_${module})
+    if(NOT need IN_LIST _tgraph_before)  # the package config loads in this order
+      message(FATAL_ERROR "cmake/Install.cmake: ${module} links ${need}, listed after it")
+    endif()
+  endforeach()
+  list(APPEND _tgraph_before ${module})
+  set(exported tgraph_${module})
+  if(module STREQUAL "graph")
+    list(APPEND exported tgraph_options)
+    set_target_properties(tgraph_options PROPERTIES EXPORT_NAME options)
+  elseif(module STREQUAL "partition")
+    foreach(dep metis scotch)
+      set_target_properties(tgraph_${dep} PROPERTIES EXPORT_NAME ${dep})
+      list(APPEND exported tgraph_${dep})
+    endforeach()
+  endif()
   set_target_properties(tgraph_${module} PROPERTIES EXPORT_NAME ${module})
   # The module's public include folder is in the source tree: seen from the build only; the
   # installed target finds the same headers under <prefix>/include.
   get_target_property(_dirs tgraph_${module} INTERFACE_INCLUDE_DIRECTORIES)
   set(_wrapped "")
   foreach(dir IN LISTS _dirs)
-    list(APPEND _wrapped "$<BUILD_INTERFACE:${dir}>")
+    if(dir MATCHES "^\\$<")
+      list(APPEND _wrapped "${dir}")  # already wrapped (generated headers)
+    else()
+      list(APPEND _wrapped "$<BUILD_INTERFACE:${dir}>")
+    endif()
   endforeach()
   list(APPEND _wrapped "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
+  list(REMOVE_DUPLICATES _wrapped)
   set_target_properties(tgraph_${module} PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_wrapped}")
-  install(DIRECTORY "${PROJECT_SOURCE_DIR}/${folder}/include/"
+  install(DIRECTORY "${PROJECT_SOURCE_DIR}/${_tgraph_folder_${module}}/include/"
           DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}" FILES_MATCHING PATTERN "*.hpp")
-endforeach()
-foreach(dep metis scotch)
-  if(TARGET tgraph_${dep} AND TARGET tgraph_partition)
-    set_target_properties(tgraph_${dep} PROPERTIES EXPORT_NAME ${dep})
-    list(APPEND _tgraph_exported tgraph_${dep})
+  # Generated public headers (tgraph/version.hpp).
+  if(EXISTS "${PROJECT_BINARY_DIR}/${_tgraph_folder_${module}}/include")
+    install(DIRECTORY "${PROJECT_BINARY_DIR}/${_tgraph_folder_${module}}/include/"
+            DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}" FILES_MATCHING PATTERN "*.hpp")
   endif()
-endforeach()
-set_target_properties(tgraph_options PROPERTIES EXPORT_NAME options)
+  install(TARGETS ${exported} EXPORT tgraph-${module}-targets
+          ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
+          LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
+  install(EXPORT tgraph-${module}-targets NAMESPACE tgraph::
+          DESTINATION "${TGRAPH_INSTALL_CMAKEDIR}")
 
-install(TARGETS ${_tgraph_exported} EXPORT tgraphTargets
-        ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
-        LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}")
+  # The component's part of tgraphConfig.cmake: the components it needs, and how to find
+  # each imported target it links (the code sets _ok).
+  string(APPEND TGRAPH_PACKAGE_COMPONENTS
+         "set(_tgraph_needs_${module} \"${_tgraph_needs_${module}}\")\n"
+         "set(_tgraph_imports_${module} \"${_tgraph_imports_${module}}\")\n")
+  foreach(import IN LISTS _tgraph_imports_${module})
+    if(import IN_LIST _tgraph_emitted)
+      continue()
+    endif()
+    list(APPEND _tgraph_emitted ${import})
+    if(import MATCHES "^PkgConfig::(.*)$")
+      set(name "${CMAKE_MATCH_1}")
+      get_property(pc_modules GLOBAL PROPERTY TGRAPH_PKG_CONFIG_${name})
+      if(NOT pc_modules AND DEFINED __pkg_config_arguments_${name})
+        # Made by a plain pkg_check_modules: its arguments (an internal cache entry of
+        # FindPkgConfig) less the keywords are the modules.
+        set(pc_modules ${__pkg_config_arguments_${name}})
+        list(REMOVE_ITEM pc_modules REQUIRED QUIET IMPORTED_TARGET GLOBAL NO_CMAKE_PATH
+             NO_CMAKE_ENVIRONMENT_PATH)
+      endif()
+      if(NOT pc_modules)
+        message(FATAL_ERROR "cmake/Install.cmake: tgraph_${module} links ${import}, not made "
+                            "by tgraph_pkg_config (cmake/Dependencies.cmake)")
+      endif()
+      string(REPLACE ";" " " pc_modules "${pc_modules}")
+      set(_tgraph_find_${import} "find_package(PkgConfig QUIET)\nset(_ok FALSE)
+if(PkgConfig_FOUND)
+  pkg_check_modules(${name} QUIET IMPORTED_TARGET ${pc_modules})
+  set(_ok \${${name}_FOUND})
+endif()")
+      if(NOT DEFINED _tgraph_debian_${import})
+        set(_tgraph_debian_${import} "pkg-config ${pc_modules}")
+      endif()
+    endif()
+    string(MAKE_C_IDENTIFIER "${import}" id)
+    string(APPEND TGRAPH_PACKAGE_COMPONENTS
+           "macro(_tgraph_find_${id})\n${_tgraph_find_${import}}\nendmacro()\n"
+           "set(_tgraph_debian_${import} \"${_tgraph_debian_${import}}\")\n")
+  endforeach()
+endforeach()
 if(TARGET tgraph)
   install(TARGETS tgraph RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
 endif()
-install(EXPORT tgraphTargets NAMESPACE tgraph:: DESTINATION "${TGRAPH_INSTALL_CMAKEDIR}")
 
-# What the package config must find again: the libraries are static, so their private
-# dependencies are link dependencies of the consumer.
-set(TGRAPH_PACKAGE_STARPU OFF)
-if(TARGET PkgConfig::STARPU)
-  set(TGRAPH_PACKAGE_STARPU ON)
-endif()
-set(TGRAPH_PACKAGE_SIMGRID OFF)
-if(TARGET tgraph_partition)
-  get_target_property(_tgraph_partition_defs tgraph_partition INTERFACE_COMPILE_DEFINITIONS)
-  if(_tgraph_partition_defs MATCHES "TGRAPH_HAVE_SIMGRID")
-    set(TGRAPH_PACKAGE_SIMGRID ON)
-  endif()
-endif()
-set(TGRAPH_PACKAGE_GRAPHVIZ OFF)
-if(TARGET tgraph_viz)
-  set(TGRAPH_PACKAGE_GRAPHVIZ ON)
-endif()
-set(TGRAPH_PACKAGE_EIGEN OFF)
-if(TARGET tgraph_samples)
-  set(TGRAPH_PACKAGE_EIGEN ON)
-endif()
 set(TGRAPH_PACKAGE_MODULES "${_tgraph_modules}")
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/tgraphConfig.cmake.in"
                               "${PROJECT_BINARY_DIR}/tgraphConfig.cmake"

@@ -9,7 +9,8 @@ TGRAPH_PACKAGES=(cmake g++ ninja-build pkg-config python3
   libeigen3-dev libmetis-dev metis libscotch-dev scotch libgraphviz-dev graphviz
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libhwloc-dev libcli11-dev nlohmann-json3-dev
   libstarpu-dev zlib1g-dev clang libclang-rt-14-dev libomp-14-dev libcairo2-dev
-  python3-dev python3-pybind11 pybind11-dev python3-pytest libsimgrid-dev)
+  python3-dev python3-pybind11 pybind11-dev python3-pytest libsimgrid-dev
+  liblapacke-dev libblas-dev)
 
 tgraph_install_packages() {
   local missing=()
@@ -31,12 +32,18 @@ tgraph_install_packages() {
   fi
 }
 
-# tgraph_build PRESET [TARGET...]: configure once, then build incrementally.
+# tgraph_build PRESET [TARGET...]: configure once, then build incrementally. A folder not
+# configured yet gets the preset's generator (Ninja), or TGRAPH_GENERATOR when set; one
+# already configured keeps its own.
 tgraph_build() {
   local preset="$1"; shift
   cd "$TGRAPH_ROOT"
-  if [ ! -f "build/$preset/build.ninja" ]; then
-    cmake --preset "$preset" >/dev/null
+  if [ ! -f "build/$preset/CMakeCache.txt" ]; then
+    if [ -n "${TGRAPH_GENERATOR:-}" ]; then
+      cmake --preset "$preset" -G "$TGRAPH_GENERATOR" >/dev/null
+    else
+      cmake --preset "$preset" >/dev/null
+    fi
   fi
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"

@@ -2,6 +2,8 @@
 // Recorder: builds the step graph from the coordination code's calls.
 #include "tgraph/capture/recorder.hpp"
 
+#include <algorithm>
+#include <cstring>
 #include <unordered_map>
 
 namespace tgraph::capture {
@@ -95,6 +97,41 @@ bool Recorder::append_task(KindId kind, ObjectId obj, const Access* acc, std::si
   cost_sum_.push_back(ns);
   cost_max_.push_back(ns);
   return true;
+}
+
+bool Recorder::save_written(const Access* acc, std::size_t n) {
+  std::size_t bytes = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!writes(acc[i].mode)) continue;
+    if (acc[i].datum >= ptrs_.size() || ptrs_[acc[i].datum] == nullptr) return false;
+    bytes += data_[acc[i].datum].bytes;
+  }
+  saved_.resize(bytes);
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!writes(acc[i].mode)) continue;
+    const std::size_t b = data_[acc[i].datum].bytes;
+    if (b != 0) std::memcpy(saved_.data() + at, ptrs_[acc[i].datum], b);
+    at += b;
+  }
+  return true;
+}
+
+void Recorder::restore_written(const Access* acc, std::size_t n) {
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!writes(acc[i].mode)) continue;
+    const std::size_t b = data_[acc[i].datum].bytes;
+    if (b != 0) std::memcpy(ptrs_[acc[i].datum], saved_.data() + at, b);
+    at += b;
+  }
+}
+
+std::uint64_t Recorder::median_ticks() {
+  if (pass_ticks_.empty()) return 0;
+  const auto mid = pass_ticks_.begin() + static_cast<std::ptrdiff_t>((pass_ticks_.size() - 1) / 2);
+  std::nth_element(pass_ticks_.begin(), mid, pass_ticks_.end());
+  return *mid;
 }
 
 LoopId Recorder::begin_loop(DatumId condition, std::uint32_t max_iterations) {

@@ -81,4 +81,16 @@ Metrics compute_metrics(const StepGraph& g) {
   return m;
 }
 
+UnitMetrics compute_unit_metrics(const StepGraph& g) {
+  StepGraph unit = g;
+  for (Task& t : unit.tasks) t.cost_ns = 1;
+  UnitMetrics m;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) m.work_tasks += g.runs(t);
+  for (const std::uint64_t f : earliest_finish(unit)) m.span_tasks = std::max(m.span_tasks, f);
+  m.parallelism = m.span_tasks == 0 ? 0.0
+                                    : static_cast<double>(m.work_tasks) /
+                                          static_cast<double>(m.span_tasks);
+  return m;
+}
+
 }  // namespace tgraph

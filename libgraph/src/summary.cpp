@@ -11,8 +11,34 @@
 
 namespace tgraph {
 
-TraceSummary summarize_trace(const Trace& trace) {
+namespace {
+
+// True when no task of the trace has a cost above 1 ns: no timing recorded (all 0) or unit
+// costs (all 1), where the timed span says nothing.
+bool without_costs(const Trace& trace) {
+  for (const StepGraph& g : trace.steps)
+    for (const Task& t : g.tasks)
+      if (t.cost_ns > 1) return false;
+  return !trace.steps.empty();
+}
+
+// A duration in the unit that shows it: ms, us below a millisecond, ns below a microsecond.
+std::string duration_text(std::uint64_t ns) {
+  char b[64];
+  if (ns >= 1000000)
+    std::snprintf(b, sizeof b, "%.3f ms", static_cast<double>(ns) / 1e6);
+  else if (ns >= 1000)
+    std::snprintf(b, sizeof b, "%.3f us", static_cast<double>(ns) / 1e3);
+  else
+    std::snprintf(b, sizeof b, "%llu ns", static_cast<unsigned long long>(ns));
+  return b;
+}
+
+}  // namespace
+
+TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options) {
   TraceSummary s;
+  s.unit_cost = options.unit_cost || without_costs(trace);
   s.header = trace.header;
   s.steps = trace.steps.size();
   s.tasks_min = trace.steps.empty() ? 0 : UINT64_MAX;
@@ -28,6 +54,11 @@ TraceSummary summarize_trace(const Trace& trace) {
     for (const Loop& l : g.loops) st.loop_iterations.push_back(l.iterations);
     st.work_ns = m.work_ns;
     st.span_ns = m.span_ns;
+    if (s.unit_cost) {
+      const UnitMetrics u = compute_unit_metrics(g);
+      st.work_tasks = u.work_tasks;
+      st.span_tasks = u.span_tasks;
+    }
     st.host_ns = g.host_ns;
     st.parallelism = m.parallelism;
     st.contacts = g.contacts.size();
@@ -51,6 +82,10 @@ TraceSummary summarize_trace(const Trace& trace) {
       s.max_loop_iterations = std::max(s.max_loop_iterations, it);
     s.work_ns += st.work_ns;
     s.span_ns += st.span_ns;
+    s.span_max_ns = std::max(s.span_max_ns, st.span_ns);
+    s.work_tasks += st.work_tasks;
+    s.span_tasks += st.span_tasks;
+    s.span_tasks_max = std::max(s.span_tasks_max, st.span_tasks);
     s.host_ns += st.host_ns;
     shapes.insert(st.structure);
     s.contact_changes += st.contacts_changed ? 1 : 0;
@@ -61,6 +96,9 @@ TraceSummary summarize_trace(const Trace& trace) {
   s.tasks_mean = s.steps == 0 ? 0.0 : static_cast<double>(s.tasks) / static_cast<double>(s.steps);
   s.parallelism =
       s.span_ns == 0 ? 0.0 : static_cast<double>(s.work_ns) / static_cast<double>(s.span_ns);
+  s.unit_parallelism = s.span_tasks == 0 ? 0.0
+                                          : static_cast<double>(s.work_tasks) /
+                                                static_cast<double>(s.span_tasks);
   return s;
 }
 
@@ -69,7 +107,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
   json per_step = json::array(), changes = json::array();
   for (std::size_t i = 0; i < s.per_step.size(); ++i) {
     const StepSummary& st = s.per_step[i];
-    per_step.push_back({{"step", i},
+    json one = {{"step", i},
                         {"tasks", st.tasks},
                         {"edges", st.edges},
                         {"data", st.data},
@@ -83,10 +121,15 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
                         {"collision_groups", st.collision_groups},
                         {"contacts_changed", st.contacts_changed},
                         {"structure", st.structure},
-                        {"structure_changed", st.structure_changed}});
+                        {"structure_changed", st.structure_changed}};
+    if (s.unit_cost) {
+      one["work_tasks"] = st.work_tasks;
+      one["span_tasks"] = st.span_tasks;
+    }
+    per_step.push_back(std::move(one));
     if (st.structure_changed) changes.push_back({{"step", i}, {"summary", st.change}});
   }
-  const json j = {
+  json j = {
       {"trace", trace_name},
       {"scene", s.header.scene},
       {"engine", s.header.engine},
@@ -102,6 +145,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"max_loop_iterations", s.max_loop_iterations},
       {"work_ns", s.work_ns},
       {"span_ns", s.span_ns},
+      {"span_max_ns", s.span_max_ns},
       {"host_ns", s.host_ns},
       {"parallelism", s.parallelism},
       {"distinct_structures", s.distinct_structures},
@@ -110,6 +154,12 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"structure_changes", changes},
       {"per_step", per_step},
   };
+  if (s.unit_cost) {
+    j["work_tasks"] = s.work_tasks;
+    j["span_tasks"] = s.span_tasks;
+    j["span_tasks_max"] = s.span_tasks_max;
+    j["unit_parallelism"] = s.unit_parallelism;
+  }
   return j.dump();
 }
 
@@ -133,13 +183,31 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
                     "loops          %llu, %llu iterations (max %u in one loop)\n",
                     static_cast<unsigned long long>(s.loops),
                     static_cast<unsigned long long>(s.loop_iterations), s.max_loop_iterations));
-  add(std::snprintf(line, sizeof line, "work           %.3f ms\n",
-                    static_cast<double>(s.work_ns) / 1e6));
-  add(std::snprintf(line, sizeof line, "span           %.3f ms\n",
-                    static_cast<double>(s.span_ns) / 1e6));
-  add(std::snprintf(line, sizeof line, "host           %.3f ms (engine work outside the tasks)\n",
-                    static_cast<double>(s.host_ns) / 1e6));
-  add(std::snprintf(line, sizeof line, "parallelism    %.2f\n", s.parallelism));
+  const bool timed = s.work_ns != 0;  // a trace without costs has only unit-cost figures
+  if (timed) {
+    out += "work           " + duration_text(s.work_ns) + " (sum of all task costs, all steps)\n";
+    out += "span           " + duration_text(s.span_ns) +
+           " (sum of the steps' critical paths; longest step " + duration_text(s.span_max_ns) +
+           ")\n";
+  } else {
+    out += "work, span     no task costs recorded: see the unit-cost figures\n";
+  }
+  if (s.unit_cost) {
+    add(std::snprintf(line, sizeof line, "work (unit)    %llu tasks (task runs, all steps)\n",
+                      static_cast<unsigned long long>(s.work_tasks)));
+    add(std::snprintf(line, sizeof line,
+                      "span (unit)    %llu tasks (sum of the steps' critical paths in tasks; "
+                      "longest step %llu)\n",
+                      static_cast<unsigned long long>(s.span_tasks),
+                      static_cast<unsigned long long>(s.span_tasks_max)));
+  }
+  out += "host           " + duration_text(s.host_ns) +
+         " (sum of the engine's work outside the tasks)\n";
+  if (timed)
+    add(std::snprintf(line, sizeof line, "parallelism    %.2f (work / span)\n", s.parallelism));
+  if (s.unit_cost)
+    add(std::snprintf(line, sizeof line, "parallelism    %.2f (unit costs: work / span in tasks)\n",
+                      s.unit_parallelism));
   add(std::snprintf(line, sizeof line, "structures     %llu distinct\n",
                     static_cast<unsigned long long>(s.distinct_structures)));
   add(std::snprintf(

@@ -195,9 +195,14 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
 
 TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
                                   const std::string& path, const std::string& method,
-                                  std::uint32_t k) {
+                                  std::uint32_t k, PartitionNotes* notes) {
   if (k == 0) throw UsageError("--threads must be at least 1");
-  if (path.empty()) return partition_trace(trace, method, k, Options{}).assignment;
+  if (path.empty()) {
+    const std::string m = method.empty() ? default_method(trace) : method;
+    TracePartition p = partition_trace(trace, m, k, Options{});
+    if (notes != nullptr) *notes = {m, std::move(p.placed_by), std::move(p.warnings)};
+    return std::move(p.assignment);
+  }
   TraceAssignment a = load_assignment(path, trace, trace_name);
   if (a.k != k)
     throw UsageError(path + ": assignment has k = " + std::to_string(a.k) + " but --threads is " +

@@ -127,6 +127,18 @@ class Owner final : public Strategy {
       owner[t] = owner_of(g, t);
       if (owner[t] != kUnowned) object_work[owner[t]] += work[t];
     }
+    // No task works on an object's data: owner-compute has nothing to go by and would put
+    // every task on the processor of the first one. List scheduling places such a graph by
+    // its critical path instead, on every processor its parallelism can use.
+    if (object_work.empty() && k > 1 && n > 0) {
+      Result r = make_list()->partition(g, k, Previous{}, options);
+      r.stats.placed_by = "list";
+      r.stats.warnings.clear();  // partition() adds the empty-processor check for owner
+      r.stats.warnings.push_back(
+          "owner: the tasks have no objects (kNoObject), so owner-compute has nothing to "
+          "place by; placed by list scheduling (list) instead");
+      return r;
+    }
 
     // Longest processing time first: heaviest object to the least loaded processor.
     std::vector<std::pair<ObjectId, std::uint64_t>> objs(object_work.begin(), object_work.end());

@@ -136,7 +136,9 @@ std::string partition_json(const TracePartition& tp, const std::string& output) 
             {"k", tp.assignment.k},
             {"steps", s.steps},
             {"partition_ms", s.partition_ms},
-            {"output", output}};
+            {"output", output},
+            {"placed_by", tp.placed_by},
+            {"warnings", tp.warnings}};
   add_summary(j, s);
   j["per_step"] = per_step;
   return j.dump();

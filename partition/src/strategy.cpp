@@ -112,6 +112,13 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
   a.k = k;
   if (std::string why = validate(g, a, k); !why.empty())
     throw std::logic_error("strategy " + std::string(name()) + ": " + why);
+  // Processors left without a task while there are tasks enough for all of them.
+  std::vector<bool> used(k, false);
+  for (ProcId p : a.proc) used[p] = true;
+  const auto busy = static_cast<std::uint32_t>(std::count(used.begin(), used.end(), true));
+  if (busy < std::min<std::uint64_t>(k, g.tasks.size()))
+    r.stats.warnings.push_back(std::string(name()) + " leaves " + std::to_string(k - busy) +
+                               " of " + std::to_string(k) + " processors without tasks");
 
   if (prev.graph != nullptr) {
     const std::vector<TaskId> match = match_by_key(g, *prev.graph);
@@ -141,7 +148,47 @@ TracePartition partition_trace(const Trace& trace, std::string_view method, std:
     out.assignment.steps.push_back(std::move(r.assignment));
     out.stats.push_back(r.stats);
   }
+  // Each distinct warning once, with the steps it concerns (first and last, count).
+  struct Seen {
+    std::size_t first = 0, last = 0, count = 0;
+  };
+  std::vector<std::pair<std::string, Seen>> seen;
+  std::size_t fell_back = 0;
+  std::string fallback;
+  for (std::size_t i = 0; i < out.stats.size(); ++i) {
+    const Stats& st = out.stats[i];
+    if (!st.placed_by.empty()) {
+      ++fell_back;
+      fallback = st.placed_by;
+    }
+    for (const std::string& w : st.warnings) {
+      auto it = std::find_if(seen.begin(), seen.end(), [&](const auto& x) { return x.first == w; });
+      if (it == seen.end()) it = seen.insert(seen.end(), {w, Seen{i, i, 0}});
+      it->second.last = i;
+      ++it->second.count;
+    }
+  }
+  for (const auto& [w, at] : seen)
+    out.warnings.push_back(w + " (step" +
+                           (at.count == 1 ? " " + std::to_string(at.first)
+                                          : "s " + std::to_string(at.first) + "-" +
+                                                std::to_string(at.last)) +
+                           ", " + std::to_string(at.count) + " of " +
+                           std::to_string(out.stats.size()) + ")");
+  out.placed_by = std::string(method);
+  if (fell_back > 0)
+    out.placed_by = fell_back == out.stats.size() ? fallback : out.placed_by + "+" + fallback;
   return out;
+}
+
+std::string default_method(const Trace& trace) {
+  for (const StepGraph& g : trace.steps) {
+    for (const Task& t : g.tasks)
+      if (t.object != kNoObject) return "owner";
+    for (const Datum& d : g.data)
+      if (d.object != kNoObject) return "owner";
+  }
+  return "list";
 }
 
 CostModel NamedOptions::cost_model() const { return select_cost_model(model, calibration); }

@@ -186,6 +186,19 @@ PYBIND11_MODULE(_tgraph, m) {
                ", parallelism=" + std::to_string(x.parallelism) + ")";
       });
 
+  py::class_<UnitMetrics>(m, "UnitMetrics",
+                          "Work and span of one step in tasks (every task run costs 1)")
+      .def_readonly("work_tasks", &UnitMetrics::work_tasks,
+                    "task runs (a loop body task once per iteration)")
+      .def_readonly("span_tasks", &UnitMetrics::span_tasks,
+                    "hop count of the critical path, loops unrolled")
+      .def_readonly("parallelism", &UnitMetrics::parallelism, "work_tasks / span_tasks")
+      .def("__repr__", [](const UnitMetrics& x) {
+        return "UnitMetrics(work_tasks=" + std::to_string(x.work_tasks) +
+               ", span_tasks=" + std::to_string(x.span_tasks) +
+               ", parallelism=" + std::to_string(x.parallelism) + ")";
+      });
+
   py::class_<StepView>(m, "Step", "One step's task graph (a view into its trace)")
       .def_property_readonly("index", [](const StepView& s) { return s.index; })
       .def_property_readonly("num_tasks", [](const StepView& s) { return s.g().tasks.size(); })
@@ -215,6 +228,9 @@ PYBIND11_MODULE(_tgraph, m) {
       .def_property_readonly("structural_hash",
                              [](const StepView& s) { return s.g().structural_hash(); })
       .def("metrics", [](const StepView& s) { return compute_metrics(s.g()); })
+      .def(
+          "unit_metrics", [](const StepView& s) { return compute_unit_metrics(s.g()); },
+          "work and span in tasks (tgraph info --unit-cost)")
       .def(
           "tasks", [](const StepView& s) { return tasks_table(s.g()); },
           "dict of columns: id, kind, object, object_name, cost_ns, runs, loop, key, accesses")
@@ -261,8 +277,12 @@ PYBIND11_MODULE(_tgraph, m) {
           "metrics",
           [](const TracePtr& t, std::int64_t i) { return compute_metrics(step_of(t, i)); },
           py::arg("i"), "Metrics of step i")
-      .def("_summary_json", [](const Trace& t, const std::string& name) {
-        return trace_summary_json(summarize_trace(t), name);
+      .def(
+          "unit_metrics",
+          [](const TracePtr& t, std::int64_t i) { return compute_unit_metrics(step_of(t, i)); },
+          py::arg("i"), "UnitMetrics of step i: work and span in tasks")
+      .def("_summary_json", [](const Trace& t, const std::string& name, bool unit_cost) {
+        return trace_summary_json(summarize_trace(t, SummaryOptions{.unit_cost = unit_cost}), name);
       });
 
   m.def(

@@ -13,16 +13,19 @@ lists: pandas.DataFrame(step.tasks()) makes a data frame. See docs/python.md.
 import json as _json
 
 from . import _tgraph
-from ._tgraph import Assignment, Error, Metrics, Step, Trace, __version__, read_trace, strategies
+from ._tgraph import (Assignment, Error, Metrics, Step, Trace, UnitMetrics, __version__,
+                      read_trace, strategies)
 
-__all__ = ["Assignment", "Error", "Metrics", "Step", "Trace", "__version__", "evaluate",
+__all__ = ["Assignment", "Error", "Metrics", "Step", "Trace", "UnitMetrics", "__version__",
+           "evaluate",
            "partition", "read_assignment", "read_replay", "read_trace",
            "strategies", "summary"]
 
 
-def summary(trace, name=""):
-    """What `tgraph info --json` prints for this trace, as a dict (same keys and values)."""
-    return _json.loads(trace._summary_json(name))
+def summary(trace, name="", unit_cost=False):
+    """What `tgraph info --json` prints for this trace, as a dict (same keys and values);
+    with unit_cost=True what `tgraph info --unit-cost --json` prints (span_tasks...)."""
+    return _json.loads(trace._summary_json(name, unit_cost))
 
 
 def partition(trace, method, k, imbalance=1.03, seed=0, sticky_base="metis"):

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
-// Barrier baseline (the paper's first attempt): one parallel loop per operation, i.e. per
-// run of consecutive tasks of the same kind in program order, with a barrier after each
-// (OpenMP `omp for`). A run is also cut where a task depends on a task of the same run, so
-// that the barrier is always what orders dependent tasks. CW groups run as one parallel
-// phase (per-writer temporaries) followed by a reduction phase.
+// Barrier baseline (the paper's first attempt): parallel phases (OpenMP `omp for`) with a
+// barrier after each. BarrierRule::kLevel (default): one phase per dependency level of the
+// step's dataflow graph within each loop region, so the barrier is what orders dependent
+// tasks whatever the program order. BarrierRule::kOperation: one phase per run of
+// consecutive tasks of the same kind in program order, cut where a task depends on a task of
+// the same run. Either way CW writers write per-writer temporaries and a reducer phase adds
+// them after the writers.
 #include <omp.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <atomic>
@@ -46,11 +49,62 @@ class BarrierExecutor final : public Executor {
     ThreadCounters c;
   };
 
+  std::shared_ptr<void> build(const ExecGraph& x) override {
+    switch (options_.barrier_rule) {
+      case BarrierRule::kLevel:
+        return build_by_level(x);
+      case BarrierRule::kOperation:
+        return build_by_operation(x);
+    }
+    return build_by_level(x);
+  }
+
+  // Phases by dependency level. The tasks split into loop regions (runs of tasks of one loop
+  // body, or outside loops, in program order), which follow each other with a barrier; in a
+  // region, a task's level is 1 + the highest level of its predecessors in the region (0
+  // without), and each level is one phase, its tasks in program order. Edges from earlier
+  // regions are ordered by the region boundary, loop-carried edges by the barrier ending
+  // each iteration. A loop's conditional break joins the body's last level, after which the
+  // decision is read. The CW writers of one datum have no edges among each other (per-writer
+  // temporaries) and share a phase when nothing else separates them; the reducer that adds
+  // them is one level later.
+  std::shared_ptr<void> build_by_level(const ExecGraph& x) {
+    const StepGraph& g = x.graph;
+    auto plan = std::make_shared<BarrierPlan>();
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    const detail::Csr pred = detail::build_csr(n, g.edges, true);
+    std::vector<std::uint32_t> level(n, 0);
+    for (TaskId first = 0; first < n;) {
+      const LoopId region = g.tasks[first].loop;
+      TaskId end = first + 1;
+      while (end < n && g.tasks[end].loop == region &&
+             !(region != kNoLoop && g.loops[region].first == end))
+        ++end;
+      std::uint32_t top = 0;
+      for (TaskId t = first; t < end; ++t) {
+        for (auto i = pred.begin[t]; i < pred.begin[t + 1]; ++i)
+          if (const TaskId p = pred.ids[i]; p >= first && p < t)
+            level[t] = std::max(level[t], level[p] + 1);
+        top = std::max(top, level[t]);
+      }
+      if (region != kNoLoop) level[end - 1] = top;  // the break ends the body's last phase
+      const auto base = static_cast<std::uint32_t>(plan->phases.size());
+      plan->phases.resize(base + top + 1);
+      for (TaskId t = first; t < end; ++t) plan->phases[base + level[t]].tasks.push_back(t);
+      if (region != kNoLoop) {
+        plan->phases.back().loop_end = region;
+        plan->phases.back().jump = base;
+      }
+      first = end;
+    }
+    return plan;
+  }
+
   // Phases: runs of consecutive tasks of one kind in program order, cut where a task depends
   // on a task of the current phase. Reducers (CW groups lowered per writer) do not cut the
   // run they follow: they gather in a reduction phase that runs right after it, as an
   // OpenMP user writes a parallel loop with a reduction (the loop, then the combine).
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::shared_ptr<void> build_by_operation(const ExecGraph& x) {
     const StepGraph& g = x.graph;
     auto plan = std::make_shared<BarrierPlan>();
     const auto n = static_cast<TaskId>(g.tasks.size());

@@ -30,7 +30,9 @@ CacheMissCounter::CacheMissCounter() {
   attr.exclude_hv = 1;
   const long fd = syscall(SYS_perf_event_open, &attr, 0, -1, -1, 0);
   if (fd < 0) {
-    reason_ = std::strerror(errno);
+    reason_ = std::string("not counted: the kernel refused hardware performance counters "
+                          "(perf_event_open: ") +
+              std::strerror(errno) + ")";
     return;
   }
   fd_ = static_cast<int>(fd);
@@ -195,6 +197,10 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   }
   r.wall_ns = median(r.pass_wall_ns);
   r.sequential_wall_ns = median(r.sequential_pass_wall_ns);
+  if (o.policy == Policy::kSequential) {  // its own baseline: speed-up 1 by definition
+    r.sequential_wall_ns = r.wall_ns;
+    for (StepMeasure& m : r.steps) m.sequential_wall_ns = m.wall_ns;
+  }
   r.plans_built = ex->plans_built();
   r.cw = ex->cw();
   r.scope = ex->scope();
@@ -202,7 +208,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   if (misses.available()) {
     r.cache_misses = misses.read() - misses0;
   } else {
-    r.cache_misses_note = "unavailable (" + misses.reason() + ")";
+    r.cache_misses_note = misses.reason();
   }
 
   if (o.observe) {
@@ -298,6 +304,7 @@ std::string to_json(const ReplayResult& r) {
               {"working_set_bytes", r.working_set_bytes}}},
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
+  j["warnings"] = r.warnings;
   const auto pred = r.predicted_makespan_ns();
   j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
   // Ratio of measured to predicted, both without plan builds: the sum over steps of the

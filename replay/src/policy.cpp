@@ -68,4 +68,21 @@ std::string_view to_string(ReduceScope scope) {
   return "?";
 }
 
+std::string_view to_string(BarrierRule rule) {
+  switch (rule) {
+    case BarrierRule::kLevel:
+      return "level";
+    case BarrierRule::kOperation:
+      return "operation";
+  }
+  return "?";
+}
+
+BarrierRule barrier_rule_flag(std::string_view name, std::string_view flag) {
+  if (name == "level") return BarrierRule::kLevel;
+  if (name == "operation") return BarrierRule::kOperation;
+  throw UsageError(std::string(flag) + ": expected level or operation, got '" +
+                   std::string(name) + "'");
+}
+
 }  // namespace tgraph::replay

@@ -53,6 +53,9 @@ CaptureRun capture_scene(const CaptureOptions& o) {
   capture::Recorder rec(o.no_capture ? capture::Mode::kOff : capture::Mode::kCapture);
   run.mode = std::string(capture::to_string(rec.mode()));
   rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
+  if (o.cost_passes == 0) throw UsageError("capture: --cost-passes must be >= 1");
+  rec.set_cost_passes(o.cost_passes);
+  run.cost_passes = o.cost_passes;
   std::unique_ptr<TraceWriter> writer;
   if (!o.no_capture)
     writer = std::make_unique<TraceWriter>(o.output, scene_header(*scene, o.scene_options.seed));
@@ -106,6 +109,7 @@ CaptureRun capture_scene(const CaptureOptions& o) {
     }
     run.file_bytes = writer->bytes_written();
   }
+  run.single_pass_runs = rec.single_pass_runs();
   if (rec.errors() != 0)
     throw CaptureFailure("capture: the recorder reported " + std::to_string(rec.errors()) +
                          " API misuse(s)");
@@ -128,6 +132,8 @@ std::string capture_json(const CaptureRun& r, const CaptureOptions& o) {
   j["step_ms"] = r.step_ms;
   j["cg_iterations"] = r.cg_iterations;
   j["groups"] = r.groups;
+  j["cost_passes"] = r.cost_passes;
+  j["single_pass_runs"] = r.single_pass_runs;
   return j.dump();
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/version.hpp"
 
 namespace {
 
@@ -61,6 +62,18 @@ TEST_F(Cli, UnknownVerbExits2WithOneLine) {
   const Result r = run("frobnicate");
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;
+}
+
+TEST_F(Cli, VersionPrintsTheProjectVersionFromVersionHeader) {
+  const Result r = run("--version");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out, "tgraph " + std::string(tgraph::kVersionString) + "\n");
+  // One source: the project version in CMakeLists.txt (TGRAPH_VERSION, set by CMake).
+  EXPECT_EQ(tgraph::kVersionString, TGRAPH_VERSION);
+  EXPECT_EQ(std::to_string(tgraph::kVersionMajor) + "." + std::to_string(tgraph::kVersionMinor) +
+                "." + std::to_string(tgraph::kVersionPatch),
+            TGRAPH_VERSION);
+  EXPECT_EQ(tgraph::linked_version(), tgraph::kVersionString);
 }
 
 TEST_F(Cli, InfoOnMissingFileExits2NamingIt) {
@@ -190,6 +203,136 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
   const std::string html = slurp(dir_ / "d" / "report.html");
   EXPECT_NE(html.find("<table>"), std::string::npos);
   EXPECT_NE(html.find("worksteal"), std::string::npos);
+}
+
+// A step whose tasks have no object (kNoObject tasks and data, as an engine outside physics
+// declares them): a setup task writes a shared table, then `layers` layers of `width` tasks
+// each read the table and the data of two tasks of the layer before and write their own.
+// Owner-compute by data affinity alone would follow the table onto one processor.
+void write_objectless_trace(const fs::path& path, int layers, int width, std::uint64_t cost_ns) {
+  tgraph::Trace trace;
+  trace.header.scene = "layers";
+  trace.header.engine = "cli_test";
+  tgraph::StepGraph& g = trace.steps.emplace_back();
+  const tgraph::KindId k = g.intern_kind("cell");
+  g.data.push_back({"table", tgraph::kNoObject, 65536});
+  g.add_task(g.intern_kind("setup"), tgraph::kNoObject,
+             std::vector<tgraph::Access>{{0, tgraph::AccessMode::W}}, cost_ns, 999999);
+  for (int l = 0; l < layers; ++l)
+    for (int i = 0; i < width; ++i) {
+      const auto d = static_cast<tgraph::DatumId>(g.data.size());
+      g.data.push_back({"d" + std::to_string(l) + "_" + std::to_string(i), tgraph::kNoObject, 64});
+      std::vector<tgraph::Access> acc{{d, tgraph::AccessMode::W}, {0, tgraph::AccessMode::R}};
+      if (l > 0) {
+        const auto prev = static_cast<tgraph::DatumId>(1 + (l - 1) * width);
+        acc.push_back({static_cast<tgraph::DatumId>(prev + i), tgraph::AccessMode::R});
+        acc.push_back({static_cast<tgraph::DatumId>(prev + (i + 1) % width), tgraph::AccessMode::R});
+      }
+      g.add_task(k, tgraph::kNoObject, acc, cost_ns, static_cast<tgraph::StableKey>(d + 1));
+    }
+  tgraph::write_trace(path.string(), trace);
+}
+
+TEST_F(Cli, OwnerOnAGraphWithoutObjectsFallsBackToListSchedulingAndSaysSo) {
+  write_objectless_trace(dir_ / "t.tgt", 4, 8, 1000);
+  Result r = run("partition t.tgt --method owner -k 2 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("tgraph: warning: owner: the tasks have no objects"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("list"), std::string::npos) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["placed_by"], "list");
+  EXPECT_EQ(j["warnings"].size(), 1u);
+  // A strategy that leaves a processor empty is reported too.
+  r = run("partition t.tgt --method single -k 2");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("single leaves 1 of 2 processors without tasks"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, ReplayWithoutAnAssignmentUsesEveryThreadOnAGraphWithoutObjectsAndNamesTheStrategy) {
+  write_objectless_trace(dir_ / "t.tgt", 4, 8, 1000);
+  Result r = run("replay t.tgt --threads 2 --repeat 1 --no-pin --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["assignment"], "list (computed, default for a trace without objects)");
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
+  for (const auto& t : j["per_step"][0]["threads"]) EXPECT_GT(t["tasks"].get<int>(), 0) << j.dump();
+  // Named explicitly, owner falls back and the assignment says whose strategy ran.
+  r = run("replay t.tgt --threads 2 --repeat 1 --no-pin --method owner --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["assignment"], "list (computed, fallback of owner)");
+  EXPECT_EQ(j["warnings"].size(), 1u);
+  EXPECT_NE(r.err.find("warning: owner"), std::string::npos) << r.err;
+  // On a physics trace the default stays owner.
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  r = run("replay f.tgt --threads 2 --repeat 1 --no-pin --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["assignment"], "owner (computed, default)");
+}
+
+TEST_F(Cli, InfoUnitCostGivesTheSpanInTasks) {
+  write_objectless_trace(dir_ / "t.tgt", 5, 8, 0);  // no costs recorded
+  Result r = run("info t.tgt --unit-cost --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["span_tasks"], 6);  // setup, then one task per layer
+  EXPECT_EQ(j["work_tasks"], 41);
+  EXPECT_EQ(j["span_tasks_max"], 6);
+  EXPECT_EQ(j["per_step"][0]["span_tasks"], 6);
+  EXPECT_DOUBLE_EQ(j["unit_parallelism"].get<double>(), 41.0 / 6.0);
+  // The text never claims a span of 0 ms for a trace without costs: it gives the tasks.
+  r = run("info t.tgt");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.find("0.000 ms"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("span (unit)    6 tasks"), std::string::npos) << r.out;
+  // A timed trace: the totals say they sum over steps, with the longest step's span.
+  ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
+  r = run("info f.tgt --json");
+  j = nlohmann::json::parse(r.out);
+  std::uint64_t longest = 0;
+  for (const auto& st : j["per_step"]) longest = std::max(longest, st["span_ns"].get<std::uint64_t>());
+  EXPECT_EQ(j["span_max_ns"], longest);
+  EXPECT_FALSE(j.contains("span_tasks"));  // only with --unit-cost
+  r = run("info f.tgt");
+  EXPECT_NE(r.out.find("sum of the steps' critical paths; longest step"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, SequentialReplayIsItsOwnBaselineWithSpeedupOne) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  const Result r = run("replay f.tgt --policy sequential --repeat 1 --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["speedup"], 1.0);
+  EXPECT_EQ(j["sequential_wall_ns"], j["wall_ns"]);
+}
+
+TEST_F(Cli, BarrierRuleFlagChoosesThePhasesAndRejectsUnknownRules) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  for (const char* rule : {"level", "operation"}) {
+    const Result r = run(std::string("replay f.tgt --policy barrier --threads 2 --repeat 1 --no-pin --barrier-rule ") + rule);
+    EXPECT_EQ(r.code, 0) << rule << ": " << r.err;
+  }
+  const Result bad = run("replay f.tgt --policy barrier --barrier-rule task");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_TRUE(one_line(bad.err)) << bad.err;
+  EXPECT_NE(bad.err.find("--barrier-rule"), std::string::npos) << bad.err;
+}
+
+TEST_F(Cli, CapturePassesKeepTheGraphAndRejectZero) {
+  Result r = run("capture --scene fig2 --steps 3 --cost-passes 3 -o f3.tgt --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["cost_passes"], 3);
+  EXPECT_EQ(j["single_pass_runs"], 0);
+  ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f1.tgt").code, 0);
+  const auto a = nlohmann::json::parse(run("info f1.tgt --json").out);
+  const auto b = nlohmann::json::parse(run("info f3.tgt --json").out);
+  EXPECT_EQ(a["tasks"], b["tasks"]);
+  EXPECT_EQ(a["edges"], b["edges"]);
+  EXPECT_EQ(a["distinct_structures"], b["distinct_structures"]);
+  r = run("capture --scene fig2 --steps 3 --cost-passes 0 -o f0.tgt");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_FALSE(fs::exists(dir_ / "f0.tgt"));
 }
 
 TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {

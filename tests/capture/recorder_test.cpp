@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstring>
 #include <ranges>
 #include <span>
 #include <vector>
@@ -309,6 +310,65 @@ TEST(Recorder, SampledLoopTimingEstimatesThePerIterationCost) {
   // Timed: iterations 0, 1, 2, 4, 8, 12, 16; each cost at least 200 us.
   EXPECT_GE(g.tasks[0].cost_ns, 200'000u);
   EXPECT_LT(g.tasks[0].cost_ns, 2'000'000u);
+}
+
+}  // namespace
+}  // namespace tgraph::capture
+
+namespace tgraph::capture {
+namespace {
+
+// Cost passes: the ball scene's state after every step equals a run with one pass, bit for
+// bit (the written data are restored between passes), and bodies run `passes` times.
+TEST(Recorder, CostPassesLeaveTheStateOfOneRunBitForBit) {
+  Scene once(Mode::kCapture), five(Mode::kCapture);
+  five.rec.set_cost_passes(5);
+  EXPECT_EQ(five.rec.cost_passes(), 5u);
+  for (int s = 0; s < 4; ++s) {
+    once.step();
+    const StepGraph a = once.rec.end_step();
+    five.step();
+    const StepGraph b = five.rec.end_step();
+    EXPECT_TRUE(a.same_structure(b));
+    EXPECT_EQ(a.loops[0].iterations, b.loops[0].iterations);
+    EXPECT_EQ(std::memcmp(&once.x, &five.x, sizeof(double)), 0) << "step " << s;
+    EXPECT_EQ(std::memcmp(&once.v, &five.v, sizeof(double)), 0) << "step " << s;
+    EXPECT_EQ(std::memcmp(&once.res, &five.res, sizeof(double)), 0) << "step " << s;
+  }
+  EXPECT_EQ(five.rec.single_pass_runs(), 0u);
+  EXPECT_EQ(five.rec.errors(), 0u);
+}
+
+TEST(Recorder, CostPassesKeepTheMedianSoOnePreemptedRunDoesNotSetTheCost) {
+  Recorder rec(Mode::kCapture);
+  double y = 0;
+  const DatumId d = rec.datum("y", kNoObject, sizeof y, &y);
+  const KindId k = rec.kind("k");
+  rec.set_cost_passes(3);
+  rec.begin_step();
+  int runs = 0;
+  rec.task(k, kNoObject, {{d, AccessMode::RW}}, [&] {
+    y += 1.0;
+    if (runs++ == 0) busy_wait(std::chrono::milliseconds(30));  // the "preempted" pass
+  });
+  const StepGraph g = rec.end_step();
+  EXPECT_EQ(runs, 3);
+  EXPECT_EQ(y, 1.0);  // restored before passes 2 and 3: one run's effect
+  EXPECT_LT(g.tasks[0].cost_ns, 15'000'000u);
+}
+
+TEST(Recorder, TasksWritingDataWithoutStorageAreTimedOnceAndCounted) {
+  Recorder rec(Mode::kCapture);
+  const DatumId d = rec.datum("opaque", kNoObject, 8);  // no pointer: cannot be restored
+  const KindId k = rec.kind("k");
+  rec.set_cost_passes(4);
+  rec.begin_step();
+  int runs = 0;
+  rec.task(k, kNoObject, {{d, AccessMode::W}}, [&] { ++runs; });
+  rec.task(k, kNoObject, {{d, AccessMode::R}}, [&] { ++runs; });  // reads only: repeated
+  rec.end_step();
+  EXPECT_EQ(runs, 1 + 4);
+  EXPECT_EQ(rec.single_pass_runs(), 1u);
 }
 
 }  // namespace

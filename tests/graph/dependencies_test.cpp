@@ -30,6 +30,24 @@ struct G {
 
 Edge E(TaskId from, TaskId to, DatumId d, EdgeKind k) { return {from, to, d, k}; }
 
+// The worked example of docs/design.md ("Dependency rules"): x = 0, f = 1.
+TEST(Dependencies, DesignDocWorkedExampleGivesTheEdgesItLists) {
+  G g(2);
+  g.t({{1, M::W}});                // 0 resetForce
+  g.t({{0, M::R}, {1, M::CW}});    // 1 springA
+  g.t({{0, M::R}, {1, M::CW}});    // 2 springB
+  g.t({{1, M::R}, {0, M::RW}});    // 3 integrate
+  g.t({{1, M::W}});                // 4 clearForce
+  g.t({{1, M::RW}});               // 5 scaleForce
+  g.t({{1, M::W}});                // 6 resetForce
+  EXPECT_EQ(g.edges(), (std::vector<Edge>{
+                           E(0, 1, 1, EdgeKind::WAW), E(0, 2, 1, EdgeKind::WAW),
+                           E(1, 3, 0, EdgeKind::WAR), E(1, 3, 1, EdgeKind::RAW),
+                           E(2, 3, 0, EdgeKind::WAR), E(2, 3, 1, EdgeKind::RAW),
+                           E(3, 4, 1, EdgeKind::WAR), E(4, 5, 1, EdgeKind::RAW),
+                           E(5, 6, 1, EdgeKind::WAW)}));
+}
+
 TEST(Dependencies, ReadAfterWriteGivesRawEdge) {
   G g(1);
   g.t({{0, M::W}});

@@ -73,6 +73,20 @@ TEST(Metrics, ForkJoinSpanIsLongestBranch) {
   EXPECT_EQ(m.edges, 6u);
 }
 
+TEST(UnitMetrics, CountTasksOnTheCriticalPathWithLoopsUnrolled) {
+  // Unit costs: 0 ends at 1; iterations end their break at 3, 5, 7; body task 1 of the last
+  // iteration ends at 6; task 3 reads x: 7. Work: 1 + 3 x 2 + 1 = 8 task runs.
+  const UnitMetrics u = compute_unit_metrics(loop_graph(false));
+  EXPECT_EQ(u.span_tasks, 7u);
+  EXPECT_EQ(u.work_tasks, 8u);
+  EXPECT_DOUBLE_EQ(u.parallelism, 8.0 / 7.0);
+  // The independent task costs 20 ns and sets the timed span, but it is one hop.
+  const StepGraph g = loop_graph(true);
+  EXPECT_EQ(compute_metrics(g).span_ns, 20u);
+  EXPECT_EQ(compute_unit_metrics(g).span_tasks, 7u);
+  EXPECT_EQ(compute_unit_metrics(StepGraph{}).parallelism, 0.0);
+}
+
 TEST(Metrics, EmptyGraphHasZeroParallelism) {
   StepGraph g;
   g.derive_edges();

@@ -120,6 +120,36 @@ TEST(TraceSummary, JsonAndTextCarryTheFigures) {
       std::string::npos);
 }
 
+TEST(TraceSummary, TotalsSayTheySumOverStepsAndGiveTheLongestStep) {
+  Trace t;
+  t.steps = {step(false, 3, 1000), step(false, 5, 1000)};
+  const TraceSummary s = summarize_trace(t);
+  EXPECT_EQ(s.span_ns, s.per_step[0].span_ns + s.per_step[1].span_ns);
+  EXPECT_EQ(s.span_max_ns, std::max(s.per_step[0].span_ns, s.per_step[1].span_ns));
+  EXPECT_FALSE(s.unit_cost);
+  const nlohmann::json j = nlohmann::json::parse(trace_summary_json(s, "t.tgt"));
+  EXPECT_EQ(j["span_max_ns"], s.span_max_ns);
+  EXPECT_FALSE(j.contains("span_tasks"));
+  const TraceSummary u = summarize_trace(t, {.unit_cost = true});
+  EXPECT_TRUE(u.unit_cost);
+  EXPECT_EQ(u.span_tasks, u.per_step[0].span_tasks + u.per_step[1].span_tasks);
+  EXPECT_EQ(u.span_tasks_max, std::max(u.per_step[0].span_tasks, u.per_step[1].span_tasks));
+  EXPECT_GT(u.span_tasks_max, 0u);
+}
+
+TEST(TraceSummary, UnitCostTraceGivesItsSpanInTasksNotZeroMilliseconds) {
+  Trace t;
+  t.steps = {step(false, 3, 1000)};
+  for (Task& task : t.steps[0].tasks) task.cost_ns = 1;  // unit costs
+  const TraceSummary s = summarize_trace(t);
+  EXPECT_TRUE(s.unit_cost);  // on by itself: the timed span says nothing
+  const std::string text = trace_summary_text(s, "u.tgt");
+  EXPECT_EQ(text.find("0.000 ms"), std::string::npos) << text;
+  EXPECT_NE(text.find("span (unit)    " + std::to_string(s.span_tasks) + " tasks"),
+            std::string::npos)
+      << text;
+}
+
 TEST(TraceSummary, OfAnEmptyTraceIsZero) {
   const TraceSummary s = summarize_trace(Trace{});
   EXPECT_EQ(s.steps, 0u);

@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
 # Installs the build into a temporary prefix, then, as a user of the package would:
-# builds examples/instrument-your-engine with find_package(tgraph) and again with
-# pkg-config, runs it to write a trace and checks the trace with the installed
+# builds one consumer per component (tests/install/consumers: find_package(tgraph COMPONENTS
+# <one>), calls into it and checks the results; capture's without oneTBB), checks that a
+# component whose dependency is missing is refused by name; builds examples/tiled-lu
+# (capture only, LAPACKE/CBLAS) and checks its trace's task and edge counts against the
+# analytic ones; builds examples/instrument-your-engine with find_package(tgraph) (every
+# component) and again with pkg-config, runs it and checks its trace with the installed
 # `tgraph info --json`; then imports the installed Python module and runs pytest on it.
 #   check_install.sh BUILD_DIR SOURCE_DIR [PYTHON]   (PYTHON: the interpreter with pytest)
 set -euo pipefail
@@ -17,16 +21,78 @@ step() { echo "== $*"; }
 step "install into $prefix"
 cmake --install "$build" --prefix "$prefix" > "$tmp/install.log"
 for f in bin/tgraph include/tgraph/capture/recorder.hpp include/tgraph/graph/trace_io.hpp \
+         include/tgraph/version.hpp \
          lib/cmake/tgraph/tgraphConfig.cmake lib/cmake/tgraph/tgraphConfigVersion.cmake \
          lib/pkgconfig/tgraph.pc; do
   [ -e "$prefix/$f" ] || { echo "missing after install: $f" >&2; exit 1; }
 done
 
+# configure_and_build SRC BUILD [cmake args...]: the default generator, like a new user.
+configure_and_build() {
+  local srcdir="$1" bdir="$2"
+  shift 2
+  cmake -S "$srcdir" -B "$bdir" -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$prefix" "$@" \
+    > "$bdir.configure.log" 2>&1 || { cat "$bdir.configure.log"; return 1; }
+  cmake --build "$bdir" -j 2 > "$bdir.build.log" 2>&1 || { cat "$bdir.build.log"; return 1; }
+}
+
+consumers="$src/tests/install/consumers"
+for component in graph capture partition replay viz; do
+  if [ ! -f "$prefix/lib/cmake/tgraph/tgraph-$component-targets.cmake" ]; then
+    echo "== component $component not built (TGRAPH_SKIP_MODULES): no consumer"
+    continue
+  fi
+  args=(-DCOMPONENT="$component")
+  note=""
+  if [ "$component" = capture ]; then
+    # The capture API needs none of the other modules' libraries.
+    args+=(-DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON -DCMAKE_DISABLE_FIND_PACKAGE_OpenMP=ON
+           -DCMAKE_DISABLE_FIND_PACKAGE_Eigen3=ON)
+    note=" (oneTBB, OpenMP and Eigen disabled)"
+  fi
+  step "consumer of tgraph::$component: configure$note, build, run"
+  configure_and_build "$consumers" "$tmp/consumer-$component" "${args[@]}"
+  "$tmp/consumer-$component/consumer"
+done
+
+if [ -f "$prefix/lib/cmake/tgraph/tgraph-replay-targets.cmake" ]; then
+  step "find_package(tgraph COMPONENTS replay) without oneTBB is refused, naming it"
+  if cmake -S "$consumers" -B "$tmp/consumer-no-tbb" -DCMAKE_PREFIX_PATH="$prefix" \
+       -DCOMPONENT=replay -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON > "$tmp/consumer-no-tbb.log" 2>&1; then
+    echo "configured tgraph::replay without oneTBB" >&2; exit 1
+  fi
+  # (CMake wraps the message: joined into one line first)
+  tr -s ' \n' '  ' < "$tmp/consumer-no-tbb.log" | grep -q "replay needs TBB::tbb (Debian libtbb-dev)" ||
+    { cat "$tmp/consumer-no-tbb.log"; echo "the refusal does not name TBB::tbb" >&2; exit 1; }
+fi
+
+lu="$src/examples/tiled-lu"
+step "configure and build $lu against the package (capture only, LAPACKE/CBLAS)"
+configure_and_build "$lu" "$tmp/lu" -DCMAKE_DISABLE_FIND_PACKAGE_TBB=ON
+nt=6
+"$tmp/lu/tiled_lu" "$nt" 32 "$tmp/lu.tgt" 3
+"$prefix/bin/tgraph" info "$tmp/lu.tgt" --json > "$tmp/lu.json"
+"$python" - "$tmp/lu.json" "$nt" <<'PY'
+import json, sys
+j, nt = json.load(open(sys.argv[1])), int(sys.argv[2])
+# Step k (m = NT-k-1 tiles below and right of the diagonal): 1 GETRF, 2m TRSM, m^2 GEMM.
+tasks = sum(1 + 2 * m + m * m for m in range(nt))
+# Tile (i,j), p = min(i,j), is updated in place (RW) by the GEMMs of steps 0..p-1, then by
+# GETRF or TRSM at step p, with no reader between: a RAW chain of p edges (RW after RW is
+# RAW, never WAW). Then it is only read: (p,p) by the 2m TRSMs of step p, each of the 2m
+# panel tiles of step p by m GEMMs: RAW edges from the final writer, no WAR (no later write).
+chains = sum(min(i, j) for i in range(nt) for j in range(nt))
+reads = sum(2 * m + 2 * m * m for m in range(nt))
+edges = chains + reads
+got = [(s["tasks"], s["edges"]) for s in j["per_step"]]
+if j["steps"] != 3 or any(g != (tasks, edges) for g in got):
+    sys.exit(f"tiled LU {nt}x{nt}: expected {tasks} tasks and {edges} edges per step, got {got}")
+print(f"ok: tiled LU {nt}x{nt}: {tasks} tasks and {edges} edges per step, as derived")
+PY
+
 example="$src/examples/instrument-your-engine"
 step "configure and build $example against the package"
-cmake -S "$example" -B "$tmp/example" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_PREFIX_PATH="$prefix" > "$tmp/configure.log" || { cat "$tmp/configure.log"; exit 1; }
-cmake --build "$tmp/example" > "$tmp/build.log" || { cat "$tmp/build.log"; exit 1; }
+configure_and_build "$example" "$tmp/example"
 
 step "run it: 20 steps -> springs.tgt (it reads the trace back and checks it)"
 "$tmp/example/springs" 20 "$tmp/springs.tgt"

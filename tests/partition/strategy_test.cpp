@@ -146,6 +146,60 @@ TEST(Owner, BalancesObjectsByMeasuredCostNotByCount) {
   EXPECT_EQ(l[1], 90u);
 }
 
+// Four independent chains of four tasks on shared data only (no objects, as an STG import).
+StepGraph chains_without_objects() {
+  Builder b;
+  for (int c = 0; c < 4; ++c) {
+    const DatumId x = b.datum(testing::name("x", c), 8);
+    for (int i = 0; i < 4; ++i) b.task({{x, M::RW}}, 100);
+  }
+  return b.done();
+}
+
+TEST(Owner, FallsBackToListSchedulingWithAWarningWhenTheTasksHaveNoObjects) {
+  const StepGraph g = chains_without_objects();
+  const Result r = make_strategy("owner")->partition(g, 2, {}, {});
+  EXPECT_EQ(r.stats.placed_by, "list");
+  ASSERT_EQ(r.stats.warnings.size(), 1u);
+  EXPECT_NE(r.stats.warnings[0].find("no objects"), std::string::npos) << r.stats.warnings[0];
+  EXPECT_EQ(r.assignment.proc, make_strategy("list")->partition(g, 2, {}, {}).assignment.proc);
+  const auto l = loads_of(g, r.assignment);
+  EXPECT_EQ(l[0], 800u);  // two chains on each processor
+  EXPECT_EQ(l[1], 800u);
+  // With objects, owner places by them and says nothing.
+  const Result with = make_strategy("owner")->partition(objects_scene(4, {}), 2, {}, {});
+  EXPECT_TRUE(with.stats.placed_by.empty());
+  EXPECT_TRUE(with.stats.warnings.empty());
+}
+
+TEST(Strategy, WarnsWhenProcessorsAreLeftWithoutTasksAndTheTraceSaysWhichSteps) {
+  Trace t;
+  t.steps = {chains_without_objects(), chains_without_objects()};
+  const TracePartition single = partition_trace(t, "single", 3);
+  ASSERT_EQ(single.warnings.size(), 1u);
+  EXPECT_EQ(single.warnings[0], "single leaves 2 of 3 processors without tasks (steps 0-1, 2 of 2)");
+  EXPECT_EQ(single.placed_by, "single");
+  const TracePartition owner = partition_trace(t, "owner", 2);
+  EXPECT_EQ(owner.placed_by, "list");
+  ASSERT_EQ(owner.warnings.size(), 1u);
+  EXPECT_NE(owner.warnings[0].find("placed by list scheduling"), std::string::npos);
+  EXPECT_TRUE(partition_trace(t, "list", 2).warnings.empty());
+  // More processors than tasks: nobody can fill them, so no warning.
+  Builder b;
+  b.task({{b.datum("x", 8), M::W}}, 10);
+  Trace one;
+  one.steps = {b.done()};
+  EXPECT_TRUE(partition_trace(one, "single", 4).warnings.empty());
+}
+
+TEST(Strategy, DefaultMethodIsOwnerWithObjectsAndListWithout) {
+  Trace without, with;
+  without.steps = {chains_without_objects()};
+  with.steps = {objects_scene(2, {})};
+  EXPECT_EQ(default_method(without), "list");
+  EXPECT_EQ(default_method(with), "owner");
+}
+
 TEST(Metis, BalancesEachPhaseInMultiConstraintMode) {
   // Phase 1: 16 producers; phase 2: 16 consumers each reading two producers' data.
   Builder b;

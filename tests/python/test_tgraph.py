@@ -148,6 +148,21 @@ def test_stg_import_keeps_the_stated_critical_path(tmp_path):
     assert t.metrics(0).span_ns == imported["cp_length"] * 1000
 
 
+def test_unit_metrics_count_tasks_as_info_unit_cost_does(fig2):
+    # Figure 2: reset -> addForce -> updateVelocity -> updatePosition is the longest chain
+    # (4 tasks) of 9 tasks per step, whatever the measured costs.
+    info = cli_json("info", fig2, "--unit-cost")
+    t = tgraph.read_trace(fig2)
+    for s, row in enumerate(info["per_step"]):
+        u = t.unit_metrics(s)
+        assert u.span_tasks == row["span_tasks"] == 4
+        assert u.work_tasks == row["work_tasks"] == 9
+        assert u.parallelism == pytest.approx(9 / 4)
+        assert t.step(s).unit_metrics().span_tasks == 4
+    assert info["span_tasks"] == 4 * t.steps
+    assert tgraph.summary(t, fig2, unit_cost=True) == info
+
+
 def test_read_replay_returns_the_json_of_tgraph_replay(fig2, tmp_path):
     timeline = tmp_path / "r.json"
     out = tmp_path / "replay.json"

@@ -23,6 +23,7 @@ struct Variant {
   Policy policy;
   bool serial;
   const char* name;
+  BarrierRule rule = BarrierRule::kLevel;
 };
 
 const Variant kVariants[] = {
@@ -30,6 +31,7 @@ const Variant kVariants[] = {
     {Policy::kPartition, true, "partition_serial"},
     {Policy::kWorksteal, false, "worksteal"},
     {Policy::kBarrier, false, "barrier"},
+    {Policy::kBarrier, false, "barrier_operation", BarrierRule::kOperation},
 };
 
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
@@ -45,6 +47,7 @@ ExecOptions options_for(const Variant& v, std::uint32_t k) {
   o.threads = k;
   o.serial = v.serial;
   o.spin_ns = 20'000;
+  o.barrier_rule = v.rule;
   return o;
 }
 
@@ -81,7 +84,7 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads1To8, EveryPolicy,
-                         ::testing::Combine(::testing::Range(0, 4), ::testing::Range(1u, 9u)),
+                         ::testing::Combine(::testing::Range(0, 5), ::testing::Range(1u, 9u)),
                          [](const auto& param_info) {
                            return std::string(kVariants[std::get<0>(param_info.param)].name) +
                                   "_k" + std::to_string(std::get<1>(param_info.param));

@@ -86,6 +86,16 @@ struct StepProgram {
 /// leaving out the longest one when there are 3 or more and it is over 4x the mean of the
 /// others, so that one preemption by the OS does not inflate the span; in deferred mode conditional_break returns true
 /// after recording the body once, and the executor iterates.
+///
+/// Cost passes (set_cost_passes(N), `tgraph capture --cost-passes N`): in capture mode each
+/// timed run of a task body, in a loop or not, runs N times and counts the median of the N
+/// timings, so that one preempted run does not set the task's cost. Before the first pass
+/// the recorder copies the data the task writes (W, RW, CW) from their storage (the `ptr`
+/// given to datum()), and restores them before every later pass: each pass starts from the
+/// same state and the state after the task is what one run leaves, bit for bit. A task that
+/// writes a datum declared without storage cannot be restored and is timed once
+/// (single_pass_runs() counts them). Bodies must depend only on the data they declare, as
+/// the dataflow graph assumes anyway. Scopes (RAII) and break conditions are timed once.
 class Recorder {
  public:
   /// Loop iterations always timed in capture mode.
@@ -97,6 +107,13 @@ class Recorder {
 
   /// Current mode.
   Mode mode() const { return mode_; }
+  /// Timed passes of every task body in capture mode (median kept; default 1; 0 counts as 1).
+  void set_cost_passes(std::uint32_t passes) { cost_passes_ = passes == 0 ? 1 : passes; }
+  /// Timed passes per task body (set_cost_passes).
+  std::uint32_t cost_passes() const { return cost_passes_; }
+  /// Task runs timed once although cost passes were asked: they write a datum declared
+  /// without storage, which the recorder cannot restore between passes. Since construction.
+  std::uint64_t single_pass_runs() const { return single_pass_runs_; }
   /// Whether end_step() derives the graph's edges (default true). A capture that only
   /// streams steps to a trace file turns it off: traces do not store edges, readers derive
   /// them, and the capture's hot path saves the time.
@@ -236,6 +253,10 @@ class Recorder {
           record(kind, obj, acc, n, 0);
           return;
         }
+        if (cost_passes_ > 1) {
+          record(kind, obj, acc, n, median_of_passes(acc, n, body));
+          return;
+        }
         const std::uint64_t t0 = detail::ticks();
         body();
         record(kind, obj, acc, n, detail::ticks() - t0);
@@ -263,6 +284,29 @@ class Recorder {
     return append_task(kind, obj, acc, n, ticks);
   }
   bool append_task(KindId kind, ObjectId obj, const Access* acc, std::size_t n, std::uint64_t ticks);
+  // Runs `body` cost_passes_ times from the same state (the written data restored between
+  // passes) and returns the median of the timings, in ticks; once when it cannot restore.
+  template <class F>
+  std::uint64_t median_of_passes(const Access* acc, std::size_t n, F& body) {
+    const bool restorable = save_written(acc, n);
+    if (!restorable) ++single_pass_runs_;
+    const std::uint32_t passes = restorable ? cost_passes_ : 1;
+    pass_ticks_.clear();
+    for (std::uint32_t p = 0; p < passes; ++p) {
+      if (p > 0) restore_written(acc, n);
+      const std::uint64_t t0 = detail::ticks();
+      body();
+      pass_ticks_.push_back(detail::ticks() - t0);
+    }
+    return median_ticks();
+  }
+  // Copies the bytes of every datum the accesses write into saved_; false (nothing saved)
+  // when one of them has no storage pointer.
+  bool save_written(const Access* acc, std::size_t n);
+  // Copies saved_ back (the same accesses as the last save_written).
+  void restore_written(const Access* acc, std::size_t n);
+  // Median of pass_ticks_ (the lower middle one for an even count).
+  std::uint64_t median_ticks();
   // Returns true when the loop has reached its maximum iteration count.
   bool record_break(LoopId loop, std::uint64_t ticks);
   // FNV-1a of a name, cached per object / kind id for stable keys.
@@ -298,6 +342,10 @@ class Recorder {
   bool time_task_ = true;                   // time the tasks of the current iteration
   std::vector<std::uint32_t> loop_timed_;   // per loop: timed iterations so far
   std::uint64_t errors_ = 0;
+  std::uint32_t cost_passes_ = 1;           // timed passes per body (capture mode)
+  std::uint64_t single_pass_runs_ = 0;      // runs timed once: unrestorable written data
+  std::vector<unsigned char> saved_;        // written data of the task being timed
+  std::vector<std::uint64_t> pass_ticks_;   // timings of its passes
 };
 
 }  // namespace tgraph::capture

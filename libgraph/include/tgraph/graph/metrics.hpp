@@ -36,4 +36,16 @@ Metrics compute_metrics(const StepGraph& g);
 /// unlimited processors; the span is the maximum. Same rules as compute_metrics.
 std::vector<std::uint64_t> earliest_finish(const StepGraph& g);
 
+/// The step counted in tasks rather than time: every task run costs 1.
+struct UnitMetrics {
+  std::uint64_t work_tasks = 0;  ///< task runs (a loop body task counts once per iteration)
+  std::uint64_t span_tasks = 0;  ///< hop count of the critical path, loops unrolled
+  double parallelism = 0.0;      ///< work_tasks / span_tasks (0 for an empty step)
+};
+
+/// Work and span under unit costs, by the rules of compute_metrics (the span is
+/// compute_metrics' span with every task's cost set to 1): the shape of the graph without
+/// its timing, so it does not move with a preempted task.
+UnitMetrics compute_unit_metrics(const StepGraph& g);
+
 }  // namespace tgraph

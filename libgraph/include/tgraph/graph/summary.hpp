@@ -19,6 +19,8 @@ struct StepSummary {
   std::vector<std::uint32_t> loop_iterations;  ///< per loop
   std::uint64_t work_ns = 0;
   std::uint64_t span_ns = 0;
+  std::uint64_t work_tasks = 0;  ///< unit costs (compute_unit_metrics), when summarised with them
+  std::uint64_t span_tasks = 0;  ///< unit costs: hop count of the critical path
   std::uint64_t host_ns = 0;  ///< StepGraph::host_ns: serial engine time outside the tasks
   double parallelism = 0.0;
   std::uint64_t contacts = 0;
@@ -43,6 +45,12 @@ struct TraceSummary {
   std::uint32_t max_loop_iterations = 0;  ///< in one loop of one step
   std::uint64_t work_ns = 0;
   std::uint64_t span_ns = 0;  ///< sum of the steps' spans
+  std::uint64_t span_max_ns = 0;  ///< the longest step's span
+  bool unit_cost = false;     ///< the *_tasks figures were computed
+  std::uint64_t work_tasks = 0;     ///< unit costs: task runs over all steps
+  std::uint64_t span_tasks = 0;     ///< unit costs: sum of the steps' spans in tasks
+  std::uint64_t span_tasks_max = 0;  ///< unit costs: the longest step's span in tasks
+  double unit_parallelism = 0.0;     ///< unit costs: work_tasks / span_tasks
   std::uint64_t host_ns = 0;  ///< sum of the steps' host times (outside the tasks)
   double parallelism = 0.0;   ///< work / span (0 when the span is 0)
   std::uint64_t distinct_structures = 0;
@@ -51,11 +59,18 @@ struct TraceSummary {
   std::vector<StepSummary> per_step;
 };
 
+/// What summarize_trace computes beyond the timed figures.
+struct SummaryOptions {
+  /// Also the unit-cost work and span (compute_unit_metrics), in tasks. Always on for a
+  /// trace without costs (all zero), whose timed span says nothing.
+  bool unit_cost = false;
+};
+
 /// Computes the summary (compute_metrics on every step; edges must be derived).
 ///
 ///   TraceSummary s = summarize_trace(read_trace("b.tgt"));
 ///   std::cout << trace_summary_text(s, "b.tgt");
-TraceSummary summarize_trace(const Trace& trace);
+TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options = {});
 
 /// `tgraph info --json`: one JSON object (header, totals, "per_step" array).
 std::string trace_summary_json(const TraceSummary& s, const std::string& trace_name);

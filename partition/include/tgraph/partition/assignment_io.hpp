@@ -39,12 +39,20 @@ void write_assignment(const std::string& path, const TraceAssignment& a, const T
 TraceAssignment load_assignment(const std::string& path, const Trace& trace,
                                 const std::string& trace_name);
 
+/// What load_or_partition computed, when it partitioned (TracePartition's notes).
+struct PartitionNotes {
+  std::string method;     ///< the method run (the default_method when none was named)
+  std::string placed_by;  ///< TracePartition::placed_by
+  std::vector<std::string> warnings;  ///< TracePartition::warnings
+};
+
 /// The assignment `tgraph replay` runs on `k` threads: the .tga file `path` (checked against
 /// `trace`, named `trace_name` in errors, as load_assignment does, and its K against `k`:
-/// UsageError) or, when `path` is empty, `method` applied to every step. UsageError naming
+/// UsageError) or, when `path` is empty, `method` applied to every step (default_method
+/// when `method` is empty), with what it did in `notes` when given. UsageError naming
 /// --threads when `k` is 0.
 TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
                                   const std::string& path, const std::string& method,
-                                  std::uint32_t k);
+                                  std::uint32_t k, PartitionNotes* notes = nullptr);
 
 }  // namespace tgraph::partition

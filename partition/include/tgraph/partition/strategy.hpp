@@ -102,6 +102,12 @@ struct Stats {
   bool reused = false;    ///< sticky: previous assignment reused as is
   bool fallback = false;  ///< sticky: partitioned afresh and relabelled (shape changed too much)
   bool rebalanced = false;  ///< sticky: kept the assignment, then moved tasks to fix imbalance
+  /// The strategy that placed the step when this one could not and fell back (owner on a
+  /// step whose tasks have no object: "list"); empty when the strategy placed it itself.
+  std::string placed_by;
+  /// What the caller should be told (the command line prints them on stderr): a fallback
+  /// and why, processors left without tasks.
+  std::vector<std::string> warnings;
 };
 
 /// An assignment and its statistics.
@@ -140,12 +146,23 @@ std::vector<std::string> strategy_names();
 struct TracePartition {
   TraceAssignment assignment;
   std::vector<Stats> stats;
+  /// The steps' warnings, each distinct text once with the steps it concerns
+  /// ("... (steps 0-9, 10 of 10)").
+  std::vector<std::string> warnings;
+  /// The strategy that placed the steps: the method, or its fallback when every step fell
+  /// back ("list" for owner on a trace without objects), or "method+fallback" when some did.
+  std::string placed_by;
 };
 
 /// Runs strategy `method` on every step of `trace` in order, handing each step the previous
 /// step and its assignment (what `sticky` needs).
 TracePartition partition_trace(const Trace& trace, std::string_view method, std::uint32_t k,
                                const Options& options = {});
+
+/// The strategy `tgraph replay` uses when none is given: `owner` (the paper's owner-compute
+/// rule) when some task of the trace works on an object's data, else `list` (critical-path
+/// list scheduling), which uses every processor the graph's parallelism allows.
+std::string default_method(const Trace& trace);
 
 /// Partitions one step given the previous one (null at the first step): the callback a live
 /// run calls at each step (the same type as replay::LivePartitioner).

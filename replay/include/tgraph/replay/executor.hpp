@@ -49,6 +49,8 @@ struct ExecOptions {
   /// Partition only: also build every incrementally updated plan from scratch and throw
   /// std::logic_error when the two differ (tests).
   bool verify_plans = false;
+  /// Barrier only: what one phase holds (default: one dependency level).
+  BarrierRule barrier_rule = BarrierRule::kLevel;
   /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
   std::string starpu_sched = "lws";
   /// Partition only: the watchdog. A step during which no thread finishes a task or passes

@@ -24,9 +24,11 @@ class CacheMissCounter {
   ~CacheMissCounter();
   CacheMissCounter(const CacheMissCounter&) = delete;
   CacheMissCounter& operator=(const CacheMissCounter&) = delete;
-  /// False where the kernel refused (containers, VMs without PMU): report "unavailable".
+  /// False where the kernel refused (containers, VMs without PMU): not a failure, the
+  /// reports say so in place of the count.
   bool available() const { return fd_ >= 0; }
-  /// Why it is unavailable (errno text), empty when available.
+  /// Why it is unavailable ("not counted: the kernel refused ... (errno text)"), empty when
+  /// available.
   const std::string& reason() const { return reason_; }
   /// Misses counted so far (0 when unavailable).
   std::uint64_t read() const;
@@ -90,6 +92,9 @@ struct ReplayResult {
   std::uint64_t order_fallbacks = 0;  ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;
   std::string cache_misses_note;
+  /// What the caller was warned of (a partitioner's fallback, processors without tasks);
+  /// filled by the caller, "warnings" in the JSON.
+  std::vector<std::string> warnings;
   Calibration calibration;
   double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
   std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data

@@ -56,4 +56,22 @@ enum class ReduceScope : unsigned char {
 /// "none", "per-processor" or "per-writer".
 std::string_view to_string(ReduceScope scope);
 
+/// What one parallel phase of the barrier policy holds (a barrier follows each phase).
+enum class BarrierRule : unsigned char {
+  /// One phase per dependency level: the topological level of the step's dataflow graph
+  /// (longest path from the start of its loop region), as a competent OpenMP user puts each
+  /// level in one `omp for`. On the physics scenes it equals the paper's barrier after
+  /// every operation; on a graph whose program order interleaves independent kinds it does
+  /// not depend on that order.
+  kLevel = 0,
+  /// One phase per run of consecutive tasks of one kind in program order (the paper's "one
+  /// parallel loop per operation"), cut where a task depends on the run.
+  kOperation = 1,
+};
+
+/// "level" or "operation".
+std::string_view to_string(BarrierRule rule);
+/// Parses "level" / "operation"; UsageError naming `flag` otherwise.
+BarrierRule barrier_rule_flag(std::string_view name, std::string_view flag);
+
 }  // namespace tgraph::replay

@@ -23,6 +23,8 @@ struct CaptureOptions {
   SceneOptions scene_options;  ///< dt, seed, sub-objects, coupling
   bool no_capture = false;     ///< run uninstrumented (Mode::kOff), write nothing
   bool progress = false;       ///< a progress line on stderr
+  /// Timed passes of every task body, median kept (Recorder::set_cost_passes; 1: one run).
+  std::uint32_t cost_passes = 1;
   /// Called with each of the scene's warnings (unstable dt...) before the first step.
   std::function<void(const std::string&)> warn;
 };
@@ -40,6 +42,9 @@ struct CaptureRun {
   std::vector<double> step_ms;
   std::vector<std::uint32_t> cg_iterations;
   std::vector<std::uint32_t> groups;  ///< collision groups after each step
+  std::uint32_t cost_passes = 1;      ///< CaptureOptions::cost_passes
+  /// Task runs timed once despite cost passes (Recorder::single_pass_runs).
+  std::uint64_t single_pass_runs = 0;
 };
 
 /// The work of a capture failed (a diverging simulation, a failed write, API misuse): the
