@@ -12,14 +12,22 @@
 
 namespace tgraph::app {
 
+namespace {
+// "fig2, bars64, ...": the built-in scenes, for the help text.
+std::string scene_list() {
+  std::string s;
+  for (const std::string& n : samples::builtin_scene_names()) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+}  // namespace
+
 void add_capture(CLI::App& app) {
   auto o = std::make_shared<samples::CaptureOptions>();
   auto a = std::make_shared<Args>();
   auto* cmd = app.add_subcommand(
       "capture", "Run the instrumented engine on a scene and record each step's task graph");
   cmd->add_option("--scene", o->scene,
-                  "Built-in scene (fig2, bars64, falling, cloth128, cloth256, cloth512, torso) "
-                  "or scene file")
+                  "Built-in scene (" + scene_list() + ") or scene file")
       ->required();
   cmd->add_option("--steps", o->steps, "Steps to run (default: the scene's)");
   cmd->add_option("-o,--output", o->output, "Trace file to write (.tgt)");
@@ -27,6 +35,9 @@ void add_capture(CLI::App& app) {
   cmd->add_option("--seed", o->scene_options.seed, "Seed of the scene's random placement");
   cmd->add_option("--subobjects", o->scene_options.subobjects,
                   "Cloth scenes: number of sub-objects (a perfect square)");
+  cmd->add_option("--split", o->scene_options.split,
+                  "Deformable objects: split each internal force field into N tasks (overrides split=)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--coupling", a->policy,
                   "Solver sharing: groups (one CG per collision group) or shared")
       ->check(CLI::IsMember({"groups", "shared"}));

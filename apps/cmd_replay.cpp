@@ -97,11 +97,13 @@ void run(const Args& a, tr::LiveOptions& o) {
   const tr::MethodChoice m = tr::choose_method(a.method, a.policy);
   std::optional<tp::StepPartitioner> part;
   if (m.policy == tr::Policy::kPartition) part = tp::step_partitioner(m.method);
-  const int scene_steps = samples::make_scene(a.input)->default_steps();  // InputError if unknown
+  samples::SceneOptions scene_options;
+  scene_options.split = a.split;
+  const int scene_steps = samples::make_scene(a.input, scene_options)->default_steps();  // InputError if unknown
   o.policy = m.policy;
   o.steps = static_cast<std::uint32_t>(a.steps.value_or(scene_steps));
   const std::string scene = a.input, method = part ? m.method : std::string(to_string(m.policy));
-  const tr::LiveResult r = tr::run_live([scene] { return samples::make_live_engine(scene); },
+  const tr::LiveResult r = tr::run_live([scene, scene_options] { return samples::make_live_engine(scene, scene_options); },
                                         part ? &*part : nullptr, o);
   std::cout << (a.json ? tr::to_json(r, scene, method) + "\n"
                        : tr::to_text(r, scene, method, o.repeat))
@@ -155,6 +157,9 @@ void add_replay_verbs(CLI::App& app) {
                   "(worksteal, barrier, starpu, omp-tasks, sequential)");
   cmd->add_option("--policy", a->policy, "Override the policy");
   cmd->add_option("--steps", a->steps, "Steps (default: the scene's)");
+  cmd->add_option("--split", a->split,
+                  "Deformable objects: split each internal force field into N tasks (overrides split=)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--repeat", live->repeat, "Timed passes (medians reported; default 1)");
   cmd->add_flag_callback(
       "--no-reuse", [live] { live->reuse_structure = false; },

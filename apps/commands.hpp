@@ -37,6 +37,7 @@ struct Args {
   std::vector<std::uint32_t> counts;
   std::vector<double> values;
   std::optional<int> steps;
+  std::optional<int> split;  ///< run --split: force-field tasks per deformable object
   std::size_t step = 0;
   std::uint32_t k = 0;
   std::uint64_t unit_ns = 1000, edge_bytes = 8;

@@ -50,6 +50,8 @@ std::vector<std::string> result_columns() {
           "measured_live_ms_per_step",
           "measured_engine_ms_per_step",
           "measured_live_speedup",
+          "measured_integration_speedup",
+          "measured_step_speedup",
           "measured_core_bound",
           "measured_record_ms_per_step",
           "measured_graph_update_ms_per_step",
@@ -62,6 +64,8 @@ std::vector<std::string> result_columns() {
           "measured_replay_sequential_ms_per_step",
           "measured_replay_speedup",
           "predicted_speedup",
+          "predicted_integration_speedup",
+          "predicted_step_speedup",
           "predicted_ms_per_step",
           "predicted_work_ms_per_step",
           "predicted_imbalance",
@@ -83,7 +87,8 @@ std::string results_csv(const std::vector<ResultRow>& rows, std::uint32_t cores)
                                   std::string(r.threads_kind(cores))};
     if (r.measured) {
       const Measured& m = *r.measured;
-      for (double v : {m.live_ms_per_step, m.engine_ms_per_step, m.live_speedup, m.core_bound,
+      for (double v : {m.live_ms_per_step, m.engine_ms_per_step, m.live_speedup,
+                       m.integration_speedup, m.step_speedup, m.core_bound,
                        m.record_ms_per_step, m.graph_update_ms_per_step, m.partition_ms_per_step,
                        m.build_ms_per_step})
         c.push_back(number_text(v));
@@ -93,16 +98,17 @@ std::string results_csv(const std::vector<ResultRow>& rows, std::uint32_t cores)
       c.push_back(opt(m.replay_sequential_ms_per_step));
       c.push_back(opt(m.replay_speedup));
     } else {
-      c.resize(c.size() + 14);
+      c.resize(c.size() + 16);
     }
     if (r.predicted) {
       const Predicted& p = *r.predicted;
-      for (double v : {p.speedup, p.ms_per_step, p.work_ms_per_step, p.imbalance})
+      for (double v : {p.speedup, p.integration_speedup, p.step_speedup, p.ms_per_step,
+                       p.work_ms_per_step, p.imbalance})
         c.push_back(number_text(v));
       c.push_back(std::to_string(p.migrated_tasks));
       c.push_back(number_text(p.partition_ms_per_step));
     } else {
-      c.resize(c.size() + 6);
+      c.resize(c.size() + 8);
     }
     c.push_back(r.failure);
     out += join_row(c);

@@ -14,6 +14,7 @@
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
@@ -113,12 +114,18 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   return run;
 }
 
-Measured measured_of(const tr::LiveResult& r, std::uint32_t steps) {
+// `work_ns`: the captured trace's task work over the same steps (the sequential cost of
+// the time integration alone).
+Measured measured_of(const tr::LiveResult& r, std::uint32_t steps, double work_ns) {
   Measured m;
   const double n = std::max<double>(steps, 1);
   m.live_ms_per_step = ms(static_cast<double>(r.wall_ns)) / n;
   m.engine_ms_per_step = ms(static_cast<double>(r.baseline_wall_ns)) / n;
   m.live_speedup = r.speedup;
+  m.step_speedup = r.speedup;
+  double execute_ns = 0;
+  for (const tr::LiveStepMeasure& s : r.steps) execute_ns += static_cast<double>(s.execute_ns);
+  m.integration_speedup = execute_ns > 0 ? work_ns / execute_ns : 0;
   m.core_bound = r.core_bound;
   std::uint64_t recorded = 0;
   for (const tr::LiveStepMeasure& s : r.steps) {
@@ -155,6 +162,9 @@ Predictions predict(const Trace& trace, const ExperimentPlan& p, const tp::CostM
       const tp::Report ev = tp::evaluate(trace, part.assignment, model, method);
       Predicted pr;
       pr.speedup = ev.total.speedup;
+      pr.step_speedup = ev.total.speedup;
+      const double graph_ns = static_cast<double>(ev.total.makespan_ns) - static_cast<double>(ev.total.host_ns);
+      pr.integration_speedup = graph_ns > 0 ? static_cast<double>(ev.total.work_ns) / graph_ns : 0;
       pr.ms_per_step = ms(static_cast<double>(ev.total.makespan_ns)) / n;
       pr.work_ms_per_step = ms(static_cast<double>(ev.total.work_ns)) / n;
       pr.imbalance = ev.total.imbalance;
@@ -238,6 +248,8 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
     write_trace(p.out_dir + "/" + trace_file, trace);
     res.files.push_back(trace_file);
     const Predictions pred = predict(trace, p, model);
+    double trace_work_ns = 0;  // the time integration's sequential cost over the captured steps
+    for (const StepGraph& g : trace.steps) trace_work_ns += static_cast<double>(compute_metrics(g).work_ns);
 
     for (const std::string& method : p.methods) {
       const tr::MethodChoice choice = tr::choose_method(method);
@@ -258,7 +270,7 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
           progress.begin(label + " live");
           try {
             const LiveRun live = run_live(v, method, k, p, false);
-            row.measured = measured_of(live.result, p.steps);
+            row.measured = measured_of(live.result, p.steps, trace_work_ns);
             progress.end(label + ": live " + fixed(row.measured->live_ms_per_step, 2) +
                          " ms/step, engine " + fixed(row.measured->engine_ms_per_step, 2) +
                          " ms/step, speed-up " + fixed(row.measured->live_speedup, 2));

@@ -2,6 +2,7 @@
 // Corotational hexahedral FEM (linear elasticity in each element's rotated frame).
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -130,7 +131,8 @@ HexFemForceField::Mat24 HexFemForceField::element_stiffness(const Mat38& rest, c
 }
 
 HexFemForceField::HexFemForceField(std::string name, ParticleBody* body,
-                                   std::vector<std::array<Index, 8>> elements, const FemMaterial& material)
+                                   std::vector<std::array<Index, 8>> elements, const FemMaterial& material,
+                                   const HexFemForceField* whole)
     : ForceField(std::move(name), body), body_(body), elements_(std::move(elements)) {
   const StateVec& x0 = body->rest();
   const std::size_t ne = elements_.size();
@@ -152,7 +154,13 @@ HexFemForceField::HexFemForceField(std::string name, ParticleBody* body,
       for (int c = 0; c < 3; ++c)
         key[static_cast<std::size_t>(3 * i + c)] = std::llround((r(c, i) - r(c, 0)) / scale);
     auto [it, inserted] = shapes.emplace(key, static_cast<std::uint32_t>(ke_.size()));
-    if (inserted) ke_.push_back(element_stiffness(r, material));
+    if (inserted) {
+      const auto known = whole ? std::find(whole->ke_keys_.begin(), whole->ke_keys_.end(), key) : ke_keys_.end();
+      ke_.push_back(whole && known != whole->ke_keys_.end()
+                        ? whole->ke_[static_cast<std::size_t>(known - whole->ke_keys_.begin())]
+                        : element_stiffness(r, material));
+      ke_keys_.push_back(key);
+    }
     ke_index_[e] = it->second;
   }
   batches_.resize(ke_.size());
@@ -166,7 +174,7 @@ std::uint64_t HexFemForceField::state_bytes() const { return rotations_.size() *
 // (rotated) displacements form a 24 x kBatch matrix multiplied by K_e at once, which keeps
 // K_e in registers and cache instead of streaming it once per element.
 namespace {
-constexpr int kBatch = 32;
+constexpr int kBatch = HexFemForceField::kBatch;
 using Batch = Eigen::Matrix<double, 24, kBatch>;
 }  // namespace
 
@@ -219,6 +227,16 @@ void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor, double /*
       }
     }
   }
+}
+
+std::vector<std::vector<std::array<Index, 8>>> HexFemForceField::element_batches() const {
+  std::vector<std::vector<std::array<Index, 8>>> out;
+  for (const auto& [ke, elems] : batches_)
+    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
+      auto& b = out.emplace_back();
+      for (std::size_t c = start; c < std::min(elems.size(), start + kBatch); ++c) b.push_back(elements_[elems[c]]);
+    }
+  return out;
 }
 
 double HexFemForceField::potential_energy() const {

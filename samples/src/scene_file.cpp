@@ -441,6 +441,58 @@ class SceneBuilder {
     if (!collide) b.surface.clear();
   }
 
+  // The attributes every object takes: parsed on an array's first instance (`first`),
+  // copied to the others.
+  void instance_common(Directive& d, Body& b, double spacing, bool first) {
+    const bool rigid = dynamic_cast<RigidBody*>(&b) != nullptr;
+    if (first) {
+      common(d, b, spacing);
+      damping_ = b.mass_damping;
+      velocity_ = b.vec(VecId::kV).cols() > 0 ? Vec3(b.vec(VecId::kV).col(0)) : Vec3::Zero();
+      radius_ = b.contact_radius;
+      layer_ = b.collision_layer;
+      collide_ = !b.surface.empty();
+      return;
+    }
+    b.mass_damping = damping_;
+    if (rigid)
+      b.vec(VecId::kV).col(0) = velocity_;
+    else
+      b.vec(VecId::kV).colwise() = velocity_;
+    b.contact_radius = radius_;
+    b.collision_layer = layer_;
+    if (!collide_) b.surface.clear();
+  }
+
+  // split=N (or --split): the object's internal force field as up to N fields over
+  // consecutive runs of its elements or springs, each a task of its own (cumulative writes
+  // into the object's force vectors), so one big object no longer serialises its force and
+  // CG products. Run one after the other, the fields add the same terms into every node in
+  // the same order as the whole field (FEM: runs of whole element batches).
+  int split_of(Directive& d) {
+    const int split = d.integer("split", 1, 1, 1024);
+    if (options_.split) {
+      if (*options_.split < 1 || *options_.split > 1024) throw UsageError("--split must be in [1, 1024]");
+      return *options_.split;
+    }
+    return split;
+  }
+
+  // `units` in order, cut into up to `split` consecutive runs; make(name, run) builds a field.
+  template <class Unit, class Make>
+  void add_split_fields(const std::string& name, const std::vector<Unit>& units, int split, Make make) {
+    const std::size_t per = (units.size() + static_cast<std::size_t>(split) - 1) / static_cast<std::size_t>(split);
+    if (split <= 1 || per >= units.size()) {
+      scene_->add_force_field(make(name, units.begin(), units.end()));
+      return;
+    }
+    int block = 0;
+    for (std::size_t start = 0; start < units.size(); start += per, ++block)
+      scene_->add_force_field(make(name + "[" + std::to_string(block) + "]",
+                                   units.begin() + static_cast<std::ptrdiff_t>(start),
+                                   units.begin() + static_cast<std::ptrdiff_t>(std::min(units.size(), start + per))));
+  }
+
   std::vector<Index> fixed_nodes(Directive& d, const StateVec& x, const std::string& spec) {
     std::vector<Index> out;
     if (spec.empty() || spec == "none") return out;
@@ -598,6 +650,7 @@ class SceneBuilder {
       k = d.positive("stiffness");
     }
     const std::string fix = d.text("fix", "none");
+    const int split = split_of(d);
     const HexMesh proto = detail::make_hex_grid(nodes, size, Vec3::Zero(), shape);
     if (proto.elements.empty()) d.fail("the shape contains no element (use more nodes)");
     const std::vector<Spring> springs = fem ? std::vector<Spring>{} : detail::grid_springs(proto, k);
@@ -628,26 +681,23 @@ class SceneBuilder {
       pb->surface = proto.surface;
       pb->triangles = proto.triangles;
       scene_->add_body(std::move(body));
-      if (first) {
-        common(d, *pb, proto.spacing.minCoeff());
-        damping_ = pb->mass_damping;
-        velocity_ = pb->vec(VecId::kV).cols() > 0 ? Vec3(pb->vec(VecId::kV).col(0)) : Vec3::Zero();
-        radius_ = pb->contact_radius;
-        layer_ = pb->collision_layer;
-        collide_ = !pb->surface.empty();
-        first = false;
-      } else {
-        pb->mass_damping = damping_;
-        pb->vec(VecId::kV).colwise() = velocity_;
-        pb->contact_radius = radius_;
-        pb->collision_layer = layer_;
-        if (!collide_) pb->surface.clear();
-      }
+      instance_common(d, *pb, proto.spacing.minCoeff(), first);
+      first = false;
       add_gravity(*pb);
-      if (fem)
+      if (fem && split > 1) {
+        const HexFemForceField whole(inst + ".fem", pb, proto.elements, mat);
+        add_split_fields(inst + ".fem", whole.element_batches(), split, [&](const std::string& n, auto first, auto last) {
+          std::vector<std::array<Index, 8>> elements;
+          for (auto it = first; it != last; ++it) elements.insert(elements.end(), it->begin(), it->end());
+          return std::make_unique<HexFemForceField>(n, pb, std::move(elements), mat, &whole);
+        });
+      } else if (fem) {
         scene_->add_force_field(std::make_unique<HexFemForceField>(inst + ".fem", pb, proto.elements, mat));
-      else
-        scene_->add_force_field(std::make_unique<SpringForceField>(inst + ".springs", pb, nullptr, springs));
+      } else {
+        add_split_fields(inst + ".springs", springs, split, [&](const std::string& n, auto first, auto last) {
+          return std::make_unique<SpringForceField>(n, pb, nullptr, std::vector<Spring>(first, last));
+        });
+      }
       add_fix(*pb, fixed_nodes(d, x, fix));
     }
   }
@@ -702,21 +752,8 @@ class SceneBuilder {
       for (Index i = 0; i < surf.points.cols(); ++i) rb->surface.push_back(i);
       rb->triangles = surf.triangles;
       scene_->add_body(std::move(body));
-      if (first) {
-        common(d, *rb, surf.spacing);
-        damping_ = rb->mass_damping;
-        velocity_ = rb->vec(VecId::kV).col(0);
-        radius_ = rb->contact_radius;
-        layer_ = rb->collision_layer;
-        collide_ = !rb->surface.empty();
-        first = false;
-      } else {
-        rb->mass_damping = damping_;
-        rb->vec(VecId::kV).col(0) = velocity_;
-        rb->contact_radius = radius_;
-        rb->collision_layer = layer_;
-        if (!collide_) rb->surface.clear();
-      }
+      instance_common(d, *rb, surf.spacing, first);
+      first = false;
       if (fixed)
         add_fix(*rb, {0, 1});
       else
@@ -724,12 +761,15 @@ class SceneBuilder {
     }
   }
 
-  // A serpentine chain of particles (the torso's intestine): stretch and bending springs.
+  // A serpentine chain of particles (the torso's intestine): stretch and bending springs;
+  // `array=` makes copies (name0, name1, ...) like the grid objects.
   void chain(Directive& d) {
     const std::string name = d.text("name");
-    check_new_name(d, name);
     const int n = d.integer("nodes", std::nullopt, 3, 1000000);
-    add_points(d, static_cast<std::uint64_t>(n));
+    {
+      const auto copies = d.int3("array", std::array<int, 3>{1, 1, 1}, 1, 4096);
+      add_points(d, static_cast<std::uint64_t>(n) * copies[0] * copies[1] * copies[2]);
+    }
     const int rows = d.integer("rows", 1, 1, n);
     const double seg = d.positive("segment");
     const Vec3 center = d.vec3("center", Vec3::Zero());
@@ -737,27 +777,38 @@ class SceneBuilder {
     const double kb = d.non_negative("bend", 0.0);
     const double mass = d.positive("mass");
     const int per_row = (n + rows - 1) / rows;
-    StateVec x(3, n);
+    StateVec proto(3, n);
     const double width = seg * (per_row - 1);
     const double row_gap = d.positive("row_gap", 2.0 * seg);
     for (int i = 0; i < n; ++i) {
       const int row = i / per_row;
       int col = i % per_row;
       if (row % 2 == 1) col = per_row - 1 - col;
-      x.col(i) = center + Vec3(col * seg - 0.5 * width, 0.0, row * row_gap - 0.5 * row_gap * (rows - 1));
+      proto.col(i) = Vec3(col * seg - 0.5 * width, 0.0, row * row_gap - 0.5 * row_gap * (rows - 1));
     }
-    auto body = std::make_unique<ParticleBody>(name, x, std::vector<double>(static_cast<std::size_t>(n), mass / n));
-    for (Index i = 0; i < n; ++i) body->surface.push_back(i);
-    Body& b = scene_->add_body(std::move(body));
-    common(d, b, seg);
     std::vector<Spring> springs;
-    for (Index i = 0; i + 1 < n; ++i) springs.push_back({i, i + 1, (x.col(i + 1) - x.col(i)).norm(), k});
+    for (Index i = 0; i + 1 < n; ++i) springs.push_back({i, i + 1, (proto.col(i + 1) - proto.col(i)).norm(), k});
     if (kb > 0.0)
-      for (Index i = 0; i + 2 < n; ++i) springs.push_back({i, i + 2, (x.col(i + 2) - x.col(i)).norm(), kb});
-    add_gravity(b);
-    bound_.springs(name, springs, b, nullptr);
-    scene_->add_force_field(std::make_unique<SpringForceField>(name + ".springs", &b, nullptr, std::move(springs)));
-    add_fix(b, fixed_nodes(d, x, d.text("fix", "none")));
+      for (Index i = 0; i + 2 < n; ++i) springs.push_back({i, i + 2, (proto.col(i + 2) - proto.col(i)).norm(), kb});
+    const std::string fix = d.text("fix", "none");
+    const int split = split_of(d);
+    bool first = true;
+    for (const auto& [inst, c] : instances(d, name, center)) {
+      check_new_name(d, inst);
+      StateVec x = proto;
+      x.colwise() += c;
+      auto body = std::make_unique<ParticleBody>(inst, x, std::vector<double>(static_cast<std::size_t>(n), mass / n));
+      for (Index i = 0; i < n; ++i) body->surface.push_back(i);
+      Body& b = scene_->add_body(std::move(body));
+      if (first) bound_.springs(inst, springs, b, nullptr);
+      instance_common(d, b, seg, first);
+      first = false;
+      add_gravity(b);
+      add_split_fields(inst + ".springs", springs, split, [&](const std::string& fn, auto first, auto last) {
+        return std::make_unique<SpringForceField>(fn, &b, nullptr, std::vector<Spring>(first, last));
+      });
+      add_fix(b, fixed_nodes(d, x, fix));
+    }
   }
 
   // An N x N mass-spring sheet cut into split x split sub-objects joined by interaction

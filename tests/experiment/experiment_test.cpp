@@ -141,7 +141,10 @@ TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {
   o.name = ExperimentName::kHeterogeneous;
   o.threads = "1,2,16";
   const ExperimentPlan p = plan_experiment(o, 4);
-  EXPECT_EQ(p.scenes[0].scene, "falling");
+  EXPECT_EQ(p.scenes[0].scene, "falling64");
+  o.quick = true;  // the small scene, up to its first contacts
+  EXPECT_EQ(plan_experiment(o, 4).scenes[0].scene, "falling");
+  o.quick = false;
   EXPECT_EQ(p.series_methods, (std::vector<std::string>{"sticky", "metis", "metis-relabel"}));
   EXPECT_EQ(p.series_threads, 2u);
   o.threads = "8,16";  // nothing measured: predictions only, no per-step runs
@@ -213,8 +216,12 @@ std::vector<ResultRow> sample_rows() {
   measured.measured = Measured{};
   measured.measured->live_speedup = 1.85;
   measured.measured->replay_speedup = 1.7;
+  measured.measured->integration_speedup = 1.92;
+  measured.measured->step_speedup = 1.85;
   measured.predicted = Predicted{};
   measured.predicted->speedup = 1.95;
+  measured.predicted->step_speedup = 1.95;
+  measured.predicted->integration_speedup = 1.99;
   ResultRow predicted = measured;
   predicted.threads = 16;
   predicted.measured.reset();
@@ -252,6 +259,13 @@ TEST(Csv, KeepsMeasuredAndPredictedInTheirOwnColumns) {
   EXPECT_EQ(m[col("predicted_speedup")], "1.95");
   EXPECT_EQ(p[col("threads_kind")], "predicted");
   EXPECT_EQ(p[col("predicted_speedup")], "14.5");
+  // The time integration alone and the whole step: separate columns, never mixed.
+  EXPECT_EQ(m[col("measured_integration_speedup")], "1.92");
+  EXPECT_EQ(m[col("measured_step_speedup")], "1.85");
+  EXPECT_EQ(m[col("predicted_integration_speedup")], "1.99");
+  EXPECT_EQ(m[col("predicted_step_speedup")], "1.95");
+  EXPECT_LT(col("measured_integration_speedup"), columns.size());
+  EXPECT_NE(col("measured_integration_speedup"), col("measured_step_speedup"));
   for (std::size_t i = 0; i < columns.size(); ++i) {
     if (columns[i].rfind("measured_", 0) == 0) {
       EXPECT_EQ(p[i], "") << columns[i];

@@ -17,7 +17,7 @@ namespace tgraph::samples {
 namespace {
 
 TEST(Scenes, EveryBuiltInSceneIsTheFileUnderSamplesScenes) {
-  const std::vector<std::string> expected = {"bars64", "cloth128", "cloth256", "cloth512", "falling", "fig2", "torso"};
+  const std::vector<std::string> expected = {"bars64", "cloth128", "cloth256", "cloth512", "falling", "falling64", "fig2", "torso-small", "torso"};
   EXPECT_EQ(builtin_scene_names(), expected);
   for (const std::string& name : builtin_scene_names()) {
     std::ifstream in(std::string(TGRAPH_SCENES_DIR) + "/" + name + ".scene");
@@ -162,8 +162,8 @@ TEST(Deferred, ProgramsRunSequentiallyReproduceTheCapturedSteps) {
   // The coordination code records runnable bodies: executing each deferred step program in
   // program order (loops repeated until their condition) gives the captured physics bit for
   // bit, with the same loop iteration counts.
-  auto a = make_scene("torso");
-  auto b = make_scene("torso");
+  auto a = make_scene("torso-small");
+  auto b = make_scene("torso-small");
   capture::Recorder cap(capture::Mode::kCapture);
   capture::Recorder def(capture::Mode::kDeferred);
   for (int k = 0; k < 30; ++k) {

@@ -19,6 +19,12 @@ struct Measured {
   double live_ms_per_step = 0;
   double engine_ms_per_step = 0;        ///< uninstrumented sequential engine, same run
   double live_speedup = 0;              ///< engine / live
+  /// The paper's measure, the time integration alone: the captured trace's work (its tasks'
+  /// sequential cost) over the live run's task execution time (no recording, collision
+  /// detection or other host work). Never mixed with step_speedup.
+  double integration_speedup = 0;
+  /// The whole step (collision detection and host work included): engine / live.
+  double step_speedup = 0;
   double core_bound = 0;                ///< speed-up the timed cores allow (0: not known)
   double record_ms_per_step = 0;        ///< recording the step in deferred mode (edges included)
   double graph_update_ms_per_step = 0;  ///< edge derivation, part of recording
@@ -35,7 +41,11 @@ struct Measured {
 
 /// Figures the simulator predicts from the captured trace (partition strategies only).
 struct Predicted {
-  double speedup = 0;           ///< work / simulated makespan
+  double speedup = 0;           ///< (work + host) / simulated makespan (= step_speedup)
+  /// The time integration alone (the paper's measure): work / (makespan - host).
+  double integration_speedup = 0;
+  /// The whole step, host work included: (work + host) / makespan.
+  double step_speedup = 0;
   double ms_per_step = 0;       ///< simulated makespan
   double work_ms_per_step = 0;  ///< sum of the captured task costs
   double imbalance = 1;         ///< max load / mean load

@@ -128,8 +128,11 @@ class HexFemForceField final : public ForceField {
  public:
   /// Elements given as 8 node indices each, in the order (x,y,z) = (0,0,0), (1,0,0),
   /// (1,1,0), (0,1,0), (0,0,1), (1,0,1), (1,1,1), (0,1,1) of the reference cube.
+  /// With `whole` (the unsplit field of a split object), the element matrices of shapes it
+  /// has are taken from it rather than recomputed from this field's first element of that
+  /// shape, so that a split field computes exactly what the whole one does.
   HexFemForceField(std::string name, ParticleBody* body, std::vector<std::array<Index, 8>> elements,
-                   const FemMaterial& material);
+                   const FemMaterial& material, const HexFemForceField* whole = nullptr);
   void add_force() override;
   void add_dforce(VecId df, VecId dx, double k_factor, double b_factor = 0.0) override;
   bool has_stiffness() const override { return true; }
@@ -138,6 +141,14 @@ class HexFemForceField final : public ForceField {
   double potential_energy() const override;
   /// Number of elements.
   std::size_t num_elements() const { return elements_.size(); }
+  /// Elements of one stiffness matrix processed together (one 24 x kBatch product); a
+  /// field split into element ranges that are multiples of it adds the same terms in the
+  /// same order as the whole field.
+  static constexpr int kBatch = 32;
+  /// The elements in the batches add_force processes, in order (up to kBatch elements of
+  /// one stiffness matrix each). Fields made of consecutive runs of these batches, run one
+  /// after the other, add the same terms into every node in the same order as this field.
+  std::vector<std::vector<std::array<Index, 8>>> element_batches() const;
 
   using Mat24 = Eigen::Matrix<double, 24, 24>;
   /// The 24x24 stiffness matrix of a hexahedron with rest corners `rest` (3 x 8).
@@ -149,6 +160,7 @@ class HexFemForceField final : public ForceField {
   std::vector<Eigen::Matrix<double, 3, 8>> rest_;        // rest corners per element
   std::vector<Eigen::Matrix<double, 3, 8>> grad_;        // shape gradients at the centre
   std::vector<Mat24, Eigen::aligned_allocator<Mat24>> ke_;  // distinct element matrices
+  std::vector<std::array<long long, 24>> ke_keys_;       // shape key of each matrix
   std::vector<std::uint32_t> ke_index_;                  // element -> matrix
   std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> batches_;  // matrix -> elements
   std::vector<Mat3> rotations_;                          // cached by add_force

@@ -45,6 +45,9 @@ struct SceneOptions {
   std::uint64_t seed = 1;            ///< random placement jitter (scenes that use it)
   std::optional<int> subobjects;     ///< cloth scenes: number of sub-objects (a square)
   std::optional<Coupling> coupling;  ///< solver sharing
+  /// Deformable objects (fem, springgrid, chain): split each internal force field into this
+  /// many tasks over element or spring ranges (overrides the scene file's split=).
+  std::optional<int> split;
   /// Ceiling on the points of a scene file (nodes, particles, rigid surface points), checked
   /// before each object is built.
   std::uint64_t max_nodes = std::uint64_t{1} << 24;
