@@ -13,9 +13,8 @@
 namespace tgraph::partition {
 namespace {
 
-// tests/data/assignments, found from this file's path (tests/partition/).
-const std::filesystem::path kDir =
-    std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "assignments";
+// tests/data/assignments (the build passes the source tree's tests/data).
+const std::filesystem::path kDir = std::filesystem::path(TGRAPH_TEST_DATA) / "assignments";
 
 TEST(AssignmentCompat, CrcIsZlibsCrc32) {
   const std::string text = "123456789";
