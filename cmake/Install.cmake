@@ -184,6 +184,9 @@ endforeach()
 if(TARGET tgraph)
   install(TARGETS tgraph RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
 endif()
+if(TARGET tgraph-mpi)
+  install(TARGETS tgraph-mpi RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
+endif()
 
 set(TGRAPH_PACKAGE_MODULES "${_tgraph_modules}")
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/tgraphConfig.cmake.in"

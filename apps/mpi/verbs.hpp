@@ -1,0 +1,15 @@
+// SPDX-License-Identifier: MIT
+// The verbs of `tgraph-mpi`, each in its own cmd_<verb>.cpp: they parse flags and call
+// tgraph::mpi. Every rank parses the same command line.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace tgraph::mpi_app {
+
+/// `tgraph-mpi replay T.tgt [A.tga] --threads-per-rank T [--check] [--json]`.
+void add_replay_verb(CLI::App& app);
+/// `tgraph-mpi partition T.tgt --method ptscotch ... -o A.tga`.
+void add_partition_verb(CLI::App& app);
+
+}  // namespace tgraph::mpi_app
