@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// `tgraph replay` (a trace's steps on real threads, synthetic bodies: replay::replay_trace)
-// and `tgraph run` (live: the engine's own bodies through the executor: replay::run_live).
+// `tgraph replay` (a trace's steps on real threads, synthetic bodies: measure::replay_trace)
+// and `tgraph run` (live: the engine's own bodies through the executor: measure::run_live).
 #include <algorithm>
 #include <cstdint>
 #include <iostream>
@@ -10,9 +10,9 @@
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/replay/live.hpp"
-#include "tgraph/replay/measure.hpp"
-#include "tgraph/samples/live_engine.hpp"
+#include "tgraph/measure/live.hpp"
+#include "tgraph/measure/replay_trace.hpp"
+#include "tgraph/measure/report.hpp"
 #include "tgraph/viz/timeline.hpp"
 
 namespace tgraph::app {
@@ -20,6 +20,7 @@ namespace {
 
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
+namespace meas = tgraph::measure;
 
 // --timeout SECONDS as ExecOptions::timeout_ms.
 std::int64_t timeout_ms(double seconds) {
@@ -56,7 +57,7 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
   cmd->add_flag("--json", a.json, "Print one JSON object");
 }
 
-void replay(const Args& a, tr::ReplayOptions& o, const tp::NamedOptions& model) {
+void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model) {
   const Trace trace = read_trace(a.input);
   o.policy = tr::policy_flag(a.policy.empty() ? "partition" : a.policy, "--policy");
   std::optional<TraceAssignment> as;
@@ -71,7 +72,7 @@ void replay(const Args& a, tr::ReplayOptions& o, const tp::NamedOptions& model) 
   }
   tr::TimelineObserver timeline;
   const bool observe = !a.timeline.empty() || !a.chrome.empty();
-  tr::ReplayResult r = tr::replay_trace(
+  meas::ReplayResult r = meas::replay_trace(
       trace, as ? &*as : nullptr, o, as ? &predicted : nullptr, observe ? &timeline : nullptr);
   r.warnings = notes.warnings;
   if (!a.timeline.empty()) write_file_atomic(a.timeline, timeline.to_json());
@@ -88,11 +89,11 @@ void replay(const Args& a, tr::ReplayOptions& o, const tp::NamedOptions& model) 
     if (notes.placed_by != notes.method) label += ", fallback of " + notes.method;
     label += ")";
   }
-  std::cout << (a.json ? tr::to_json(r, a.input, label) + "\n" : tr::to_text(r, a.input, o.repeat));
+  std::cout << (a.json ? meas::to_json(r, a.input, label) + "\n" : meas::to_text(r, a.input, o.repeat));
 }
 
-// The live loop tests/replay/live_test.cpp exercises: replay::run_live on the samples engine.
-void run(const Args& a, tr::LiveOptions& o) {
+// The live loop tests/measure/live_test.cpp exercises: measure::run_live on the samples engine.
+void run(const Args& a, meas::LiveOptions& o) {
   if (a.steps && *a.steps < 1) throw UsageError("--steps must be at least 1");
   const tr::MethodChoice m = tr::choose_method(a.method, a.policy);
   std::optional<tp::StepPartitioner> part;
@@ -103,10 +104,11 @@ void run(const Args& a, tr::LiveOptions& o) {
   o.policy = m.policy;
   o.steps = static_cast<std::uint32_t>(a.steps.value_or(scene_steps));
   const std::string scene = a.input, method = part ? m.method : std::string(to_string(m.policy));
-  const tr::LiveResult r = tr::run_live([scene, scene_options] { return samples::make_live_engine(scene, scene_options); },
-                                        part ? &*part : nullptr, o);
-  std::cout << (a.json ? tr::to_json(r, scene, method) + "\n"
-                       : tr::to_text(r, scene, method, o.repeat))
+  const meas::LiveResult r =
+      meas::run_live([scene, scene_options] { return meas::make_live_engine(scene, scene_options); },
+                     part ? &*part : nullptr, o);
+  std::cout << (a.json ? meas::to_json(r, scene, method) + "\n"
+                       : meas::to_text(r, scene, method, o.repeat))
             << std::flush;
   if (r.difference)
     throw Failure("state differs from the sequential run: " + to_string(*r.difference));
@@ -116,7 +118,7 @@ void run(const Args& a, tr::LiveOptions& o) {
 
 void add_replay_verbs(CLI::App& app) {
   auto a = std::make_shared<Args>();
-  auto o = std::make_shared<tr::ReplayOptions>();
+  auto o = std::make_shared<meas::ReplayOptions>();
   auto model = std::make_shared<tp::NamedOptions>();
   auto* cmd =
       app.add_subcommand("replay", "Replay a trace's steps on real threads (synthetic bodies)");
@@ -147,7 +149,7 @@ void add_replay_verbs(CLI::App& app) {
   cmd->callback([a, o, model] { replay(*a, *o, *model); });
 
   a = std::make_shared<Args>();
-  auto live = std::make_shared<tr::LiveOptions>();
+  auto live = std::make_shared<meas::LiveOptions>();
   a->method = "owner";
   cmd = app.add_subcommand("run", "Run a scene live through the executor (engine bodies)");
   cmd->add_option("--scene", a->input, "Built-in scene or scene file")->required();

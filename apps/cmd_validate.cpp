@@ -1,15 +1,16 @@
 // SPDX-License-Identifier: MIT
 // `tgraph validate`: live run, replay of a capture and simulator side by side
-// (samples::validate_scene; the live run is the truth).
+// (measure::validate; the live run is the truth).
 #include <iostream>
 
 #include "commands.hpp"
-#include "tgraph/samples/validate.hpp"
+#include "tgraph/measure/report.hpp"
+#include "tgraph/measure/validate.hpp"
 
 namespace tgraph::app {
 
 void add_validate(CLI::App& app) {
-  auto o = std::make_shared<samples::ValidateOptions>();
+  auto o = std::make_shared<measure::ValidateOptions>();
   auto a = std::make_shared<Args>();
   o->threads = default_threads();
   auto* cmd = app.add_subcommand(
@@ -23,8 +24,8 @@ void add_validate(CLI::App& app) {
                   "Rounds of live pass, capture, replay pass and simulation (medians; default 3)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([o, a] {
-    const samples::Validation v = samples::validate_scene(*o);
-    std::cout << (a->json ? samples::validation_json(v, *o) : samples::validation_text(v, *o));
+    const measure::Validation v = measure::validate(*o);
+    std::cout << (a->json ? measure::to_json(v, *o) : measure::to_text(v, *o));
   });
 }
 

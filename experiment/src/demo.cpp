@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
@@ -17,42 +16,27 @@
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/replay/measure.hpp"
+#include "tgraph/measure/capture.hpp"
+#include "tgraph/measure/replay_trace.hpp"
 #include "tgraph/replay/observer.hpp"
-#include "tgraph/samples/capture_run.hpp"
-#include "tgraph/samples/scene.hpp"
 
 namespace tgraph::experiment {
 namespace {
 
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
+namespace meas = tgraph::measure;
 
-Trace capture(const DemoOptions& o) {
-  auto scene = samples::make_scene(o.scene, {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  trace.header = samples::scene_header(*scene, 1);
-  for (int s = 0; s < o.steps; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
-  if (rec.errors() != 0)
-    throw std::runtime_error("demo: the capture API reported " + std::to_string(rec.errors()) +
-                             " misuses");
-  return trace;
-}
-
-tr::ReplayResult replay(const Trace& trace, const TraceAssignment* a, tr::Policy policy,
+meas::ReplayResult replay(const Trace& trace, const TraceAssignment* a, tr::Policy policy,
                         const DemoOptions& o) {
-  tr::ReplayOptions ro;
+  meas::ReplayOptions ro;
   ro.policy = policy;
   ro.exec.threads = policy == tr::Policy::kSequential ? 1 : o.threads;
   ro.repeat = o.repeat;
-  return tr::replay_trace(trace, a, ro);
+  return meas::replay_trace(trace, a, ro);
 }
 
-void fill_measured(viz::MethodRow& row, const tr::ReplayResult& r) {
+void fill_measured(viz::MethodRow& row, const meas::ReplayResult& r) {
   row.measured_ms = static_cast<double>(r.wall_ns) / 1e6;
   row.sequential_ms = static_cast<double>(r.sequential_wall_ns) / 1e6;
   row.speedup = r.speedup;
@@ -63,13 +47,13 @@ void fill_measured(viz::MethodRow& row, const tr::ReplayResult& r) {
 // Replays the chosen method once more on its first steps, observed, for the report's timeline.
 viz::Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
                                 const DemoOptions& o) {
-  tr::ReplayOptions ro;
+  meas::ReplayOptions ro;
   ro.exec.threads = o.threads;
   ro.repeat = 1;
   ro.steps = std::min<std::uint32_t>(2, static_cast<std::uint32_t>(trace.steps.size()));
   ro.sequential_baseline = false;
   tr::TimelineObserver t;
-  tr::replay_trace(trace, &a, ro, nullptr, &t);
+  meas::replay_trace(trace, &a, ro, nullptr, &t);
   return viz::parse_timeline(t.to_json(), "demo timeline");
 }
 
@@ -98,7 +82,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
     if (say_fn) say_fn(s);
   };
   say("capturing " + o.scene + " (" + std::to_string(o.steps) + " steps)...");
-  const Trace trace = capture(o);
+  const Trace trace = meas::capture_trace(o.scene, static_cast<std::uint32_t>(o.steps));
   DemoResult res;
   res.scene = o.scene;
   res.steps = o.steps;

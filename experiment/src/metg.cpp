@@ -18,16 +18,14 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/experiment/threads.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/median.hpp"
+#include "tgraph/measure/capture.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
-#include "tgraph/samples/capture_run.hpp"
-#include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/series_chart.hpp"
 
 namespace tgraph::experiment {
@@ -103,14 +101,7 @@ void dependences(MetgShape shape, std::uint32_t width, std::uint32_t t, std::uin
 }
 
 /// bars64's first step as the engine records it.
-StepGraph capture_bars64() {
-  auto scene = samples::make_scene("bars64", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  scene->step(rec);
-  StepGraph g = rec.end_step();
-  if (rec.errors() != 0) throw std::runtime_error("metg: the capture API reported misuses");
-  return g;
-}
+StepGraph capture_bars64() { return measure::capture_trace("bars64", 1).steps.front(); }
 
 /// Task instances of one step (loop bodies times their recorded iterations).
 std::uint64_t instances_of(const StepGraph& g) {

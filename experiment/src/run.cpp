@@ -11,7 +11,6 @@
 #include <memory>
 
 #include "output.hpp"
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
@@ -19,10 +18,9 @@
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/replay/live.hpp"
-#include "tgraph/replay/measure.hpp"
-#include "tgraph/samples/capture_run.hpp"
-#include "tgraph/samples/live_engine.hpp"
+#include "tgraph/measure/capture.hpp"
+#include "tgraph/measure/live.hpp"
+#include "tgraph/measure/replay_trace.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::experiment {
@@ -30,6 +28,7 @@ namespace {
 
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
+namespace meas = tgraph::measure;
 
 double ms(double ns) { return ns / 1e6; }
 
@@ -55,26 +54,16 @@ samples::SceneOptions scene_options(const SceneVariant& v) {
 }
 
 Trace capture_variant(const SceneVariant& v, std::uint32_t steps) {
-  auto scene = samples::make_scene(v.scene, scene_options(v));
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  trace.header = samples::scene_header(*scene, 1);
+  Trace trace = meas::capture_trace(v.scene, steps, scene_options(v));
   if (v.subobjects) trace.header.scene += " (" + std::to_string(*v.subobjects) + " sub-objects)";
-  for (std::uint32_t s = 0; s < steps; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
-  if (rec.errors() != 0)
-    throw std::runtime_error(v.label() + ": the capture API reported " +
-                             std::to_string(rec.errors()) + " misuses");
   return trace;
 }
 
-// A strategy as a live partitioner that keeps each call's statistics (migrations).
+// A strategy as a step partitioner that keeps each call's statistics (migrations).
 struct RecordingPartitioner {
   std::shared_ptr<tp::Strategy> strategy;
   std::shared_ptr<std::vector<tp::Stats>> calls = std::make_shared<std::vector<tp::Stats>>();
-  tr::LivePartitioner callback() const {
+  tp::StepPartitioner callback() const {
     return [s = strategy, c = calls](const StepGraph& g, std::uint32_t k, const StepGraph* pg,
                                      const Assignment* pa) {
       tp::Result r = s->partition(g, k, tp::Previous{pg, pa}, tp::Options{});
@@ -85,14 +74,14 @@ struct RecordingPartitioner {
 };
 
 struct LiveRun {
-  tr::LiveResult result;
+  meas::LiveResult result;
   std::vector<tp::Stats> calls;  // the partitioner's calls, in order (first pass first)
 };
 
 LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t k,
                  const ExperimentPlan& p, bool every_step) {
   const tr::MethodChoice m = tr::choose_method(method);
-  tr::LiveOptions o;
+  meas::LiveOptions o;
   o.policy = m.policy;
   o.exec.threads = k;
   o.steps = p.steps;
@@ -100,7 +89,7 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   o.observe = false;
   o.repartition_every_step = every_step;
   std::optional<RecordingPartitioner> rp;
-  tr::LivePartitioner callback;
+  tp::StepPartitioner callback;
   if (m.policy == tr::Policy::kPartition) {
     rp = RecordingPartitioner{tp::make_strategy(m.method)};
     callback = rp->callback();
@@ -108,7 +97,7 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   const std::string scene = v.scene;
   const samples::SceneOptions so = scene_options(v);
   LiveRun run;
-  run.result = tr::run_live([scene, so] { return samples::make_live_engine(scene, so); },
+  run.result = meas::run_live([scene, so] { return meas::make_live_engine(scene, so); },
                             rp ? &callback : nullptr, o);
   if (rp) run.calls = *rp->calls;
   return run;
@@ -116,7 +105,7 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
 
 // `work_ns`: the captured trace's task work over the same steps (the sequential cost of
 // the time integration alone).
-Measured measured_of(const tr::LiveResult& r, std::uint32_t steps, double work_ns) {
+Measured measured_of(const meas::LiveResult& r, std::uint32_t steps, double work_ns) {
   Measured m;
   const double n = std::max<double>(steps, 1);
   m.live_ms_per_step = ms(static_cast<double>(r.wall_ns)) / n;
@@ -124,11 +113,11 @@ Measured measured_of(const tr::LiveResult& r, std::uint32_t steps, double work_n
   m.live_speedup = r.speedup;
   m.step_speedup = r.speedup;
   double execute_ns = 0;
-  for (const tr::LiveStepMeasure& s : r.steps) execute_ns += static_cast<double>(s.execute_ns);
+  for (const meas::LiveStepMeasure& s : r.steps) execute_ns += static_cast<double>(s.execute_ns);
   m.integration_speedup = execute_ns > 0 ? work_ns / execute_ns : 0;
   m.core_bound = r.core_bound;
   std::uint64_t recorded = 0;
-  for (const tr::LiveStepMeasure& s : r.steps) {
+  for (const meas::LiveStepMeasure& s : r.steps) {
     m.record_ms_per_step += ms(static_cast<double>(s.record_ns)) / n;
     m.graph_update_ms_per_step += ms(static_cast<double>(s.graph_update_ns)) / n;
     m.partition_ms_per_step += ms(static_cast<double>(s.partition_ns)) / n;
@@ -281,14 +270,14 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
           if (p.replays(method, k)) {
             progress.begin(label + " replay");
             try {
-              tr::ReplayOptions ro;
+              meas::ReplayOptions ro;
               ro.policy = choice.policy;
               ro.exec.threads = k;
               ro.repeat = p.repeat;
               ro.observe = false;
               const auto a = pred.assignments.find({method, k});
-              const tr::ReplayResult rr =
-                  tr::replay_trace(trace, a == pred.assignments.end() ? nullptr : &a->second, ro);
+              const meas::ReplayResult rr =
+                  meas::replay_trace(trace, a == pred.assignments.end() ? nullptr : &a->second, ro);
               if (row.measured) {
                 const double n = static_cast<double>(trace.steps.size());
                 row.measured->replay_ms_per_step = ms(static_cast<double>(rr.wall_ns)) / n;
@@ -318,7 +307,7 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
         const LiveRun live = run_live(v, method, k, p, true);
         std::uint64_t moved = 0;
         for (std::uint32_t s = 0; s < live.result.steps.size(); ++s) {
-          const tr::LiveStepMeasure& m = live.result.steps[s];
+          const meas::LiveStepMeasure& m = live.result.steps[s];
           StepRow r;
           r.method = method;
           r.threads = k;

@@ -18,13 +18,14 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/live.hpp"
+#include "tgraph/measure/live.hpp"
 #include "tgraph/replay/lowering.hpp"
-#include "tgraph/samples/live_engine.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::replay {
 namespace {
+
+using namespace tgraph::measure;
 
 // Threads of this process (/proc/self/status).
 int process_threads() {
@@ -189,7 +190,7 @@ class ThrowingEngine : public LiveEngine {
 
 TEST(ThrowingTask, EndsALiveRunWithItsMessageForEveryPolicy) {
   std::shared_ptr<partition::Strategy> owner = partition::make_strategy("owner");
-  const LivePartitioner part = [owner](const StepGraph& g, std::uint32_t k, const StepGraph* pg,
+  const partition::StepPartitioner part = [owner](const StepGraph& g, std::uint32_t k, const StepGraph* pg,
                                        const Assignment* pa) {
     return owner->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
   };
@@ -205,7 +206,7 @@ TEST(ThrowingTask, EndsALiveRunWithItsMessageForEveryPolicy) {
     o.observe = false;
     try {
       run_live(
-          [] { return std::make_unique<ThrowingEngine>(samples::make_live_engine("fig2"), 2); },
+          [] { return std::make_unique<ThrowingEngine>(measure::make_live_engine("fig2"), 2); },
           c.policy == Policy::kPartition ? &part : nullptr, o);
       ADD_FAILURE() << name_of(c) << ": no exception";
     } catch (const std::runtime_error& e) {

@@ -9,40 +9,18 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
+#include "tgraph/measure/step_record.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
-namespace tgraph::replay {
-
-/// Hardware cache-miss counter of this process's threads (perf_event_open), where the
-/// kernel allows it.
-class CacheMissCounter {
- public:
-  /// Opens the counter (inherit: threads created afterwards are counted too).
-  CacheMissCounter();
-  ~CacheMissCounter();
-  CacheMissCounter(const CacheMissCounter&) = delete;
-  CacheMissCounter& operator=(const CacheMissCounter&) = delete;
-  /// False where the kernel refused (containers, VMs without PMU): not a failure, the
-  /// reports say so in place of the count.
-  bool available() const { return fd_ >= 0; }
-  /// Why it is unavailable ("not counted: the kernel refused ... (errno text)"), empty when
-  /// available.
-  const std::string& reason() const { return reason_; }
-  /// Misses counted so far (0 when unavailable).
-  std::uint64_t read() const;
-
- private:
-  int fd_ = -1;
-  std::string reason_;
-};
+namespace tgraph::measure {
 
 /// What to replay and how.
 struct ReplayOptions {
-  Policy policy = Policy::kPartition;
-  ExecOptions exec;  ///< threads, spin, pinning, CW mode
-  SyntheticOptions synthetic;
+  replay::Policy policy = replay::Policy::kPartition;
+  replay::ExecOptions exec;  ///< threads, spin, pinning, CW mode
+  replay::SyntheticOptions synthetic;
   std::uint32_t first_step = 0;
   std::uint32_t steps = 0;   ///< 0: every step from first_step
   std::uint32_t repeat = 3;  ///< timed passes per policy (medians reported)
@@ -52,14 +30,9 @@ struct ReplayOptions {
 };
 
 /// One step's figures (wall times: medians over the timed passes).
-struct StepMeasure {
+struct StepMeasure : StepRecord {
   std::uint32_t step = 0;
-  std::int64_t wall_ns = 0;
   std::int64_t sequential_wall_ns = 0;
-  std::int64_t build_ns = 0;  ///< plan build in the first pass (0: reused)
-  /// The plan part of build_ns (per-processor programs, without lowering), first pass.
-  std::int64_t rebuild_ns = 0;
-  std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built, first pass
   /// Median over passes of each pass's wall time minus that pass's own plan build.
   std::int64_t run_ns = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
@@ -70,15 +43,14 @@ struct StepMeasure {
   /// the step and counted in wall_ns, sequential_wall_ns and run_ns.
   std::uint64_t host_ns = 0;
   std::optional<std::uint64_t> predicted_makespan_ns;
-  std::vector<StatsObserver::Thread> threads;  ///< from the observed pass
 };
 
 /// The whole replay.
 struct ReplayResult {
-  Policy policy = Policy::kPartition;
+  replay::Policy policy = replay::Policy::kPartition;
   std::uint32_t threads = 1;               ///< ExecOptions::threads; 1 for the sequential policy
-  CwMode cw = CwMode::kReduce;             ///< how CW groups ran
-  ReduceScope scope = ReduceScope::kNone;  ///< where their temporaries lived
+  replay::CwMode cw = replay::CwMode::kReduce;             ///< how CW groups ran
+  replay::ReduceScope scope = replay::ReduceScope::kNone;  ///< where their temporaries lived
   std::vector<StepMeasure> steps;
   std::int64_t wall_ns = 0;             ///< median over passes of the pass total
   std::int64_t sequential_wall_ns = 0;  ///< same for sequential
@@ -95,7 +67,7 @@ struct ReplayResult {
   /// What the caller was warned of (a partitioner's fallback, processors without tasks);
   /// filled by the caller, "warnings" in the JSON.
   std::vector<std::string> warnings;
-  Calibration calibration;
+  replay::Calibration calibration;
   double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
   std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data
   std::uint64_t signals() const;
@@ -116,16 +88,6 @@ struct ReplayResult {
 ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments,
                           const ReplayOptions& options,
                           const std::vector<std::uint64_t>* predicted = nullptr,
-                          TimelineObserver* timeline = nullptr);
+                          replay::TimelineObserver* timeline = nullptr);
 
-/// The result as one JSON object (keys: policy, threads, steps, wall_ns, per_step, speedup,
-/// efficiency, signals, wait_ns, remote_bytes, migrated_bytes, predicted_makespan_ns, ...).
-std::string to_json(const ReplayResult& r);
-/// `tgraph replay --json`: to_json(r) plus the trace's name and how its assignment was
-/// obtained (a .tga path, "<method> (computed)", or "" for the other policies).
-std::string to_json(const ReplayResult& r, const std::string& trace_name,
-                    const std::string& assignment);
-/// `tgraph replay`'s text report of `r`, a replay of `trace_name` with `repeat` passes.
-std::string to_text(const ReplayResult& r, const std::string& trace_name, std::uint32_t repeat);
-
-}  // namespace tgraph::replay
+}  // namespace tgraph::measure

@@ -1,23 +1,25 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/samples/live_engine.hpp"
+// The samples engine (a Scene) behind the live-run interface.
+#include "tgraph/measure/engine.hpp"
 
 #include <utility>
 
+#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
 
-namespace tgraph::samples {
+namespace tgraph::measure {
 namespace {
 
-class SceneEngine final : public replay::LiveEngine {
+class SceneEngine final : public LiveEngine {
  public:
-  explicit SceneEngine(std::unique_ptr<Scene> scene)
+  explicit SceneEngine(std::unique_ptr<samples::Scene> scene)
       : scene_(std::move(scene)), rec_(capture::Mode::kDeferred), plain_(capture::Mode::kOff) {}
 
-  replay::LiveStep record_step(bool allow_reuse) override {
+  LiveStep record_step(bool allow_reuse) override {
     if (!allow_reuse) {
       scene_->step(rec_);
     } else if (!scene_->step_if_changed(rec_)) {
-      replay::LiveStep same;
+      LiveStep same;
       same.reuse_previous = true;
       return same;
     }
@@ -25,7 +27,7 @@ class SceneEngine final : public replay::LiveEngine {
     if (rec_.errors() != 0)
       throw UsageError("scene " + scene_->name() + ": the recorder counted " +
                        std::to_string(rec_.errors()) + " API misuses");
-    replay::LiveStep step;
+    LiveStep step;
     step.graph = std::move(p.graph);
     step.bodies = std::move(p.bodies);
     step.conditions = std::move(p.conditions);
@@ -40,8 +42,8 @@ class SceneEngine final : public replay::LiveEngine {
     used_ = &plain_;
   }
 
-  std::vector<replay::StateRegion> state() const override {
-    std::vector<replay::StateRegion> r;
+  std::vector<StateRegion> state() const override {
+    std::vector<StateRegion> r;
     const std::vector<Datum>& data = used_->data();
     for (DatumId d = 0; d < data.size(); ++d)
       if (used_->datum_ptr(d) != nullptr)
@@ -50,7 +52,7 @@ class SceneEngine final : public replay::LiveEngine {
   }
 
  private:
-  std::unique_ptr<Scene> scene_;
+  std::unique_ptr<samples::Scene> scene_;
   capture::Recorder rec_;
   capture::Recorder plain_;
   const capture::Recorder* used_ = &rec_;  // the recorder whose ids name the state
@@ -58,9 +60,9 @@ class SceneEngine final : public replay::LiveEngine {
 
 }  // namespace
 
-std::unique_ptr<replay::LiveEngine> make_live_engine(const std::string& scene,
-                                                     const SceneOptions& options) {
-  return std::make_unique<SceneEngine>(make_scene(scene, options));
+std::unique_ptr<LiveEngine> make_live_engine(const std::string& scene,
+                                             const samples::SceneOptions& options) {
+  return std::make_unique<SceneEngine>(samples::make_scene(scene, options));
 }
 
-}  // namespace tgraph::samples
+}  // namespace tgraph::measure

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // replay_trace (`tgraph replay`): which passes it times, what it reports per step, its errors.
-#include "tgraph/replay/measure.hpp"
+#include "tgraph/measure/replay_trace.hpp"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,10 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
 
-namespace tgraph::replay {
+namespace tgraph::measure {
 namespace {
+
+using namespace tgraph::replay;
 
 Trace two_step_trace() {
   Trace t;
@@ -89,4 +91,4 @@ TEST(ReplayTrace, RejectsMissingAssignmentsAndZeroThreads) {
 }
 
 }  // namespace
-}  // namespace tgraph::replay
+}  // namespace tgraph::measure

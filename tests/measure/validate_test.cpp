@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-// `tgraph validate` (samples::validate_scene): rounds of live pass, capture, replay pass and
+// `tgraph validate` (measure::validate): rounds of live pass, capture, replay pass and
 // simulation; medians of the rounds and of each round's own ratios.
-#include "tgraph/samples/validate.hpp"
+#include "tgraph/measure/validate.hpp"
+#include "tgraph/measure/report.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +13,7 @@
 
 #include "tgraph/graph/error.hpp"
 
-namespace tgraph::samples {
+namespace tgraph::measure {
 namespace {
 
 double median(std::vector<double> v) {
@@ -33,7 +34,7 @@ ValidateOptions falling(const std::string& method, std::uint32_t steps, std::uin
 
 TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   const ValidateOptions o = falling("metis", 2, 3);
-  const Validation v = validate_scene(o);
+  const Validation v = validate(o);
   ASSERT_EQ(v.rounds.size(), 3u);
   std::vector<double> live, replay_over_live, predicted_over_live;
   for (const ValidationRound& r : v.rounds) {
@@ -54,7 +55,7 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   EXPECT_DOUBLE_EQ(v.replay_over_live, median(replay_over_live));
   EXPECT_DOUBLE_EQ(v.predicted_over_live, median(predicted_over_live));
 
-  const auto j = nlohmann::json::parse(validation_json(v, o));
+  const auto j = nlohmann::json::parse(to_json(v, o));
   ASSERT_EQ(j.at("rounds").size(), 3u);
   EXPECT_EQ(j.at("rounds")[1].at("live_wall_ns").get<std::int64_t>(), v.rounds[1].live_ns);
   EXPECT_EQ(j.at("method"), "metis");
@@ -64,10 +65,10 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
 
 TEST(Validate, ABaselinePolicyHasNoPrediction) {
   const ValidateOptions o = falling("worksteal", 1, 1);
-  const Validation v = validate_scene(o);
+  const Validation v = validate(o);
   ASSERT_EQ(v.rounds.size(), 1u);
   EXPECT_EQ(v.predicted_ns, 0u);
-  const auto j = nlohmann::json::parse(validation_json(v, o));
+  const auto j = nlohmann::json::parse(to_json(v, o));
   EXPECT_TRUE(j.at("predicted_ns").is_null());
   EXPECT_TRUE(j.at("predicted_over_live").is_null());
   EXPECT_GT(j.at("replay_over_live").get<double>(), 0.0);
@@ -76,14 +77,14 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
 TEST(Validate, RefusesZeroThreadsStepsOrRounds) {
   ValidateOptions o = falling("owner", 1, 1);
   o.threads = 0;
-  EXPECT_THROW(validate_scene(o), UsageError);
+  EXPECT_THROW(validate(o), UsageError);
   o.threads = 1;
   o.steps = 0;
-  EXPECT_THROW(validate_scene(o), UsageError);
+  EXPECT_THROW(validate(o), UsageError);
   o.steps = 1;
   o.repeat = 0;
-  EXPECT_THROW(validate_scene(o), UsageError);
+  EXPECT_THROW(validate(o), UsageError);
 }
 
 }  // namespace
-}  // namespace tgraph::samples
+}  // namespace tgraph::measure

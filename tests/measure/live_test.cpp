@@ -1,10 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Live runs (replay::run_live): the engine's own task bodies through every executor, with
+// Live runs (measure::run_live): the engine's own task bodies through every executor, with
 // parallel reductions, give the state of a sequential run that uses the same reduction
 // order, bit for bit, over steps where contacts change and plans are rebuilt.
 #include <gtest/gtest.h>
-
-#if defined(TGRAPH_HAVE_SAMPLES) && defined(TGRAPH_HAVE_PARTITION) && defined(TGRAPH_HAVE_CAPTURE)
 
 #include <cmath>
 #include <cstring>
@@ -13,11 +11,13 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/replay/live.hpp"
-#include "tgraph/samples/live_engine.hpp"
+#include "tgraph/measure/live.hpp"
+#include "tgraph/replay/program_workload.hpp"
 
-namespace tgraph::replay {
+namespace tgraph::measure {
 namespace {
+
+using namespace tgraph::replay;
 
 #if defined(__SANITIZE_THREAD__)
 // ThreadSanitizer runs ~10x slower; the first contact change of falling is at step 43.
@@ -26,7 +26,7 @@ constexpr std::uint32_t kFallingSteps = 50;
 constexpr std::uint32_t kFallingSteps = 150;
 #endif
 
-LivePartitioner partitioner_for(const std::string& method) {
+partition::StepPartitioner partitioner_for(const std::string& method) {
   std::shared_ptr<partition::Strategy> s = partition::make_strategy(method);
   return [s](const StepGraph& g, std::uint32_t k, const StepGraph* pg, const Assignment* pa) {
     return s->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
@@ -45,8 +45,8 @@ LiveResult live(const std::string& scene, Policy policy, const std::string& meth
   o.baseline = false;
   o.observe = false;
   o.check = true;
-  const LivePartitioner p = policy == Policy::kPartition ? partitioner_for(method) : nullptr;
-  return run_live([scene] { return samples::make_live_engine(scene); },
+  const partition::StepPartitioner p = policy == Policy::kPartition ? partitioner_for(method) : nullptr;
+  return run_live([scene] { return make_live_engine(scene); },
                   policy == Policy::kPartition ? &p : nullptr, o);
 }
 
@@ -62,7 +62,7 @@ TEST_P(FallingLive, MatchesTheSameReductionOrderBitForBitThroughContactChanges) 
   const Case c = GetParam();
   const LiveResult r = live("falling", c.policy, c.method, c.threads, kFallingSteps);
   EXPECT_EQ(r.cw, CwMode::kReduce);
-  EXPECT_EQ(r.check, "identical") << (r.difference ? r.difference->datum : "");
+  EXPECT_EQ(r.check, Check::kIdentical) << (r.difference ? r.difference->datum : "");
   EXPECT_GT(r.data_compared, 100u);
   // Contacts changed: the engine recorded new structures and the executor built new plans.
   std::uint32_t recorded = 0;
@@ -89,7 +89,7 @@ TEST(Live, EveryPolicyAndThreadCountMatchesItsReferenceOnBarsAndCloth) {
         // (executor_test), and libgomp's per-task cost makes whole scenes slow under TSan.
         if (p == Policy::kOmpTasks && k != 2) continue;
         const LiveResult r = live(scene, p, "owner", k, 2);
-        EXPECT_EQ(r.check, "identical") << scene << " " << to_string(p) << " k=" << k << ": "
+        EXPECT_EQ(r.check, Check::kIdentical) << scene << " " << to_string(p) << " k=" << k << ": "
                                         << (r.difference ? r.difference->datum : "");
         EXPECT_FALSE(r.steps[0].loop_iterations.empty());
         EXPECT_GT(r.steps[0].loop_iterations[0], 1u) << "the CG loop ran one iteration";
@@ -99,19 +99,19 @@ TEST(Live, EveryPolicyAndThreadCountMatchesItsReferenceOnBarsAndCloth) {
 TEST(Live, SerializedReductionsMatchThePlainProgramOrder) {
   const LiveResult r = live("bars64", Policy::kPartition, "metis", 2, 2, CwMode::kSerialize);
   EXPECT_EQ(r.cw, CwMode::kSerialize);
-  EXPECT_EQ(r.check, "identical");
+  EXPECT_EQ(r.check, Check::kIdentical);
   EXPECT_NE(r.check_reference.find("program order"), std::string::npos);
 }
 
 // Physics, not bits: parallel reductions change the order of additions only, so positions
 // after a few implicit steps agree with the uninstrumented engine to rounding level.
 TEST(Live, ParallelReductionsLeaveThePhysicsWithinRounding) {
-  auto plain = samples::make_live_engine("bars64");
-  auto engine = samples::make_live_engine("bars64");
+  auto plain = make_live_engine("bars64");
+  auto engine = make_live_engine("bars64");
   ExecOptions eo;
   eo.threads = 2;
   auto ex = make_executor(Policy::kPartition, eo);
-  const LivePartitioner p = partitioner_for("owner");
+  const partition::StepPartitioner p = partitioner_for("owner");
   LiveStep cur;
   ProgramWorkload w;
   Assignment a;
@@ -164,11 +164,9 @@ TEST(LiveCompare, NamesTheFirstDifferingDatum) {
 TEST(Live, RefusesThePartitionPolicyWithoutAPartitioner) {
   LiveOptions o;
   o.policy = Policy::kPartition;
-  EXPECT_THROW(run_live([] { return samples::make_live_engine("fig2"); }, nullptr, o),
+  EXPECT_THROW(run_live([] { return make_live_engine("fig2"); }, nullptr, o),
                UsageError);
 }
 
 }  // namespace
-}  // namespace tgraph::replay
-
-#endif
+}  // namespace tgraph::measure

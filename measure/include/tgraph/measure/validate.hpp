@@ -6,10 +6,11 @@
 #include <cstdint>
 #include <string>
 
-#include "tgraph/replay/live.hpp"
-#include "tgraph/replay/measure.hpp"
+#include <vector>
 
-namespace tgraph::samples {
+#include "tgraph/replay/policy.hpp"
+
+namespace tgraph::measure {
 
 /// What to validate (the flags of `tgraph validate`).
 struct ValidateOptions {
@@ -45,11 +46,6 @@ struct Validation {
 /// capture of the same steps, its replay under the same policy (one pass) and the
 /// simulation of the partition. UsageError for zero threads, steps or rounds, or an unknown
 /// method.
-Validation validate_scene(const ValidateOptions& options);
+Validation validate(const ValidateOptions& options);
 
-/// `tgraph validate --json` (ratios replay / live, predicted / live, predicted / replay).
-std::string validation_json(const Validation& v, const ValidateOptions& options);
-/// `tgraph validate`'s text.
-std::string validation_text(const Validation& v, const ValidateOptions& options);
-
-}  // namespace tgraph::samples
+}  // namespace tgraph::measure

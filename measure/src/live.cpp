@@ -1,0 +1,223 @@
+// SPDX-License-Identifier: MIT
+// Live runs: timed passes interleaved with the uninstrumented engine, the observed passes
+// and the check of the final state.
+#include "tgraph/measure/live.hpp"
+
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "live_observers.hpp"
+#include "live_pass.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/measure/passes.hpp"
+#include "tgraph/replay/thread_binding.hpp"
+
+namespace tgraph::measure {
+
+namespace tr = tgraph::replay;
+
+std::string_view to_string(Check check) {
+  switch (check) {
+    case Check::kIdentical:
+      return "identical";
+    case Check::kDiffers:
+      return "differs";
+  }
+  return "?";
+}
+
+namespace {
+
+/// The uninstrumented engine's passes, on each of the first cores the run uses (cores of a
+/// VM can differ in speed; a sequential run could land on either), the fastest kept.
+struct Baseline {
+  std::vector<PassTimes> by_core;  ///< every pass on each core
+  PassTimes fastest;               ///< each pass's fastest core, by step
+};
+
+void time_baseline_pass(const EngineFactory& make_engine, const LiveOptions& o, Baseline& b) {
+  std::int64_t best = -1;
+  std::vector<std::int64_t> best_steps;
+  tr::BindingScope binding;
+  for (std::uint32_t c = 0; c < b.by_core.size(); ++c) {
+    if (o.exec.pin) binding.pin(c);
+    std::unique_ptr<LiveEngine> engine = make_engine();
+    std::int64_t total = 0;
+    std::vector<std::int64_t> steps(o.steps);
+    for (std::uint32_t s = 0; s < o.steps; ++s) {
+      const std::int64_t t0 = tr::now_ns();
+      engine->plain_step();
+      steps[s] = tr::now_ns() - t0;
+      total += steps[s];
+      b.by_core[c].add(s, steps[s]);
+    }
+    b.by_core[c].end_pass();
+    if (best < 0 || total < best) {
+      best = total;
+      best_steps = std::move(steps);
+    }
+  }
+  for (std::uint32_t s = 0; s < o.steps; ++s) b.fastest.add(s, best_steps[s]);
+  b.fastest.end_pass();
+}
+
+}  // namespace
+
+LiveResult run_live(const EngineFactory& make_engine,
+                    const partition::StepPartitioner* partitioner, const LiveOptions& o) {
+  if (o.steps == 0) throw UsageError("--steps must be at least 1");
+  if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
+  if (o.policy == tr::Policy::kPartition && (partitioner == nullptr || !*partitioner))
+    throw UsageError("the partition policy needs a partitioning method");
+  LiveResult res;
+  res.policy = o.policy;
+  // A fresh executor per pass: its threads and pinning end with the pass, so the
+  // uninstrumented engine that follows runs where the OS puts it, as users run it (the
+  // partition executor pins the calling thread to the first core while it lives).
+  auto make = [&o] {
+    auto e = tr::make_executor(o.policy, o.exec);
+    e->set_observe_stride(o.cost_stride);
+    return e;
+  };
+  std::unique_ptr<tr::Executor> ex = make();
+  res.threads = ex->threads();
+  res.cw = ex->cw();
+  res.scope = ex->scope();
+  ex.reset();
+  const bool partition = o.policy == tr::Policy::kPartition;
+
+  std::vector<detail::PassResult> passes;
+  const std::uint32_t baseline_cores =
+      o.exec.pin ? std::min<std::uint32_t>({res.threads, tr::hardware_pus(), 4}) : 1;
+  Baseline baseline{std::vector<PassTimes>(baseline_cores, PassTimes(o.steps)),
+                    PassTimes(o.steps)};
+  PassTimes wall(o.steps), record(o.steps), part(o.steps), prepare(o.steps), execute(o.steps);
+  for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
+    if (o.baseline) time_baseline_pass(make_engine, o, baseline);
+    if (!ex) ex = make();
+    detail::PassOptions po;
+    po.feed_costs = partition;
+    po.keep_assignments = po.keep_state = pass == 0 && o.check;
+    passes.push_back(detail::run_pass(make_engine, partitioner, *ex, o, po));
+    res.plans_built += ex->plans_built();
+    res.order_fallbacks += ex->order_fallbacks();
+    ex.reset();
+    for (std::uint32_t s = 0; s < o.steps; ++s) {
+      const LiveStepMeasure& m = passes.back().steps[s];
+      wall.add(s, m.wall_ns);
+      record.add(s, m.record_ns);
+      part.add(s, m.partition_ns);
+      prepare.add(s, m.prepare_ns);
+      execute.add(s, m.execute_ns);
+    }
+    for (PassTimes* t : {&wall, &record, &part, &prepare, &execute}) t->end_pass();
+  }
+  const detail::PassResult& first = passes[0];
+  res.signals = first.signals;
+  res.waits = first.waits;
+  res.blocked_waits = first.blocked_waits;
+  res.parks = first.parks;
+  res.pass_wall_ns = wall.pass_totals();
+  res.steps = first.steps;  // the first pass's plan and structure figures
+  for (std::uint32_t s = 0; s < o.steps; ++s) {
+    LiveStepMeasure& m = res.steps[s];
+    m.wall_ns = wall.step_median(s);
+    m.record_ns = record.step_median(s);
+    m.partition_ns = part.step_median(s);
+    m.prepare_ns = prepare.step_median(s);
+    m.execute_ns = execute.step_median(s);
+    m.baseline_ns = baseline.fastest.step_median(s);
+    m.threads.clear();
+  }
+  res.wall_ns = wall.median_total();
+  for (const PassTimes& core : baseline.by_core) {
+    res.baseline_core_pass_wall_ns.push_back(core.pass_totals());
+    const std::int64_t m = core.median_total();
+    if (m > 0 && (res.baseline_wall_ns == 0 || m < res.baseline_wall_ns)) res.baseline_wall_ns = m;
+  }
+  if (res.baseline_wall_ns > 0 && baseline_cores == res.threads)
+    for (const PassTimes& core : baseline.by_core)
+      res.core_bound +=
+          static_cast<double>(res.baseline_wall_ns) / static_cast<double>(core.median_total());
+  if (res.wall_ns > 0 && res.baseline_wall_ns > 0)
+    res.speedup = static_cast<double>(res.baseline_wall_ns) / static_cast<double>(res.wall_ns);
+
+  if (o.observe) {
+    // The policy with per-thread and per-kind observers (every instance), then sequential.
+    replay::StatsObserver stats;
+    detail::KindObserver kinds;
+    ex = make();
+    ex->set_observe_stride(1);
+    ex->add_observer(stats);
+    ex->add_observer(kinds);
+    detail::PassResult observed;
+    detail::PassOptions po;
+    po.feed_costs = partition;
+    po.stats = &stats;
+    try {
+      observed = detail::run_pass(make_engine, partitioner, *ex, o, po);
+    } catch (...) {
+      ex->clear_observers();
+      throw;
+    }
+    ex->clear_observers();
+    for (std::uint32_t s = 0; s < o.steps; ++s) res.steps[s].threads = observed.steps[s].threads;
+    detail::KindObserver seq_kinds;
+    if (o.policy != tr::Policy::kSequential) {
+      tr::ExecOptions so = o.exec;
+      so.threads = 1;
+      auto seq = tr::make_executor(tr::Policy::kSequential, so);
+      seq->add_observer(seq_kinds);
+      detail::run_pass(make_engine, nullptr, *seq, o, {});
+    }
+    for (const auto& [kind, t] : kinds.total()) {
+      KindTime k;
+      k.kind = kind;
+      k.instances = t.second;
+      k.mean_ns = t.second ? static_cast<double>(t.first) / static_cast<double>(t.second) : 0;
+      const auto it = seq_kinds.total().find(kind);
+      if (it != seq_kinds.total().end() && it->second.second > 0)
+        k.sequential_mean_ns =
+            static_cast<double>(it->second.first) / static_cast<double>(it->second.second);
+      res.kinds.push_back(std::move(k));
+    }
+  }
+
+  if (o.check) {
+    // A sequential run with the same reduction order (see the header).
+    tr::ExecOptions ro = o.exec;
+    std::unique_ptr<tr::Executor> ref;
+    detail::PassOptions po;
+    po.keep_state = true;
+    if (res.cw == tr::CwMode::kSerialize || o.policy == tr::Policy::kSequential) {
+      ro.threads = 1;
+      ro.reduce_scope = tr::ReduceScope::kNone;
+      ref = tr::make_executor(tr::Policy::kSequential, ro);
+      res.check_reference = "sequential executor, program order";
+    } else if (partition) {
+      ro.serial = true;
+      ref = tr::make_executor(tr::Policy::kPartition, ro);
+      po.fixed = &first.assignments;
+      res.check_reference =
+          "serial partition executor, same assignments and per-processor reducers";
+    } else {
+      ro.threads = 1;
+      ro.reduce_scope = res.scope;
+      ref = tr::make_executor(tr::Policy::kSequential, ro);
+      res.check_reference = "sequential executor, same per-writer reducers";
+    }
+    try {
+      const detail::PassResult reference = detail::run_pass(make_engine, partitioner, *ref, o, po);
+      res.difference = compare(reference.state, first.state);
+      res.data_compared = reference.state.names.size();
+    } catch (const UsageError& e) {
+      // The reference could not follow the same steps (its graphs differ): a difference.
+      res.difference = StateDifference{std::string("structure: ") + e.what(), 0, 0};
+    }
+    res.check = res.difference ? Check::kDiffers : Check::kIdentical;
+  }
+  return res;
+}
+
+}  // namespace tgraph::measure

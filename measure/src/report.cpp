@@ -1,0 +1,338 @@
+// SPDX-License-Identifier: MIT
+// The JSON and text of the three measurements (replay, live run, validation), with one
+// writer of the per-step record they share.
+#include "tgraph/measure/report.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+namespace tgraph::measure {
+
+namespace tr = tgraph::replay;
+using nlohmann::json;
+
+namespace {
+
+json threads_json(const std::vector<tr::StatsObserver::Thread>& threads) {
+  json a = json::array();
+  for (const auto& t : threads)
+    a.push_back(
+        {{"busy_ns", t.busy_ns}, {"wait_ns", t.wait_ns}, {"idle_ns", t.idle_ns}, {"tasks", t.tasks}});
+  return a;
+}
+
+// The keys every per-step record has (replays and live runs alike).
+json step_record_json(const StepRecord& m) {
+  return {{"wall_ns", m.wall_ns},
+          {"build_ns", m.build_ns},
+          {"rebuild_ns", m.rebuild_ns},
+          {"rebuilt_procs", m.rebuilt_procs},
+          {"rebuild_over_wall",
+           m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) / static_cast<double>(m.wall_ns)
+                         : 0.0},
+          {"threads", threads_json(m.threads)}};
+}
+
+}  // namespace
+
+// ---- replay ------------------------------------------------------------------------------
+
+std::string to_json(const ReplayResult& r) {
+  json per_step = json::array();
+  for (const StepMeasure& m : r.steps) {
+    json s = step_record_json(m);
+    s.update({{"step", m.step},
+              {"sequential_wall_ns", m.sequential_wall_ns},
+              {"run_ns", m.run_ns},
+              {"signals", m.signals},
+              {"waits", m.waits},
+              {"blocked_waits", m.blocked_waits},
+              {"parks", m.parks},
+              {"wait_ns", m.wait_ns},
+              {"remote_bytes", m.remote_bytes},
+              {"migrated_bytes", m.migrated_bytes},
+              {"work_ns", m.work_ns},
+              {"span_ns", m.span_ns},
+              {"host_ns", m.host_ns}});
+    s["predicted_makespan_ns"] =
+        m.predicted_makespan_ns ? json(*m.predicted_makespan_ns) : json(nullptr);
+    per_step.push_back(std::move(s));
+  }
+  json j = {{"policy", std::string(to_string(r.policy))},
+            {"threads", r.threads},
+            {"cw", std::string(to_string(r.cw))},
+            {"reduce_scope", std::string(to_string(r.scope))},
+            {"steps", r.steps.size()},
+            {"wall_ns", r.wall_ns},
+            {"sequential_wall_ns", r.sequential_wall_ns},
+            {"pass_wall_ns", r.pass_wall_ns},
+            {"sequential_pass_wall_ns", r.sequential_pass_wall_ns},
+            {"speedup", r.speedup},
+            {"bound", r.bound},
+            {"efficiency", r.efficiency},
+            {"work_ns", r.work_ns},
+            {"span_ns", r.span_ns},
+            {"host_ns", r.host_ns},
+            {"signals", r.signals()},
+            {"waits", r.waits()},
+            {"wait_ns", r.wait_ns()},
+            {"build_ns", r.build_ns()},
+            {"rebuild_ns", r.rebuild_ns()},
+            {"plans_built", r.plans_built},
+            {"order_fallbacks", r.order_fallbacks},
+            {"remote_bytes", r.remote_bytes()},
+            {"migrated_bytes", r.migrated_bytes()},
+            {"calibration",
+             {{"spin_iterations_per_ns", r.calibration.spin_iterations_per_ns},
+              {"touch_ns_per_byte_in_cache", r.calibration.touch_ns_per_byte},
+              {"touch_ns_per_byte", r.touch_ns_per_byte},
+              {"working_set_bytes", r.working_set_bytes}}},
+            {"per_step", per_step}};
+  j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
+  j["warnings"] = r.warnings;
+  const auto pred = r.predicted_makespan_ns();
+  j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
+  // Ratio of measured to predicted, both without plan builds: the sum over steps of the
+  // median over passes of (wall - that pass's build).
+  if (pred && *pred > 0) {
+    std::int64_t measured = 0;
+    for (const auto& m : r.steps) measured += m.run_ns;
+    j["measured_over_predicted"] = static_cast<double>(measured) / static_cast<double>(*pred);
+  } else {
+    j["measured_over_predicted"] = nullptr;
+  }
+  return j.dump();
+}
+
+std::string to_json(const ReplayResult& r, const std::string& trace_name,
+                    const std::string& assignment) {
+  auto j = nlohmann::json::parse(to_json(r));
+  j["trace"] = trace_name;
+  j["assignment"] = assignment;
+  return j.dump();
+}
+
+std::string to_text(const ReplayResult& r, const std::string& trace_name, std::uint32_t repeat) {
+  std::string out;
+  char line[512];
+  const auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 511)));
+  };
+  const auto ms = [](auto ns) { return static_cast<double>(ns) / 1e6; };
+  const auto pred = r.predicted_makespan_ns();
+  std::int64_t measured_nobuild = 0;
+  for (const auto& m : r.steps) measured_nobuild += m.run_ns;
+  add(std::snprintf(line, sizeof line, "replay %s: %zu steps, policy %s, %u threads, cw %s\n",
+                    trace_name.c_str(), r.steps.size(), std::string(to_string(r.policy)).c_str(),
+                    r.threads, std::string(to_string(r.cw)).c_str()));
+  add(std::snprintf(line, sizeof line, "  wall            %10.3f ms (median of %u passes)\n",
+                    ms(r.wall_ns), repeat));
+  if (r.sequential_wall_ns > 0)
+    add(std::snprintf(
+        line, sizeof line,
+        "  sequential      %10.3f ms   speed-up %.2f   efficiency %.2f (bound %.2f)\n",
+        ms(r.sequential_wall_ns), r.speedup, r.efficiency, r.bound));
+  add(std::snprintf(line, sizeof line, "  work / span     %10.3f / %.3f ms\n", ms(r.work_ns),
+                    ms(r.span_ns)));
+  add(std::snprintf(line, sizeof line,
+                    "  signals %llu, waits %llu, wait time %.3f ms, plan builds %llu (%.3f ms)\n",
+                    static_cast<unsigned long long>(r.signals()),
+                    static_cast<unsigned long long>(r.waits()), ms(r.wait_ns()),
+                    static_cast<unsigned long long>(r.plans_built), ms(r.build_ns())));
+  add(std::snprintf(line, sizeof line, "  remote bytes %llu, migrated bytes %llu\n",
+                    static_cast<unsigned long long>(r.remote_bytes()),
+                    static_cast<unsigned long long>(r.migrated_bytes())));
+  if (pred)
+    add(std::snprintf(
+        line, sizeof line, "  predicted       %10.3f ms   measured/predicted %.3f\n", ms(*pred),
+        *pred ? static_cast<double>(measured_nobuild) / static_cast<double>(*pred) : 0.0));
+  add(std::snprintf(
+      line, sizeof line, "  cache misses    %s\n",
+      r.cache_misses ? std::to_string(*r.cache_misses).c_str() : r.cache_misses_note.c_str()));
+  return out;
+}
+
+// ---- live run ----------------------------------------------------------------------------
+
+std::string to_json(const LiveResult& r) {
+  json per_step = json::array();
+  std::int64_t record = 0, part = 0, prepare = 0, build = 0, execute = 0;
+  std::vector<tr::StatsObserver::Thread> totals;
+  for (const LiveStepMeasure& m : r.steps) {
+    if (totals.size() < m.threads.size()) totals.resize(m.threads.size());
+    for (std::size_t i = 0; i < m.threads.size(); ++i) {
+      const auto& t = m.threads[i];
+      totals[i].busy_ns += t.busy_ns;
+      totals[i].wait_ns += t.wait_ns;
+      totals[i].idle_ns += t.idle_ns;
+      totals[i].tasks += t.tasks;
+    }
+    record += m.record_ns;
+    part += m.partition_ns;
+    prepare += m.prepare_ns;
+    build += m.build_ns;
+    execute += m.execute_ns;
+    json s = step_record_json(m);
+    s.update({{"engine_wall_ns", m.baseline_ns},
+              {"record_ns", m.record_ns},
+              {"partition_ns", m.partition_ns},
+              {"prepare_ns", m.prepare_ns},
+              {"graph_update_ns", m.graph_update_ns},
+              {"execute_ns", m.execute_ns},
+              {"rebuilt", m.rebuilt},
+              {"recorded", m.recorded},
+              {"partitioned", m.partitioned},
+              {"loop_iterations", m.loop_iterations}});
+    per_step.push_back(std::move(s));
+  }
+  const json threads = threads_json(totals);
+  json kinds = json::array();
+  for (const KindTime& k : r.kinds) {
+    json e = {{"kind", k.kind}, {"instances", k.instances}, {"mean_ns", k.mean_ns}};
+    e["sequential_mean_ns"] = k.sequential_mean_ns > 0 ? json(k.sequential_mean_ns) : json(nullptr);
+    e["ratio"] = k.sequential_mean_ns > 0 ? json(k.mean_ns / k.sequential_mean_ns) : json(nullptr);
+    kinds.push_back(std::move(e));
+  }
+  json j = {{"policy", std::string(to_string(r.policy))},
+            {"threads", r.threads},
+            {"cw", std::string(to_string(r.cw))},
+            {"reduce_scope", std::string(to_string(r.scope))},
+            {"steps", r.steps.size()},
+            {"repeat", r.pass_wall_ns.size()},
+            {"wall_ns", r.wall_ns},
+            {"pass_wall_ns", r.pass_wall_ns},
+            {"engine_wall_ns", r.baseline_wall_ns},
+            {"engine_core_pass_wall_ns", r.baseline_core_pass_wall_ns},
+            {"sequential_wall_ns", r.baseline_wall_ns},
+            {"speedup", r.speedup},
+            {"core_bound", r.core_bound},
+            {"breakdown",
+             {{"record_ns", record},
+              {"partition_ns", part},
+              {"prepare_ns", prepare},
+              {"build_ns", build},
+              {"execute_ns", execute}}},
+            {"threads_total", threads},
+            {"kinds", kinds},
+            {"signals", r.signals},
+            {"waits", r.waits},
+            {"blocked_waits", r.blocked_waits},
+            {"parks", r.parks},
+            {"plans_built", r.plans_built},
+            {"order_fallbacks", r.order_fallbacks},
+            {"per_step", per_step}};
+  if (r.check) {
+    j["check"] = std::string(to_string(*r.check));
+    j["check_reference"] = r.check_reference;
+    j["data_compared"] = r.data_compared;
+    if (r.difference)
+      j["first_difference"] = {{"datum", r.difference->datum},
+                               {"offset", r.difference->offset},
+                               {"differing_bytes", r.difference->differing_bytes}};
+  }
+  return j.dump();
+}
+
+std::string to_json(const LiveResult& r, const std::string& scene, const std::string& method) {
+  auto j = nlohmann::json::parse(to_json(r));
+  j["scene"] = scene;
+  j["method"] = method;
+  return j.dump();
+}
+
+std::string to_text(const LiveResult& r, const std::string& scene, const std::string& method,
+                    std::uint32_t repeat) {
+  std::string out;
+  char line[512];
+  const auto add = [&](int n) {
+    out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 511)));
+  };
+  const auto ms = [](auto ns) { return static_cast<double>(ns) / 1e6; };
+  add(std::snprintf(
+      line, sizeof line, "run %s: %zu steps, %s (%s), %u threads, cw %s: %.3f ms (median of %u)\n",
+      scene.c_str(), r.steps.size(), std::string(to_string(r.policy)).c_str(), method.c_str(),
+      r.threads, std::string(to_string(r.cw)).c_str(), ms(r.wall_ns), repeat));
+  if (r.baseline_wall_ns > 0)
+    add(std::snprintf(line, sizeof line, "  uninstrumented engine %.3f ms   speed-up %.2f\n",
+                      ms(r.baseline_wall_ns), r.speedup));
+  const auto b = nlohmann::json::parse(to_json(r))["breakdown"];
+  add(std::snprintf(line, sizeof line,
+                    "  record %.3f ms, partition %.3f ms, plans %.3f ms, execute %.3f ms\n",
+                    b["record_ns"].get<double>() / 1e6, b["partition_ns"].get<double>() / 1e6,
+                    b["prepare_ns"].get<double>() / 1e6, b["execute_ns"].get<double>() / 1e6));
+  if (r.check)
+    add(std::snprintf(line, sizeof line, "  check against %s: %s (%zu data compared)\n",
+                      r.check_reference.c_str(), r.difference ? "DIFFERS" : "identical bit for bit",
+                      r.data_compared));
+  return out;
+}
+
+// ---- validation --------------------------------------------------------------------------
+
+namespace {
+
+std::string method_name(const Validation& v) {
+  return v.choice.policy == tr::Policy::kPartition ? v.choice.method
+                                                       : std::string(to_string(v.choice.policy));
+}
+}  // namespace
+
+std::string to_json(const Validation& v, const ValidateOptions& o) {
+  const bool pred = v.predicted_ns != 0;
+  nlohmann::json rounds = nlohmann::json::array();
+  for (const ValidationRound& r : v.rounds)
+    rounds.push_back({{"live_wall_ns", r.live_ns},
+                      {"engine_wall_ns", r.engine_ns},
+                      {"replay_wall_ns", r.replay_ns},
+                      {"predicted_ns", pred ? nlohmann::json(r.predicted_ns) : nlohmann::json(nullptr)},
+                      {"host_ns", r.host_ns}});
+  nlohmann::json j = {{"scene", o.scene},
+                      {"policy", std::string(to_string(v.choice.policy))},
+                      {"method", method_name(v)},
+                      {"threads", v.threads},
+                      {"steps", o.steps},
+                      {"rounds", rounds},
+                      {"live_wall_ns", v.live_ns},
+                      {"engine_wall_ns", v.engine_ns},
+                      {"live_speedup", v.live_ns > 0 ? static_cast<double>(v.engine_ns) /
+                                                           static_cast<double>(v.live_ns)
+                                                     : 0.0},
+                      {"replay_wall_ns", v.replay_ns},
+                      {"replay_over_live", v.replay_over_live}};
+  j["predicted_ns"] = pred ? nlohmann::json(v.predicted_ns) : nlohmann::json(nullptr);
+  j["predicted_over_live"] = pred ? nlohmann::json(v.predicted_over_live) : nlohmann::json(nullptr);
+  j["predicted_over_replay"] =
+      pred ? nlohmann::json(v.predicted_over_replay) : nlohmann::json(nullptr);
+  return j.dump() + "\n";
+}
+
+std::string to_text(const Validation& v, const ValidateOptions& o) {
+  char line[512];
+  std::string out;
+  std::snprintf(line, sizeof line,
+                "validate %s, %s (%s), %u threads, %u steps (medians of %zu rounds; ratios: "
+                "medians of each round's)\n",
+                o.scene.c_str(), std::string(to_string(v.choice.policy)).c_str(),
+                method_name(v).c_str(), v.threads, o.steps, v.rounds.size());
+  out += line;
+  std::snprintf(line, sizeof line,
+                "  live run        %10.3f ms   (uninstrumented engine %.3f ms, speed-up %.2f)\n",
+                static_cast<double>(v.live_ns) / 1e6, static_cast<double>(v.engine_ns) / 1e6,
+                v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns)
+                              : 0.0);
+  out += line;
+  std::snprintf(line, sizeof line, "  replay          %10.3f ms   replay / live %.3f\n",
+                static_cast<double>(v.replay_ns) / 1e6, v.replay_over_live);
+  out += line;
+  if (v.predicted_ns != 0) {
+    std::snprintf(line, sizeof line,
+                  "  simulator       %10.3f ms   simulator / live %.3f, simulator / replay %.3f\n",
+                  static_cast<double>(v.predicted_ns) / 1e6, v.predicted_over_live,
+                  v.predicted_over_replay);
+    out += line;
+  }
+  return out;
+}
+
+}  // namespace tgraph::measure

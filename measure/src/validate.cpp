@@ -1,0 +1,90 @@
+// SPDX-License-Identifier: MIT
+// `tgraph validate`'s pipeline: live run, capture + replay, simulation.
+#include "tgraph/measure/validate.hpp"
+
+#include <optional>
+#include <vector>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
+#include "tgraph/measure/capture.hpp"
+#include "tgraph/measure/live.hpp"
+#include "tgraph/measure/replay_trace.hpp"
+#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/partition/simulator.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::measure {
+
+Validation validate(const ValidateOptions& o) {
+  Validation v;
+  v.choice = replay::choose_method(o.method);
+  const bool partition = v.choice.policy == replay::Policy::kPartition;
+  std::optional<partition::StepPartitioner> part;
+  if (partition) part = partition::step_partitioner(v.choice.method);
+  v.threads = v.choice.policy == replay::Policy::kSequential ? 1 : o.threads;
+  if (v.threads == 0 || o.steps == 0 || o.repeat == 0)
+    throw UsageError("--threads, --steps and --repeat must be at least 1");
+  const auto model = partition::select_cost_model("calibrated", "");
+
+  for (std::uint32_t round = 0; round < o.repeat; ++round) {
+    ValidationRound r;
+    // 1. The live run (the truth), timed against the uninstrumented engine.
+    LiveOptions lo;
+    lo.policy = v.choice.policy;
+    lo.exec.threads = v.threads;
+    lo.steps = o.steps;
+    lo.repeat = 1;
+    lo.observe = false;
+    const std::string scene = o.scene;
+    const LiveResult live = run_live(
+        [scene] { return make_live_engine(scene); }, part ? &*part : nullptr, lo);
+    r.live_ns = live.wall_ns;
+    r.engine_ns = live.baseline_wall_ns;
+
+    // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
+    const Trace trace = capture_trace(o.scene, o.steps);
+    for (const StepGraph& g : trace.steps) r.host_ns += g.host_ns;
+    std::optional<TraceAssignment> assignment;
+    if (partition)
+      assignment = partition::partition_trace(trace, v.choice.method, v.threads).assignment;
+    ReplayOptions ro;
+    ro.policy = v.choice.policy;
+    ro.exec.threads = v.threads;
+    ro.repeat = 1;
+    ro.observe = false;
+    ro.sequential_baseline = false;
+    r.replay_ns = replay_trace(trace, assignment ? &*assignment : nullptr, ro).wall_ns;
+
+    // 3. The simulator's makespan of the same partition (partition policy only).
+    if (assignment)
+      for (std::uint64_t ns : partition::predicted_makespans(trace, *assignment, model))
+        r.predicted_ns += ns;
+    v.rounds.push_back(r);
+  }
+
+  std::vector<double> live, engine, rep, pred, rl, pl, pr;
+  for (const ValidationRound& r : v.rounds) {
+    const double l = static_cast<double>(r.live_ns), x = static_cast<double>(r.replay_ns),
+                 p = static_cast<double>(r.predicted_ns);
+    live.push_back(l);
+    engine.push_back(static_cast<double>(r.engine_ns));
+    rep.push_back(x);
+    pred.push_back(p);
+    rl.push_back(x / l);
+    pl.push_back(p / l);
+    pr.push_back(p / x);
+  }
+  v.live_ns = static_cast<std::int64_t>(median(live));
+  v.engine_ns = static_cast<std::int64_t>(median(engine));
+  v.replay_ns = static_cast<std::int64_t>(median(rep));
+  v.predicted_ns = partition ? static_cast<std::uint64_t>(median(pred)) : 0;
+  v.replay_over_live = median(rl);
+  if (partition) {
+    v.predicted_over_live = median(pl);
+    v.predicted_over_replay = median(pr);
+  }
+  return v;
+}
+
+}  // namespace tgraph::measure
