@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // `tgraph simulate`'s engines and `tgraph platform`'s file: the cluster shape, the platform
 // XML, exact transfer costs on SimGrid, agreement of SimGrid with the built-in simulator on
-// one host (random graphs, bars64, falling), bad platforms and assignments.
+// one host (random graphs; bars64 and falling in tests/measure/simgrid_agreement_test.cpp),
+// bad platforms and assignments.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -15,11 +16,6 @@
 #include "tgraph/partition/simulation.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
-
-#if TGRAPH_HAVE_SAMPLES
-#include "tgraph/capture/recorder.hpp"
-#include "tgraph/samples/scene.hpp"
-#endif
 
 namespace tgraph::partition {
 namespace {
@@ -345,45 +341,6 @@ TEST_F(PlatformFiles, TooFewCoresIsAnError) {
                Error);
 }
 
-#if TGRAPH_HAVE_SAMPLES
-
-Trace capture(const char* scene, int steps) {
-  Trace t;
-  auto s = samples::make_scene(scene);
-  capture::Recorder rec(capture::Mode::kCapture);
-  for (int i = 0; i < steps; ++i) {
-    s->step(rec);
-    t.steps.push_back(rec.end_step());
-  }
-  return t;
-}
-
-// Issue 20's acceptance: on one host (--cluster 1x2) with the same cost model, SimGrid and
-// the built-in simulator agree within 1 % on every step of bars64 and falling.
-void expect_agreement(const Trace& trace, const char* method, std::uint32_t k) {
-  const TracePartition tp = partition_trace(trace, method, k);
-  const SimulatedPlatform p = on_cluster(ClusterShape{1, k}, CostModel::defaults());
-  const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
-  const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
-  ASSERT_EQ(b.steps.size(), trace.steps.size());
-  ASSERT_EQ(s.steps.size(), trace.steps.size());
-  for (std::size_t i = 0; i < trace.steps.size(); ++i) {
-    const double bm = static_cast<double>(b.steps[i].makespan_ns);
-    EXPECT_NEAR(static_cast<double>(s.steps[i].makespan_ns), bm, 0.01 * bm)
-        << method << " k " << k << " step " << i;
-    EXPECT_EQ(s.steps[i].bytes, b.steps[i].bytes) << "step " << i;
-  }
-}
-
-TEST(SimgridEngine, AgreesWithinOnePercentWithTheBuiltinSimulatorOnBars64) {
-  expect_agreement(capture("bars64", 2), "metis", 2);
-}
-
-TEST(SimgridEngine, AgreesWithinOnePercentWithTheBuiltinSimulatorOnFalling) {
-  expect_agreement(capture("falling", 60), "metis", 2);
-}
-
-#endif  // TGRAPH_HAVE_SAMPLES
 #endif  // TGRAPH_HAVE_SIMGRID
 
 }  // namespace

@@ -1,30 +1,21 @@
 // SPDX-License-Identifier: MIT
-// Sticky on a real capture of the `falling` scene (collision groups merge and split):
-// fewer moved tasks than METIS relabelled every step, fallbacks exercised.
+// Sticky on a real capture of the `falling` scene (collision groups merge and split, through
+// measure::capture_trace): fewer moved tasks than METIS relabelled every step, fallbacks
+// exercised. Here rather than in tests/partition, which does not link the engine.
 #include <gtest/gtest.h>
 
-#if TGRAPH_HAVE_SAMPLES
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/diff.hpp"
+#include "tgraph/measure/capture.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/samples/scene.hpp"
 
 namespace tgraph::partition {
 namespace {
 
 const Trace& falling_trace() {
-  static const Trace trace = [] {
-    Trace t;
-    auto scene = samples::make_scene("falling");
-    capture::Recorder rec(capture::Mode::kCapture);
-    for (int s = 0; s < scene->default_steps(); ++s) {
-      scene->step(rec);
-      t.steps.push_back(rec.end_step());
-    }
-    return t;
-  }();
+  static const Trace trace = measure::capture_trace(
+      "falling", static_cast<std::uint32_t>(samples::make_scene("falling")->default_steps()));
   return trace;
 }
 
@@ -124,4 +115,3 @@ TEST(DiffOnFalling, NamesTheContactThatMergedTheGroupsAtEveryMerge) {
 
 }  // namespace
 }  // namespace tgraph::partition
-#endif
