@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "flags.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -47,7 +48,7 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
       });
   cmd->add_option_function<std::string>(
       "--barrier-rule",
-      [&exec](const std::string& r) { exec.barrier_rule = tr::barrier_rule_flag(r, "--barrier-rule"); },
+      [&exec](const std::string& r) { exec.barrier_rule = barrier_rule_flag(r, "--barrier-rule"); },
       "Barrier policy's phases: level (default; one per dependency level) or operation (one "
       "per run of same-kind tasks in program order, the paper's rule)");
   cmd->add_option("--starpu-sched", exec.starpu_sched,
@@ -59,7 +60,7 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
 
 void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model) {
   const Trace trace = read_trace(a.input);
-  o.policy = tr::policy_flag(a.policy.empty() ? "partition" : a.policy, "--policy");
+  o.policy = policy_flag(a.policy.empty() ? "partition" : a.policy, "--policy");
   std::optional<TraceAssignment> as;
   std::vector<std::uint64_t> predicted;
   tp::PartitionNotes notes;
@@ -70,6 +71,11 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
   } else if (!a.assignment.empty()) {
     throw UsageError("an assignment file is only used by --policy partition");
   }
+  if (o.exec.threads == 0) throw UsageError("--threads must be at least 1");
+  if (o.first_step >= trace.steps.size() && !trace.steps.empty())
+    throw UsageError("--first-step " + std::to_string(o.first_step) + ": the trace has " +
+                     std::to_string(trace.steps.size()) + " steps");
+  if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
   tr::TimelineObserver timeline;
   const bool observe = !a.timeline.empty() || !a.chrome.empty();
   meas::ReplayResult r = meas::replay_trace(
@@ -95,7 +101,8 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
 // The live loop tests/measure/live_test.cpp exercises: measure::run_live on the samples engine.
 void run(const Args& a, meas::LiveOptions& o) {
   if (a.steps && *a.steps < 1) throw UsageError("--steps must be at least 1");
-  const tr::MethodChoice m = tr::choose_method(a.method, a.policy);
+  if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
+  const meas::MethodChoice m = method_flags(a.method, a.policy);
   std::optional<tp::StepPartitioner> part;
   if (m.policy == tr::Policy::kPartition) part = tp::step_partitioner(m.method);
   samples::SceneOptions scene_options;
@@ -103,7 +110,7 @@ void run(const Args& a, meas::LiveOptions& o) {
   const int scene_steps = samples::make_scene(a.input, scene_options)->default_steps();  // InputError if unknown
   o.policy = m.policy;
   o.steps = static_cast<std::uint32_t>(a.steps.value_or(scene_steps));
-  const std::string scene = a.input, method = part ? m.method : std::string(to_string(m.policy));
+  const std::string scene = a.input, method = meas::method_name(m);
   const meas::LiveResult r =
       meas::run_live([scene, scene_options] { return meas::make_live_engine(scene, scene_options); },
                      part ? &*part : nullptr, o);

@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "flags.hpp"
 #include "tgraph/measure/report.hpp"
 #include "tgraph/measure/validate.hpp"
 
@@ -24,6 +25,11 @@ void add_validate(CLI::App& app) {
                   "Rounds of live pass, capture, replay pass and simulation (medians; default 3)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([o, a] {
+    const measure::MethodChoice m = method_flags(o->method);
+    o->method = measure::method_name(m);
+    if ((o->threads == 0 && m.policy != replay::Policy::kSequential) || o->steps == 0 ||
+        o->repeat == 0)
+      throw UsageError("--threads, --steps and --repeat must be at least 1");
     const measure::Validation v = measure::validate(*o);
     std::cout << (a->json ? measure::to_json(v, *o) : measure::to_text(v, *o));
   });

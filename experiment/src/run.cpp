@@ -20,6 +20,7 @@
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/measure/capture.hpp"
 #include "tgraph/measure/live.hpp"
+#include "tgraph/measure/method.hpp"
 #include "tgraph/measure/replay_trace.hpp"
 #include "tgraph/samples/scene.hpp"
 
@@ -80,7 +81,7 @@ struct LiveRun {
 
 LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t k,
                  const ExperimentPlan& p, bool every_step) {
-  const tr::MethodChoice m = tr::choose_method(method);
+  const meas::MethodChoice m = meas::choose_method(method);
   meas::LiveOptions o;
   o.policy = m.policy;
   o.exec.threads = k;
@@ -145,7 +146,7 @@ Predictions predict(const Trace& trace, const ExperimentPlan& p, const tp::CostM
   Predictions out;
   const double n = static_cast<double>(std::max<std::size_t>(trace.steps.size(), 1));
   for (const std::string& method : p.methods) {
-    if (tr::choose_method(method).policy != tr::Policy::kPartition) continue;
+    if (meas::choose_method(method).policy != tr::Policy::kPartition) continue;
     for (std::uint32_t k : p.threads.all()) {
       tp::TracePartition part = tp::partition_trace(trace, method, k);
       const tp::Report ev = tp::evaluate(trace, part.assignment, model, method);
@@ -241,7 +242,7 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
     for (const StepGraph& g : trace.steps) trace_work_ns += static_cast<double>(compute_metrics(g).work_ns);
 
     for (const std::string& method : p.methods) {
-      const tr::MethodChoice choice = tr::choose_method(method);
+      const meas::MethodChoice choice = meas::choose_method(method);
       const std::string policy(tr::to_string(choice.policy));
       for (std::uint32_t k : p.threads.all()) {
         ResultRow row;

@@ -63,10 +63,9 @@ std::optional<std::uint64_t> ReplayResult::predicted_makespan_ns() const {
 ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments,
                           const ReplayOptions& o, const std::vector<std::uint64_t>* predicted,
                           TimelineObserver* timeline) {
-  if (o.exec.threads == 0) throw UsageError("--threads must be at least 1");
   if (trace.steps.empty()) throw UsageError("the trace has no steps");
   if (o.first_step >= trace.steps.size())
-    throw UsageError("--first-step " + std::to_string(o.first_step) + ": the trace has " +
+    throw UsageError("replay: first step " + std::to_string(o.first_step) + ", the trace has " +
                      std::to_string(trace.steps.size()) + " steps");
   const std::uint32_t last =
       o.steps == 0 ? static_cast<std::uint32_t>(trace.steps.size())
@@ -79,7 +78,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       throw UsageError("the assignment covers " + std::to_string(assignments->steps.size()) +
                        " steps, " + std::to_string(last) + " are replayed");
   }
-  if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
+  if (o.repeat == 0) throw UsageError("replay: at least one timed pass");
 
   ReplayResult r;
   r.policy = o.policy;

@@ -270,14 +270,6 @@ std::string to_text(const LiveResult& r, const std::string& scene, const std::st
 
 // ---- validation --------------------------------------------------------------------------
 
-namespace {
-
-std::string method_name(const Validation& v) {
-  return v.choice.policy == tr::Policy::kPartition ? v.choice.method
-                                                       : std::string(to_string(v.choice.policy));
-}
-}  // namespace
-
 std::string to_json(const Validation& v, const ValidateOptions& o) {
   const bool pred = v.predicted_ns != 0;
   nlohmann::json rounds = nlohmann::json::array();
@@ -289,7 +281,7 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
                       {"host_ns", r.host_ns}});
   nlohmann::json j = {{"scene", o.scene},
                       {"policy", std::string(to_string(v.choice.policy))},
-                      {"method", method_name(v)},
+                      {"method", method_name(v.choice)},
                       {"threads", v.threads},
                       {"steps", o.steps},
                       {"rounds", rounds},
@@ -314,7 +306,7 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
                 "validate %s, %s (%s), %u threads, %u steps (medians of %zu rounds; ratios: "
                 "medians of each round's)\n",
                 o.scene.c_str(), std::string(to_string(v.choice.policy)).c_str(),
-                method_name(v).c_str(), v.threads, o.steps, v.rounds.size());
+                method_name(v.choice).c_str(), v.threads, o.steps, v.rounds.size());
   out += line;
   std::snprintf(line, sizeof line,
                 "  live run        %10.3f ms   (uninstrumented engine %.3f ms, speed-up %.2f)\n",

@@ -18,13 +18,13 @@ namespace tgraph::measure {
 
 Validation validate(const ValidateOptions& o) {
   Validation v;
-  v.choice = replay::choose_method(o.method);
+  v.choice = choose_method(o.method);
   const bool partition = v.choice.policy == replay::Policy::kPartition;
   std::optional<partition::StepPartitioner> part;
   if (partition) part = partition::step_partitioner(v.choice.method);
   v.threads = v.choice.policy == replay::Policy::kSequential ? 1 : o.threads;
   if (v.threads == 0 || o.steps == 0 || o.repeat == 0)
-    throw UsageError("--threads, --steps and --repeat must be at least 1");
+    throw UsageError("validate: threads, steps and rounds must be at least 1");
   const auto model = partition::select_cost_model("calibrated", "");
 
   for (std::uint32_t round = 0; round < o.repeat; ++round) {

@@ -1,10 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "tgraph/replay/policy.hpp"
 
-#include <string>
-
-#include "tgraph/graph/error.hpp"
-
 namespace tgraph::replay {
 
 std::string_view to_string(Policy policy) {
@@ -30,22 +26,6 @@ std::optional<Policy> parse_policy(std::string_view name) {
                    Policy::kStarpu, Policy::kOmpTasks})
     if (to_string(p) == name) return p;
   return std::nullopt;
-}
-
-Policy policy_flag(std::string_view name, std::string_view flag) {
-  if (const auto p = parse_policy(name)) return *p;
-  throw UsageError(std::string(flag) + " " + std::string(name) +
-                   ": expected partition, worksteal, barrier, starpu, omp-tasks or sequential");
-}
-
-MethodChoice choose_method(std::string_view method, std::string_view policy) {
-  MethodChoice c{Policy::kPartition, std::string(method)};
-  if (const auto p = parse_policy(method); p && *p != Policy::kPartition)
-    c.policy = *p;
-  else if (method == "partition")
-    c.method = "owner";
-  if (!policy.empty()) c.policy = policy_flag(policy, "--policy");
-  return c;
 }
 
 std::string_view to_string(CwMode mode) {
@@ -80,11 +60,10 @@ std::string_view to_string(BarrierRule rule) {
   return "?";
 }
 
-BarrierRule barrier_rule_flag(std::string_view name, std::string_view flag) {
-  if (name == "level") return BarrierRule::kLevel;
-  if (name == "operation") return BarrierRule::kOperation;
-  throw UsageError(std::string(flag) + ": expected level or operation, got '" +
-                   std::string(name) + "'");
+std::optional<BarrierRule> parse_barrier_rule(std::string_view name) {
+  for (BarrierRule r : {BarrierRule::kLevel, BarrierRule::kOperation})
+    if (to_string(r) == name) return r;
+  return std::nullopt;
 }
 
 }  // namespace tgraph::replay

@@ -8,14 +8,14 @@
 
 #include <vector>
 
-#include "tgraph/replay/policy.hpp"
+#include "tgraph/measure/method.hpp"
 
 namespace tgraph::measure {
 
-/// What to validate (the flags of `tgraph validate`).
+/// What to validate.
 struct ValidateOptions {
   std::string scene;
-  std::string method = "owner";  ///< strategy, or a baseline policy (worksteal, barrier...)
+  std::string method = "owner";  ///< strategy, or a baseline policy (choose_method)
   std::uint32_t threads = 1;
   std::uint32_t steps = 20;
   std::uint32_t repeat = 3;  ///< rounds (live pass, capture, replay pass, simulation); medians
@@ -34,7 +34,7 @@ struct ValidationRound {
 /// The three figures of one validation: medians over the rounds, and the medians of each
 /// round's own ratios.
 struct Validation {
-  replay::MethodChoice choice;
+  MethodChoice choice;
   std::uint32_t threads = 1;
   std::vector<ValidationRound> rounds;
   std::int64_t live_ns = 0, engine_ns = 0, replay_ns = 0;

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <optional>
-#include <string>
 #include <string_view>
 
 namespace tgraph::replay {
@@ -22,18 +21,6 @@ enum class Policy : unsigned char {
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);
-
-/// The policy named by a `--policy` flag `flag`; UsageError naming the flag and the names.
-Policy policy_flag(std::string_view name, std::string_view flag);
-
-/// A run's policy and partitioning method from `--method` (a strategy, or a baseline policy
-/// name such as worksteal) and an optional `--policy` override (empty: none).
-struct MethodChoice {
-  Policy policy = Policy::kPartition;
-  std::string method;  ///< the strategy for the partition policy ("partition" -> "owner")
-};
-/// Resolves `--method` and `--policy` as `tgraph run` and `tgraph validate` take them.
-MethodChoice choose_method(std::string_view method, std::string_view policy = {});
 
 /// How cumulative (CW) writes by tasks on different threads are made safe.
 enum class CwMode : unsigned char {
@@ -72,7 +59,7 @@ enum class BarrierRule : unsigned char {
 
 /// "level" or "operation".
 std::string_view to_string(BarrierRule rule);
-/// Parses "level" / "operation"; UsageError naming `flag` otherwise.
-BarrierRule barrier_rule_flag(std::string_view name, std::string_view flag);
+/// Inverse of to_string; nullopt for an unknown name.
+std::optional<BarrierRule> parse_barrier_rule(std::string_view name);
 
 }  // namespace tgraph::replay
