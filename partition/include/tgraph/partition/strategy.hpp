@@ -165,7 +165,7 @@ TracePartition partition_trace(const Trace& trace, std::string_view method, std:
 std::string default_method(const Trace& trace);
 
 /// Partitions one step given the previous one (null at the first step): the callback a live
-/// run calls at each step (the same type as replay::LivePartitioner).
+/// run calls at each step (measure::run_live).
 using StepPartitioner = std::function<Assignment(
     const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph, const Assignment* prev)>;
 /// Strategy `method` as a StepPartitioner (UsageError for an unknown name).
