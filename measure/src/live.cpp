@@ -128,7 +128,6 @@ LiveResult run_live(const EngineFactory& make_engine,
     m.prepare_ns = prepare.step_median(s);
     m.execute_ns = execute.step_median(s);
     m.baseline_ns = baseline.fastest.step_median(s);
-    m.threads.clear();
   }
   res.wall_ns = wall.median_total();
   for (const PassTimes& core : baseline.by_core) {

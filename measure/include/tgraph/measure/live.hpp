@@ -109,7 +109,7 @@ struct LiveResult {
 /// The check compares the final state with a sequential run that uses the same reduction
 /// order: for the partition policy the serial twin of the executor with the assignments of
 /// the first timed pass, for the dynamic policies the sequential executor with per-writer
-/// temporaries, for `--cw serialize` and the sequential policy the plain program order.
+/// temporaries, for CwMode::kSerialize and the sequential policy the plain program order.
 LiveResult run_live(const EngineFactory& make_engine,
                     const partition::StepPartitioner* partitioner, const LiveOptions& options);
 
