@@ -23,8 +23,9 @@ CacheMissCounter::CacheMissCounter() {
   attr.exclude_hv = 1;
   const long fd = syscall(SYS_perf_event_open, &attr, 0, -1, -1, 0);
   if (fd < 0) {
-    reason_ = std::string("not counted: the kernel refused hardware performance counters "
-                          "(perf_event_open: ") +
+    reason_ = std::string(
+                  "not counted: the kernel refused hardware performance counters "
+                  "(perf_event_open: ") +
               std::strerror(errno) + ")";
     return;
   }

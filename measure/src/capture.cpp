@@ -19,8 +19,8 @@ Trace capture_trace(const std::string& scene, std::uint32_t steps,
     trace.steps.push_back(rec.end_step());
   }
   if (rec.errors() != 0)
-    throw std::runtime_error(scene + ": the capture API reported " +
-                             std::to_string(rec.errors()) + " misuses");
+    throw std::runtime_error(scene + ": the capture API reported " + std::to_string(rec.errors()) +
+                             " misuses");
   return trace;
 }
 

@@ -64,8 +64,8 @@ void time_baseline_pass(const EngineFactory& make_engine, const LiveOptions& o, 
 
 }  // namespace
 
-LiveResult run_live(const EngineFactory& make_engine,
-                    const partition::StepPartitioner* partitioner, const LiveOptions& o) {
+LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
+                    const LiveOptions& o) {
   if (o.steps == 0) throw UsageError("live run: at least one step");
   if (o.repeat == 0) throw UsageError("live run: at least one timed pass");
   if (o.policy == tr::Policy::kPartition && (partitioner == nullptr || !*partitioner))
@@ -90,8 +90,7 @@ LiveResult run_live(const EngineFactory& make_engine,
   std::vector<detail::PassResult> passes;
   const std::uint32_t baseline_cores =
       o.exec.pin ? std::min<std::uint32_t>({res.threads, tr::hardware_pus(), 4}) : 1;
-  Baseline baseline{std::vector<PassTimes>(baseline_cores, PassTimes(o.steps)),
-                    PassTimes(o.steps)};
+  Baseline baseline{std::vector<PassTimes>(baseline_cores, PassTimes(o.steps)), PassTimes(o.steps)};
   PassTimes wall(o.steps), record(o.steps), part(o.steps), prepare(o.steps), execute(o.steps);
   for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
     if (o.baseline) time_baseline_pass(make_engine, o, baseline);

@@ -44,7 +44,8 @@ class CostObserver : public replay::Observer {
       for (Task& t : g.tasks) t.cost_ns = 1;
       return;
     }
-    if (&measured == &g || (g.tasks.size() == measured.tasks.size() && g.same_structure(measured))) {
+    if (&measured == &g ||
+        (g.tasks.size() == measured.tasks.size() && g.same_structure(measured))) {
       // Same tasks: an exponential average with the costs already there (half weight to
       // the new sample), so that one preempted step does not look like an imbalance.
       for (TaskId t = 0; t < sum_.size(); ++t) {

@@ -38,9 +38,8 @@ void apply_iterations(const std::vector<std::uint32_t>& last, bool same, StepGra
 
 }  // namespace
 
-PassResult run_pass(const EngineFactory& make_engine,
-                    const partition::StepPartitioner* partitioner, replay::Executor& ex,
-                    const LiveOptions& o, const PassOptions& po) {
+PassResult run_pass(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
+                    replay::Executor& ex, const LiveOptions& o, const PassOptions& po) {
   const bool feed_costs = po.feed_costs;
   const std::vector<Assignment>* fixed = po.fixed;
   PassResult r;
@@ -49,9 +48,9 @@ PassResult run_pass(const EngineFactory& make_engine,
   CostObserver costs;
   if (feed_costs) ex.add_observer(costs);
   const bool partition = ex.policy() == replay::Policy::kPartition;
-  LiveStep cur;             // the program in use
-  StepGraph prev_graph;     // the graph of the previous recorded program
-  Assignment assignment;    // the assignment in use
+  LiveStep cur;           // the program in use
+  StepGraph prev_graph;   // the graph of the previous recorded program
+  Assignment assignment;  // the assignment in use
   std::vector<std::uint32_t> last_iterations;
   bool have_prev = false;
   try {
@@ -61,7 +60,8 @@ PassResult run_pass(const EngineFactory& make_engine,
       LiveStep next = engine->record_step(o.reuse_structure);
       const bool reused = next.reuse_previous && s > 0;
       if (!reused) {
-        if (next.reuse_previous) throw UsageError("live run: the engine reused a program at step 0");
+        if (next.reuse_previous)
+          throw UsageError("live run: the engine reused a program at step 0");
         if (partition && s > 0) prev_graph = std::move(cur.graph);
         cur = std::move(next);
       }

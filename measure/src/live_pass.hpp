@@ -32,8 +32,7 @@ struct PassResult {
 };
 
 /// One pass of `options.steps` steps of a fresh engine through `ex`.
-PassResult run_pass(const EngineFactory& make_engine,
-                    const partition::StepPartitioner* partitioner, replay::Executor& ex,
-                    const LiveOptions& options, const PassOptions& pass);
+PassResult run_pass(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
+                    replay::Executor& ex, const LiveOptions& options, const PassOptions& pass);
 
 }  // namespace tgraph::measure::detail

@@ -17,21 +17,23 @@ namespace {
 json threads_json(const std::vector<tr::StatsObserver::Thread>& threads) {
   json a = json::array();
   for (const auto& t : threads)
-    a.push_back(
-        {{"busy_ns", t.busy_ns}, {"wait_ns", t.wait_ns}, {"idle_ns", t.idle_ns}, {"tasks", t.tasks}});
+    a.push_back({{"busy_ns", t.busy_ns},
+                 {"wait_ns", t.wait_ns},
+                 {"idle_ns", t.idle_ns},
+                 {"tasks", t.tasks}});
   return a;
 }
 
 // The keys every per-step record has (replays and live runs alike).
 json step_record_json(const StepRecord& m) {
-  return {{"wall_ns", m.wall_ns},
-          {"build_ns", m.build_ns},
-          {"rebuild_ns", m.rebuild_ns},
-          {"rebuilt_procs", m.rebuilt_procs},
-          {"rebuild_over_wall",
-           m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) / static_cast<double>(m.wall_ns)
-                         : 0.0},
-          {"threads", threads_json(m.threads)}};
+  return {
+      {"wall_ns", m.wall_ns},
+      {"build_ns", m.build_ns},
+      {"rebuild_ns", m.rebuild_ns},
+      {"rebuilt_procs", m.rebuilt_procs},
+      {"rebuild_over_wall",
+       m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) / static_cast<double>(m.wall_ns) : 0.0},
+      {"threads", threads_json(m.threads)}};
 }
 
 }  // namespace
@@ -274,24 +276,25 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
   const bool pred = v.predicted_ns != 0;
   nlohmann::json rounds = nlohmann::json::array();
   for (const ValidationRound& r : v.rounds)
-    rounds.push_back({{"live_wall_ns", r.live_ns},
-                      {"engine_wall_ns", r.engine_ns},
-                      {"replay_wall_ns", r.replay_ns},
-                      {"predicted_ns", pred ? nlohmann::json(r.predicted_ns) : nlohmann::json(nullptr)},
-                      {"host_ns", r.host_ns}});
-  nlohmann::json j = {{"scene", o.scene},
-                      {"policy", std::string(to_string(v.choice.policy))},
-                      {"method", method_name(v.choice)},
-                      {"threads", v.threads},
-                      {"steps", o.steps},
-                      {"rounds", rounds},
-                      {"live_wall_ns", v.live_ns},
-                      {"engine_wall_ns", v.engine_ns},
-                      {"live_speedup", v.live_ns > 0 ? static_cast<double>(v.engine_ns) /
-                                                           static_cast<double>(v.live_ns)
-                                                     : 0.0},
-                      {"replay_wall_ns", v.replay_ns},
-                      {"replay_over_live", v.replay_over_live}};
+    rounds.push_back(
+        {{"live_wall_ns", r.live_ns},
+         {"engine_wall_ns", r.engine_ns},
+         {"replay_wall_ns", r.replay_ns},
+         {"predicted_ns", pred ? nlohmann::json(r.predicted_ns) : nlohmann::json(nullptr)},
+         {"host_ns", r.host_ns}});
+  nlohmann::json j = {
+      {"scene", o.scene},
+      {"policy", std::string(to_string(v.choice.policy))},
+      {"method", method_name(v.choice)},
+      {"threads", v.threads},
+      {"steps", o.steps},
+      {"rounds", rounds},
+      {"live_wall_ns", v.live_ns},
+      {"engine_wall_ns", v.engine_ns},
+      {"live_speedup",
+       v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns) : 0.0},
+      {"replay_wall_ns", v.replay_ns},
+      {"replay_over_live", v.replay_over_live}};
   j["predicted_ns"] = pred ? nlohmann::json(v.predicted_ns) : nlohmann::json(nullptr);
   j["predicted_over_live"] = pred ? nlohmann::json(v.predicted_over_live) : nlohmann::json(nullptr);
   j["predicted_over_replay"] =
@@ -308,11 +311,11 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
                 o.scene.c_str(), std::string(to_string(v.choice.policy)).c_str(),
                 method_name(v.choice).c_str(), v.threads, o.steps, v.rounds.size());
   out += line;
-  std::snprintf(line, sizeof line,
-                "  live run        %10.3f ms   (uninstrumented engine %.3f ms, speed-up %.2f)\n",
-                static_cast<double>(v.live_ns) / 1e6, static_cast<double>(v.engine_ns) / 1e6,
-                v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns)
-                              : 0.0);
+  std::snprintf(
+      line, sizeof line,
+      "  live run        %10.3f ms   (uninstrumented engine %.3f ms, speed-up %.2f)\n",
+      static_cast<double>(v.live_ns) / 1e6, static_cast<double>(v.engine_ns) / 1e6,
+      v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns) : 0.0);
   out += line;
   std::snprintf(line, sizeof line, "  replay          %10.3f ms   replay / live %.3f\n",
                 static_cast<double>(v.replay_ns) / 1e6, v.replay_over_live);

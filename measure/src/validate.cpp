@@ -37,8 +37,8 @@ Validation validate(const ValidateOptions& o) {
     lo.repeat = 1;
     lo.observe = false;
     const std::string scene = o.scene;
-    const LiveResult live = run_live(
-        [scene] { return make_live_engine(scene); }, part ? &*part : nullptr, lo);
+    const LiveResult live =
+        run_live([scene] { return make_live_engine(scene); }, part ? &*part : nullptr, lo);
     r.live_ns = live.wall_ns;
     r.engine_ns = live.baseline_wall_ns;
 

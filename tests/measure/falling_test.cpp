@@ -79,8 +79,10 @@ TEST(StickyOnFalling, RefiningAtMergesMovesAQuarterOfMetisRelabelsTasksAtMetissM
     const TracePartition relabel = partition_trace(trace, "metis-relabel", k);
     EXPECT_LE(4 * summarize(sticky.stats).moved_tasks, summarize(relabel.stats).moved_tasks) << k;
     const CostModel model = CostModel::defaults();
-    const double s = static_cast<double>(evaluate(trace, sticky.assignment, model).total.makespan_ns);
-    const double m = static_cast<double>(evaluate(trace, relabel.assignment, model).total.makespan_ns);
+    const double s =
+        static_cast<double>(evaluate(trace, sticky.assignment, model).total.makespan_ns);
+    const double m =
+        static_cast<double>(evaluate(trace, relabel.assignment, model).total.makespan_ns);
     EXPECT_LE(s, 1.25 * m) << "k " << k;
     EXPECT_NO_THROW(check_fits(trace, sticky.assignment, "sticky"));
   }

@@ -2,6 +2,8 @@
 // Live runs (measure::run_live): the engine's own task bodies through every executor, with
 // parallel reductions, give the state of a sequential run that uses the same reduction
 // order, bit for bit, over steps where contacts change and plans are rebuilt.
+#include "tgraph/measure/live.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,7 +13,6 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "tgraph/measure/live.hpp"
 #include "tgraph/replay/program_workload.hpp"
 
 namespace tgraph::measure {
@@ -33,8 +34,8 @@ partition::StepPartitioner partitioner_for(const std::string& method) {
   };
 }
 
-LiveResult live(const std::string& scene, Policy policy, const std::string& method,
-                std::uint32_t k, std::uint32_t steps, CwMode cw = CwMode::kReduce) {
+LiveResult live(const std::string& scene, Policy policy, const std::string& method, std::uint32_t k,
+                std::uint32_t steps, CwMode cw = CwMode::kReduce) {
   LiveOptions o;
   o.policy = policy;
   o.exec.threads = k;
@@ -45,7 +46,8 @@ LiveResult live(const std::string& scene, Policy policy, const std::string& meth
   o.baseline = false;
   o.observe = false;
   o.check = true;
-  const partition::StepPartitioner p = policy == Policy::kPartition ? partitioner_for(method) : nullptr;
+  const partition::StepPartitioner p =
+      policy == Policy::kPartition ? partitioner_for(method) : nullptr;
   return run_live([scene] { return make_live_engine(scene); },
                   policy == Policy::kPartition ? &p : nullptr, o);
 }
@@ -90,7 +92,7 @@ TEST(Live, EveryPolicyAndThreadCountMatchesItsReferenceOnBarsAndCloth) {
         if (p == Policy::kOmpTasks && k != 2) continue;
         const LiveResult r = live(scene, p, "owner", k, 2);
         EXPECT_EQ(r.check, Check::kIdentical) << scene << " " << to_string(p) << " k=" << k << ": "
-                                        << (r.difference ? r.difference->datum : "");
+                                              << (r.difference ? r.difference->datum : "");
         EXPECT_FALSE(r.steps[0].loop_iterations.empty());
         EXPECT_GT(r.steps[0].loop_iterations[0], 1u) << "the CG loop ran one iteration";
       }
@@ -164,8 +166,7 @@ TEST(LiveCompare, NamesTheFirstDifferingDatum) {
 TEST(Live, RefusesThePartitionPolicyWithoutAPartitioner) {
   LiveOptions o;
   o.policy = Policy::kPartition;
-  EXPECT_THROW(run_live([] { return make_live_engine("fig2"); }, nullptr, o),
-               UsageError);
+  EXPECT_THROW(run_live([] { return make_live_engine("fig2"); }, nullptr, o), UsageError);
 }
 
 }  // namespace

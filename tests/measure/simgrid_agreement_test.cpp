@@ -39,7 +39,6 @@ TEST(SimgridEngine, AgreesWithinOnePercentWithTheBuiltinSimulatorOnFalling) {
   expect_agreement(measure::capture_trace("falling", 60), "metis", 2);
 }
 
-
 #endif  // TGRAPH_HAVE_SIMGRID
 
 }  // namespace

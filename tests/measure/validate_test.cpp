@@ -2,7 +2,6 @@
 // `tgraph validate` (measure::validate): rounds of live pass, capture, replay pass and
 // simulation; medians of the rounds and of each round's own ratios.
 #include "tgraph/measure/validate.hpp"
-#include "tgraph/measure/report.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/measure/report.hpp"
 
 namespace tgraph::measure {
 namespace {

@@ -30,15 +30,15 @@ std::string_view to_string(Check check);
 /// What a live run does.
 struct LiveOptions {
   replay::Policy policy = replay::Policy::kPartition;
-  replay::ExecOptions exec;            ///< threads, pinning, spin, CW mode
+  replay::ExecOptions exec;  ///< threads, pinning, spin, CW mode
   std::uint32_t steps = 10;
-  std::uint32_t repeat = 1;    ///< timed passes (medians reported)
+  std::uint32_t repeat = 1;  ///< timed passes (medians reported)
   /// Time the uninstrumented engine too, pass by pass interleaved, on each of the first
   /// min(threads, 4) cores the run uses (pinned), keeping the fastest.
   bool baseline = true;
-  bool observe = true;         ///< one more pass with observers (threads, kinds), plus a
-                               ///< sequential one for the per-kind comparison
-  bool check = false;          ///< compare the final state with a sequential reference
+  bool observe = true;            ///< one more pass with observers (threads, kinds), plus a
+                                  ///< sequential one for the per-kind comparison
+  bool check = false;             ///< compare the final state with a sequential reference
   std::uint32_t cost_stride = 8;  ///< cost feedback samples loop iterations 0, 1, every n-th
   /// Partition policy: call the partitioner at every step. Default: only when the structure
   /// changed or the last assignment's imbalance under the newly measured costs exceeds
@@ -52,24 +52,24 @@ struct LiveOptions {
 /// Mean duration of the instances of one task kind.
 struct KindTime {
   std::string kind;
-  std::uint64_t instances = 0;     ///< instances timed
-  double mean_ns = 0;              ///< in the observed run of the policy
-  double sequential_mean_ns = 0;   ///< in the observed sequential run (0: not run)
+  std::uint64_t instances = 0;    ///< instances timed
+  double mean_ns = 0;             ///< in the observed run of the policy
+  double sequential_mean_ns = 0;  ///< in the observed sequential run (0: not run)
 };
 
 /// One step of a live run (medians over the timed passes; threads from the observed pass).
 /// StepRecord::wall_ns: record + partition + prepare + execute.
 struct LiveStepMeasure : StepRecord {
-  std::int64_t record_ns = 0;     ///< coordination code in deferred mode, edges derived
-  std::int64_t partition_ns = 0;  ///< the partitioner callback
-  std::int64_t prepare_ns = 0;    ///< plan lookup, lowering and plan build, binding
+  std::int64_t record_ns = 0;        ///< coordination code in deferred mode, edges derived
+  std::int64_t partition_ns = 0;     ///< the partitioner callback
+  std::int64_t prepare_ns = 0;       ///< plan lookup, lowering and plan build, binding
   std::int64_t graph_update_ns = 0;  ///< edge derivation within record_ns, first pass
-  std::int64_t execute_ns = 0;    ///< the executor running the tasks
-  std::int64_t baseline_ns = 0;   ///< the same step of the uninstrumented engine
-  bool rebuilt = false;           ///< a plan was built for this step (first pass)
-  bool recorded = true;           ///< the engine recorded the step (false: program reused)
-  bool partitioned = false;       ///< the partitioner was called (first pass)
-  std::vector<std::uint32_t> loop_iterations;   ///< first pass
+  std::int64_t execute_ns = 0;       ///< the executor running the tasks
+  std::int64_t baseline_ns = 0;      ///< the same step of the uninstrumented engine
+  bool rebuilt = false;              ///< a plan was built for this step (first pass)
+  bool recorded = true;              ///< the engine recorded the step (false: program reused)
+  bool partitioned = false;          ///< the partitioner was called (first pass)
+  std::vector<std::uint32_t> loop_iterations;  ///< first pass
 };
 
 /// A whole live run.
@@ -83,21 +83,21 @@ struct LiveResult {
   /// Uninstrumented engine passes, by core (thread p's core, p < min(threads, 4); one
   /// unpinned series when pinning is off).
   std::vector<std::vector<std::int64_t>> baseline_core_pass_wall_ns;
-  std::int64_t wall_ns = 0;           ///< median pass
+  std::int64_t wall_ns = 0;  ///< median pass
   /// The fastest core's median uninstrumented pass (0: not timed): the sequential engine
   /// where it runs best, so that a slow core of a VM never flatters the speed-up.
   std::int64_t baseline_wall_ns = 0;
-  double speedup = 0;                 ///< baseline_wall_ns / wall_ns
+  double speedup = 0;  ///< baseline_wall_ns / wall_ns
   /// The speed-up the measured cores allow: sum over the timed cores of baseline_wall_ns /
   /// that core's median (2.0 for two equal cores; less when one is slower). 0 when fewer
   /// cores than threads were timed.
   double core_bound = 0;
   std::uint64_t plans_built = 0, order_fallbacks = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;  ///< first pass
-  std::vector<KindTime> kinds;        ///< observed passes
+  std::vector<KindTime> kinds;                                         ///< observed passes
   /// The check of the final state (LiveOptions::check; nullopt: not checked).
   std::optional<Check> check;
-  std::string check_reference;        ///< what the final state was compared with
+  std::string check_reference;  ///< what the final state was compared with
   std::optional<StateDifference> difference;
   std::size_t data_compared = 0;
 };
@@ -110,7 +110,7 @@ struct LiveResult {
 /// order: for the partition policy the serial twin of the executor with the assignments of
 /// the first timed pass, for the dynamic policies the sequential executor with per-writer
 /// temporaries, for CwMode::kSerialize and the sequential policy the plain program order.
-LiveResult run_live(const EngineFactory& make_engine,
-                    const partition::StepPartitioner* partitioner, const LiveOptions& options);
+LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
+                    const LiveOptions& options);
 
 }  // namespace tgraph::measure

@@ -48,7 +48,7 @@ struct StepMeasure : StepRecord {
 /// The whole replay.
 struct ReplayResult {
   replay::Policy policy = replay::Policy::kPartition;
-  std::uint32_t threads = 1;               ///< ExecOptions::threads; 1 for the sequential policy
+  std::uint32_t threads = 1;  ///< ExecOptions::threads; 1 for the sequential policy
   replay::CwMode cw = replay::CwMode::kReduce;             ///< how CW groups ran
   replay::ReduceScope scope = replay::ReduceScope::kNone;  ///< where their temporaries lived
   std::vector<StepMeasure> steps;

@@ -13,8 +13,8 @@ namespace tgraph::measure {
 /// build of the first pass, and the threads of the observed pass. Written to JSON once
 /// (report.hpp) for replays and live runs alike.
 struct StepRecord {
-  std::int64_t wall_ns = 0;     ///< median over the timed passes
-  std::int64_t build_ns = 0;    ///< lowering and plan build in the first pass (0: reused)
+  std::int64_t wall_ns = 0;   ///< median over the timed passes
+  std::int64_t build_ns = 0;  ///< lowering and plan build in the first pass (0: reused)
   /// The plan part of build_ns (per-processor programs, without lowering), first pass.
   std::int64_t rebuild_ns = 0;
   std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built, first pass

@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <string>
-
 #include <vector>
 
 #include "tgraph/measure/method.hpp"
@@ -24,9 +23,9 @@ struct ValidateOptions {
 /// One round of a validation: the three measured back to back, so that a machine whose
 /// speed drifts (a shared VM) moves all three alike and their ratios stay comparable.
 struct ValidationRound {
-  std::int64_t live_ns = 0;    ///< live run, one pass
-  std::int64_t engine_ns = 0;  ///< uninstrumented engine, same round
-  std::int64_t replay_ns = 0;  ///< synthetic replay of this round's capture, one pass
+  std::int64_t live_ns = 0;        ///< live run, one pass
+  std::int64_t engine_ns = 0;      ///< uninstrumented engine, same round
+  std::int64_t replay_ns = 0;      ///< synthetic replay of this round's capture, one pass
   std::uint64_t predicted_ns = 0;  ///< simulator on this round's capture (0: no partition)
   std::uint64_t host_ns = 0;       ///< the capture's host time (outside the graph)
 };

@@ -40,10 +40,10 @@ class ProgramWorkload : public Workload {
   std::span<const std::function<void()>> bodies_;
   std::span<const std::function<bool()>> conditions_;
   std::span<const Accumulator* const> accumulators_;
-  std::vector<bool> reducible_;                 // by original datum
+  std::vector<bool> reducible_;  // by original datum
   const ExecGraph* exec_ = nullptr;
-  std::vector<std::shared_ptr<void>> temps_;    // by exec datum (temporaries only)
-  std::vector<std::uint8_t> redirected_;        // by exec task: writes a temporary
+  std::vector<std::shared_ptr<void>> temps_;  // by exec datum (temporaries only)
+  std::vector<std::uint8_t> redirected_;      // by exec task: writes a temporary
 };
 
 }  // namespace tgraph::replay
