@@ -154,3 +154,20 @@ void scotch_repart(const UndirectedGraph& pg, const LibraryWeights& w, std::uint
 }
 
 }  // namespace tgraph::partition::detail
+
+namespace tgraph::partition {
+
+std::vector<std::uint32_t> scotch_partition(const UndirectedGraph& pg, const LibraryWeights& w,
+                                            std::uint32_t k, const Options& options) {
+  const std::uint32_t n = pg.vertices();
+  std::vector<std::uint32_t> part(n, 0);
+  if (k <= 1) return part;
+  if (k >= n) {
+    for (std::uint32_t v = 0; v < n; ++v) part[v] = v;
+    return part;
+  }
+  detail::scotch_part(pg, w, k, options, part);
+  return part;
+}
+
+}  // namespace tgraph::partition
