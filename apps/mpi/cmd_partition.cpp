@@ -5,6 +5,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <exception>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -34,6 +35,30 @@ struct PartitionArgs {
 };
 
 #if defined(TGRAPH_HAVE_PTSCOTCH)
+/// Reads and checks the input on every rank. When that fails somewhere, the lowest failing
+/// rank rethrows (main prints its one line and aborts the job) and the others wait for the
+/// abort: bad input gives one line, not one per rank.
+Trace read_input(const PartitionArgs& a, int rank, int ranks) {
+  Trace trace;
+  std::exception_ptr error;
+  try {
+    if (a.nodes == 0) throw UsageError("--nodes: expected at least 1");
+    if (a.cores == 0) throw UsageError("--cores: expected at least 1");
+    trace = read_trace(a.trace);
+    if (a.step && *a.step >= trace.steps.size())
+      throw UsageError("--step: " + std::to_string(*a.step) + " is past the trace's " +
+                       std::to_string(trace.steps.size()) + " steps");
+  } catch (...) {
+    error = std::current_exception();
+  }
+  int failing = error ? rank : ranks;
+  MPI_Allreduce(MPI_IN_PLACE, &failing, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (failing == rank) std::rethrow_exception(error);
+  if (failing < ranks)  // never sent: MPI_Abort from rank `failing` ends this wait
+    MPI_Recv(nullptr, 0, MPI_BYTE, failing, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  return trace;
+}
+
 nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
   return {{"step", step},
           {"tasks", r.vertices},
@@ -49,16 +74,11 @@ nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
 }
 
 void run(const PartitionArgs& a) {
-  if (a.nodes == 0) throw UsageError("--nodes: expected at least 1");
-  if (a.cores == 0) throw UsageError("--cores: expected at least 1");
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   const double t0 = MPI_Wtime();
-  const Trace trace = read_trace(a.trace);
-  if (a.step && *a.step >= trace.steps.size())
-    throw UsageError("--step: " + std::to_string(*a.step) + " is past the trace's " +
-                     std::to_string(trace.steps.size()) + " steps");
+  const Trace trace = read_input(a, rank, ranks);
   double read_ms = (MPI_Wtime() - t0) * 1e3;
   MPI_Allreduce(MPI_IN_PLACE, &read_ms, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   partition::Options options = a.options;
