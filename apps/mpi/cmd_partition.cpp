@@ -3,6 +3,7 @@
 // [--json]`: every rank reads the trace; each step is partitioned by all ranks together
 // (tgraph::mpi::ptscotch_partition), and rank 0 writes the .tga and the report.
 #include <mpi.h>
+#include <sys/resource.h>
 
 #include <algorithm>
 #include <exception>
@@ -59,6 +60,15 @@ Trace read_input(const PartitionArgs& a, int rank, int ranks) {
   return trace;
 }
 
+/// The largest peak resident set of any rank, in MiB (a collective call).
+double max_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  double mib = static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
+  MPI_Allreduce(MPI_IN_PLACE, &mib, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return mib;
+}
+
 nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
   return {{"step", step},
           {"tasks", r.vertices},
@@ -105,6 +115,7 @@ void run(const PartitionArgs& a) {
     out.steps.push_back(std::move(r.assignment));
     hashes.push_back(g.structural_hash());
   }
+  const double rss_mib = max_rss_mib();
   if (rank != 0) return;
   if (!a.output.empty()) partition::write_assignment(a.output, out, hashes);
   if (!a.json) {
@@ -128,6 +139,7 @@ void run(const PartitionArgs& a) {
                               {"imbalance", imbalance},
                               {"read_ms", read_ms},
                               {"partition_ms", partition_ms},
+                              {"max_rss_mib", rss_mib},
                               {"per_step", per_step}}
                    .dump()
             << std::endl;
@@ -154,7 +166,8 @@ void add_partition_verb(CLI::App& app) {
   cmd->add_option("--step", a->step,
                   "Partition only this step (the .tga then holds one step); default every step");
   cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga), by rank 0");
-  cmd->add_option("--imbalance", a->options.imbalance, "Max/mean load allowed per level (1.03)")
+  cmd->add_option("--imbalance", a->options.imbalance,
+                  "Max/mean processor load allowed (1.03; its square root per level)")
       ->check(CLI::Range(1.0, 100.0));
   cmd->add_option("--seed", a->options.seed, "Scotch / PT-Scotch seed (0)");
   cmd->add_option("--scotch-strategy", a->scotch, "Flavour: default, quality, speed, balance")

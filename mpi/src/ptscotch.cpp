@@ -315,10 +315,15 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
 
   const Slice s = build_slice(g, rank, ranks, comm);
   const partition::LibraryWeights w = partition::library_weights(s.g);
+  // Each level gets the square root of the tolerance, so that node x core imbalance stays
+  // within `options.imbalance`, as for sequential Scotch at K = nodes x cores.
+  partition::Options level = options;
+  const bool two_levels = nodes > 1 && cores > 1;
+  if (two_levels) level.imbalance = std::sqrt(options.imbalance);
   const Clock t1 = MPI_Wtime();
-  const std::vector<std::uint32_t> node_of = all_gather(partition_nodes(s, w, nodes, options, comm), comm);
+  const std::vector<std::uint32_t> node_of = all_gather(partition_nodes(s, w, nodes, level, comm), comm);
   const Clock t2 = MPI_Wtime();
-  const std::vector<std::uint32_t> placed = all_gather(partition_cores(s, w, node_of, cores, options, comm), comm);
+  const std::vector<std::uint32_t> placed = all_gather(partition_cores(s, w, node_of, cores, level, comm), comm);
   const Clock t3 = MPI_Wtime();
 
   const std::uint32_t k = nodes * cores;

@@ -40,9 +40,9 @@ struct PtScotchResult {
 /// Partitions step `g` (edges derived, the same on every rank of `comm`) over `nodes` x
 /// `cores` processors; a collective call. Rank r builds only its slice (tasks [n r / R,
 /// n (r + 1) / R)) of the undirected graph, weighted as partition::library_graph weights it;
-/// node i's subgraph is partitioned by rank i mod R. Uses `options`' imbalance, seed and
-/// Scotch flavour. Throws UsageError for 0 nodes or cores, std::runtime_error when PT-Scotch
-/// fails.
+/// node i's subgraph is partitioned by rank i mod R. Uses `options`' seed, Scotch flavour and
+/// imbalance (its square root at each of the two levels, so that the product stays within).
+/// Throws UsageError for 0 nodes or cores, std::runtime_error when PT-Scotch fails.
 PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::uint32_t cores,
                                   const partition::Options& options, MPI_Comm comm);
 
