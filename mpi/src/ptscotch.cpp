@@ -25,8 +25,6 @@ namespace tgraph::mpi {
 
 namespace {
 
-using Clock = double;  // MPI_Wtime seconds
-
 /// First task of rank r's slice.
 std::uint32_t slice_begin(std::uint32_t n, int rank, int ranks) {
   return static_cast<std::uint32_t>(static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(rank) /
@@ -108,20 +106,6 @@ Slice build_slice(const StepGraph& sg, int rank, int ranks, MPI_Comm comm) {
   return s;
 }
 
-SCOTCH_Num dgraph_flags(partition::ScotchFlavour f) {
-  switch (f) {
-    case partition::ScotchFlavour::kDefault:
-      return SCOTCH_STRATDEFAULT;
-    case partition::ScotchFlavour::kQuality:
-      return SCOTCH_STRATQUALITY;
-    case partition::ScotchFlavour::kSpeed:
-      return SCOTCH_STRATSPEED;
-    case partition::ScotchFlavour::kBalance:
-      return SCOTCH_STRATBALANCE;
-  }
-  return SCOTCH_STRATDEFAULT;
-}
-
 /// SCOTCH_dgraphPart of the slices into `nodes` parts; returns the node of each local task.
 std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::LibraryWeights& w,
                                            std::uint32_t nodes, const partition::Options& options,
@@ -157,7 +141,7 @@ std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::Libr
   }
 #endif
   if (status == 0) {
-    status = SCOTCH_stratDgraphMapBuild(&strat, dgraph_flags(options.scotch), ranks,
+    status = SCOTCH_stratDgraphMapBuild(&strat, partition::scotch_strategy_flags(options.scotch), ranks,
                                         static_cast<SCOTCH_Num>(nodes), options.imbalance - 1.0);
     what = "SCOTCH_stratDgraphMapBuild failed";
   }
@@ -307,7 +291,7 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
   int rank = 0, ranks = 1;
   MPI_Comm_rank(comm, &rank);
   MPI_Comm_size(comm, &ranks);
-  const Clock t0 = MPI_Wtime();
+  const double t0 = MPI_Wtime();
   PtScotchResult r;
   r.nodes = nodes;
   r.cores = cores;
@@ -320,11 +304,11 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
   partition::Options level = options;
   const bool two_levels = nodes > 1 && cores > 1;
   if (two_levels) level.imbalance = std::sqrt(options.imbalance);
-  const Clock t1 = MPI_Wtime();
+  const double t1 = MPI_Wtime();
   const std::vector<std::uint32_t> node_of = all_gather(partition_nodes(s, w, nodes, level, comm), comm);
-  const Clock t2 = MPI_Wtime();
+  const double t2 = MPI_Wtime();
   const std::vector<std::uint32_t> placed = all_gather(partition_cores(s, w, node_of, cores, level, comm), comm);
-  const Clock t3 = MPI_Wtime();
+  const double t3 = MPI_Wtime();
 
   const std::uint32_t k = nodes * cores;
   r.assignment.k = k;
@@ -357,7 +341,7 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
   std::vector<std::int64_t> node_load(nodes, 0);
   for (std::uint32_t p = 0; p < k; ++p) node_load[p / cores] += load[p];
   r.node_imbalance = imbalance(node_load);
-  const Clock t4 = MPI_Wtime();
+  const double t4 = MPI_Wtime();
   r.build_ms = max_all((t1 - t0) * 1e3, comm);
   r.nodes_ms = max_all((t2 - t1) * 1e3, comm);
   r.cores_ms = max_all((t3 - t2) * 1e3, comm);

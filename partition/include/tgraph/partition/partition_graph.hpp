@@ -12,6 +12,7 @@
 namespace tgraph::partition {
 
 struct Options;
+enum class ScotchFlavour : std::uint8_t;
 
 /// Totals above which make_undirected scales weights down; the same bound as
 /// `tgraph export`, so that the METIS objective matches gpmetis on the exported file.
@@ -47,6 +48,10 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
 /// Returns the part of every vertex.
 std::vector<std::uint32_t> scotch_partition(const UndirectedGraph& pg, const LibraryWeights& w,
                                             std::uint32_t k, const Options& options);
+
+/// The SCOTCH_STRAT* flags of a flavour (SCOTCH_Num), for Scotch's and PT-Scotch's
+/// strategy builders alike.
+std::int32_t scotch_strategy_flags(ScotchFlavour f);
 
 /// Edge cut of `part` in the graph's (scaled) weight units: what METIS's objval counts.
 std::int64_t edgecut(const UndirectedGraph& u, const std::vector<std::uint32_t>& part);
