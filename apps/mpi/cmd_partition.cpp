@@ -9,10 +9,9 @@
 #include <exception>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-
-#include <nlohmann/json.hpp>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace_io.hpp"
@@ -146,8 +145,9 @@ void run(const PartitionArgs& a) {
 }
 #else
 void run(const PartitionArgs&) {
-  throw UsageError("--method ptscotch: this tgraph-mpi was built without PT-Scotch "
-                   "(Debian libptscotch-dev)");
+  throw UsageError(
+      "--method ptscotch: this tgraph-mpi was built without PT-Scotch "
+      "(Debian libptscotch-dev)");
 }
 #endif
 

@@ -2,10 +2,12 @@
 // PT-Scotch into nodes, then Scotch within each node. Scotch's headers come after <stdint.h>,
 // <stdio.h> and <mpi.h>, by their scotch/ prefix only (/usr/include/scotch holds a metis.h
 // that must never shadow METIS's).
+#include "tgraph/mpi/ptscotch.hpp"
+
 #include <mpi.h>
+#include <scotch/ptscotch.h>
 #include <stdint.h>
 #include <stdio.h>
-#include <scotch/ptscotch.h>
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +18,6 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/undirected.hpp"
-#include "tgraph/mpi/ptscotch.hpp"
 #include "tgraph/partition/partition_graph.hpp"
 
 static_assert(sizeof(SCOTCH_Num) == 4, "tgraph expects PT-Scotch built with 32-bit SCOTCH_Num");
@@ -27,7 +28,8 @@ namespace {
 
 /// First task of rank r's slice.
 std::uint32_t slice_begin(std::uint32_t n, int rank, int ranks) {
-  return static_cast<std::uint32_t>(static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(rank) /
+  return static_cast<std::uint32_t>(static_cast<std::uint64_t>(n) *
+                                    static_cast<std::uint64_t>(rank) /
                                     static_cast<std::uint64_t>(ranks));
 }
 
@@ -41,7 +43,8 @@ long double scale_factor(long double total, std::int64_t max_total) {
 void scale(std::vector<std::int64_t>& w, long double f) {
   if (f == 1.0L) return;
   for (auto& x : w)
-    x = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::llround(static_cast<long double>(x) * f)));
+    x = std::max<std::int64_t>(
+        1, static_cast<std::int64_t>(std::llround(static_cast<long double>(x) * f)));
 }
 
 long double sum_all(long double local, MPI_Comm comm) {
@@ -75,7 +78,8 @@ Slice build_slice(const StepGraph& sg, int rank, int ranks, MPI_Comm comm) {
   std::vector<Half> halves;
   auto add = [&](const Edge& e) {
     if (e.from == e.to) return;
-    const std::int64_t w = std::max<std::int64_t>(1, static_cast<std::int64_t>(sg.data[e.datum].bytes));
+    const std::int64_t w =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(sg.data[e.datum].bytes));
     if (e.from >= s.begin && e.from < end) halves.push_back({e.from, e.to, w});
     if (e.to >= s.begin && e.to < end) halves.push_back({e.to, e.from, w});
   };
@@ -88,7 +92,8 @@ Slice build_slice(const StepGraph& sg, int rank, int ranks, MPI_Comm comm) {
   for (std::size_t i = 0; i < halves.size();) {
     std::size_t j = i;
     std::int64_t w = 0;
-    while (j < halves.size() && halves[j].u == halves[i].u && halves[j].v == halves[i].v) w += halves[j++].w;
+    while (j < halves.size() && halves[j].u == halves[i].u && halves[j].v == halves[i].v)
+      w += halves[j++].w;
     g.adjncy.push_back(halves[i].v);
     g.adjwgt.push_back(w);
     ++g.xadj[halves[i].u - s.begin + 1];
@@ -97,7 +102,8 @@ Slice build_slice(const StepGraph& sg, int rank, int ranks, MPI_Comm comm) {
   for (std::uint32_t i = 0; i + 1 < g.xadj.size(); ++i) g.xadj[i + 1] += g.xadj[i];
   g.vwgt.resize(end - s.begin);
   for (TaskId t = s.begin; t < end; ++t)
-    g.vwgt[t - s.begin] = std::max<std::int64_t>(1, static_cast<std::int64_t>(sg.tasks[t].cost_ns * sg.runs(t)));
+    g.vwgt[t - s.begin] =
+        std::max<std::int64_t>(1, static_cast<std::int64_t>(sg.tasks[t].cost_ns * sg.runs(t)));
   // The totals of the whole graph decide the scaling, as in make_undirected.
   const long double vtotal = sum_all(std::accumulate(g.vwgt.begin(), g.vwgt.end(), 0.0L), comm);
   const long double etotal = sum_all(std::accumulate(g.adjwgt.begin(), g.adjwgt.end(), 0.0L), comm);
@@ -130,9 +136,9 @@ std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::Libr
   if (SCOTCH_dgraphInit(&dg, comm) != 0) throw std::runtime_error("SCOTCH_dgraphInit failed");
   SCOTCH_Strat strat;
   SCOTCH_stratInit(&strat);
-  int status = SCOTCH_dgraphBuild(&dg, 0, static_cast<SCOTCH_Num>(nloc), static_cast<SCOTCH_Num>(nloc),
-                                  vert.data(), nullptr, velo.data(), nullptr, arcs, arcs,
-                                  edge.data(), nullptr, edlo.data());
+  int status = SCOTCH_dgraphBuild(&dg, 0, static_cast<SCOTCH_Num>(nloc),
+                                  static_cast<SCOTCH_Num>(nloc), vert.data(), nullptr, velo.data(),
+                                  nullptr, arcs, arcs, edge.data(), nullptr, edlo.data());
   const char* what = "SCOTCH_dgraphBuild failed";
 #if defined(TGRAPH_ENABLE_ASSERT)
   if (status == 0 && SCOTCH_dgraphCheck(&dg) != 0) {
@@ -141,8 +147,9 @@ std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::Libr
   }
 #endif
   if (status == 0) {
-    status = SCOTCH_stratDgraphMapBuild(&strat, partition::scotch_strategy_flags(options.scotch), ranks,
-                                        static_cast<SCOTCH_Num>(nodes), options.imbalance - 1.0);
+    status =
+        SCOTCH_stratDgraphMapBuild(&strat, partition::scotch_strategy_flags(options.scotch), ranks,
+                                   static_cast<SCOTCH_Num>(nodes), options.imbalance - 1.0);
     what = "SCOTCH_stratDgraphMapBuild failed";
   }
   if (status == 0) {
@@ -156,7 +163,8 @@ std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::Libr
   // A failure is collective in PT-Scotch; agree anyway so that no rank goes on alone.
   int failed = status != 0 ? 1 : 0;
   MPI_Allreduce(MPI_IN_PLACE, &failed, 1, MPI_INT, MPI_MAX, comm);
-  if (failed != 0) throw std::runtime_error(status != 0 ? what : "PT-Scotch failed on another rank");
+  if (failed != 0)
+    throw std::runtime_error(status != 0 ? what : "PT-Scotch failed on another rank");
   for (std::uint32_t v = 0; v < nloc; ++v) {
     if (part[v] < 0 || static_cast<std::uint32_t>(part[v]) >= nodes)
       throw std::runtime_error("PT-Scotch returned node " + std::to_string(part[v]) + " for task " +
@@ -170,7 +178,8 @@ std::vector<std::uint32_t> partition_nodes(const Slice& s, const partition::Libr
 std::vector<std::uint32_t> all_gather(const std::vector<std::uint32_t>& local, MPI_Comm comm) {
   int ranks = 1;
   MPI_Comm_size(comm, &ranks);
-  std::vector<int> counts(static_cast<std::size_t>(ranks)), displs(static_cast<std::size_t>(ranks), 0);
+  std::vector<int> counts(static_cast<std::size_t>(ranks)),
+      displs(static_cast<std::size_t>(ranks), 0);
   const int mine = static_cast<int>(local.size());
   MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
   for (int r = 1; r < ranks; ++r) displs[r] = displs[r - 1] + counts[r - 1];
@@ -181,9 +190,11 @@ std::vector<std::uint32_t> all_gather(const std::vector<std::uint32_t>& local, M
 }
 
 /// Sends `out[r]` to rank r, returns what every rank sent here, in rank order.
-std::vector<std::uint32_t> all_to_all(const std::vector<std::vector<std::uint32_t>>& out, MPI_Comm comm) {
+std::vector<std::uint32_t> all_to_all(const std::vector<std::vector<std::uint32_t>>& out,
+                                      MPI_Comm comm) {
   const auto ranks = static_cast<int>(out.size());
-  std::vector<int> scount(out.size()), sdispl(out.size(), 0), rcount(out.size()), rdispl(out.size(), 0);
+  std::vector<int> scount(out.size()), sdispl(out.size(), 0), rcount(out.size()),
+      rdispl(out.size(), 0);
   for (int r = 0; r < ranks; ++r) scount[r] = static_cast<int>(out[r].size());
   MPI_Alltoall(scount.data(), 1, MPI_INT, rcount.data(), 1, MPI_INT, comm);
   for (int r = 1; r < ranks; ++r) {
@@ -194,8 +205,8 @@ std::vector<std::uint32_t> all_to_all(const std::vector<std::vector<std::uint32_
   send.reserve(static_cast<std::size_t>(sdispl.back() + scount.back()));
   for (const auto& o : out) send.insert(send.end(), o.begin(), o.end());
   std::vector<std::uint32_t> recv(static_cast<std::size_t>(rdispl.back() + rcount.back()));
-  MPI_Alltoallv(send.data(), scount.data(), sdispl.data(), MPI_UINT32_T, recv.data(),
-                rcount.data(), rdispl.data(), MPI_UINT32_T, comm);
+  MPI_Alltoallv(send.data(), scount.data(), sdispl.data(), MPI_UINT32_T, recv.data(), rcount.data(),
+                rdispl.data(), MPI_UINT32_T, comm);
   return recv;
 }
 
@@ -241,7 +252,8 @@ std::vector<std::uint32_t> partition_cores(const Slice& s, const partition::Libr
   std::vector<std::uint32_t> placed;
   for (auto& vs : by_node) {
     if (vs.empty()) continue;
-    std::sort(vs.begin(), vs.end(), [](const Vertex& a, const Vertex& b) { return a.task < b.task; });
+    std::sort(vs.begin(), vs.end(),
+              [](const Vertex& a, const Vertex& b) { return a.task < b.task; });
     const std::uint32_t node = node_of[vs.front().task];
     auto local = [&](std::uint32_t task) {
       return static_cast<std::uint32_t>(
@@ -277,7 +289,8 @@ double imbalance(const std::vector<std::int64_t>& load) {
   const long double total = std::accumulate(load.begin(), load.end(), 0.0L);
   if (total <= 0) return 1.0;
   const long double mean = total / static_cast<long double>(load.size());
-  return static_cast<double>(static_cast<long double>(*std::max_element(load.begin(), load.end())) / mean);
+  return static_cast<double>(static_cast<long double>(*std::max_element(load.begin(), load.end())) /
+                             mean);
 }
 
 }  // namespace
@@ -305,15 +318,18 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
   const bool two_levels = nodes > 1 && cores > 1;
   if (two_levels) level.imbalance = std::sqrt(options.imbalance);
   const double t1 = MPI_Wtime();
-  const std::vector<std::uint32_t> node_of = all_gather(partition_nodes(s, w, nodes, level, comm), comm);
+  const std::vector<std::uint32_t> node_of =
+      all_gather(partition_nodes(s, w, nodes, level, comm), comm);
   const double t2 = MPI_Wtime();
-  const std::vector<std::uint32_t> placed = all_gather(partition_cores(s, w, node_of, cores, level, comm), comm);
+  const std::vector<std::uint32_t> placed =
+      all_gather(partition_cores(s, w, node_of, cores, level, comm), comm);
   const double t3 = MPI_Wtime();
 
   const std::uint32_t k = nodes * cores;
   r.assignment.k = k;
   r.assignment.proc.assign(g.tasks.size(), k);
-  for (std::size_t i = 0; i + 1 < placed.size(); i += 2) r.assignment.proc[placed[i]] = placed[i + 1];
+  for (std::size_t i = 0; i + 1 < placed.size(); i += 2)
+    r.assignment.proc[placed[i]] = placed[i + 1];
   for (std::size_t t = 0; t < r.assignment.proc.size(); ++t)
     if (r.assignment.proc[t] >= k)
       throw std::runtime_error("ptscotch: task " + std::to_string(t) + " was not placed");

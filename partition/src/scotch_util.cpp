@@ -129,7 +129,8 @@ void scotch_repart(const UndirectedGraph& pg, const LibraryWeights& w, std::uint
     std::lock_guard<std::mutex> lock(scotch_mutex());
     ScotchCall call(pg, w);
     call.build_graph();
-    call.build_strategy(scotch_strategy_flags(options.scotch) | SCOTCH_STRATREMAP, k, options.imbalance - 1.0);
+    call.build_strategy(scotch_strategy_flags(options.scotch) | SCOTCH_STRATREMAP, k,
+                        options.imbalance - 1.0);
     SCOTCH_randomSeed(static_cast<SCOTCH_Num>(options.seed % 0x7fffffff));
     SCOTCH_randomReset();
     if (SCOTCH_graphRepart(&call.graph_, static_cast<SCOTCH_Num>(k), parotab.data(), emraval,

@@ -9,11 +9,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
@@ -50,7 +49,8 @@ class PtScotch : public ::testing::Test {
   /// Runs `cmd` (a shell command line), stdout and stderr captured.
   Outcome run(const std::string& cmd) const {
     const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const int status = std::system((cmd + " >'" + out.string() + "' 2>'" + err.string() + "'").c_str());
+    const int status =
+        std::system((cmd + " >'" + out.string() + "' 2>'" + err.string() + "'").c_str());
     Outcome r;
     r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     r.out = slurp(out);
@@ -59,15 +59,16 @@ class PtScotch : public ::testing::Test {
   }
   /// `mpirun -np N tgraph-mpi ARGS` (quiet: mpirun's own banners off; CI runs as root).
   Outcome mpi(int np, const std::string& args) const {
-    return run(std::string(TGRAPH_MPIEXEC) + " -q --allow-run-as-root " + (np > 2 ? "--oversubscribe " : "") +
-               "-np " + std::to_string(np) + " '" + TGRAPH_MPI_EXE + "' " + args);
+    return run(std::string(TGRAPH_MPIEXEC) + " -q --allow-run-as-root " +
+               (np > 2 ? "--oversubscribe " : "") + "-np " + std::to_string(np) + " '" +
+               TGRAPH_MPI_EXE + "' " + args);
   }
   /// `tgraph generate --tasks N --pattern P` into the test's folder.
   std::string generate(const std::string& pattern, int tasks, int steps = 1) const {
     const std::string path = (dir_ / (pattern + ".tgt")).string();
-    const Outcome r = run(std::string("'") + TGRAPH_EXE + "' generate --tasks " + std::to_string(tasks) +
-                      " --pattern " + pattern + " --steps " + std::to_string(steps) + " -o '" +
-                      path + "'");
+    const Outcome r =
+        run(std::string("'") + TGRAPH_EXE + "' generate --tasks " + std::to_string(tasks) +
+            " --pattern " + pattern + " --steps " + std::to_string(steps) + " -o '" + path + "'");
     EXPECT_EQ(r.rc, 0) << r.err;
     return path;
   }
@@ -108,8 +109,8 @@ class PtScotchPattern : public PtScotch, public ::testing::WithParamInterface<co
 TEST_P(PtScotchPattern, WritesAValidAssignmentWithinTenPercentOfScotchsCut) {
   const std::string trace_path = generate(GetParam(), 10000);
   const std::string tga = path("a.tga");
-  const Outcome r = mpi(2, "partition '" + trace_path + "' --method ptscotch --nodes 2 --cores 4 -o '" +
-                           tga + "' --json");
+  const Outcome r = mpi(2, "partition '" + trace_path +
+                               "' --method ptscotch --nodes 2 --cores 4 -o '" + tga + "' --json");
   ASSERT_EQ(r.rc, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("ranks"), 2);
@@ -124,8 +125,8 @@ TEST_P(PtScotchPattern, WritesAValidAssignmentWithinTenPercentOfScotchsCut) {
   EXPECT_LE(static_cast<double>(cuts[0]), 1.10 * static_cast<double>(sequential))
       << "ptscotch " << cuts[0] << ", scotch " << sequential;
 
-  const Outcome eval = run(std::string("'") + TGRAPH_EXE + "' evaluate '" + trace_path + "' '" + tga +
-                       "' --json");
+  const Outcome eval =
+      run(std::string("'") + TGRAPH_EXE + "' evaluate '" + trace_path + "' '" + tga + "' --json");
   ASSERT_EQ(eval.rc, 0) << eval.err;
   EXPECT_EQ(nlohmann::json::parse(eval.out).at("k"), 8);
 }
@@ -136,22 +137,25 @@ INSTANTIATE_TEST_SUITE_P(Generated, PtScotchPattern,
 TEST_F(PtScotch, PlacesMoreNodesThanRanksOnThreeOversubscribedRanks) {
   const std::string trace_path = generate("random", 10000);
   const std::string tga = path("a.tga");
-  const Outcome r = mpi(3, "partition '" + trace_path + "' --nodes 5 --cores 3 -o '" + tga + "' --json");
+  const Outcome r =
+      mpi(3, "partition '" + trace_path + "' --nodes 5 --cores 3 -o '" + tga + "' --json");
   ASSERT_EQ(r.rc, 0) << r.err;
   const tgraph::Trace trace = tgraph::read_trace(trace_path);
   const std::vector<std::int64_t> cuts = check_assignment(trace, tga, 15);
   EXPECT_EQ(nlohmann::json::parse(r.out).at("cut").get<std::int64_t>(), cuts.at(0));
-  EXPECT_LE(static_cast<double>(cuts[0]), 1.10 * static_cast<double>(scotch_cut(trace.steps[0], 15)));
+  EXPECT_LE(static_cast<double>(cuts[0]),
+            1.10 * static_cast<double>(scotch_cut(trace.steps[0], 15)));
 }
 
 TEST_F(PtScotch, PartitionsEveryStepOrTheOneNamed) {
   const std::string trace_path = generate("stencil", 2000, 3);
   const tgraph::Trace trace = tgraph::read_trace(trace_path);
-  const Outcome all = mpi(2, "partition '" + trace_path + "' --nodes 2 --cores 2 -o '" + path("all.tga") + "'");
+  const Outcome all =
+      mpi(2, "partition '" + trace_path + "' --nodes 2 --cores 2 -o '" + path("all.tga") + "'");
   ASSERT_EQ(all.rc, 0) << all.err;
   EXPECT_EQ(check_assignment(trace, path("all.tga"), 4).size(), 3u);
   const Outcome one = mpi(2, "partition '" + trace_path + "' --nodes 2 --cores 2 --step 2 -o '" +
-                             path("one.tga") + "' --json");
+                                 path("one.tga") + "' --json");
   ASSERT_EQ(one.rc, 0) << one.err;
   const tgraph::TraceAssignment a = tp::read_assignment(path("one.tga"));
   ASSERT_EQ(a.steps.size(), 1u);
@@ -168,7 +172,8 @@ std::size_t lines(const std::string& text) {
 }
 
 TEST_F(PtScotch, RejectsAMissingTraceWithOneLineAndExit2) {
-  const Outcome r = mpi(2, "partition '" + path("missing.tgt") + "' --nodes 2 -o '" + path("a.tga") + "'");
+  const Outcome r =
+      mpi(2, "partition '" + path("missing.tgt") + "' --nodes 2 -o '" + path("a.tga") + "'");
   EXPECT_EQ(r.rc, 2);
   EXPECT_EQ(lines(r.err), 1u) << r.err;
   EXPECT_NE(r.err.find("missing.tgt"), std::string::npos) << r.err;

@@ -28,13 +28,13 @@ struct PtScotchResult {
   /// Weight of the edges whose ends are on different processors (library units: the
   /// weights the `scotch` strategy gives Scotch, so comparable with its edgecut).
   std::int64_t cut = 0;
-  std::int64_t node_cut = 0;      ///< weight of the edges between different nodes
-  double imbalance = 1.0;         ///< max / mean processor load (library vertex weights)
-  double node_imbalance = 1.0;    ///< max / mean node load
-  double build_ms = 0.0;          ///< building the slices and the distributed graph (max over ranks)
-  double nodes_ms = 0.0;          ///< SCOTCH_dgraphPart into nodes (max over ranks)
-  double cores_ms = 0.0;          ///< gathering each node's subgraph and Scotch within it (max)
-  double total_ms = 0.0;          ///< all of it, including the cut and load reductions (max)
+  std::int64_t node_cut = 0;    ///< weight of the edges between different nodes
+  double imbalance = 1.0;       ///< max / mean processor load (library vertex weights)
+  double node_imbalance = 1.0;  ///< max / mean node load
+  double build_ms = 0.0;        ///< building the slices and the distributed graph (max over ranks)
+  double nodes_ms = 0.0;        ///< SCOTCH_dgraphPart into nodes (max over ranks)
+  double cores_ms = 0.0;        ///< gathering each node's subgraph and Scotch within it (max)
+  double total_ms = 0.0;        ///< all of it, including the cut and load reductions (max)
 };
 
 /// Partitions step `g` (edges derived, the same on every rank of `comm`) over `nodes` x
