@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -130,11 +131,14 @@ class StepRun {
     waiting_.assign(T + 1, std::string());
     std::vector<Counters> counters(T);
     std::vector<std::thread> threads;
-    std::atomic<bool> running{true};
+    bool running = true;  // guarded by stop_mu
+    std::mutex stop_mu;
+    std::condition_variable stop_cv;
     std::thread watchdog([&] {
-      while (running.load(std::memory_order_acquire)) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-        if (watchdog_ns > 0 &&
+      std::unique_lock lock(stop_mu);
+      while (running) {
+        stop_cv.wait_for(lock, std::chrono::milliseconds(20));
+        if (running && watchdog_ns > 0 &&
             now_ns() - last_progress_.load(std::memory_order_relaxed) > watchdog_ns)
           stuck(watchdog_ns);
       }
@@ -150,7 +154,11 @@ class StepRun {
       lock.unlock();
       sched_yield();
     }
-    running.store(false, std::memory_order_release);
+    {
+      std::lock_guard lock(stop_mu);
+      running = false;
+    }
+    stop_cv.notify_one();
     watchdog.join();
     Counters sum;
     for (const Counters& c : counters) {

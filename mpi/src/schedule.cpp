@@ -53,7 +53,7 @@ Holders everywhere(std::size_t data, std::uint32_t ranks) {
 }
 
 std::uint32_t ChannelTable::get(const Channel& c) {
-  const auto key = std::make_tuple(c.decision, c.source, c.what, c.to);
+  const auto key = std::make_tuple(c.decision, c.source, c.what, c.from, c.to);
   if (auto it = index_.find(key); it != index_.end()) return it->second;
   const auto id = static_cast<std::uint32_t>(channels_.size());
   channels_.push_back(c);

@@ -143,3 +143,22 @@ TEST(Schedule, ChannelsAreReusedByLaterSteps) {
 
 }  // namespace
 }  // namespace tgraph::mpi
+
+namespace tgraph::mpi {
+namespace {
+
+TEST(Schedule, AVersionFromAnotherHolderTakesAnotherChannel) {
+  ChannelTable channels;
+  Channel a;
+  a.what = 3;
+  a.from = 0;
+  a.to = 2;
+  Channel b = a;
+  b.from = 1;  // the same datum from before the step, held by another rank this time
+  EXPECT_NE(channels.get(a), channels.get(b));
+  EXPECT_EQ(channels.get(a), 0u);
+  EXPECT_EQ(channels.channels().size(), 2u);
+}
+
+}  // namespace
+}  // namespace tgraph::mpi

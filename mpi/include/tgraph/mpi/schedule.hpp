@@ -78,7 +78,7 @@ class ChannelTable {
 
  private:
   std::vector<Channel> channels_;
-  std::map<std::tuple<bool, TaskId, std::uint32_t, std::uint32_t>, std::uint32_t> index_;
+  std::map<std::tuple<bool, TaskId, std::uint32_t, std::uint32_t, std::uint32_t>, std::uint32_t> index_;
 };
 
 /// What a task instance waits for before it runs.
