@@ -13,11 +13,11 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/mpi/calibrate.hpp"
-#include "tgraph/partition/cost_model.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/mpi/calibrate.hpp"
 #include "tgraph/mpi/replay.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/cost_model.hpp"
 #include "verbs.hpp"
 
 namespace tgraph::mpi_app {
@@ -36,7 +36,8 @@ void replay(const ReplayArgs& a) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   if (a.threads_per_rank < 1 || a.threads_per_rank > 256)
-    throw UsageError("--threads-per-rank " + std::to_string(a.threads_per_rank) + ": expected 1 to 256");
+    throw UsageError("--threads-per-rank " + std::to_string(a.threads_per_rank) +
+                     ": expected 1 to 256");
   if (a.steps && *a.steps < 1) throw UsageError("--steps must be at least 1");
   if (!(a.watchdog >= 0) || a.watchdog > 1e6)
     throw UsageError("--watchdog: expected 0 (off) to 1e6 seconds");
@@ -51,7 +52,9 @@ void replay(const ReplayArgs& a) {
   o.watchdog_s = a.watchdog;
   o.test_drop_message = a.drop;
   const mpi::MpiReplayResult r = mpi::replay_distributed(trace, as, o);
-  if (rank == 0) std::cout << (a.json ? mpi::to_json(r, a.trace) + "\n" : mpi::to_text(r, a.trace)) << std::flush;
+  if (rank == 0)
+    std::cout << (a.json ? mpi::to_json(r, a.trace) + "\n" : mpi::to_text(r, a.trace))
+              << std::flush;
   if (r.identical && !*r.identical && rank == 0)
     std::cerr << "tgraph-mpi: the distributed state differs from the sequential replay\n";
   int differs = r.identical && !*r.identical ? 1 : 0;
@@ -77,12 +80,13 @@ void calibrate(const std::string& path_flag, bool json) {
   if (rank != 0) return;
   write_file_atomic(path, mpi::with_mpi_link(text, path, link));
   if (json) {
-    std::cout << "{\"mpi_latency_ns\":" << link.latency_ns << ",\"mpi_per_byte_ns\":"
-              << link.per_byte_ns << ",\"output\":\"" << path << "\"}\n";
+    std::cout << "{\"mpi_latency_ns\":" << link.latency_ns
+              << ",\"mpi_per_byte_ns\":" << link.per_byte_ns << ",\"output\":\"" << path << "\"}\n";
   } else {
     std::cout << "MPI between two local ranks: latency " << link.latency_ns << " ns, "
-              << link.per_byte_ns << " ns/byte (" << (link.per_byte_ns > 0 ? 1.0 / link.per_byte_ns : 0)
-              << " GB/s) -> " << path << "\n";
+              << link.per_byte_ns << " ns/byte ("
+              << (link.per_byte_ns > 0 ? 1.0 / link.per_byte_ns : 0) << " GB/s) -> " << path
+              << "\n";
   }
 }
 
@@ -90,12 +94,14 @@ void calibrate(const std::string& path_flag, bool json) {
 
 void add_replay_verb(CLI::App& app) {
   auto a = std::make_shared<ReplayArgs>();
-  auto* cmd = app.add_subcommand("replay", "Replay a trace across the MPI ranks (synthetic bodies)");
+  auto* cmd =
+      app.add_subcommand("replay", "Replay a trace across the MPI ranks (synthetic bodies)");
   cmd->add_option("trace", a->trace, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", a->assignment,
                   "Assignment file (.tga) with K = ranks x threads per rank (default: the "
                   "strategy tgraph replay uses)");
-  cmd->add_option("--threads-per-rank", a->threads_per_rank, "Threads (processors) per rank")->required();
+  cmd->add_option("--threads-per-rank", a->threads_per_rank, "Threads (processors) per rank")
+      ->required();
   cmd->add_option("--steps", a->steps, "Replay the first N steps");
   cmd->add_flag("--check", a->check, "Compare the final state with the sequential replay");
   cmd->add_flag("--json", a->json, "Print one JSON object");
@@ -109,8 +115,9 @@ void add_replay_verb(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto json = std::make_shared<bool>(false);
   auto* cal = app.add_subcommand(
-      "calibrate", "Add the MPI latency and bandwidth between two local ranks to the calibration "
-                   "file (mpirun -np 2)");
+      "calibrate",
+      "Add the MPI latency and bandwidth between two local ranks to the calibration "
+      "file (mpirun -np 2)");
   cal->add_option("-o,--output", *out,
                   "Calibration file written by `tgraph calibrate` (default: its default path)");
   cal->add_flag("--json", *json, "Print one JSON object");

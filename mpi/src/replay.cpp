@@ -53,7 +53,8 @@ std::span<std::uint64_t> RankWorkload::mutable_words(DatumId d) {
 }
 
 std::uint64_t datum_hash(DatumId d, std::span<const std::uint64_t> words) {
-  std::uint64_t h = 1469598103934665603ull ^ (static_cast<std::uint64_t>(d) * 0x9e3779b97f4a7c15ull);
+  std::uint64_t h =
+      1469598103934665603ull ^ (static_cast<std::uint64_t>(d) * 0x9e3779b97f4a7c15ull);
   for (std::uint64_t w : words) h = (h ^ w) * 1099511628211ull;
   return h ^ (h >> 29);
 }
@@ -62,6 +63,9 @@ namespace {
 
 using replay::now_ns;
 
+// Plans (lowered structure + assignment, channels, persistent requests) kept at once.
+constexpr std::size_t kMaxPlans = 16;
+
 // A lowered structure + assignment with its channels and persistent requests.
 struct Plan {
   StepGraph structure;
@@ -69,7 +73,7 @@ struct Plan {
   std::uint64_t hash = 0;
   replay::ExecGraph exec;
   ChannelTable channels;
-  std::vector<MPI_Request> requests;              // by channel (MPI_REQUEST_NULL: not ours)
+  std::vector<MPI_Request> requests;                // by channel (MPI_REQUEST_NULL: not ours)
   std::vector<std::vector<std::uint64_t>> buffers;  // by channel
   ~Plan() {
     for (MPI_Request& r : requests)
@@ -89,20 +93,27 @@ class StepRun {
  public:
   StepRun(Plan& plan, const StepSchedule& s, RankWorkload& w, std::uint32_t me,
           const Layout& layout, std::optional<std::uint32_t> drop)
-      : plan_(plan), s_(s), w_(w), me_(me), layout_(layout), drop_(drop),
+      : plan_(plan),
+        s_(s),
+        w_(w),
+        me_(me),
+        layout_(layout),
+        drop_(drop),
         done_(new std::atomic<std::uint8_t>[s.instances.size()]),
         arrived_(new std::atomic<std::uint8_t>[s.messages.size()]),
         installed_(new std::atomic<std::uint8_t>[s.messages.size()]),
         checked_(new std::atomic<std::uint8_t>[s.messages.size()]),
         decided_(new std::atomic<std::int8_t>[s.decisions.size()]),
         measured_(layout.ranks) {
-    for (std::size_t i = 0; i < s.instances.size(); ++i) done_[i].store(0, std::memory_order_relaxed);
+    for (std::size_t i = 0; i < s.instances.size(); ++i)
+      done_[i].store(0, std::memory_order_relaxed);
     for (std::size_t i = 0; i < s.messages.size(); ++i) {
       arrived_[i].store(0, std::memory_order_relaxed);
       installed_[i].store(0, std::memory_order_relaxed);
       checked_[i].store(0, std::memory_order_relaxed);
     }
-    for (std::size_t i = 0; i < s.decisions.size(); ++i) decided_[i].store(-1, std::memory_order_relaxed);
+    for (std::size_t i = 0; i < s.decisions.size(); ++i)
+      decided_[i].store(-1, std::memory_order_relaxed);
     const std::size_t nc = plan.channels.channels().size();
     plan.requests.resize(nc, MPI_REQUEST_NULL);
     plan.buffers.resize(nc);
@@ -144,7 +155,8 @@ class StepRun {
       }
     });
     for (std::uint32_t t = 0; t < T; ++t)
-      threads.emplace_back([this, t, &counters] { work(me_ * layout_.threads_per_rank + t, t, counters[t]); });
+      threads.emplace_back(
+          [this, t, &counters] { work(me_ * layout_.threads_per_rank + t, t, counters[t]); });
     for (auto& th : threads) th.join();
     set_waiting(T, "the completion of its sends");
     for (;;) {
@@ -243,18 +255,24 @@ class StepRun {
     return true;
   }
 
+  // Waits until channel c's previous message has left (its buffer is free again); `lock`
+  // holds mu_, released while yielding.
+  void wait_channel_free(std::unique_lock<std::mutex>& lock, std::uint32_t c) {
+    while (sending_[c]) {
+      poll();
+      lock.unlock();
+      sched_yield();
+      lock.lock();
+    }
+  }
+
   // Sends message m (the producing instance has run; its datum is not being written).
   void send(std::uint32_t m) {
     if (drop_ && *drop_ == m) return;
     const Message& msg = s_.messages[m];
     const std::uint32_t c = msg.channel;
     std::unique_lock lock(mu_);
-    while (sending_[c]) {  // the previous version on this channel is still in flight
-      poll();
-      lock.unlock();
-      sched_yield();
-      lock.lock();
-    }
+    wait_channel_free(lock, c);
     auto& buf = plan_.buffers[c];
     const auto src = w_.mutable_words(msg.datum);
     std::fill(buf.begin(), buf.end(), 0);
@@ -275,12 +293,7 @@ class StepRun {
     std::unique_lock lock(mu_);
     for (std::size_t j = 0; j < d.to.size(); ++j) {
       const std::uint32_t c = d.channels[j];
-      while (sending_[c]) {
-        poll();
-        lock.unlock();
-        sched_yield();
-        lock.lock();
-      }
+      wait_channel_free(lock, c);
       auto& buf = plan_.buffers[c];
       buf[0] = stop ? 1 : 0;
       buf[1] = static_cast<std::uint64_t>(now_ns());
@@ -353,7 +366,8 @@ class StepRun {
         }
     }
     std::fprintf(stderr, "tgraph-mpi: watchdog: rank %u made no progress for %.1f s: %s\n", me_,
-                 static_cast<double>(watchdog_ns) / 1e9, what.empty() ? "(running a task)" : what.c_str());
+                 static_cast<double>(watchdog_ns) / 1e9,
+                 what.empty() ? "(running a task)" : what.c_str());
     std::fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, 1);
     std::abort();
@@ -429,9 +443,17 @@ class StepRun {
   std::uint32_t me_;
   Layout layout_;
   std::optional<std::uint32_t> drop_;
-  std::unique_ptr<std::atomic<std::uint8_t>[]> done_, arrived_, installed_, checked_;
+  // done_: release by the thread that ran the instance, acquire by waiters (its writes).
+  std::unique_ptr<std::atomic<std::uint8_t>[]> done_;
+  // arrived_: written and read under mu_ (relaxed is enough; the lock orders).
+  std::unique_ptr<std::atomic<std::uint8_t>[]> arrived_;
+  // installed_: release after the copy into the rank's datum, acquire by its readers.
+  std::unique_ptr<std::atomic<std::uint8_t>[]> installed_;
+  // checked_: only counts the versions that arrived before anyone waited (a statistic).
+  std::unique_ptr<std::atomic<std::uint8_t>[]> checked_;
+  // decided_: release by whoever learnt the decision, acquire by the threads it lets go on.
   std::unique_ptr<std::atomic<std::int8_t>[]> decided_;
-  std::mutex mu_;  // MPI calls and the channel state below
+  std::mutex mu_;                                  // MPI calls and the channel state below
   std::vector<std::vector<std::uint32_t>> queue_;  // by channel: this rank's receives in order
   std::vector<std::size_t> next_;
   std::vector<bool> sending_;
@@ -472,10 +494,13 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   const auto me = static_cast<std::uint32_t>(rank);
   Layout layout{static_cast<std::uint32_t>(size), options.threads_per_rank};
   if (assignment.k != layout.processors())
-    throw UsageError("the assignment has " + std::to_string(assignment.k) +
-                     " processors; ranks x --threads-per-rank = " + std::to_string(layout.processors()));
-  const std::size_t steps = std::min<std::size_t>(trace.steps.size(), options.steps.value_or(trace.steps.size()));
-  if (assignment.steps.size() < steps) throw UsageError("the assignment has fewer steps than the trace");
+    throw UsageError(
+        "the assignment has " + std::to_string(assignment.k) +
+        " processors; ranks x --threads-per-rank = " + std::to_string(layout.processors()));
+  const std::size_t steps =
+      std::min<std::size_t>(trace.steps.size(), options.steps.value_or(trace.steps.size()));
+  if (assignment.steps.size() < steps)
+    throw UsageError("the assignment has fewer steps than the trace");
 
   MpiReplayResult result;
   result.ranks = layout.ranks;
@@ -496,11 +521,20 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
     for (auto& p : plans)
       if (p->hash == hash && p->proc == a.proc && p->structure.same_structure(step)) plan = p.get();
     if (plan == nullptr) {
+      // At most kMaxPlans kept (every rank evicts the same ones: they see the same steps);
+      // between steps no request is active, so freeing a plan's requests is safe.
+      if (plans.size() >= kMaxPlans) {
+        const auto victim = std::find_if(plans.begin(), plans.end(), [&](const auto& q) {
+          return q.get() != bound && &q->proc != previous_proc;
+        });
+        if (victim != plans.end()) plans.erase(victim);
+      }
       auto p = std::make_unique<Plan>();
       p->structure = step;
       p->proc = a.proc;
       p->hash = hash;
-      p->exec = replay::lower(step, &a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
+      p->exec =
+          replay::lower(step, &a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
       plan = p.get();
       plans.push_back(std::move(p));
     }
@@ -527,11 +561,13 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
     const std::int64_t t0 = now_ns();
     StepRun run(*plan, s, w, me, layout, drop);
     const Counters c = run.run(static_cast<std::int64_t>(options.watchdog_s * 1e9));
-    std::vector<std::uint64_t> sums = {
-        static_cast<std::uint64_t>(c.local_wait_ns), static_cast<std::uint64_t>(c.message_wait_ns),
-        static_cast<std::uint64_t>(c.decision_wait_ns), static_cast<std::uint64_t>(c.received),
-        static_cast<std::uint64_t>(c.hidden), static_cast<std::uint64_t>(c.decisions_received),
-        static_cast<std::uint64_t>(c.decision_latency_ns)};
+    std::vector<std::uint64_t> sums = {static_cast<std::uint64_t>(c.local_wait_ns),
+                                       static_cast<std::uint64_t>(c.message_wait_ns),
+                                       static_cast<std::uint64_t>(c.decision_wait_ns),
+                                       static_cast<std::uint64_t>(c.received),
+                                       static_cast<std::uint64_t>(c.hidden),
+                                       static_cast<std::uint64_t>(c.decisions_received),
+                                       static_cast<std::uint64_t>(c.decision_latency_ns)};
     static_assert(kCounters == 7);
     const Traffic& m = run.measured();
     sums.insert(sums.end(), m.messages.begin(), m.messages.end());

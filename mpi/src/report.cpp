@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `tgraph-mpi replay`'s JSON and text reports.
 #include <nlohmann/json.hpp>
-
 #include <sstream>
 
 #include "tgraph/mpi/replay.hpp"
@@ -15,7 +14,9 @@ nlohmann::json pairs(const Traffic& measured, const Traffic& predicted) {
     for (std::uint32_t t = 0; t < measured.ranks; ++t) {
       const std::size_t i = f * measured.ranks + t;
       if (f == t) continue;
-      if (measured.messages[i] + predicted.messages[i] + measured.decisions[i] + predicted.decisions[i] == 0)
+      if (measured.messages[i] + predicted.messages[i] + measured.decisions[i] +
+              predicted.decisions[i] ==
+          0)
         continue;
       out.push_back({{"from", f},
                      {"to", t},
@@ -29,7 +30,9 @@ nlohmann::json pairs(const Traffic& measured, const Traffic& predicted) {
   return out;
 }
 
-double ratio(std::int64_t a, std::int64_t b) { return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0; }
+double ratio(std::int64_t a, std::int64_t b) {
+  return b > 0 ? static_cast<double>(a) / static_cast<double>(b) : 0.0;
+}
 
 nlohmann::json common(const MpiStepResult& s) {
   return {{"wall_ns", s.wall_ns},
@@ -46,10 +49,12 @@ nlohmann::json common(const MpiStepResult& s) {
           {"message_wait_ns", s.message_wait_ns},
           {"decision_wait_ns", s.decision_wait_ns},
           {"received", s.received},
-          {"overlap", s.received > 0 ? static_cast<double>(s.hidden) / static_cast<double>(s.received) : 1.0},
-          {"decision_latency_ns", s.decisions_received > 0
-                                      ? s.decision_latency_ns / static_cast<std::int64_t>(s.decisions_received)
-                                      : 0}};
+          {"overlap",
+           s.received > 0 ? static_cast<double>(s.hidden) / static_cast<double>(s.received) : 1.0},
+          {"decision_latency_ns",
+           s.decisions_received > 0
+               ? s.decision_latency_ns / static_cast<std::int64_t>(s.decisions_received)
+               : 0}};
 }
 
 MpiStepResult total(const MpiReplayResult& r) {
@@ -81,7 +86,8 @@ std::string to_json(const MpiReplayResult& r, const std::string& trace_name) {
   j["trace"] = trace_name;
   j["ranks"] = r.ranks;
   j["threads_per_rank"] = r.threads_per_rank;
-  j["check"] = r.identical ? nlohmann::json(*r.identical ? "identical" : "differs") : nlohmann::json();
+  j["check"] =
+      r.identical ? nlohmann::json(*r.identical ? "identical" : "differs") : nlohmann::json();
   j["checksum"] = r.checksum;
   j["sequential_ns"] = r.sequential_ns;
   j["speedup"] = ratio(r.sequential_ns, r.wall_ns);
@@ -104,16 +110,17 @@ std::string to_text(const MpiReplayResult& r, const std::string& trace_name) {
   o << trace_name << ": " << r.steps.size() << " steps on " << r.ranks << " ranks x "
     << r.threads_per_rank << " threads\n";
   o << "  wall " << static_cast<double>(t.wall_ns) / 1e6 << " ms, sequential "
-    << static_cast<double>(r.sequential_ns) / 1e6 << " ms, speed-up " << ratio(r.sequential_ns, r.wall_ns)
+    << static_cast<double>(r.sequential_ns) / 1e6 << " ms, speed-up "
+    << ratio(r.sequential_ns, r.wall_ns) << "\n";
+  o << "  messages " << t.measured.total_messages() << " (predicted "
+    << t.predicted.total_messages() << "), bytes " << t.measured.total_bytes() << " (predicted "
+    << t.predicted.total_bytes() << "), loop decisions " << t.measured.total_decisions()
+    << ", per rank pair " << (t.measured == t.predicted ? "as predicted" : "NOT as predicted")
     << "\n";
-  o << "  messages " << t.measured.total_messages() << " (predicted " << t.predicted.total_messages()
-    << "), bytes " << t.measured.total_bytes() << " (predicted " << t.predicted.total_bytes()
-    << "), loop decisions " << t.measured.total_decisions() << ", per rank pair "
-    << (t.measured == t.predicted ? "as predicted" : "NOT as predicted") << "\n";
   o << "  blocked: local " << static_cast<double>(t.local_wait_ns) / 1e6 << " ms, messages "
     << static_cast<double>(t.message_wait_ns) / 1e6 << " ms, decisions "
-    << static_cast<double>(t.decision_wait_ns) / 1e6 << " ms; migrated "
-    << t.migrated_bytes << " bytes\n";
+    << static_cast<double>(t.decision_wait_ns) / 1e6 << " ms; migrated " << t.migrated_bytes
+    << " bytes\n";
   if (r.identical) o << "  check: " << (*r.identical ? "identical" : "differs") << "\n";
   return o.str();
 }

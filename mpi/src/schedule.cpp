@@ -7,7 +7,9 @@
 
 namespace tgraph::mpi {
 
-std::uint64_t wire_bytes(const Datum& d) { return std::max<std::uint64_t>(1, (d.bytes + 7) / 8 * 8); }
+std::uint64_t wire_bytes(const Datum& d) {
+  return std::max<std::uint64_t>(1, (d.bytes + 7) / 8 * 8);
+}
 
 std::uint64_t Traffic::total_messages() const {
   std::uint64_t s = 0;
@@ -70,7 +72,7 @@ constexpr std::int64_t kStale = -2;     // an older version
 struct Copy {
   std::int64_t version = kEntering;
   bool has_producer = false;
-  Wait producer;                     // what made this copy current
+  Wait producer;                       // what made this copy current
   std::vector<std::uint32_t> readers;  // local readers of this version
   std::uint32_t zero_pending = kNone;  // sender instance: reset to zero once the reducer ran
 };
@@ -110,7 +112,8 @@ StepSchedule schedule_step(const replay::ExecGraph& x, const StepGraph& step, co
     inst.proc = proc_of(t);
     const std::uint32_t r = layout.rank_of(inst.proc);
     auto add_wait = [&](Wait w) {
-      if (w.kind == WaitKind::kInstance && (w.index == id || s.instances[w.index].proc == inst.proc))
+      if (w.kind == WaitKind::kInstance &&
+          (w.index == id || s.instances[w.index].proc == inst.proc))
         return;  // program order on this processor
       for (const Wait& o : inst.waits)
         if (o.kind == w.kind && o.index == w.index) return;

@@ -42,8 +42,9 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   fs::create_directories(dir);
   const std::string file = (dir / "cal.json").string();
   write_file_atomic(file, kCalibration);
-  const std::string cmd = std::string(TGRAPH_MPIEXEC) + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +
-                          " calibrate -o " + file + " > " + (dir / "out.txt").string() + " 2>&1";
+  const std::string cmd = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " + dir.string() +
+                          " -np 2 --oversubscribe " + TGRAPH_MPI_BIN + " calibrate -o " + file +
+                          " > " + (dir / "out.txt").string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0) << read_file_text((dir / "out.txt").string());
   const partition::CostModel m = partition::load_calibration(file);
@@ -54,9 +55,9 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   EXPECT_GT(m.mpi_per_byte_ns, 0.0);
   EXPECT_LT(m.mpi_per_byte_ns, 1.0);
   // No file to add to: exit 2.
-  const std::string missing = std::string(TGRAPH_MPIEXEC) + " -np 2 --oversubscribe " +
-                              TGRAPH_MPI_BIN + " calibrate -o " + (dir / "none.json").string() +
-                              " > /dev/null 2>&1";
+  const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
+                              dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +
+                              " calibrate -o " + (dir / "none.json").string() + " > /dev/null 2>&1";
   const int rc2 = std::system(missing.c_str());
   EXPECT_TRUE(WIFEXITED(rc2) && WEXITSTATUS(rc2) == 2);
   fs::remove_all(dir);

@@ -27,9 +27,9 @@ struct Outcome {
 };
 
 fs::path scratch() {
-  const fs::path d = fs::temp_directory_path() /
-                     ("tgraph_mpi_test_" + std::to_string(::getpid()) + "_" +
-                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path d =
+      fs::temp_directory_path() / ("tgraph_mpi_test_" + std::to_string(::getpid()) + "_" +
+                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::create_directories(d);
   return d;
 }
@@ -51,13 +51,15 @@ Outcome run(const std::string& command, const fs::path& dir) {
   return r;
 }
 
-std::string mpirun(int np) {
-  return std::string(TGRAPH_MPIEXEC) + " -np " + std::to_string(np) + " --oversubscribe " +
-         TGRAPH_MPI_BIN;
+// mpirun with its session directory under `dir`: OpenMPI 4 creates /tmp/ompi.<host>.<uid>
+// with mkdir and fails ("File exists") when two jobs start at once (ctest -j).
+std::string mpirun(int np, const fs::path& dir) {
+  return std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " + dir.string() + " -np " +
+         std::to_string(np) + " --oversubscribe " + TGRAPH_MPI_BIN;
 }
 
 nlohmann::json replay_json(const std::string& args, int np, const fs::path& dir) {
-  const Outcome r = run(mpirun(np) + " replay " + args + " --check --json --watchdog 60", dir);
+  const Outcome r = run(mpirun(np, dir) + " replay " + args + " --check --json --watchdog 60", dir);
   EXPECT_EQ(r.status, 0) << r.err;
   return nlohmann::json::parse(r.out);
 }
@@ -87,9 +89,9 @@ TEST_P(SceneOverRanks, IsIdenticalToTheSequentialReplayAndSendsWhatWasPredicted)
   const auto& [scene, np] = GetParam();
   const fs::path dir = scratch();
   const fs::path trace = dir / (scene + ".tgt");
-  const Outcome cap = run(std::string(TGRAPH_BIN) + " capture --scene " + scene + " --steps 3 -o " +
-                          trace.string(),
-                      dir);
+  const Outcome cap =
+      run(std::string(TGRAPH_BIN) + " capture --scene " + scene + " --steps 3 -o " + trace.string(),
+          dir);
   ASSERT_EQ(cap.status, 0) << cap.err;
   const nlohmann::json j = replay_json(trace.string() + " --threads-per-rank 1", np, dir);
   expect_exact(j, np);
@@ -134,10 +136,10 @@ TEST_P(RandomOverRanks, HundredRandomGraphsAreIdenticalAndAsPredicted) {
   const fs::path dir = scratch();
   const auto k = static_cast<std::uint32_t>(np * threads);
   write_random(dir / "random.tgt", dir / "random.tga", k);
-  const nlohmann::json j = replay_json((dir / "random.tgt").string() + " " +
-                                           (dir / "random.tga").string() +
-                                           " --threads-per-rank " + std::to_string(threads),
-                                       np, dir);
+  const nlohmann::json j =
+      replay_json((dir / "random.tgt").string() + " " + (dir / "random.tga").string() +
+                      " --threads-per-rank " + std::to_string(threads),
+                  np, dir);
   expect_exact(j, np);
   EXPECT_EQ(j["per_step"].size(), 100u);
   if (np > 1) {
@@ -159,10 +161,10 @@ TEST(MpiReplay, WatchdogNamesTheStuckRankAndWhatItWaitsFor) {
   const fs::path dir = scratch();
   write_random(dir / "random.tgt", dir / "random.tga", 2);
   // Message 0 of step 0 is never sent: its receiver waits until the watchdog fires.
-  const Outcome r = run(mpirun(2) + " replay " + (dir / "random.tgt").string() + " " +
-                        (dir / "random.tga").string() +
-                        " --threads-per-rank 1 --watchdog 1 --test-drop-message 0",
-                    dir);
+  const Outcome r = run(mpirun(2, dir) + " replay " + (dir / "random.tgt").string() + " " +
+                            (dir / "random.tga").string() +
+                            " --threads-per-rank 1 --watchdog 1 --test-drop-message 0",
+                        dir);
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("watchdog: rank "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("waits for datum "), std::string::npos) << r.err;
@@ -173,12 +175,13 @@ TEST(MpiReplay, WatchdogNamesTheStuckRankAndWhatItWaitsFor) {
 TEST(MpiReplay, RejectsAnAssignmentForAnotherProcessorCount) {
   const fs::path dir = scratch();
   write_random(dir / "random.tgt", dir / "random.tga", 3);
-  const Outcome r = run(mpirun(2) + " replay " + (dir / "random.tgt").string() + " " +
-                        (dir / "random.tga").string() + " --threads-per-rank 1",
-                    dir);
+  const Outcome r = run(mpirun(2, dir) + " replay " + (dir / "random.tgt").string() + " " +
+                            (dir / "random.tga").string() + " --threads-per-rank 1",
+                        dir);
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("random.tga"), std::string::npos) << r.err;
-  const Outcome missing = run(mpirun(1) + " replay " + (dir / "none.tgt").string() + " --threads-per-rank 1", dir);
+  const Outcome missing =
+      run(mpirun(1, dir) + " replay " + (dir / "none.tgt").string() + " --threads-per-rank 1", dir);
   EXPECT_EQ(missing.status, 2);
   EXPECT_NE(missing.err.find("none.tgt"), std::string::npos) << missing.err;
   fs::remove_all(dir);

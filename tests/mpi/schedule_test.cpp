@@ -117,7 +117,8 @@ TEST(Schedule, VersionsFromBeforeTheStepComeFromAHolder) {
   EXPECT_EQ(s.holders_after.has, (std::vector<std::uint8_t>{0, 0, 1}));
   // The reader and the writer of the same datum on other ranks: the writer does not wait
   // for the reader (each rank has its own copy).
-  EXPECT_TRUE(s.instances[1].waits.size() == 1 && s.instances[1].waits[0].kind == WaitKind::kMessage);
+  EXPECT_TRUE(s.instances[1].waits.size() == 1 &&
+              s.instances[1].waits[0].kind == WaitKind::kMessage);
 }
 
 TEST(Schedule, ChannelsAreReusedByLaterSteps) {

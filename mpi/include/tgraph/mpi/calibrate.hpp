@@ -11,15 +11,16 @@ namespace tgraph::mpi {
 
 /// What a ping-pong between ranks 0 and 1 measured.
 struct MpiLink {
-  double latency_ns = 0;      ///< one-way time of a small message (median over batches)
-  double per_byte_ns = 0;     ///< extra one-way time per byte of a large message (median)
-  int rounds = 0;             ///< small round trips measured
+  double latency_ns = 0;            ///< one-way time of a small message (median over batches)
+  double per_byte_ns = 0;           ///< extra one-way time per byte of a large message (median)
+  int rounds = 0;                   ///< small round trips measured
   std::uint64_t message_bytes = 0;  ///< size of the large message
 };
 
 /// Ping-pong between ranks 0 and 1 of MPI_COMM_WORLD (other ranks wait); every rank calls
 /// it, the result is rank 0's. Throws UsageError with fewer than 2 ranks.
-MpiLink measure_mpi_link(int rounds = 4000, std::uint64_t message_bytes = 1 << 20, int repeats = 15);
+MpiLink measure_mpi_link(int rounds = 4000, std::uint64_t message_bytes = 1 << 20,
+                         int repeats = 15);
 
 /// The calibration file `text` (named `name` in errors; what `tgraph calibrate` wrote) with
 /// "mpi_latency_ns" and "mpi_per_byte_ns" set from `link` (and "mpi_calibration" saying how),

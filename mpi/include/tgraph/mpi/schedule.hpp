@@ -37,7 +37,7 @@ struct Traffic {
   std::uint32_t ranks = 1;
   std::vector<std::uint64_t> messages, bytes;  ///< datum versions (entering ones included)
   std::vector<std::uint64_t> decisions;        ///< loop decisions (kDecisionBytes each)
-  std::uint64_t entering_messages = 0;  ///< versions from before the step (also in messages)
+  std::uint64_t entering_messages = 0;         ///< versions from before the step (also in messages)
   std::uint64_t entering_bytes = 0;
   explicit Traffic(std::uint32_t r = 1)
       : ranks(r), messages(r * r, 0), bytes(r * r, 0), decisions(r * r, 0) {}
@@ -78,7 +78,8 @@ class ChannelTable {
 
  private:
   std::vector<Channel> channels_;
-  std::map<std::tuple<bool, TaskId, std::uint32_t, std::uint32_t, std::uint32_t>, std::uint32_t> index_;
+  std::map<std::tuple<bool, TaskId, std::uint32_t, std::uint32_t, std::uint32_t>, std::uint32_t>
+      index_;
 };
 
 /// What a task instance waits for before it runs.
@@ -105,7 +106,7 @@ struct Message {
   DatumId datum = 0;
   std::uint32_t from = 0, to = 0;
   std::uint64_t bytes = 0;
-  bool zero_after_send = false;  ///< a temporary: the sender's copy is reset (the reducer's)
+  bool zero_after_send = false;        ///< a temporary: the sender's copy is reset (the reducer's)
   std::vector<std::uint32_t> hazards;  ///< instances on `to` that must end before install
 };
 
