@@ -19,6 +19,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <unordered_map>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
@@ -509,7 +510,9 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   std::vector<std::unique_ptr<Plan>> plans;
   Plan* bound = nullptr;
   Holders holders = everywhere(0, layout.ranks);
-  const std::vector<ProcId>* previous_proc = nullptr;
+  // The previous step's processor of each task, by stable key (a repartition moves a task
+  // that both steps have; a new structure alone is not one).
+  std::unordered_map<StableKey, ProcId> previous_owner;
   for (std::size_t si = 0; si < steps; ++si) {
     const StepGraph& step = trace.steps[si];
     Assignment a = assignment.steps[si];
@@ -524,9 +527,8 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
       // At most kMaxPlans kept (every rank evicts the same ones: they see the same steps);
       // between steps no request is active, so freeing a plan's requests is safe.
       if (plans.size() >= kMaxPlans) {
-        const auto victim = std::find_if(plans.begin(), plans.end(), [&](const auto& q) {
-          return q.get() != bound && &q->proc != previous_proc;
-        });
+        const auto victim = std::find_if(plans.begin(), plans.end(),
+                                         [&](const auto& q) { return q.get() != bound; });
         if (victim != plans.end()) plans.erase(victim);
       }
       auto p = std::make_unique<Plan>();
@@ -555,8 +557,14 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
     StepSchedule s = schedule_step(plan->exec, step, layout, holders, plan->channels);
     MpiStepResult sr;
     sr.predicted = s.traffic;
-    sr.repartitioned = previous_proc != nullptr && *previous_proc != plan->proc;
-    previous_proc = &plan->proc;
+    std::unordered_map<StableKey, ProcId> owner;
+    for (TaskId t = 0; t < step.tasks.size(); ++t) {
+      owner[step.tasks[t].key] = a.proc[t];
+      const auto it = previous_owner.find(step.tasks[t].key);
+      sr.repartitioned =
+          sr.repartitioned || (it != previous_owner.end() && it->second != a.proc[t]);
+    }
+    previous_owner = std::move(owner);
     MPI_Barrier(MPI_COMM_WORLD);
     const std::int64_t t0 = now_ns();
     StepRun run(*plan, s, w, me, layout, drop);

@@ -73,9 +73,9 @@ struct MpiStepResult {
   std::uint64_t hidden = 0;           ///< of them, arrived before a thread needed them
   std::uint64_t decisions_received = 0;
   std::int64_t decision_latency_ns = 0;  ///< sum over received decisions: made -> known here
-  std::uint64_t migrated_bytes = 0;      ///< entering bytes when the assignment changed
-  bool repartitioned = false;
-  std::int64_t sequential_ns = 0;  ///< rank 0's sequential replay of the step (with check)
+  std::uint64_t migrated_bytes = 0;      ///< entering bytes when the step was repartitioned
+  bool repartitioned = false;            ///< a task of the previous step (same stable key) moved
+  std::int64_t sequential_ns = 0;        ///< rank 0's sequential replay of the step (with check)
 };
 
 /// The whole run (meaningful on rank 0).
