@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
@@ -286,6 +287,13 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
           &e);
     return th;
   };
+  // An event's start_ns and end_ns: not negative, the end not before the start.
+  const auto span_of = [](const json& e) {
+    const std::int64_t start = get_i64(e, "start_ns"), end = get_i64(e, "end_ns");
+    if (end < start || start < 0)
+      throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
+    return std::pair{start, end};
+  };
   try {
     t.threads = j.contains("threads") ? get_u32(j, "threads") : 0;
     for (const json& e : j["tasks"]) {
@@ -296,10 +304,7 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
       ev.origin = get_optional_u32(e, "origin");
       ev.kind = e.contains("kind") && e["kind"].is_string() ? e["kind"].get<std::string>() : "task";
       ev.iteration = e.contains("iteration") ? get_u32(e, "iteration") : 0;
-      ev.start_ns = get_i64(e, "start_ns");
-      ev.end_ns = get_i64(e, "end_ns");
-      if (ev.end_ns < ev.start_ns || ev.start_ns < 0)
-        throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
+      std::tie(ev.start_ns, ev.end_ns) = span_of(e);
       t.tasks.push_back(std::move(ev));
       ++index;
     }
@@ -313,11 +318,8 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
         w.step = step_of(e);
         w.thread = thread_of(e);
         w.task = get_optional_u32(e, "task");
-        w.start_ns = get_i64(e, "start_ns");
-        w.end_ns = get_i64(e, "end_ns");
+        std::tie(w.start_ns, w.end_ns) = span_of(e);
         w.parked = e.value("parked", false);
-        if (w.end_ns < w.start_ns || w.start_ns < 0)
-          throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
         t.waits.push_back(w);
         ++index;
       }
