@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 
+#include "tgraph/graph/enum_names.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/viz/critical_path.hpp"
@@ -67,11 +68,9 @@ std::string_view to_string(Collapse c) {
 }
 
 Collapse parse_collapse(std::string_view s) {
-  for (Collapse c :
-       {Collapse::kNone, Collapse::kObject, Collapse::kKind, Collapse::kProcessor, Collapse::kLoop})
-    if (to_string(c) == s) return c;
-  throw UsageError("--collapse " + std::string(s) +
-                   ": expected none, object, kind, processor or loop");
+  return parse_enum(
+      s, {Collapse::kNone, Collapse::kObject, Collapse::kKind, Collapse::kProcessor, Collapse::kLoop},
+      "--collapse");
 }
 
 std::string_view to_string(NodeKind k) {
