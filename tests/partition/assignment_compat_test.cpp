@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/byte_codec.hpp"
@@ -16,6 +17,20 @@ namespace {
 // tests/data/assignments (the build passes the source tree's tests/data).
 const std::filesystem::path kDir = std::filesystem::path(TGRAPH_TEST_DATA) / "assignments";
 
+// One file of kDir: its bytes, the assignment decoded from them and the step hashes read.
+struct OldFile {
+  std::vector<std::uint8_t> bytes;
+  std::vector<std::uint64_t> hashes;
+  TraceAssignment a;
+};
+
+OldFile read_old(const std::string& name) {
+  OldFile f;
+  f.bytes = read_file_bytes((kDir / name).string());
+  f.a = decode_assignment(f.bytes, name, &f.hashes);
+  return f;
+}
+
 TEST(AssignmentCompat, CrcIsZlibsCrc32) {
   const std::string text = "123456789";
   const std::vector<std::uint8_t> b(text.begin(), text.end());
@@ -24,9 +39,7 @@ TEST(AssignmentCompat, CrcIsZlibsCrc32) {
 }
 
 TEST(AssignmentCompat, ReadsAnOwnerAssignmentWrittenBeforeTheSharedCodec) {
-  const std::vector<std::uint8_t> bytes = read_file_bytes((kDir / "small_owner_k2.tga").string());
-  std::vector<std::uint64_t> hashes;
-  const TraceAssignment a = decode_assignment(bytes, "small_owner_k2.tga", &hashes);
+  const auto [bytes, hashes, a] = read_old("small_owner_k2.tga");
   EXPECT_EQ(a.k, 2u);
   EXPECT_EQ(a.method, "owner");
   ASSERT_EQ(a.steps.size(), 3u);
@@ -39,9 +52,7 @@ TEST(AssignmentCompat, ReadsAnOwnerAssignmentWrittenBeforeTheSharedCodec) {
 }
 
 TEST(AssignmentCompat, ReadsAListAssignmentWithOrdersWrittenBeforeTheSharedCodec) {
-  const std::vector<std::uint8_t> bytes = read_file_bytes((kDir / "small_list_k3.tga").string());
-  std::vector<std::uint64_t> hashes;
-  const TraceAssignment a = decode_assignment(bytes, "small_list_k3.tga", &hashes);
+  const auto [bytes, hashes, a] = read_old("small_list_k3.tga");
   EXPECT_EQ(a.k, 3u);
   EXPECT_EQ(a.method, "list");
   ASSERT_EQ(a.steps.size(), 3u);
