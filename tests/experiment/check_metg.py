@@ -6,26 +6,17 @@
 #   check_metg.py TGRAPH
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from experiment_check import check, problems, run_experiment  # noqa: E402
+
 tgraph = sys.argv[1]
-problems = []
-
-
-def check(ok, what):
-    if not ok:
-        problems.append(what)
-    return ok
-
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "metg")
-    run = subprocess.run([tgraph, "experiment", "metg", "--quick", "--out", out, "--json"],
-                         capture_output=True, text=True, timeout=600)
-    if run.returncode != 0:
-        sys.exit(f"exit {run.returncode}\nstdout:\n{run.stdout}\nstderr:\n{run.stderr}")
+    run = run_experiment(tgraph, ["metg", "--quick", "--out", out, "--json"], timeout=600)
     printed = json.loads(run.stdout)
     j = json.load(open(os.path.join(out, "results.json")))
     check(printed["metg"] == j["metg"], "--json and results.json disagree on metg")
