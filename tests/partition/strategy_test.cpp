@@ -308,31 +308,39 @@ TEST(Sticky, KeepsExistingTasksAndPlacesNewOnesByAffinity) {
   EXPECT_TRUE(p == p2 || p == p5);
 }
 
-TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
-  // Costs in microseconds: moving a task pays off against the cost model's sync + transfer.
+// Two steps of 16 objects, the second with new heavy tasks on object 0's data only (affinity
+// placement overloads its processor); costs in microseconds, so that moving a task pays off
+// against the cost model's sync + transfer.
+std::pair<StepGraph, StepGraph> overloaded_step() {
   StepGraph g0 = objects_scene(16, {});
-  // New heavy tasks on object 0's data only: affinity placement overloads its processor.
   StepGraph g1 = objects_scene(16, {}, 8);
   for (Task& t : g0.tasks) t.cost_ns *= 1000;
   for (Task& t : g1.tasks) t.cost_ns *= 1000;
+  return {std::move(g0), std::move(g1)};
+}
+
+// Max/mean load of `a` over 4 processors.
+double imbalance_on_4(const StepGraph& g, const Assignment& a) {
+  const auto l = loads_of(g, a);
+  const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
+  return static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total);
+}
+
+TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
+  const auto [g0, g1] = overloaded_step();
   Options o;
   o.sticky_threshold = 1.2;
   auto s = make_strategy("sticky");
   const Result r0 = s->partition(g0, 4, {}, o);
   const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, o);
   EXPECT_TRUE(r1.stats.rebalanced);
-  const auto l = loads_of(g1, r1.assignment);
-  const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
-  EXPECT_LE(static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total), 1.2);
+  EXPECT_LE(imbalance_on_4(g1, r1.assignment), 1.2);
   // Greedy rebalancing moves the heavy new tasks first: few of the 32 existing tasks move.
   EXPECT_LE(r1.stats.moved_tasks, 8u);
 }
 
 TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTasksThanMetisRelabel) {
-  StepGraph g0 = objects_scene(16, {});
-  StepGraph g1 = objects_scene(16, {}, 8);
-  for (Task& t : g0.tasks) t.cost_ns *= 1000;
-  for (Task& t : g1.tasks) t.cost_ns *= 1000;
+  const auto [g0, g1] = overloaded_step();
   Options o;
   o.sticky_threshold = 1.2;
   o.rebalance = Rebalance::kScotch;
@@ -348,10 +356,7 @@ TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTask
     EXPECT_FALSE(r.stats.fallback) << emraval;
     ASSERT_EQ(r.assignment.proc.size(), g1.tasks.size());
     for (ProcId p : r.assignment.proc) ASSERT_LT(p, 4u);
-    const auto l = loads_of(g1, r.assignment);
-    const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
-    const double imbalance = static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total);
-    EXPECT_LE(imbalance, 1.2) << emraval;
+    EXPECT_LE(imbalance_on_4(g1, r.assignment), 1.2) << emraval;
     EXPECT_EQ(r.stats.matched_tasks, g0.tasks.size());
     EXPECT_LT(r.stats.moved_tasks, fresh.stats.moved_tasks) << emraval;
   }
