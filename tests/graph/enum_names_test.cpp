@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // An enum value from its to_string() name; the error lists the names in order.
-#include <gtest/gtest.h>
-
 #include "tgraph/graph/enum_names.hpp"
+
+#include <gtest/gtest.h>
 
 namespace tgraph {
 namespace {
@@ -23,7 +23,8 @@ std::string_view to_string(Colour c) {
 
 TEST(ParseEnum, ReturnsTheValueOfEachName) {
   for (Colour c : {Colour::kRed, Colour::kGreen, Colour::kBlue})
-    EXPECT_EQ(parse_enum(to_string(c), {Colour::kRed, Colour::kGreen, Colour::kBlue}, "--colour"), c);
+    EXPECT_EQ(parse_enum(to_string(c), {Colour::kRed, Colour::kGreen, Colour::kBlue}, "--colour"),
+              c);
 }
 
 TEST(ParseEnum, RejectsAnotherNameListingTheNamesInOrder) {

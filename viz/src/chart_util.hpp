@@ -41,8 +41,7 @@ int decimals_for(double step);
 /// Sets the source colour from "#RRGGBB".
 void set_colour(cairo_t* cr, const std::string& hex, double alpha = 1.0);
 /// Writes `s` at (x, y); `align`: 0 left, 0.5 centre, 1 right.
-void text_at(cairo_t* cr, double x, double y, const std::string& s, double size,
-             double align = 0);
+void text_at(cairo_t* cr, double x, double y, const std::string& s, double size, double align = 0);
 /// Runs `draw` on a `width` x `height` SVG or PNG surface and returns the document; throws
 /// std::runtime_error on a cairo failure.
 std::string render_cairo(TimelineFormat format, double width, double height,
