@@ -3,6 +3,7 @@
 #include "chart_util.hpp"
 
 #include <cairo-svg.h>
+#include <cairo.h>
 
 #include <cmath>
 #include <cstdio>

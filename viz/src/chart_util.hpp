@@ -3,8 +3,6 @@
 // tick labels, and cairo drawing onto an SVG or PNG in memory.
 #pragma once
 
-#include <cairo.h>
-
 #include <functional>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
@@ -12,6 +10,9 @@
 #include <string_view>
 
 #include "tgraph/viz/timeline.hpp"
+
+// cairo's own declaration (cairo.h), so that users of these helpers need not see cairo.
+typedef struct _cairo cairo_t;
 
 namespace tgraph::viz::detail {
 
