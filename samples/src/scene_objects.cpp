@@ -159,16 +159,16 @@ void SceneBuilder::grid_object(Directive& d) {
     add_gravity(*pb);
     if (fem && split > 1) {
       const HexFemForceField whole(inst + ".fem", pb, proto.elements, mat);
-      add_split_fields(inst + ".fem", whole.element_batches(), split, [&](const std::string& n, auto first, auto last) {
+      add_split_fields(inst + ".fem", whole.element_batches(), split, [&](const std::string& n, auto run_begin, auto run_end) {
         std::vector<std::array<Index, 8>> elements;
-        for (auto it = first; it != last; ++it) elements.insert(elements.end(), it->begin(), it->end());
+        for (auto it = run_begin; it != run_end; ++it) elements.insert(elements.end(), it->begin(), it->end());
         return std::make_unique<HexFemForceField>(n, pb, std::move(elements), mat, &whole);
       });
     } else if (fem) {
       scene_->add_force_field(std::make_unique<HexFemForceField>(inst + ".fem", pb, proto.elements, mat));
     } else {
-      add_split_fields(inst + ".springs", springs, split, [&](const std::string& n, auto first, auto last) {
-        return std::make_unique<SpringForceField>(n, pb, nullptr, std::vector<Spring>(first, last));
+      add_split_fields(inst + ".springs", springs, split, [&](const std::string& n, auto run_begin, auto run_end) {
+        return std::make_unique<SpringForceField>(n, pb, nullptr, std::vector<Spring>(run_begin, run_end));
       });
     }
     add_fix(*pb, fixed_nodes(d, x, fix));
@@ -277,8 +277,8 @@ void SceneBuilder::chain(Directive& d) {
     instance_common(d, b, seg, first);
     first = false;
     add_gravity(b);
-    add_split_fields(inst + ".springs", springs, split, [&](const std::string& fn, auto first, auto last) {
-      return std::make_unique<SpringForceField>(fn, &b, nullptr, std::vector<Spring>(first, last));
+    add_split_fields(inst + ".springs", springs, split, [&](const std::string& fn, auto run_begin, auto run_end) {
+      return std::make_unique<SpringForceField>(fn, &b, nullptr, std::vector<Spring>(run_begin, run_end));
     });
     add_fix(b, fixed_nodes(d, x, fix));
   }
