@@ -65,6 +65,14 @@ void RankWorkload::run(const replay::TaskRun& r) {
   (void)sink;
 }
 
+void RankWorkload::run_host(const StepGraph& step) {
+#ifdef TGRAPH_SMPI
+  if (step.host_ns > 0) smpi_execute_flops(static_cast<double>(step.host_ns) * scale_);
+#else
+  inner_.run_host(step);
+#endif
+}
+
 std::span<std::uint64_t> RankWorkload::mutable_words(DatumId d) {
   const auto w = inner_.words(d);
   // The buffer is this workload's own, allocated non-const (SyntheticWorkload::first_touch).
@@ -646,6 +654,10 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
     previous_owner = std::move(owner);
     MPI_Barrier(MPI_COMM_WORLD);
     const std::int64_t t0 = now_ns();
+    if (options.host_work) {
+      if (me == 0) w.run_host(step);
+      MPI_Barrier(MPI_COMM_WORLD);
+    }
     StepRun run(*plan, s, w, me, layout, drop);
     const Counters c = run.run(static_cast<std::int64_t>(options.watchdog_s * 1e9));
     std::vector<std::uint64_t> sums = {static_cast<std::uint64_t>(c.local_wait_ns),
@@ -703,6 +715,7 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
       for (std::size_t si = 0; si < steps; ++si) {
         sw.set_step(trace.steps[si]);
         const std::int64_t t0 = now_ns();
+        if (options.host_work) sw.run_host(trace.steps[si]);
         seq->run_step(trace.steps[si], nullptr, sw);
         result.steps[si].sequential_ns = now_ns() - t0;
         result.sequential_ns += result.steps[si].sequential_ns;
