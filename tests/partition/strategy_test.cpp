@@ -364,6 +364,22 @@ TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTask
   EXPECT_THROW(parse_rebalance("magic"), UsageError);
 }
 
+// Sticky with `o` on `apart` (r0), then on `merged` from it (r1): the groups merge, so r1
+// falls back (checked here).
+struct StickyMerge {
+  std::unique_ptr<Strategy> s;
+  Result r0, r1;
+};
+
+StickyMerge sticky_merge(const StepGraph& apart, const StepGraph& merged, std::uint32_t k,
+                         const Options& o) {
+  StickyMerge m{make_strategy("sticky"), {}, {}};
+  m.r0 = m.s->partition(apart, k, {}, o);
+  m.r1 = m.s->partition(merged, k, {&apart, &m.r0.assignment}, o);
+  EXPECT_TRUE(m.r1.stats.fallback) << k;
+  return m;
+}
+
 TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
   using testing::grouped_scene;
   const StepGraph apart = grouped_scene(8, {{0, 1, 2, 3}, {4, 5, 6, 7}});
@@ -373,10 +389,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
   Options fresh;
   fresh.sticky_fallback = StickyFallback::kFresh;
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, fresh);
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, fresh);
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, fresh);
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_FALSE(r1.stats.reused);
     // What metis-relabel gives from the same previous step: METIS afresh, optimally renamed.
@@ -410,10 +423,7 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   Options o;
   o.sticky_fallback = StickyFallback::kRepartition;
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, o);
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, o);
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, o);
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
     // Balanced within the tolerance METIS gets, with fewer moves than a fresh partition
@@ -437,10 +447,7 @@ TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeByDefault) {
   const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
   EXPECT_EQ(Options{}.sticky_fallback, StickyFallback::kRefine);
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, {});
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, {});
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, {});
     EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
     // Fewer moves than METIS afresh relabelled, at a predicted makespan no worse than 5 %
     // above METIS's, and every processor keeps work.
