@@ -16,7 +16,7 @@
 // thread: they are not used.
 //
 // Loops: a loop whose iteration count the workload knows (a replay) is unrolled at
-// submission, with a `taskwait` after each iteration when ExecOptions::omp_iteration_wait
+// submission, with a `taskwait` after each iteration when OmpTasksOptions::iteration_wait
 // (as an OpenMP program testing convergence must do; it also keeps libgomp's dependence
 // lists short). Otherwise (live physics) one iteration is submitted, the submitting thread
 // waits for it and reads the break task's decision. A loop task that writes none of its data
@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
@@ -60,10 +61,10 @@ enum class Check : std::uint8_t {
   kUnrolled = 2,  ///< unrolled: the condition must agree with the known count
 };
 
-class OmpTasksExecutor final : public Executor {
+class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
  public:
   explicit OmpTasksExecutor(const ExecOptions& o)
-      : Executor(Policy::kOmpTasks, o), counters_(std::make_unique<Slot[]>(o.threads)) {}
+      : PlannedExecutor(Policy::kOmpTasks, o), counters_(std::make_unique<Slot[]>(o.threads)) {}
   ~OmpTasksExecutor() override {
     if (pinned_main_) detail::restore_binding(main_binding_);
   }
@@ -73,9 +74,9 @@ class OmpTasksExecutor final : public Executor {
     ThreadCounters c;
   };
 
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<OmpPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<OmpPlan>();
+    auto plan = std::make_unique<OmpPlan>();
     plan->objects = static_cast<std::uint32_t>(g.data.size());
     const auto n = static_cast<TaskId>(g.tasks.size());
     plan->deps.resize(n);
@@ -147,10 +148,10 @@ class OmpTasksExecutor final : public Executor {
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
         const ExecGraph& x = *exec_;
-        const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
-        if (observe) detail::notify_begin(observers_, thread, t, it);
+        const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
+        if (observe) detail::notify_begin(observers(), thread, t, it);
         workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
-        if (observe) detail::notify_end(observers_, thread, t, it);
+        if (observe) detail::notify_end(observers(), thread, t, it);
         ++counters_[thread].c.tasks;
         const LoopId l = x.graph.tasks[t].loop;
         if (check == Check::kDecide)
@@ -200,7 +201,7 @@ class OmpTasksExecutor final : public Executor {
           for (std::uint32_t it = 0; it < count; ++it) {
             for (TaskId u = loop.first; u < loop.last; ++u)
               submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
-            if (options_.omp_iteration_wait) {
+            if (options().omp_tasks.iteration_wait) {
 #pragma omp taskwait
               TGRAPH_TSAN_ACQUIRE(&join_token_);
               if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
@@ -226,27 +227,27 @@ class OmpTasksExecutor final : public Executor {
     }
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
+  void run(OmpPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh)
       for (DatumId d = 0; d < g.data.size(); ++d)
         if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    if (options_.pin && !saved_) {
+    if (options().pin && !saved_) {
       saved_ = true;
       detail::save_binding(main_binding_);
       pinned_main_ = true;
     }
-    plan_ = static_cast<OmpPlan*>(plan_ptr);
+    plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
-    const bool pin = options_.pin;
+    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
+    const bool pin = options().pin;
     TGRAPH_TSAN_RELEASE(&submit_token_);
-#pragma omp parallel num_threads(static_cast<int>(options_.threads))
+#pragma omp parallel num_threads(static_cast<int>(options().threads))
     {
       TGRAPH_TSAN_ACQUIRE(&submit_token_);
       if (pin) detail::pin_current_thread(static_cast<std::uint32_t>(omp_get_thread_num()));
@@ -262,8 +263,8 @@ class OmpTasksExecutor final : public Executor {
     }
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    stats.threads.resize(options().threads);
+    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);

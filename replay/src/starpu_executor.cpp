@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "tsan.hpp"
 
 namespace tgraph::replay {
@@ -151,18 +152,18 @@ class ScopedEnv {
   std::optional<std::string> old_;
 };
 
-class StarpuExecutor final : public Executor {
+class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
  public:
   explicit StarpuExecutor(const ExecOptions& o)
-      : Executor(Policy::kStarpu, o),
+      : PlannedExecutor(Policy::kStarpu, o),
         registry_(std::make_shared<Registry>()),
         counters_(std::make_unique<Slot[]>(o.threads)) {
     if (o.threads > STARPU_MAXCPUS)
       throw UsageError("--policy starpu: --threads " + std::to_string(o.threads) +
                        ": this StarPU build has at most " + std::to_string(STARPU_MAXCPUS) +
                        " CPU workers (STARPU_MAXCPUS)");
-    if (!known_scheduler(o.starpu_sched))
-      throw UsageError("--starpu-sched " + o.starpu_sched +
+    if (!known_scheduler(o.starpu.sched))
+      throw UsageError("--starpu-sched " + o.starpu.sched +
                        ": not a StarPU scheduler; expected one of " + scheduler_names());
     if (g_starpu_in_use.exchange(true))
       throw UsageError(
@@ -177,7 +178,7 @@ class StarpuExecutor final : public Executor {
     conf.nopencl = 0;
     conf.nmic = 0;
     conf.nmpi_ms = 0;
-    conf.sched_policy_name = options_.starpu_sched.c_str();
+    conf.sched_policy_name = options().starpu.sched.c_str();
     conf.catch_signals = 0;  // leave SIGINT/SIGSEGV to the application
     conf.calibrate = 0;
     conf.bus_calibrate = 0;
@@ -223,9 +224,9 @@ class StarpuExecutor final : public Executor {
     ThreadCounters c;
   };
 
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<StarpuPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<StarpuPlan>();
+    auto plan = std::make_unique<StarpuPlan>();
     plan->handles.resize(g.data.size());
     for (starpu_data_handle_t& h : plan->handles) starpu_void_data_register(&h);
     plan->registry = registry_;
@@ -277,7 +278,7 @@ class StarpuExecutor final : public Executor {
 
   void run_instance(Instance& in) {
     const int id = starpu_worker_get_id();
-    const auto thread = static_cast<std::uint32_t>(id < 0 ? 0 : id) % options_.threads;
+    const auto thread = static_cast<std::uint32_t>(id < 0 ? 0 : id) % options().threads;
     const StarpuPlan& p = *plan_;
     if constexpr (kTsan) {
       // StarPU's queues and dependency release are not instrumented: make the hand-off from
@@ -290,9 +291,9 @@ class StarpuExecutor final : public Executor {
       try {
         const ExecGraph& x = *exec_;
         ThreadCounters& tc = counters_[thread].c;
-        if (!observers_.empty()) detail::notify_begin(observers_, thread, in.task, in.iteration);
+        if (!observers().empty()) detail::notify_begin(observers(), thread, in.task, in.iteration);
         workload_->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
-        if (!observers_.empty()) detail::notify_end(observers_, thread, in.task, in.iteration);
+        if (!observers().empty()) detail::notify_end(observers(), thread, in.task, in.iteration);
         ++tc.tasks;
         const LoopId l = x.graph.tasks[in.task].loop;
         if (in.check == Check::kDecide) {
@@ -356,7 +357,7 @@ class StarpuExecutor final : public Executor {
   }
 
   /// Submits the whole step (loops unrolled or host-synchronised); returns early on failure.
-  void submit_step(const ExecGraph& x, Workload& w, StepStats& stats) {
+  void submit_step(const ExecGraph& x, Workload& w, ExecStepStats& stats) {
     const StepGraph& g = x.graph;
     const auto n = static_cast<TaskId>(g.tasks.size());
     std::size_t next_loop = 0;
@@ -395,19 +396,19 @@ class StarpuExecutor final : public Executor {
     }
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
+  void run(StarpuPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh)
       for (DatumId d = 0; d < g.data.size(); ++d)
         if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    plan_ = static_cast<StarpuPlan*>(plan_ptr);
+    plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
     instances_.clear();
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
     stats.loop_iterations.assign(g.loops.size(), 0);
     starpu_resume();
     try {
@@ -418,8 +419,8 @@ class StarpuExecutor final : public Executor {
     starpu_task_wait_for_all();  // never leave a submitted task behind, even on error
     starpu_pause();
     TGRAPH_TSAN_ACQUIRE(&join_token_);
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    stats.threads.resize(options().threads);
+    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 #include "worksteal_task.hpp"
@@ -46,10 +47,10 @@ struct WsPlan {
   std::unique_ptr<std::atomic<std::uint32_t>[]> count0;  // non-loop tasks
 };
 
-class WorkstealExecutor final : public Executor {
+class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
  public:
   explicit WorkstealExecutor(const ExecOptions& o)
-      : Executor(Policy::kWorksteal, o),
+      : PlannedExecutor(Policy::kWorksteal, o),
         control_(tbb::global_control::max_allowed_parallelism, o.threads),
         arena_(static_cast<int>(o.threads)),
         counters_(std::make_unique<Slot[]>(o.threads)) {}
@@ -59,9 +60,9 @@ class WorkstealExecutor final : public Executor {
     ThreadCounters c;
   };
 
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<WsPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<WsPlan>();
+    auto plan = std::make_unique<WsPlan>();
     const auto n = g.tasks.size();
     plan->n = n;
     plan->succ = detail::build_csr(n, g.edges, false);
@@ -157,13 +158,13 @@ class WorkstealExecutor final : public Executor {
 
   void run_instance(TaskId t, std::uint32_t it) {
     const int idx = tbb::this_task_arena::current_thread_index();
-    const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options_.threads;
+    const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options().threads;
     ThreadCounters& tc = counters_[thread].c;
     const ExecGraph& x = *exec_;
-    const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
-    if (observe) detail::notify_begin(observers_, thread, t, it);
+    const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
+    if (observe) detail::notify_begin(observers(), thread, t, it);
     workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
-    if (observe) detail::notify_end(observers_, thread, t, it);
+    if (observe) detail::notify_end(observers(), thread, t, it);
     ++tc.tasks;
     const LoopId l = x.graph.tasks[t].loop;
     const WsPlan& p = *plan_;
@@ -205,9 +206,8 @@ class WorkstealExecutor final : public Executor {
     }
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
-    WsPlan& plan = *static_cast<WsPlan*>(plan_ptr);
+  void run(WsPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh)
       for (DatumId d = 0; d < g.data.size(); ++d)
@@ -216,7 +216,7 @@ class WorkstealExecutor final : public Executor {
     exec_ = &x;
     workload_ = &w;
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
     for (TaskId t = 0; t < plan.n; ++t)
       plan.count0[t].store(plan.init0[t], std::memory_order_relaxed);  // relaxed: before any spawn
     for (LoopState& ls : plan.loops) {
@@ -244,8 +244,8 @@ class WorkstealExecutor final : public Executor {
         delete b;
         e.store(nullptr, std::memory_order_relaxed);  // relaxed: no task runs now
       }
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    stats.threads.resize(options().threads);
+    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
     stats.loop_iterations = iterations_;
     if (error) std::rethrow_exception(error);
   }

@@ -39,7 +39,7 @@ const Variant kVariants[] = {
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
   ExecOptions o;
   o.threads = k;
-  o.serial = serial;
+  o.partition.serial = serial;
   o.spin_ns = spin_ns;
   return o;
 }
@@ -47,9 +47,9 @@ ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kD
 ExecOptions options_for(const Variant& v, std::uint32_t k) {
   ExecOptions o;
   o.threads = k;
-  o.serial = v.serial;
+  o.partition.serial = v.serial;
   o.spin_ns = 20'000;
-  o.barrier_rule = v.rule;
+  o.barrier.rule = v.rule;
   return o;
 }
 
@@ -67,7 +67,7 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
     SyntheticWorkload w({.cost_scale = 0.2});
     w.set_step(g);
     for (int step = 0; step < 2; ++step) {
-      const StepStats s = ex->run_step(g, &a, w);
+      const ExecStepStats s = ex->run_step(g, &a, w);
       EXPECT_EQ(s.rebuilt, step == 0);
       for (LoopId l = 0; l < g.loops.size(); ++l)
         EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
@@ -241,7 +241,7 @@ TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
   auto ex = make_executor(Policy::kPartition, opts(2));
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
-  const StepStats first = ex->run_step(g, &a, w);
+  const ExecStepStats first = ex->run_step(g, &a, w);
   EXPECT_TRUE(first.rebuilt);
   EXPECT_GT(first.build_ns, 0);
   EXPECT_GE(first.wall_ns, first.build_ns);
@@ -249,7 +249,7 @@ TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
   for (Task& t : g2.tasks) t.cost_ns += 7;
   g2.loops[0].iterations = 1;
   w.set_step(g2);
-  const StepStats second = ex->run_step(g2, &a, w);
+  const ExecStepStats second = ex->run_step(g2, &a, w);
   EXPECT_FALSE(second.rebuilt);
   EXPECT_EQ(second.build_ns, 0);
   EXPECT_EQ(second.loop_iterations[0], 1u);

@@ -119,7 +119,7 @@ TEST_P(CrossingReducers, RunWithTheExplicitOrderAndMatchTheSequentialState) {
   for (bool serial : {true, false}) {
     ExecOptions o;
     o.threads = 2;
-    o.serial = serial;
+    o.partition.serial = serial;
     o.spin_ns = 20'000;
     auto ex = make_executor(Policy::kPartition, o);
     SyntheticWorkload w({.cost_scale = 0.0});
@@ -178,12 +178,12 @@ TEST(CwReduction, ReducerStaysInItsLoopBlockBehindTheExitOfEarlierLoops) {
   for (bool serial : {true, false}) {
     ExecOptions o;
     o.threads = 2;
-    o.serial = serial;
+    o.partition.serial = serial;
     o.spin_ns = 20'000;
     auto ex = make_executor(Policy::kPartition, o);
     SyntheticWorkload w({.cost_scale = 0.0});
     w.set_step(g);
-    StepStats s;
+    ExecStepStats s;
     ASSERT_NO_THROW(s = ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
     EXPECT_EQ(ex->order_fallbacks(), 0u);
     EXPECT_EQ(s.loop_iterations, (std::vector<std::uint32_t>{2, 2}));
@@ -203,7 +203,7 @@ TEST(CwReduction, ListScheduleOrdersRunWithReducersOnRandomPrograms) {
       ASSERT_FALSE(a.order.empty());
       ExecOptions o;
       o.threads = k;
-      o.serial = true;
+      o.partition.serial = true;
       auto ex = make_executor(Policy::kPartition, o);
       SyntheticWorkload w({.cost_scale = 0.0});
       w.set_step(g);
@@ -241,7 +241,7 @@ TEST(CwReduction, OrdersRunWithoutDeadlockOnRandomProgramsOfEveryShape) {
         const Assignment a = strategy->partition(g, k, {}, partition::Options{}).assignment;
         ExecOptions o;
         o.threads = k;
-        o.serial = true;
+        o.partition.serial = true;
         auto ex = make_executor(Policy::kPartition, o);
         SyntheticWorkload w({.cost_scale = 0.0});
         w.set_step(g);
@@ -262,7 +262,7 @@ TEST(CwReduction, AnOrderThatNeedsATaskBehindAnotherProcessorsLoopBlockFallsBack
   ASSERT_FALSE(a.order.empty());
   ExecOptions o;
   o.threads = 4;
-  o.serial = true;
+  o.partition.serial = true;
   auto ex = make_executor(Policy::kPartition, o);
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);

@@ -116,7 +116,7 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
     w->set_step(g);
     const std::uint64_t built = ex->plans_built();
     for (int step = 0; step < 2; ++step) {
-      const StepStats s = ex->run_step(g, nullptr, *w);
+      const ExecStepStats s = ex->run_step(g, nullptr, *w);
       EXPECT_EQ(s.rebuilt, step == 0);
       ASSERT_EQ(s.loop_iterations.size(), g.loops.size());
       for (LoopId l = 0; l < g.loops.size(); ++l)
@@ -233,7 +233,7 @@ TEST(Starpu, RejectsKnownIterationsThatContradictTheCondition) {
   w.set_known(3);
   EXPECT_THROW(ex->run_step(g, nullptr, w), UsageError);
   w.set_known(2);
-  const StepStats s = ex->run_step(g, nullptr, w);
+  const ExecStepStats s = ex->run_step(g, nullptr, w);
   for (std::uint32_t it : s.loop_iterations) EXPECT_EQ(it, 2u);
 }
 
@@ -251,7 +251,7 @@ TEST(Starpu, AllowsOneRuntimePerProcessAndChecksItsOptions) {
   }
   EXPECT_NO_THROW(make_executor(Policy::kStarpu, starpu_options(1)));  // the first is gone
   ExecOptions bad = starpu_options(2);
-  bad.starpu_sched = "no-such-scheduler";
+  bad.starpu.sched = "no-such-scheduler";
   try {
     make_executor(Policy::kStarpu, bad);
     FAIL() << "unknown scheduler accepted";
@@ -261,7 +261,7 @@ TEST(Starpu, AllowsOneRuntimePerProcessAndChecksItsOptions) {
   EXPECT_THROW(make_executor(Policy::kStarpu, starpu_options(64)), UsageError);
   for (const char* sched : {"eager", "ws", "prio"}) {
     ExecOptions o = starpu_options(2);
-    o.starpu_sched = sched;
+    o.starpu.sched = sched;
     auto ex = make_executor(Policy::kStarpu, o);
     const StepGraph g = test::random_graph(3);
     SyntheticWorkload w({.cost_scale = 0.0});
