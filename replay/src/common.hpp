@@ -35,6 +35,26 @@ inline std::uint32_t unrolled_count(const Loop& loop, std::uint32_t known) {
 bool check_unrolled(const ExecGraph& x, LoopId l, std::uint32_t i, std::uint32_t count,
                     Workload& w);
 
+/// Walks step `g` in program order for the executors that submit or run it from one thread:
+/// `task(t)` for each task outside loops, `loop(l)` once for each loop (at its first task;
+/// the loop's body is then skipped). Stops before the next task or loop once `stop()`.
+template <class Stop, class TaskFn, class LoopFn>
+void walk_step(const StepGraph& g, Stop stop, TaskFn task, LoopFn loop) {
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  std::size_t next_loop = 0;
+  for (TaskId t = 0; t < n;) {
+    if (stop()) return;
+    if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
+      const auto l = static_cast<LoopId>(next_loop++);
+      loop(l);
+      t = g.loops[l].last;
+      continue;
+    }
+    task(t);
+    ++t;
+  }
+}
+
 /// Whether observers see loop iteration `it` under Executor::set_observe_stride(stride):
 /// iterations 0 and 1 and every stride-th one (every instance outside loops).
 inline bool sampled(std::uint32_t it, std::uint32_t stride) { return it < 2 || it % stride == 0; }

@@ -304,24 +304,17 @@ class SequentialExecutor final : public detail::PlannedExecutor<SequentialPlan> 
       if (observe && detail::sampled(it, stride)) detail::notify_end(obs, 0, t, it);
       ++c.tasks;
     };
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        std::uint32_t it = 0;
-        for (;; ++it) {
-          for (TaskId u = loop.first; u < loop.last; ++u) run_task(u, it);
-          if (detail::leave_loop(x, l, it, w)) break;
-        }
-        stats.loop_iterations[l] = it + 1;
-        t = loop.last;
-        continue;
-      }
-      run_task(t, 0);
-      ++t;
-    }
+    detail::walk_step(
+        g, [] { return false; }, [&](TaskId t) { run_task(t, 0); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          std::uint32_t it = 0;
+          for (;; ++it) {
+            for (TaskId u = loop.first; u < loop.last; ++u) run_task(u, it);
+            if (detail::leave_loop(x, l, it, w)) break;
+          }
+          stats.loop_iterations[l] = it + 1;
+        });
   }
 };
 

@@ -189,42 +189,35 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
   /// Submits the whole step from the `single` thread; returns early on failure.
   void submit_step(const ExecGraph& x, Workload& w) {
     const StepGraph& g = x.graph;
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
-          const std::uint32_t count = detail::unrolled_count(loop, *known);
-          for (std::uint32_t it = 0; it < count; ++it) {
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
-            if (options().omp_tasks.iteration_wait) {
+    detail::walk_step(
+        g, [this] { return failed_.load(std::memory_order_relaxed); },  // relaxed: see fail()
+        [this](TaskId t) { submit(t, 0, Check::kNone, 0); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
+            const std::uint32_t count = detail::unrolled_count(loop, *known);
+            for (std::uint32_t it = 0; it < count; ++it) {
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
+              if (options().omp_tasks.iteration_wait) {
+#pragma omp taskwait
+                TGRAPH_TSAN_ACQUIRE(&join_token_);
+                if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+              }
+            }
+            iterations_[l] = count;
+          } else {
+            for (std::uint32_t it = 0;; ++it) {
+              decision_ = -1;
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
 #pragma omp taskwait
               TGRAPH_TSAN_ACQUIRE(&join_token_);
-              if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+              iterations_[l] = it + 1;
+              if (decision_ != 0) break;  // leave, or the break task did not run (failure)
             }
           }
-          iterations_[l] = count;
-        } else {
-          for (std::uint32_t it = 0;; ++it) {
-            decision_ = -1;
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
-#pragma omp taskwait
-            TGRAPH_TSAN_ACQUIRE(&join_token_);
-            iterations_[l] = it + 1;
-            if (decision_ != 0) break;  // leave, or the break task did not run (failure)
-          }
-        }
-        t = loop.last;
-        continue;
-      }
-      submit(t, 0, Check::kNone, 0);
-      ++t;
-    }
+        });
   }
 
   void run(OmpPlan& plan, const ExecGraph& x, Workload& w, bool fresh,

@@ -359,41 +359,36 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   /// Submits the whole step (loops unrolled or host-synchronised); returns early on failure.
   void submit_step(const ExecGraph& x, Workload& w, ExecStepStats& stats) {
     const StepGraph& g = x.graph;
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
-          // Unrolled: the break tasks still evaluate the condition, which must agree.
-          const std::uint32_t count = detail::unrolled_count(loop, *known);
-          for (std::uint32_t it = 0; it < count; ++it)
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it,
-                     u + 1 < loop.last ? Check::kNone
-                                       : (it + 1 == count ? Check::kStop : Check::kContinue),
-                     false);
-          stats.loop_iterations[l] = count;
-        } else {
-          for (std::uint32_t it = 0;; ++it) {
-            for (TaskId u = loop.first; u + 1 < loop.last; ++u) submit(u, it, Check::kNone, false);
-            starpu_task* brk = submit(loop.last - 1, it, Check::kDecide, true);
-            const Instance& in = instances_.back();
-            if (const int rc = starpu_task_wait(brk); rc != 0)
-              throw Error("--policy starpu: starpu_task_wait failed (" + std::to_string(rc) + ")");
-            TGRAPH_TSAN_ACQUIRE(&join_token_);
-            stats.loop_iterations[l] = it + 1;
-            if (in.decision != 0) break;  // leave, or the break task did not run (failure)
+    detail::walk_step(
+        g, [this] { return failed_.load(std::memory_order_relaxed); },  // relaxed: see fail()
+        [this](TaskId t) { submit(t, 0, Check::kNone, false); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
+            // Unrolled: the break tasks still evaluate the condition, which must agree.
+            const std::uint32_t count = detail::unrolled_count(loop, *known);
+            for (std::uint32_t it = 0; it < count; ++it)
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it,
+                       u + 1 < loop.last ? Check::kNone
+                                         : (it + 1 == count ? Check::kStop : Check::kContinue),
+                       false);
+            stats.loop_iterations[l] = count;
+          } else {
+            for (std::uint32_t it = 0;; ++it) {
+              for (TaskId u = loop.first; u + 1 < loop.last; ++u)
+                submit(u, it, Check::kNone, false);
+              starpu_task* brk = submit(loop.last - 1, it, Check::kDecide, true);
+              const Instance& in = instances_.back();
+              if (const int rc = starpu_task_wait(brk); rc != 0)
+                throw Error("--policy starpu: starpu_task_wait failed (" + std::to_string(rc) +
+                            ")");
+              TGRAPH_TSAN_ACQUIRE(&join_token_);
+              stats.loop_iterations[l] = it + 1;
+              if (in.decision != 0) break;  // leave, or the break task did not run (failure)
+            }
           }
-        }
-        t = loop.last;
-        continue;
-      }
-      submit(t, 0, Check::kNone, false);
-      ++t;
-    }
+        });
   }
 
   void run(StarpuPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
