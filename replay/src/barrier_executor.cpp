@@ -38,18 +38,10 @@ struct BarrierPlan {
 
 class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
  public:
-  explicit BarrierExecutor(const ExecOptions& o) : PlannedExecutor(Policy::kBarrier, o) {
-    counters_ = std::make_unique<Slot[]>(o.threads);
-  }
-  ~BarrierExecutor() override {
-    if (pinned_main_) detail::restore_binding(main_binding_);
-  }
+  explicit BarrierExecutor(const ExecOptions& o)
+      : PlannedExecutor(Policy::kBarrier, o), counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
   std::unique_ptr<BarrierPlan> build_plan(const ExecGraph& x) override {
     switch (options().barrier.rule) {
       case BarrierRule::kLevel:
@@ -172,12 +164,8 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     const auto k = static_cast<int>(options().threads);
-    if (options().pin && !saved_) {
-      saved_ = true;
-      detail::save_binding(main_binding_);
-      pinned_main_ = true;
-    }
-    for (int p = 0; p < k; ++p) counters_[p].c = {};
+    if (options().pin) main_binding_.save_once();
+    counters_.reset();
     std::vector<std::uint32_t> iterations(g.loops.size(), 0);
     // Decision of iteration i of a loop lives in slot i % 2: a fast thread may write the
     // next iteration's decision while a slow one still reads this one's.
@@ -198,7 +186,7 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
       TGRAPH_TSAN_ACQUIRE(&token);
       const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
       if (pin) detail::pin_current_thread(thread);
-      ThreadCounters& tc = counters_[thread].c;
+      ThreadCounters& tc = counters_[thread];
       if (fresh) {
 #pragma omp for schedule(static) nowait
         for (DatumId d = 0; d < g.data.size(); ++d)
@@ -261,16 +249,13 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
       TGRAPH_TSAN_RELEASE(&token);
     }
     TGRAPH_TSAN_ACQUIRE(&token);
-    stats.threads.resize(options().threads);
-    for (int p = 0; p < k; ++p) stats.threads[static_cast<std::size_t>(p)] = counters_[p].c;
+    counters_.copy_to(stats);
     stats.loop_iterations = iterations;
     if (error) std::rethrow_exception(error);
   }
 
-  std::unique_ptr<Slot[]> counters_;
-  bool saved_ = false;
-  bool pinned_main_ = false;
-  detail::SavedBinding main_binding_;
+  detail::ThreadSlots counters_;
+  detail::MainThreadBinding main_binding_;
 };
 
 }  // namespace

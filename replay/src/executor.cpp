@@ -289,9 +289,7 @@ class SequentialExecutor final : public detail::PlannedExecutor<SequentialPlan> 
   void run(SequentialPlan&, const ExecGraph& x, Workload& w, bool fresh,
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);
+    if (fresh) detail::touch_all(g, w);
     stats.threads.assign(1, {});
     stats.loop_iterations.assign(g.loops.size(), 0);
     ThreadCounters& c = stats.threads[0];

@@ -64,16 +64,9 @@ enum class Check : std::uint8_t {
 class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
  public:
   explicit OmpTasksExecutor(const ExecOptions& o)
-      : PlannedExecutor(Policy::kOmpTasks, o), counters_(std::make_unique<Slot[]>(o.threads)) {}
-  ~OmpTasksExecutor() override {
-    if (pinned_main_) detail::restore_binding(main_binding_);
-  }
+      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
   std::unique_ptr<OmpPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
     auto plan = std::make_unique<OmpPlan>();
@@ -152,7 +145,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
         if (observe) detail::notify_begin(observers(), thread, t, it);
         workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
         if (observe) detail::notify_end(observers(), thread, t, it);
-        ++counters_[thread].c.tasks;
+        ++counters_[thread].tasks;
         const LoopId l = x.graph.tasks[t].loop;
         if (check == Check::kDecide)
           decision_ = detail::leave_loop(x, l, it, *workload_) ? 1 : 0;
@@ -223,21 +216,15 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
   void run(OmpPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    if (options().pin && !saved_) {
-      saved_ = true;
-      detail::save_binding(main_binding_);
-      pinned_main_ = true;
-    }
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    if (options().pin) main_binding_.save_once();
     plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
+    counters_.reset();
     const bool pin = options().pin;
     TGRAPH_TSAN_RELEASE(&submit_token_);
 #pragma omp parallel num_threads(static_cast<int>(options().threads))
@@ -256,8 +243,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     }
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
-    stats.threads.resize(options().threads);
-    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);
@@ -266,7 +252,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     if (error) std::rethrow_exception(error);
   }
 
-  std::unique_ptr<Slot[]> counters_;
+  detail::ThreadSlots counters_;
   OmpPlan* plan_ = nullptr;
   const ExecGraph* exec_ = nullptr;
   Workload* workload_ = nullptr;
@@ -275,9 +261,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
-  bool saved_ = false;
-  bool pinned_main_ = false;
-  detail::SavedBinding main_binding_;
+  detail::MainThreadBinding main_binding_;
   char submit_token_ = 0;  // TSan: address standing for libgomp's task creation hand-off
   char join_token_ = 0;    // TSan: address standing for taskwait and the region's end
 };

@@ -65,7 +65,6 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       parking_.wake(step_seq_);
       for (auto& t : workers_) t.join();
     }
-    if (pinned_main_) detail::restore_binding(main_binding_);
   }
 
  private:
@@ -170,8 +169,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     if (started_) return;
     started_ = true;
     if (options().pin) {
-      detail::save_binding(main_binding_);
-      pinned_main_ = detail::pin_current_thread(0);
+      main_binding_.save_once();  // restored when the executor is destroyed
+      detail::pin_current_thread(0);
     }
     for (std::uint32_t p = 1; p < options().threads; ++p)
       workers_.emplace_back([this, p] { worker(p); });
@@ -433,8 +432,7 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   detail::Parking parking_;
   std::vector<std::thread> workers_;
   bool started_ = false;
-  bool pinned_main_ = false;
-  detail::SavedBinding main_binding_;
+  detail::MainThreadBinding main_binding_;
   std::unique_ptr<Slot[]> counters_;
   std::unique_ptr<PaddedCounter[]> done_;
   std::size_t done_cap_ = 0;

@@ -157,7 +157,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   explicit StarpuExecutor(const ExecOptions& o)
       : PlannedExecutor(Policy::kStarpu, o),
         registry_(std::make_shared<Registry>()),
-        counters_(std::make_unique<Slot[]>(o.threads)) {
+        counters_(o.threads) {
     if (o.threads > STARPU_MAXCPUS)
       throw UsageError("--policy starpu: --threads " + std::to_string(o.threads) +
                        ": this StarPU build has at most " + std::to_string(STARPU_MAXCPUS) +
@@ -220,10 +220,6 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   }
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
   std::unique_ptr<StarpuPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
     auto plan = std::make_unique<StarpuPlan>();
@@ -290,7 +286,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
         const ExecGraph& x = *exec_;
-        ThreadCounters& tc = counters_[thread].c;
+        ThreadCounters& tc = counters_[thread];
         if (!observers().empty()) detail::notify_begin(observers(), thread, in.task, in.iteration);
         workload_->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
         if (!observers().empty()) detail::notify_end(observers(), thread, in.task, in.iteration);
@@ -394,16 +390,14 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   void run(StarpuPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
     plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
     instances_.clear();
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
-    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
+    counters_.reset();
     stats.loop_iterations.assign(g.loops.size(), 0);
     starpu_resume();
     try {
@@ -414,8 +408,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     starpu_task_wait_for_all();  // never leave a submitted task behind, even on error
     starpu_pause();
     TGRAPH_TSAN_ACQUIRE(&join_token_);
-    stats.threads.resize(options().threads);
-    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);
@@ -425,7 +418,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   }
 
   std::shared_ptr<Registry> registry_;
-  std::unique_ptr<Slot[]> counters_;
+  detail::ThreadSlots counters_;
   starpu_codelet codelet_{};
   StarpuPlan* plan_ = nullptr;
   const ExecGraph* exec_ = nullptr;

@@ -53,13 +53,9 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
       : PlannedExecutor(Policy::kWorksteal, o),
         control_(tbb::global_control::max_allowed_parallelism, o.threads),
         arena_(static_cast<int>(o.threads)),
-        counters_(std::make_unique<Slot[]>(o.threads)) {}
+        counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
   std::unique_ptr<WsPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
     auto plan = std::make_unique<WsPlan>();
@@ -159,7 +155,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
   void run_instance(TaskId t, std::uint32_t it) {
     const int idx = tbb::this_task_arena::current_thread_index();
     const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options().threads;
-    ThreadCounters& tc = counters_[thread].c;
+    ThreadCounters& tc = counters_[thread];
     const ExecGraph& x = *exec_;
     const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
     if (observe) detail::notify_begin(observers(), thread, t, it);
@@ -209,14 +205,12 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
   void run(WsPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
     plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options().threads; ++p) counters_[p].c = {};
+    counters_.reset();
     for (TaskId t = 0; t < plan.n; ++t)
       plan.count0[t].store(plan.init0[t], std::memory_order_relaxed);  // relaxed: before any spawn
     for (LoopState& ls : plan.loops) {
@@ -244,15 +238,14 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
         delete b;
         e.store(nullptr, std::memory_order_relaxed);  // relaxed: no task runs now
       }
-    stats.threads.resize(options().threads);
-    for (std::uint32_t p = 0; p < options().threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     stats.loop_iterations = iterations_;
     if (error) std::rethrow_exception(error);
   }
 
   tbb::global_control control_;
   tbb::task_arena arena_;
-  std::unique_ptr<Slot[]> counters_;
+  detail::ThreadSlots counters_;
   WsPlan* plan_ = nullptr;
   const ExecGraph* exec_ = nullptr;
   Workload* workload_ = nullptr;

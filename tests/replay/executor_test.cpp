@@ -37,18 +37,11 @@ const Variant kVariants[] = {
 };
 
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
-  ExecOptions o;
-  o.threads = k;
-  o.partition.serial = serial;
-  o.spin_ns = spin_ns;
-  return o;
+  return test::partition_options(k, serial, spin_ns);
 }
 
 ExecOptions options_for(const Variant& v, std::uint32_t k) {
-  ExecOptions o;
-  o.threads = k;
-  o.partition.serial = v.serial;
-  o.spin_ns = 20'000;
+  ExecOptions o = test::partition_options(k, v.serial, 20'000);
   o.barrier.rule = v.rule;
   return o;
 }
@@ -73,8 +66,9 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
         EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
       ASSERT_NE(ex->last_exec(), nullptr);
       test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
-                               static_cast<std::uint32_t>(step), true);
-      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step), false, true);
+                               static_cast<std::uint32_t>(step), {.exec = true});
+      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step),
+                               {.raw_only = true});
     }
     EXPECT_EQ(ex->plans_built(), 1u);
     const auto got = final_state(w, g), want = sequential_state(g, 2);
@@ -200,18 +194,7 @@ TEST(CwReduction, IsDeterministicAcrossRunsAndEqualsTheSerialTwin) {
   EXPECT_NEAR(expected, plain, 1e-12);
 }
 
-class Throwing : public Workload {
- public:
-  explicit Throwing(TaskId bad) : bad_(bad) {}
-  void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
-  }
-  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
-
- private:
-  TaskId bad_;
-};
+using test::Throwing;
 
 TEST(Executor, RethrowsATaskExceptionAfterJoiningAndStaysUsable) {
   const StepGraph g = test::random_graph(42);

@@ -146,10 +146,7 @@ TEST(IncrementalPlan, RunsRandomSequencesInDependencyOrder) {
   for (std::uint32_t k : {2u, 3u, 5u, 8u}) {
     for (std::uint32_t seed = 1; seed <= 8; ++seed) {
       const Sequence s = random_sequence(seed * 31 + k, k, 12);
-      ExecOptions o;
-      o.threads = k;
-      o.partition.serial = true;
-      auto ex = make_executor(Policy::kPartition, o);
+      auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
       TimelineObserver timeline;
       ex->add_observer(timeline);
       SyntheticWorkload w({.cost_scale = 0.0});
@@ -164,7 +161,7 @@ TEST(IncrementalPlan, RunsRandomSequencesInDependencyOrder) {
           ++steps;
         }
         test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
-                                 static_cast<std::uint32_t>(i), true);
+                                 static_cast<std::uint32_t>(i), {.exec = true});
         if (::testing::Test::HasFailure()) return;
       }
     }
@@ -194,10 +191,7 @@ TEST(IncrementalPlan, MovingASinkTaskRebuildsOnlyTheTwoProcessorsInvolved) {
   ASSERT_NE(t, kNoTask);
   const std::uint32_t k = 4;
   const Assignment a = test::random_assignment(g, k, 5);
-  ExecOptions o;
-  o.threads = k;
-  o.partition.serial = true;
-  auto ex = make_executor(Policy::kPartition, o);
+  auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
   EXPECT_EQ(ex->run_step(g, &a, w).rebuilt_procs, k);  // first plan: from scratch

@@ -32,6 +32,12 @@ StepGraph chain_graph(const std::vector<std::vector<Access>>& tasks, std::size_t
   return g;
 }
 
+// t0 writes d0; t1 reads d0, writes d1; t2 reads d1.
+StepGraph three_task_chain() {
+  return chain_graph(
+      {{{0, AccessMode::W}}, {{0, AccessMode::R}, {1, AccessMode::W}}, {{1, AccessMode::R}}}, 2);
+}
+
 Assignment on(std::vector<ProcId> proc, std::uint32_t k) {
   Assignment a;
   a.k = k;
@@ -64,11 +70,8 @@ bool signals(const PartitionPlan& plan, TaskId t) {
 }
 
 TEST(PartitionPlan, WaitsOnlyForProducersOnOtherProcessors) {
-  // t0 writes d0; t1 reads d0, writes d1; t2 reads d1. t0 and t2 on processor 0, t1 on 1.
-  const StepGraph g = chain_graph({{{0, AccessMode::W}},
-                                   {{0, AccessMode::R}, {1, AccessMode::W}},
-                                   {{1, AccessMode::R}}},
-                                  2);
+  // t0 and t2 on processor 0, t1 on 1.
+  const StepGraph g = three_task_chain();
   const Assignment a = on({0, 1, 0}, 2);
   const ExecGraph x = lower(g, &a, CwMode::kReduce);
   const PartitionPlan plan = detail::build_plan(x, 2, true, true);
@@ -148,10 +151,7 @@ TEST(PartitionPlan, ExplicitOrderIsFollowedAndADeadlockingOneIsRejected) {
 }
 
 TEST(PartitionPlan, SerialTwinRunsEveryTaskAndCountsItsWaits) {
-  const StepGraph g = chain_graph({{{0, AccessMode::W}},
-                                   {{0, AccessMode::R}, {1, AccessMode::W}},
-                                   {{1, AccessMode::R}}},
-                                  2);
+  const StepGraph g = three_task_chain();
   const Assignment a = on({0, 1, 0}, 2);
   const ExecGraph x = lower(g, &a, CwMode::kReduce);
   const PartitionPlan plan = detail::build_plan(x, 2, true, true);

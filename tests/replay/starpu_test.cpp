@@ -58,45 +58,6 @@ class UnknownCounts : public SyntheticWorkload {
   std::optional<std::uint32_t> known_iterations(LoopId) const override { return std::nullopt; }
 };
 
-/// Every exec task ran g.runs(t) times, after its predecessors in the exec graph (intra-step
-/// and loop-carried edges) and after its own previous iteration. Unlike the other policies,
-/// an unrolled loop has no gate: iteration i + 1 may start before the break of iteration i.
-void expect_dataflow_order(const StepGraph& g, const std::vector<TimelineEvent>& events,
-                           std::uint32_t step) {
-  std::map<std::pair<TaskId, std::uint32_t>, std::pair<std::int64_t, std::int64_t>> when;
-  std::vector<std::uint32_t> count(g.tasks.size(), 0);
-  for (const TimelineEvent& e : events) {
-    if (e.step != step) continue;
-    ASSERT_LT(e.task, g.tasks.size());
-    ++count[e.task];
-    ASSERT_TRUE(
-        when.emplace(std::make_pair(e.task, e.iteration), std::make_pair(e.start_ns, e.end_ns))
-            .second)
-        << "task " << e.task << " iteration " << e.iteration << " ran twice";
-  }
-  for (TaskId t = 0; t < g.tasks.size(); ++t)
-    ASSERT_EQ(count[t], g.runs(t)) << "task " << t << " ran " << count[t] << " times";
-  auto end_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).second; };
-  auto start_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).first; };
-  for (const Edge& e : g.edges) {
-    const LoopId lu = g.tasks[e.from].loop, lv = g.tasks[e.to].loop;
-    for (std::uint32_t i = 0; i < g.runs(e.to); ++i) {
-      const std::uint32_t iu =
-          (lu != kNoLoop && lu == lv) ? i : static_cast<std::uint32_t>(g.runs(e.from) - 1);
-      EXPECT_GE(start_of(e.to, i), end_of(e.from, iu))
-          << "edge " << e.from << " -> " << e.to << " violated at iteration " << i;
-    }
-  }
-  for (const Edge& e : g.carried_edges)
-    for (std::uint32_t i = 1; i < g.runs(e.to); ++i)
-      EXPECT_GE(start_of(e.to, i), end_of(e.from, i - 1))
-          << "carried edge " << e.from << " -> " << e.to << " violated at iteration " << i;
-  for (const Loop& l : g.loops)
-    for (TaskId v = l.first; v < l.last; ++v)
-      for (std::uint32_t i = 1; i < l.iterations; ++i)
-        EXPECT_GE(start_of(v, i), end_of(v, i - 1)) << "task " << v << " overtook itself";
-}
-
 class StarpuPolicy
     : public ::testing::TestWithParam<std::tuple<std::uint32_t, Cw, bool /*unknown*/>> {};
 
@@ -131,7 +92,10 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
       EXPECT_EQ(counted, instances);
       EXPECT_EQ(observed, instances);
       const auto step_index = static_cast<std::uint32_t>(timeline.events().back().step);
-      expect_dataflow_order(xg, timeline.events(), step_index);
+      // Unlike the other policies, an unrolled loop has no gate: iteration i + 1 may start
+      // before the break of iteration i.
+      test::expect_valid_order(xg, timeline.events(), step_index,
+                               {.exec = true, .loop_gate = false});
     }
     EXPECT_EQ(ex->plans_built(), built + 1);
     const auto got = final_state(*w, g), want = sequential_state(g, 2);
@@ -180,25 +144,12 @@ TEST(Starpu, CommutingWritersWithManyHandlesMatchSequential) {
     ex->run_step(g, nullptr, w);
     ex->run_step(g, nullptr, w);
     EXPECT_EQ(final_state(w, g), sequential_state(g, 2)) << cw_name(cw);
-    expect_dataflow_order(ex->last_exec()->graph, timeline.events(), 1);
+    test::expect_valid_order(ex->last_exec()->graph, timeline.events(), 1,
+                             {.exec = true, .loop_gate = false});
   }
 }
 
-class Throwing : public Workload {
- public:
-  explicit Throwing(TaskId bad) : bad_(bad) {}
-  void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
-  }
-  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
-  std::optional<std::uint32_t> known_iterations(LoopId) const override { return known_; }
-  void set_known(std::optional<std::uint32_t> n) { known_ = n; }
-
- private:
-  TaskId bad_;
-  std::optional<std::uint32_t> known_;
-};
+using test::Throwing;
 
 TEST(Starpu, RethrowsATaskExceptionAfterWaitingAndStaysUsable) {
   TGRAPH_NEED_STARPU();
