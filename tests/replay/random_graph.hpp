@@ -194,24 +194,6 @@ inline std::vector<std::vector<std::uint64_t>> final_state(const SyntheticWorklo
   return s;
 }
 
-/// A workload that throws in iteration 0 of task `bad` (original id) and stops every loop
-/// after iteration 1; `set_known` makes it announce its loops' iteration counts.
-class Throwing : public Workload {
- public:
-  explicit Throwing(TaskId bad) : bad_(bad) {}
-  void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
-  }
-  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
-  std::optional<std::uint32_t> known_iterations(LoopId) const override { return known_; }
-  void set_known(std::optional<std::uint32_t> n) { known_ = n; }
-
- private:
-  TaskId bad_;
-  std::optional<std::uint32_t> known_;
-};
-
 /// Final words of the original data after `steps` sequential steps of g.
 inline std::vector<std::vector<std::uint64_t>> sequential_state(const StepGraph& g, int steps) {
   auto ex = make_executor(Policy::kSequential, {});
