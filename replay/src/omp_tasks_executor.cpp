@@ -130,7 +130,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
 
   /// Body of one task instance (runs on whichever thread of the team libgomp picks).
   void run_instance(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
-    const OmpPlan& p = *plan_;
+    const OmpPlan& p = *step_.plan;
     const TaskDeps& d = p.deps[t];
     const std::uint32_t nd = d.in + d.out + d.inout + d.mutex;
     // TSan: libgomp's dependence release is not instrumented; each object stands for it.
@@ -140,17 +140,17 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     // relaxed: only skips work after a failure; the error itself is passed under a mutex.
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
-        const ExecGraph& x = *exec_;
+        const ExecGraph& x = *step_.exec;
         const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
         if (observe) detail::notify_begin(observers(), thread, t, it);
-        workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
+        step_.workload->run(TaskRun{&x, t, x.origin[t], it, thread});
         if (observe) detail::notify_end(observers(), thread, t, it);
         ++counters_[thread].tasks;
         const LoopId l = x.graph.tasks[t].loop;
         if (check == Check::kDecide)
-          decision_ = detail::leave_loop(x, l, it, *workload_) ? 1 : 0;
+          decision_ = detail::leave_loop(x, l, it, *step_.workload) ? 1 : 0;
         else if (check == Check::kUnrolled)
-          detail::check_unrolled(x, l, it, count, *workload_);
+          detail::check_unrolled(x, l, it, count, *step_.workload);
       } catch (...) {
         fail(std::current_exception());
       }
@@ -161,7 +161,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
 
   /// Creates the OpenMP task of instance (t, it), its dependences from the plan.
   void submit(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
-    const OmpPlan& p = *plan_;
+    const OmpPlan& p = *step_.plan;
     const TaskDeps& d = p.deps[t];
     char* obj = p.object.get();
     const std::uint32_t* in = p.ids.data() + d.first;
@@ -218,9 +218,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     const StepGraph& g = x.graph;
     if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
     if (options().pin) main_binding_.save_once();
-    plan_ = &plan;
-    exec_ = &x;
-    workload_ = &w;
+    step_ = {&plan, &x, &w};
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
     iterations_.assign(g.loops.size(), 0);
@@ -253,9 +251,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
   }
 
   detail::ThreadSlots counters_;
-  OmpPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::StepContext<OmpPlan> step_;
   std::vector<std::uint32_t> iterations_;
   int decision_ = -1;  // the live loop's break: 1 leave, 0 continue (read after taskwait)
   std::atomic<bool> failed_{false};

@@ -12,6 +12,14 @@
 
 namespace tgraph::replay::detail {
 
+/// What the tasks of the running step read (set by the executor before any task starts).
+template <class Plan>
+struct StepContext {
+  Plan* plan = nullptr;
+  const ExecGraph* exec = nullptr;
+  Workload* workload = nullptr;
+};
+
 /// A plan in Executor's cache; its dynamic type is PlannedExecutor<P>::Held.
 class ExecPlan {
  public:

@@ -275,7 +275,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   void run_instance(Instance& in) {
     const int id = starpu_worker_get_id();
     const auto thread = static_cast<std::uint32_t>(id < 0 ? 0 : id) % options().threads;
-    const StarpuPlan& p = *plan_;
+    const StarpuPlan& p = *step_.plan;
     if constexpr (kTsan) {
       // StarPU's queues and dependency release are not instrumented: make the hand-off from
       // the previous accessors of each handle visible to TSan (the submitter's: see body).
@@ -285,19 +285,19 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     // relaxed: only skips work after a failure; the error itself is passed under a mutex.
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
-        const ExecGraph& x = *exec_;
+        const ExecGraph& x = *step_.exec;
         ThreadCounters& tc = counters_[thread];
         if (!observers().empty()) detail::notify_begin(observers(), thread, in.task, in.iteration);
-        workload_->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
+        step_.workload->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
         if (!observers().empty()) detail::notify_end(observers(), thread, in.task, in.iteration);
         ++tc.tasks;
         const LoopId l = x.graph.tasks[in.task].loop;
         if (in.check == Check::kDecide) {
-          in.decision = detail::leave_loop(x, l, in.iteration, *workload_) ? 1 : 0;
+          in.decision = detail::leave_loop(x, l, in.iteration, *step_.workload) ? 1 : 0;
         } else if (in.check != Check::kNone) {
           // The count is only compared with: any count past the next iteration continues.
           const std::uint32_t count = in.iteration + (in.check == Check::kStop ? 1 : 2);
-          in.decision = detail::check_unrolled(x, l, in.iteration, count, *workload_) ? 1 : 0;
+          in.decision = detail::check_unrolled(x, l, in.iteration, count, *step_.workload) ? 1 : 0;
         }
       } catch (...) {
         fail(std::current_exception());
@@ -319,7 +319,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
 
   /// Submits instance (t, it); returns the task when `wait` (not detached), else nullptr.
   starpu_task* submit(TaskId t, std::uint32_t it, Check check, bool wait) {
-    const StarpuPlan& p = *plan_;
+    const StarpuPlan& p = *step_.plan;
     instances_.push_back(Instance{this, t, it, check, -1});
     starpu_task* task = starpu_task_create();
     if (task == nullptr) throw std::bad_alloc();
@@ -391,9 +391,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
-    plan_ = &plan;
-    exec_ = &x;
-    workload_ = &w;
+    step_ = {&plan, &x, &w};
     instances_.clear();
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
@@ -420,9 +418,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
   std::shared_ptr<Registry> registry_;
   detail::ThreadSlots counters_;
   starpu_codelet codelet_{};
-  StarpuPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::StepContext<StarpuPlan> step_;
   std::deque<Instance> instances_;  // this step's instances (stable addresses)
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;

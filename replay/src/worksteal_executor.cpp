@@ -114,7 +114,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
     // relaxed: the block is published afterwards by a release store of its table entry (or
     // before any spawn, which TBB orders), so these initial values are seen by all users.
     for (std::size_t j = 0; j < size; ++j)
-      b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j],
+      b->count[j].store(first ? step_.plan->init0[ls.first + j] : ls.init_next[j],
                         std::memory_order_relaxed);
     b->remaining.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
     return b;
@@ -141,11 +141,11 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
 
   // A dependency of task s on an instance outside its loop (or s outside loops) is met.
   void release_first(TaskId s, ThreadCounters& tc) {
-    const LoopId ls = exec_->graph.tasks[s].loop;
+    const LoopId ls = step_.exec->graph.tasks[s].loop;
     if (ls == kNoLoop) {
-      dec(plan_->count0[s], s, 0, tc);
+      dec(step_.plan->count0[s], s, 0, tc);
     } else {
-      LoopState& st = plan_->loops[ls];
+      LoopState& st = step_.plan->loops[ls];
       // acquire: the block was published with release before any instance could see it.
       Block* b = st.table[0].load(std::memory_order_acquire);
       dec(b->count[s - st.first], s, 0, tc);
@@ -156,19 +156,19 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
     const int idx = tbb::this_task_arena::current_thread_index();
     const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options().threads;
     ThreadCounters& tc = counters_[thread];
-    const ExecGraph& x = *exec_;
+    const ExecGraph& x = *step_.exec;
     const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
     if (observe) detail::notify_begin(observers(), thread, t, it);
-    workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
+    step_.workload->run(TaskRun{&x, t, x.origin[t], it, thread});
     if (observe) detail::notify_end(observers(), thread, t, it);
     ++tc.tasks;
     const LoopId l = x.graph.tasks[t].loop;
-    const WsPlan& p = *plan_;
+    const WsPlan& p = *step_.plan;
     if (l == kNoLoop) {
       for (auto i = p.succ.begin[t]; i < p.succ.begin[t + 1]; ++i) release_first(p.succ.ids[i], tc);
       return;
     }
-    LoopState& ls = plan_->loops[l];
+    LoopState& ls = step_.plan->loops[l];
     // acquire: blocks are published with release before the instances that use them run.
     Block* cur = ls.table[it].load(std::memory_order_acquire);
     Block* next = ls.table[it + 1].load(std::memory_order_acquire);
@@ -182,7 +182,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
     }
     dec(next->count[t - ls.first], t, it + 1, tc);
     if (t + 1 == ls.last) {
-      const bool stop = detail::leave_loop(x, l, it, *workload_);
+      const bool stop = detail::leave_loop(x, l, it, *step_.workload);
       // relaxed: published by the release of the remaining-count decrement below.
       cur->decision.store(stop ? 1 : 0, std::memory_order_relaxed);
       if (stop) {
@@ -206,9 +206,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
-    plan_ = &plan;
-    exec_ = &x;
-    workload_ = &w;
+    step_ = {&plan, &x, &w};
     iterations_.assign(g.loops.size(), 0);
     counters_.reset();
     for (TaskId t = 0; t < plan.n; ++t)
@@ -246,9 +244,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
   tbb::global_control control_;
   tbb::task_arena arena_;
   detail::ThreadSlots counters_;
-  WsPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::StepContext<WsPlan> step_;
   tbb::task_group* tg_ = nullptr;
   std::vector<std::uint32_t> iterations_;
   char spawn_token_ = 0;  // TSan: address standing for TBB's spawn hand-off
