@@ -1,15 +1,179 @@
 // SPDX-License-Identifier: MIT
-// `tgraph-mpi partition` (being built: refuses to run until then).
-#include <stdexcept>
+// `tgraph-mpi partition T.tgt --method ptscotch --nodes N --cores C [--step S] -o A.tga
+// [--json]`: every rank reads the trace; each step is partitioned by all ranks together
+// (tgraph::mpi::ptscotch_partition), and rank 0 writes the .tga and the report.
+#include <mpi.h>
+#include <sys/resource.h>
 
+#include <algorithm>
+#include <exception>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/strategy.hpp"
 #include "verbs.hpp"
+#if defined(TGRAPH_HAVE_PTSCOTCH)
+#include "tgraph/mpi/ptscotch.hpp"
+#endif
 
 namespace tgraph::mpi_app {
 
+namespace {
+
+struct PartitionArgs {
+  std::string trace, method = "ptscotch", output, scotch = "quality";
+  std::uint32_t nodes = 0, cores = 1;
+  std::optional<std::size_t> step;
+  partition::Options options;
+  bool json = false;
+};
+
+#if defined(TGRAPH_HAVE_PTSCOTCH)
+/// Reads and checks the input on every rank. When that fails somewhere, the lowest failing
+/// rank rethrows (main prints its one line and aborts the job) and the others wait for the
+/// abort: bad input gives one line, not one per rank.
+Trace read_input(const PartitionArgs& a, int rank, int ranks) {
+  Trace trace;
+  std::exception_ptr error;
+  try {
+    if (a.nodes == 0) throw UsageError("--nodes: expected at least 1");
+    if (a.cores == 0) throw UsageError("--cores: expected at least 1");
+    trace = read_trace(a.trace);
+    if (a.step && *a.step >= trace.steps.size())
+      throw UsageError("--step: " + std::to_string(*a.step) + " is past the trace's " +
+                       std::to_string(trace.steps.size()) + " steps");
+  } catch (...) {
+    error = std::current_exception();
+  }
+  int failing = error ? rank : ranks;
+  MPI_Allreduce(MPI_IN_PLACE, &failing, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  if (failing == rank) std::rethrow_exception(error);
+  if (failing < ranks)  // never sent: MPI_Abort from rank `failing` ends this wait
+    MPI_Recv(nullptr, 0, MPI_BYTE, failing, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  return trace;
+}
+
+/// The largest peak resident set of any rank, in MiB (a collective call).
+double max_rss_mib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  double mib = static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
+  MPI_Allreduce(MPI_IN_PLACE, &mib, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  return mib;
+}
+
+nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
+  return {{"step", step},
+          {"tasks", r.vertices},
+          {"edges", r.edges},
+          {"cut", r.cut},
+          {"node_cut", r.node_cut},
+          {"imbalance", r.imbalance},
+          {"node_imbalance", r.node_imbalance},
+          {"build_ms", r.build_ms},
+          {"nodes_ms", r.nodes_ms},
+          {"cores_ms", r.cores_ms},
+          {"partition_ms", r.total_ms}};
+}
+
+void run(const PartitionArgs& a) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &ranks);
+  const double t0 = MPI_Wtime();
+  const Trace trace = read_input(a, rank, ranks);
+  double read_ms = (MPI_Wtime() - t0) * 1e3;
+  MPI_Allreduce(MPI_IN_PLACE, &read_ms, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+  partition::Options options = a.options;
+  options.scotch = partition::parse_scotch_flavour(a.scotch);
+
+  TraceAssignment out;
+  out.method = a.method;
+  out.k = a.nodes * a.cores;
+  std::vector<std::uint64_t> hashes;
+  nlohmann::json per_step = nlohmann::json::array();
+  std::int64_t cut = 0, node_cut = 0;
+  double imbalance = 1.0, partition_ms = 0.0;
+  const std::size_t first = a.step.value_or(0);
+  const std::size_t last = a.step ? *a.step + 1 : trace.steps.size();
+  for (std::size_t s = first; s < last; ++s) {
+    const StepGraph& g = trace.steps[s];
+    mpi::PtScotchResult r = mpi::ptscotch_partition(g, a.nodes, a.cores, options, MPI_COMM_WORLD);
+    cut += r.cut;
+    node_cut += r.node_cut;
+    imbalance = std::max(imbalance, r.imbalance);
+    partition_ms += r.total_ms;
+    per_step.push_back(step_json(s, r));
+    out.partition_ms.push_back(r.total_ms);
+    out.steps.push_back(std::move(r.assignment));
+    hashes.push_back(g.structural_hash());
+  }
+  const double rss_mib = max_rss_mib();
+  if (rank != 0) return;
+  if (!a.output.empty()) partition::write_assignment(a.output, out, hashes);
+  if (!a.json) {
+    std::cout << "ptscotch on " << ranks << " rank(s): " << out.steps.size() << " step(s) over "
+              << a.nodes << " nodes x " << a.cores << " cores (k = " << out.k << "): cut " << cut
+              << " (between nodes " << node_cut << "), imbalance " << imbalance << ", "
+              << partition_ms << " ms partitioning\n";
+    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
+    return;
+  }
+  std::cout << nlohmann::json{{"method", a.method},
+                              {"trace", a.trace},
+                              {"output", a.output},
+                              {"ranks", ranks},
+                              {"nodes", a.nodes},
+                              {"cores", a.cores},
+                              {"k", out.k},
+                              {"steps", out.steps.size()},
+                              {"cut", cut},
+                              {"node_cut", node_cut},
+                              {"imbalance", imbalance},
+                              {"read_ms", read_ms},
+                              {"partition_ms", partition_ms},
+                              {"max_rss_mib", rss_mib},
+                              {"per_step", per_step}}
+                   .dump()
+            << std::endl;
+}
+#else
+void run(const PartitionArgs&) {
+  throw UsageError(
+      "--method ptscotch: this tgraph-mpi was built without PT-Scotch "
+      "(Debian libptscotch-dev)");
+}
+#endif
+
+}  // namespace
+
 void add_partition_verb(CLI::App& app) {
-  auto* cmd = app.add_subcommand("partition", "(not built yet)");
-  cmd->allow_extras();
-  cmd->callback([] { throw std::runtime_error("partition: not built yet"); });
+  auto a = std::make_shared<PartitionArgs>();
+  auto* cmd = app.add_subcommand(
+      "partition",
+      "Partition a trace's steps across the ranks: nodes with PT-Scotch, then cores with Scotch");
+  cmd->add_option("trace", a->trace, "Trace file (.tgt), read by every rank")->required();
+  cmd->add_option("--method,-m", a->method, "Strategy: ptscotch")
+      ->check(CLI::IsMember({"ptscotch"}));
+  cmd->add_option("--nodes", a->nodes, "Nodes: parts of the distributed partitioning")->required();
+  cmd->add_option("--cores", a->cores, "Cores per node: parts of each node (1)");
+  cmd->add_option("--step", a->step,
+                  "Partition only this step (the .tga then holds one step); default every step");
+  cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga), by rank 0");
+  cmd->add_option("--imbalance", a->options.imbalance,
+                  "Max/mean processor load allowed (1.03; its square root per level)")
+      ->check(CLI::Range(1.0, 100.0));
+  cmd->add_option("--seed", a->options.seed, "Scotch / PT-Scotch seed (0)");
+  cmd->add_option("--scotch-strategy", a->scotch, "Flavour: default, quality, speed, balance")
+      ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
+  cmd->add_flag("--json", a->json, "Print one JSON object (rank 0)");
+  cmd->callback([a] { run(*a); });
 }
 
 }  // namespace tgraph::mpi_app

@@ -1,15 +1,127 @@
 // SPDX-License-Identifier: MIT
-// `tgraph-mpi replay` (being built: refuses to run until then).
-#include <stdexcept>
+// `tgraph-mpi replay T.tgt [A.tga] --threads-per-rank T [--steps N] [--check] [--json]
+// [--watchdog SECONDS]`: the trace's steps across the MPI ranks (tgraph::mpi); and
+// `tgraph-mpi calibrate [-o F]`, registered here beside it (main.cpp registers the verb
+// files it knows): MPI latency and bandwidth between two local ranks into the calibration
+// file.
+#include <mpi.h>
 
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/mpi/calibrate.hpp"
+#include "tgraph/mpi/replay.hpp"
+#include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/cost_model.hpp"
 #include "verbs.hpp"
 
 namespace tgraph::mpi_app {
+namespace {
+
+struct ReplayArgs {
+  std::string trace, assignment;
+  std::uint32_t threads_per_rank = 1;
+  std::optional<std::uint32_t> steps, drop;
+  bool check = false, json = false;
+  double watchdog = 60;
+};
+
+void replay(const ReplayArgs& a) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (a.threads_per_rank < 1 || a.threads_per_rank > 256)
+    throw UsageError("--threads-per-rank " + std::to_string(a.threads_per_rank) +
+                     ": expected 1 to 256");
+  if (a.steps && *a.steps < 1) throw UsageError("--steps must be at least 1");
+  if (!(a.watchdog >= 0) || a.watchdog > 1e6)
+    throw UsageError("--watchdog: expected 0 (off) to 1e6 seconds");
+  const Trace trace = read_trace(a.trace);
+  const std::uint32_t k = static_cast<std::uint32_t>(size) * a.threads_per_rank;
+  // No file: the strategy `tgraph replay` uses by default (owner with objects, else list).
+  const TraceAssignment as = partition::load_or_partition(trace, a.trace, a.assignment, "", k);
+  mpi::MpiReplayOptions o;
+  o.threads_per_rank = a.threads_per_rank;
+  o.steps = a.steps;
+  o.check = a.check;
+  o.watchdog_s = a.watchdog;
+  o.test_drop_message = a.drop;
+  const mpi::MpiReplayResult r = mpi::replay_distributed(trace, as, o);
+  if (rank == 0)
+    std::cout << (a.json ? mpi::to_json(r, a.trace) + "\n" : mpi::to_text(r, a.trace))
+              << std::flush;
+  if (r.identical && !*r.identical && rank == 0)
+    std::cerr << "tgraph-mpi: the distributed state differs from the sequential replay\n";
+  int differs = r.identical && !*r.identical ? 1 : 0;
+  MPI_Bcast(&differs, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (differs) throw std::runtime_error("check failed");
+}
+
+void calibrate(const std::string& path_flag, bool json) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  const std::string path = path_flag.empty() ? partition::default_calibration_path() : path_flag;
+  // Every rank checks the file first: a bad one ends the job before any measurement.
+  std::string text;
+  try {
+    text = read_file_text(path);
+  } catch (const Error&) {
+    throw InputError(path, std::nullopt,
+                     "no calibration file to add the MPI fields to (run `tgraph calibrate -o " +
+                         path + "` first)");
+  }
+  mpi::with_mpi_link(text, path, {});
+  const mpi::MpiLink link = mpi::measure_mpi_link();
+  if (rank != 0) return;
+  write_file_atomic(path, mpi::with_mpi_link(text, path, link));
+  if (json) {
+    std::cout << "{\"mpi_latency_ns\":" << link.latency_ns
+              << ",\"mpi_per_byte_ns\":" << link.per_byte_ns << ",\"output\":\"" << path << "\"}\n";
+  } else {
+    std::cout << "MPI between two local ranks: latency " << link.latency_ns << " ns, "
+              << link.per_byte_ns << " ns/byte ("
+              << (link.per_byte_ns > 0 ? 1.0 / link.per_byte_ns : 0) << " GB/s) -> " << path
+              << "\n";
+  }
+}
+
+}  // namespace
 
 void add_replay_verb(CLI::App& app) {
-  auto* cmd = app.add_subcommand("replay", "(not built yet)");
-  cmd->allow_extras();
-  cmd->callback([] { throw std::runtime_error("replay: not built yet"); });
+  auto a = std::make_shared<ReplayArgs>();
+  auto* cmd =
+      app.add_subcommand("replay", "Replay a trace across the MPI ranks (synthetic bodies)");
+  cmd->add_option("trace", a->trace, "Trace file (.tgt)")->required();
+  cmd->add_option("assignment", a->assignment,
+                  "Assignment file (.tga) with K = ranks x threads per rank (default: the "
+                  "strategy tgraph replay uses)");
+  cmd->add_option("--threads-per-rank", a->threads_per_rank, "Threads (processors) per rank")
+      ->required();
+  cmd->add_option("--steps", a->steps, "Replay the first N steps");
+  cmd->add_flag("--check", a->check, "Compare the final state with the sequential replay");
+  cmd->add_flag("--json", a->json, "Print one JSON object");
+  cmd->add_option("--watchdog", a->watchdog,
+                  "Seconds without progress before a rank names what it waits for and the job "
+                  "ends with exit 1 (0: off; default 60)");
+  cmd->add_option("--test-drop-message", a->drop, "Testing: never send this message of step 0")
+      ->group("");
+  cmd->callback([a] { replay(*a); });
+
+  auto out = std::make_shared<std::string>();
+  auto json = std::make_shared<bool>(false);
+  auto* cal = app.add_subcommand(
+      "calibrate",
+      "Add the MPI latency and bandwidth between two local ranks to the calibration "
+      "file (mpirun -np 2)");
+  cal->add_option("-o,--output", *out,
+                  "Calibration file written by `tgraph calibrate` (default: its default path)");
+  cal->add_flag("--json", *json, "Print one JSON object");
+  cal->callback([out, json] { calibrate(*out, *json); });
 }
 
 }  // namespace tgraph::mpi_app

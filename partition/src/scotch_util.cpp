@@ -32,20 +32,6 @@ void init_scotch_environment() {
   std::call_once(once, [] { setenv("SCOTCH_PTHREAD_NUMBER", "1", 0); });
 }
 
-SCOTCH_Num flavour_flags(ScotchFlavour f) {
-  switch (f) {
-    case ScotchFlavour::kDefault:
-      return SCOTCH_STRATDEFAULT;
-    case ScotchFlavour::kQuality:
-      return SCOTCH_STRATQUALITY;
-    case ScotchFlavour::kSpeed:
-      return SCOTCH_STRATSPEED;
-    case ScotchFlavour::kBalance:
-      return SCOTCH_STRATBALANCE;
-  }
-  return SCOTCH_STRATDEFAULT;
-}
-
 // Owns a built Scotch graph and strategy (the graph keeps pointers into the arrays).
 class ScotchCall {
  public:
@@ -121,7 +107,7 @@ void scotch_part(const UndirectedGraph& pg, const LibraryWeights& w, std::uint32
     std::lock_guard<std::mutex> lock(scotch_mutex());
     ScotchCall call(pg, w);
     call.build_graph();
-    call.build_strategy(flavour_flags(options.scotch), k, options.imbalance - 1.0);
+    call.build_strategy(scotch_strategy_flags(options.scotch), k, options.imbalance - 1.0);
     SCOTCH_randomSeed(static_cast<SCOTCH_Num>(options.seed % 0x7fffffff));
     SCOTCH_randomReset();
     if (SCOTCH_graphPart(&call.graph_, static_cast<SCOTCH_Num>(k), &call.strat_, out.data()) != 0)
@@ -143,7 +129,8 @@ void scotch_repart(const UndirectedGraph& pg, const LibraryWeights& w, std::uint
     std::lock_guard<std::mutex> lock(scotch_mutex());
     ScotchCall call(pg, w);
     call.build_graph();
-    call.build_strategy(flavour_flags(options.scotch) | SCOTCH_STRATREMAP, k, options.imbalance - 1.0);
+    call.build_strategy(scotch_strategy_flags(options.scotch) | SCOTCH_STRATREMAP, k,
+                        options.imbalance - 1.0);
     SCOTCH_randomSeed(static_cast<SCOTCH_Num>(options.seed % 0x7fffffff));
     SCOTCH_randomReset();
     if (SCOTCH_graphRepart(&call.graph_, static_cast<SCOTCH_Num>(k), parotab.data(), emraval,
@@ -154,3 +141,34 @@ void scotch_repart(const UndirectedGraph& pg, const LibraryWeights& w, std::uint
 }
 
 }  // namespace tgraph::partition::detail
+
+namespace tgraph::partition {
+
+std::int32_t scotch_strategy_flags(ScotchFlavour f) {
+  switch (f) {
+    case ScotchFlavour::kDefault:
+      return SCOTCH_STRATDEFAULT;
+    case ScotchFlavour::kQuality:
+      return SCOTCH_STRATQUALITY;
+    case ScotchFlavour::kSpeed:
+      return SCOTCH_STRATSPEED;
+    case ScotchFlavour::kBalance:
+      return SCOTCH_STRATBALANCE;
+  }
+  return SCOTCH_STRATDEFAULT;
+}
+
+std::vector<std::uint32_t> scotch_partition(const UndirectedGraph& pg, const LibraryWeights& w,
+                                            std::uint32_t k, const Options& options) {
+  const std::uint32_t n = pg.vertices();
+  std::vector<std::uint32_t> part(n, 0);
+  if (k <= 1) return part;
+  if (k >= n) {
+    for (std::uint32_t v = 0; v < n; ++v) part[v] = v;
+    return part;
+  }
+  detail::scotch_part(pg, w, k, options, part);
+  return part;
+}
+
+}  // namespace tgraph::partition

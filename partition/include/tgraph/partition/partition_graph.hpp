@@ -11,6 +11,9 @@
 
 namespace tgraph::partition {
 
+struct Options;
+enum class ScotchFlavour : std::uint8_t;
+
 /// Totals above which make_undirected scales weights down; the same bound as
 /// `tgraph export`, so that the METIS objective matches gpmetis on the exported file.
 inline constexpr std::int64_t kMaxLibraryWeight = std::int64_t{1} << 30;
@@ -38,6 +41,17 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g);
 /// the phase of every task and sets `used` to the number of non-empty phases.
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
                                        std::uint32_t& used);
+
+/// Scotch graph partitioning of `pg` (weights `w`, vertex constraints summed) into `k` parts
+/// with `options`' flavour, imbalance and seed: what the `scotch` strategy calls, serialised.
+/// K = 1 puts every vertex on part 0 and K >= n vertex i on part i, without calling Scotch.
+/// Returns the part of every vertex.
+std::vector<std::uint32_t> scotch_partition(const UndirectedGraph& pg, const LibraryWeights& w,
+                                            std::uint32_t k, const Options& options);
+
+/// The SCOTCH_STRAT* flags of a flavour (SCOTCH_Num), for Scotch's and PT-Scotch's
+/// strategy builders alike.
+std::int32_t scotch_strategy_flags(ScotchFlavour f);
 
 /// Edge cut of `part` in the graph's (scaled) weight units: what METIS's objval counts.
 std::int64_t edgecut(const UndirectedGraph& u, const std::vector<std::uint32_t>& part);

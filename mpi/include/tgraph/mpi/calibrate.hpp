@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+// `tgraph-mpi calibrate`: MPI latency and bandwidth between two local ranks, added to the
+// calibration file that `tgraph calibrate` writes (its optional inter-node fields).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace tgraph::mpi {
+
+/// What a ping-pong between ranks 0 and 1 measured.
+struct MpiLink {
+  double latency_ns = 0;            ///< one-way time of a small message (median over batches)
+  double per_byte_ns = 0;           ///< extra one-way time per byte of a large message (median)
+  int rounds = 0;                   ///< small round trips measured
+  std::uint64_t message_bytes = 0;  ///< size of the large message
+};
+
+/// Ping-pong between ranks 0 and 1 of MPI_COMM_WORLD (other ranks wait); every rank calls
+/// it, the result is rank 0's. Throws UsageError with fewer than 2 ranks.
+MpiLink measure_mpi_link(int rounds = 4000, std::uint64_t message_bytes = 1 << 20,
+                         int repeats = 15);
+
+/// The calibration file `text` (named `name` in errors; what `tgraph calibrate` wrote) with
+/// "mpi_latency_ns" and "mpi_per_byte_ns" set from `link` (and "mpi_calibration" saying how),
+/// every other key kept. Throws InputError naming `name` when `text` is not a calibration.
+std::string with_mpi_link(std::string_view text, const std::string& name, const MpiLink& link);
+
+}  // namespace tgraph::mpi

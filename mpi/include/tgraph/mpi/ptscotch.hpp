@@ -1,0 +1,49 @@
+// SPDX-License-Identifier: MIT
+// `tgraph-mpi partition --method ptscotch`: a step's undirected task graph partitioned across
+// MPI ranks, nodes first with PT-Scotch (SCOTCH_dgraphPart on a graph built from per-rank
+// slices), then each node's tasks over its cores with sequential Scotch. PT-Scotch 7.0.3
+// cannot map onto a two-level nodes x cores target ("kdgraphMapRbMap: not implemented yet").
+// Built when CMake finds PT-Scotch (TGRAPH_HAVE_PTSCOTCH defined).
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/step_graph.hpp"
+#include "tgraph/partition/strategy.hpp"
+
+namespace tgraph::mpi {
+
+/// What ptscotch_partition produced and what it cost.
+struct PtScotchResult {
+  /// proc[task] = node * cores + core, in [0, nodes * cores); the same on every rank.
+  Assignment assignment;
+  std::uint32_t nodes = 1;
+  std::uint32_t cores = 1;
+  std::uint64_t vertices = 0;  ///< tasks of the step
+  std::uint64_t edges = 0;     ///< undirected edges of the partitioned graph
+  /// Weight of the edges whose ends are on different processors (library units: the
+  /// weights the `scotch` strategy gives Scotch, so comparable with its edgecut).
+  std::int64_t cut = 0;
+  std::int64_t node_cut = 0;    ///< weight of the edges between different nodes
+  double imbalance = 1.0;       ///< max / mean processor load (library vertex weights)
+  double node_imbalance = 1.0;  ///< max / mean node load
+  double build_ms = 0.0;        ///< building the slices and the distributed graph (max over ranks)
+  double nodes_ms = 0.0;        ///< SCOTCH_dgraphPart into nodes (max over ranks)
+  double cores_ms = 0.0;        ///< gathering each node's subgraph and Scotch within it (max)
+  double total_ms = 0.0;        ///< all of it, including the cut and load reductions (max)
+};
+
+/// Partitions step `g` (edges derived, the same on every rank of `comm`) over `nodes` x
+/// `cores` processors; a collective call. Rank r builds only its slice (tasks [n r / R,
+/// n (r + 1) / R)) of the undirected graph, weighted as partition::library_graph weights it;
+/// node i's subgraph is partitioned by rank i mod R. Uses `options`' seed, Scotch flavour and
+/// imbalance (its square root at each of the two levels, so that the product stays within).
+/// Throws UsageError for 0 nodes or cores, std::runtime_error when PT-Scotch fails.
+PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::uint32_t cores,
+                                  const partition::Options& options, MPI_Comm comm);
+
+}  // namespace tgraph::mpi

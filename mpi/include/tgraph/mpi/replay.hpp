@@ -1,0 +1,100 @@
+// SPDX-License-Identifier: MIT
+// A trace's steps replayed across MPI ranks (`tgraph-mpi replay`): each rank runs its
+// processors' tasks on threads with replay's synthetic bodies, datum versions travel as MPI
+// messages on persistent channels, loop decisions go to the ranks that run the loop.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/mpi/schedule.hpp"
+#include "tgraph/replay/synthetic.hpp"
+
+namespace tgraph::mpi {
+
+/// Replay's synthetic bodies with the data pass made independent of the process's own
+/// calibration (SyntheticWorkload sizes a short task's pass from it, and every rank is its
+/// own process): every task passes over all of its data, then spins for what is left of its
+/// recorded cost. The distributed run and the sequential reference both use it.
+class RankWorkload : public replay::Workload {
+ public:
+  explicit RankWorkload(replay::SyntheticOptions options = {}) : inner_(options) {}
+  /// The step the next run replays (kept by pointer).
+  void set_step(const StepGraph& step);
+  void bind(const replay::ExecGraph& exec) override { inner_.bind(exec); }
+  bool needs_touch(DatumId d) const override { return inner_.needs_touch(d); }
+  void first_touch(DatumId d) override { inner_.first_touch(d); }
+  void run(const replay::TaskRun& r) override;
+  bool stop_after(LoopId loop, std::uint32_t iteration) override {
+    return inner_.stop_after(loop, iteration);
+  }
+  std::optional<std::uint32_t> known_iterations(LoopId loop) const override {
+    return inner_.known_iterations(loop);
+  }
+  /// Words of exec datum d (empty before first touch).
+  std::span<const std::uint64_t> words(DatumId d) const { return inner_.words(d); }
+  /// The same words, to receive a version into (the buffer belongs to this workload).
+  std::span<std::uint64_t> mutable_words(DatumId d);
+
+ private:
+  replay::SyntheticWorkload inner_;
+  const StepGraph* step_ = nullptr;
+  StepGraph uncosted_;  // the step with zero costs: the inner workload's full data pass
+  double scale_ = 1.0;
+};
+
+/// A checksum of data [0, n) of `w`: the sum of one hash per datum (order-free, so ranks can
+/// add their parts).
+std::uint64_t datum_hash(DatumId d, std::span<const std::uint64_t> words);
+
+/// Options of a distributed replay.
+struct MpiReplayOptions {
+  std::uint32_t threads_per_rank = 1;
+  std::optional<std::uint32_t> steps;  ///< first N steps (default all)
+  bool check = false;                  ///< also run the sequential replay on rank 0, compare
+  double watchdog_s = 60;              ///< no progress this long: name the wait, MPI_Abort(1)
+  /// Testing only: this message (index in the first step's schedule) is never sent, so its
+  /// receiver waits until the watchdog fires.
+  std::optional<std::uint32_t> test_drop_message;
+};
+
+/// What one step cost (on rank 0: every rank's figures added up).
+struct MpiStepResult {
+  std::int64_t wall_ns = 0;
+  Traffic measured, predicted;
+  std::int64_t local_wait_ns = 0;     ///< threads blocked on tasks of their own rank
+  std::int64_t message_wait_ns = 0;   ///< threads blocked on datum versions from other ranks
+  std::int64_t decision_wait_ns = 0;  ///< threads blocked on loop decisions from other ranks
+  std::uint64_t received = 0;         ///< datum versions received
+  std::uint64_t hidden = 0;           ///< of them, arrived before a thread needed them
+  std::uint64_t decisions_received = 0;
+  std::int64_t decision_latency_ns = 0;  ///< sum over received decisions: made -> known here
+  std::uint64_t migrated_bytes = 0;      ///< entering bytes when the step was repartitioned
+  bool repartitioned = false;            ///< a task of the previous step (same stable key) moved
+  std::int64_t sequential_ns = 0;        ///< rank 0's sequential replay of the step (with check)
+};
+
+/// The whole run (meaningful on rank 0).
+struct MpiReplayResult {
+  std::uint32_t ranks = 1, threads_per_rank = 1;
+  std::vector<MpiStepResult> steps;
+  std::optional<bool> identical;  ///< with check
+  std::uint64_t checksum = 0, sequential_checksum = 0;
+  std::int64_t wall_ns = 0, sequential_ns = 0;
+};
+
+/// Replays `trace` under `assignment` (K = ranks x threads_per_rank) on MPI_COMM_WORLD.
+/// Every rank calls it with the same arguments.
+MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& assignment,
+                                   const MpiReplayOptions& options);
+
+/// The result as one JSON object (keys in docs/distributed.md).
+std::string to_json(const MpiReplayResult& r, const std::string& trace_name);
+/// The result as text.
+std::string to_text(const MpiReplayResult& r, const std::string& trace_name);
+
+}  // namespace tgraph::mpi

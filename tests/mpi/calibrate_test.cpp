@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+// The calibration file's MPI fields (pure), and `tgraph-mpi calibrate` under mpirun -np 2.
+#include "tgraph/mpi/calibrate.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::mpi {
+namespace {
+
+const char* kCalibration = R"({"sync_latency_ns": 85.5, "per_byte_ns": 0.04, "cpus": [0, 1]})";
+
+TEST(MpiLinkFile, AddsTheMpiFieldsAndKeepsTheOthers) {
+  MpiLink link;
+  link.latency_ns = 310;
+  link.per_byte_ns = 0.09;
+  const std::string out = with_mpi_link(kCalibration, "cal.json", link);
+  const partition::CostModel m = partition::parse_calibration(out, "cal.json");
+  EXPECT_DOUBLE_EQ(m.sync_latency_ns, 85.5);
+  EXPECT_DOUBLE_EQ(m.per_byte_ns, 0.04);
+  EXPECT_DOUBLE_EQ(m.mpi_latency_ns, 310);
+  EXPECT_DOUBLE_EQ(m.mpi_per_byte_ns, 0.09);
+  EXPECT_NE(out.find("\"cpus\""), std::string::npos);
+}
+
+TEST(MpiLinkFile, RejectsAFileThatIsNotACalibration) {
+  EXPECT_THROW(with_mpi_link(R"({"per_byte_ns": 1})", "bad.json", {}), InputError);
+  EXPECT_THROW(with_mpi_link("not json", "bad.json", {}), InputError);
+}
+
+TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("tgraph_mpi_cal_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string file = (dir / "cal.json").string();
+  write_file_atomic(file, kCalibration);
+  const std::string cmd = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " + dir.string() +
+                          " -np 2 --oversubscribe " + TGRAPH_MPI_BIN + " calibrate -o " + file +
+                          " > " + (dir / "out.txt").string() + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0) << read_file_text((dir / "out.txt").string());
+  const partition::CostModel m = partition::load_calibration(file);
+  EXPECT_DOUBLE_EQ(m.sync_latency_ns, 85.5);  // kept
+  // Measured between two processes: above zero, below a millisecond and 1 ns/byte (1 GB/s).
+  EXPECT_GT(m.mpi_latency_ns, 0.0);
+  EXPECT_LT(m.mpi_latency_ns, 1e6);
+  EXPECT_GT(m.mpi_per_byte_ns, 0.0);
+  EXPECT_LT(m.mpi_per_byte_ns, 1.0);
+  // No file to add to: exit 2.
+  const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
+                              dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +
+                              " calibrate -o " + (dir / "none.json").string() + " > /dev/null 2>&1";
+  const int rc2 = std::system(missing.c_str());
+  EXPECT_TRUE(WIFEXITED(rc2) && WEXITSTATUS(rc2) == 2);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace tgraph::mpi
