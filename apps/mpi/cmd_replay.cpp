@@ -1,9 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `tgraph-mpi replay T.tgt [A.tga] --threads-per-rank T [--steps N] [--check] [--json]
-// [--watchdog SECONDS]`: the trace's steps across the MPI ranks (tgraph::mpi); and
-// `tgraph-mpi calibrate [-o F]`, registered here beside it (main.cpp registers the verb
-// files it knows): MPI latency and bandwidth between two local ranks into the calibration
-// file.
+// [--watchdog SECONDS]`: the trace's steps across the MPI ranks (tgraph::mpi).
 #include <mpi.h>
 
 #include <iostream>
@@ -14,10 +11,8 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/mpi/calibrate.hpp"
 #include "tgraph/mpi/replay.hpp"
 #include "tgraph/partition/assignment_io.hpp"
-#include "tgraph/partition/cost_model.hpp"
 #include "verbs.hpp"
 
 namespace tgraph::mpi_app {
@@ -62,34 +57,6 @@ void replay(const ReplayArgs& a) {
   if (differs) throw std::runtime_error("check failed");
 }
 
-void calibrate(const std::string& path_flag, bool json) {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const std::string path = path_flag.empty() ? partition::default_calibration_path() : path_flag;
-  // Every rank checks the file first: a bad one ends the job before any measurement.
-  std::string text;
-  try {
-    text = read_file_text(path);
-  } catch (const Error&) {
-    throw InputError(path, std::nullopt,
-                     "no calibration file to add the MPI fields to (run `tgraph calibrate -o " +
-                         path + "` first)");
-  }
-  mpi::with_mpi_link(text, path, {});
-  const mpi::MpiLink link = mpi::measure_mpi_link();
-  if (rank != 0) return;
-  write_file_atomic(path, mpi::with_mpi_link(text, path, link));
-  if (json) {
-    std::cout << "{\"mpi_latency_ns\":" << link.latency_ns
-              << ",\"mpi_per_byte_ns\":" << link.per_byte_ns << ",\"output\":\"" << path << "\"}\n";
-  } else {
-    std::cout << "MPI between two local ranks: latency " << link.latency_ns << " ns, "
-              << link.per_byte_ns << " ns/byte ("
-              << (link.per_byte_ns > 0 ? 1.0 / link.per_byte_ns : 0) << " GB/s) -> " << path
-              << "\n";
-  }
-}
-
 }  // namespace
 
 void add_replay_verb(CLI::App& app) {
@@ -112,16 +79,6 @@ void add_replay_verb(CLI::App& app) {
       ->group("");
   cmd->callback([a] { replay(*a); });
 
-  auto out = std::make_shared<std::string>();
-  auto json = std::make_shared<bool>(false);
-  auto* cal = app.add_subcommand(
-      "calibrate",
-      "Add the MPI latency and bandwidth between two local ranks to the calibration "
-      "file (mpirun -np 2)");
-  cal->add_option("-o,--output", *out,
-                  "Calibration file written by `tgraph calibrate` (default: its default path)");
-  cal->add_flag("--json", *json, "Print one JSON object");
-  cal->callback([out, json] { calibrate(*out, *json); });
 }
 
 }  // namespace tgraph::mpi_app

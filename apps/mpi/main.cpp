@@ -18,15 +18,20 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   add_replay_verb(app);
   add_partition_verb(app);
+  add_calibrate_verb(app);
   try {
     tgraph::mpi::Session session(argc, argv);
     try {
       app.parse(argc, argv);
     } catch (const CLI::Success& e) {  // --help, --version
       return session.rank() == 0 ? app.exit(e) : 0;
+    } catch (const CLI::ParseError& e) {
+      // Every rank parsed the same command line and failed the same way: rank 0 says so
+      // once, and the ranks end together (no collective is pending).
+      if (session.rank() == 0) std::cerr << "tgraph-mpi: " << e.what() << "\n";
+      return 2;
     } catch (const std::exception& e) {
-      const bool bad_input =
-          dynamic_cast<const CLI::ParseError*>(&e) || dynamic_cast<const tgraph::Error*>(&e);
+      const bool bad_input = dynamic_cast<const tgraph::Error*>(&e) != nullptr;
       const bool no_memory = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
       std::cerr << "tgraph-mpi: rank " << session.rank() << ": "
                 << (no_memory ? "out of memory" : e.what()) << "\n";

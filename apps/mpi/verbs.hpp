@@ -11,5 +11,7 @@ namespace tgraph::mpi_app {
 void add_replay_verb(CLI::App& app);
 /// `tgraph-mpi partition T.tgt --method ptscotch ... -o A.tga`.
 void add_partition_verb(CLI::App& app);
+/// `tgraph-mpi calibrate [-o F]`: MPI latency and bandwidth into the calibration file.
+void add_calibrate_verb(CLI::App& app);
 
 }  // namespace tgraph::mpi_app

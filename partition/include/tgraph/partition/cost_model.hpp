@@ -22,7 +22,8 @@ struct CostModel {
   std::string source = "default";
   /// One-way MPI message latency between two nodes (ns): the inter-node links of a
   /// simulated platform (`tgraph platform`, `simulate --engine simgrid`). Calibration files
-  /// without "mpi_latency_ns" get the default, 1500 ns (`tgraph calibrate --mpi`: not yet).
+  /// without "mpi_latency_ns" get the default, 1500 ns (`mpirun -np 2 tgraph-mpi calibrate`
+  /// measures it between local ranks).
   double mpi_latency_ns = 1500.0;
   /// Cost per byte (ns) of an MPI message between two nodes (1 / bandwidth): default 0.08
   /// (12.5 GB/s, a 100 Gb/s InfiniBand EDR link), from "mpi_per_byte_ns" when present.
