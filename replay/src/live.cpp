@@ -314,7 +314,7 @@ PassResult run_pass(const EngineFactory& make_engine, const LivePartitioner* par
       }
       const std::int64_t t2 = now_ns();
       w.set_program(cur.bodies, cur.conditions, cur.accumulators);
-      const StepStats ss = ex.run_step(cur.graph, partition ? &assignment : nullptr, w);
+      const ExecStepStats ss = ex.run_step(cur.graph, partition ? &assignment : nullptr, w);
       const std::int64_t t3 = now_ns();
       m.record_ns = t1 - t0;
       m.partition_ns = t2 - t1;
@@ -498,7 +498,7 @@ LiveResult run_live(const EngineFactory& make_engine, const LivePartitioner* par
       ref = make_executor(Policy::kSequential, ro);
       res.check_reference = "sequential executor, program order";
     } else if (partition) {
-      ro.serial = true;
+      ro.partition.serial = true;
       ref = make_executor(Policy::kPartition, ro);
       fixed = &passes[0].assignments;
       res.check_reference =

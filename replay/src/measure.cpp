@@ -161,7 +161,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
         const StepGraph& g = trace.steps[o.first_step + i];
         ws.set_step(g);
         const std::int64_t host = ws.run_host(g);
-        const StepStats s = seq->run_step(g, nullptr, ws);
+        const ExecStepStats s = seq->run_step(g, nullptr, ws);
         seq_walls[i].push_back(host + s.wall_ns);
         total += host + s.wall_ns;
       }
@@ -172,7 +172,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       const StepGraph& g = trace.steps[o.first_step + i];
       w.set_step(g);
       const std::int64_t host = w.run_host(g);
-      const StepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
+      const ExecStepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
       walls[i].push_back(host + s.wall_ns);
       runs[i].push_back(host + s.wall_ns - s.build_ns);
       total += host + s.wall_ns;
