@@ -23,7 +23,7 @@ namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
 namespace meas = tgraph::measure;
 
-// --timeout SECONDS as ExecOptions::timeout_ms.
+// --timeout SECONDS as PartitionOptions::timeout_ms.
 std::int64_t timeout_ms(double seconds) {
   if (!(seconds >= 0.0) || seconds > 1e6)
     throw UsageError("--timeout " + std::to_string(seconds) + ": expected 0 (off) to 1e6 seconds");
@@ -34,11 +34,11 @@ std::int64_t timeout_ms(double seconds) {
 // The flags `replay` and `run` share, bound to `exec`.
 void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
   exec.threads = default_threads();
-  exec.timeout_exits = true;  // a body that never returns after the watchdog fired: exit 1
+  exec.partition.timeout_exits = true;  // a body that never returns after the watchdog fired: exit 1
   cmd->add_option("--threads,-k", exec.threads, "Threads (processors)");
   cmd->add_option("--spin-ns", exec.spin_ns, "Spin this long before parking a waiting thread");
   cmd->add_option_function<double>(
-      "--timeout", [&exec](double s) { exec.timeout_ms = timeout_ms(s); },
+      "--timeout", [&exec](double s) { exec.partition.timeout_ms = timeout_ms(s); },
       "Watchdog (partition policy): end a step that makes no progress for this many seconds, "
       "naming what each thread waits for (0: off; default 300)");
   cmd->add_option("--cw", a.cw, "CW writes across threads: reduce (default) or serialize")
@@ -48,10 +48,10 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
       });
   cmd->add_option_function<std::string>(
       "--barrier-rule",
-      [&exec](const std::string& r) { exec.barrier_rule = barrier_rule_flag(r, "--barrier-rule"); },
+      [&exec](const std::string& r) { exec.barrier.rule = barrier_rule_flag(r, "--barrier-rule"); },
       "Barrier policy's phases: level (default; one per dependency level) or operation (one "
       "per run of same-kind tasks in program order, the paper's rule)");
-  cmd->add_option("--starpu-sched", exec.starpu_sched,
+  cmd->add_option("--starpu-sched", exec.starpu.sched,
                   "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
   cmd->add_flag_callback(
       "--no-pin", [&exec] { exec.pin = false; }, "Do not bind threads to cores");
@@ -176,7 +176,7 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_flag("--repartition-every-step", live->repartition_every_step,
                 "Call the partitioner at every step (default: on change or imbalance)");
   cmd->add_flag_callback(
-      "--no-elide-waits", [live] { live->exec.elide_waits = false; },
+      "--no-elide-waits", [live] { live->exec.partition.elide_waits = false; },
       "One wait per cross-processor producer (default: implied waits dropped)");
   cmd->add_option("--cost-stride", live->cost_stride,
                   "Cost feedback times loop iterations 0, 1 and every N-th (default 8)");

@@ -22,7 +22,7 @@ struct ReplayArgs {
   std::string trace, assignment;
   std::uint32_t threads_per_rank = 1;
   std::optional<std::uint32_t> steps, drop;
-  bool check = false, json = false;
+  bool check = false, json = false, host_work = false;
   double watchdog = 60;
 };
 
@@ -44,6 +44,7 @@ void replay(const ReplayArgs& a) {
   o.threads_per_rank = a.threads_per_rank;
   o.steps = a.steps;
   o.check = a.check;
+  o.host_work = a.host_work;
   o.watchdog_s = a.watchdog;
   o.test_drop_message = a.drop;
   const mpi::MpiReplayResult r = mpi::replay_distributed(trace, as, o);
@@ -71,6 +72,9 @@ void add_replay_verb(CLI::App& app) {
       ->required();
   cmd->add_option("--steps", a->steps, "Replay the first N steps");
   cmd->add_flag("--check", a->check, "Compare the final state with the sequential replay");
+  cmd->add_flag("--host-work", a->host_work,
+                "Run each step's serial host work (recorded outside the tasks) on rank 0 "
+                "before any task, as tgraph replay and tgraph simulate do");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->add_option("--watchdog", a->watchdog,
                   "Seconds without progress before a rank names what it waits for and the job "

@@ -3,6 +3,11 @@
 // tgraph::mpi. Every rank parses the same command line.
 #pragma once
 
+// smpicxx (an SMPI build) force-includes smpi_helpers.h, whose function-like macro exit(x)
+// would rename CLI11's App::exit; the program never calls exit() itself.
+#ifdef TGRAPH_SMPI
+#undef exit
+#endif
 #include <CLI/CLI.hpp>
 
 namespace tgraph::mpi_app {

@@ -22,7 +22,7 @@
 // step's (a contact change) and times that step alone; the counters are, over those
 // steps, the median (median_us) and the maximum (max_us) of each step's median over the
 // iterations; the benchmark's own time is the sum over the changes. Plan rebuilds are
-// timed by the executor (StepStats::rebuild_ns: the per-processor programs, lowering
+// timed by the executor (ExecStepStats::rebuild_ns: the per-processor programs, lowering
 // excluded; lowering_us is the lowering's median), on a fresh executor that first built
 // the previous step's plan. Graph updates alternate between the previous step and the
 // changed one, so that each derivation starts from the other step.
@@ -141,7 +141,7 @@ void BM_FallingPlanRebuild(benchmark::State& state, bool incremental) {
   const tgraph::partition::TracePartition& tp = sticky(k);
   tgraph::replay::ExecOptions o;
   o.threads = k;
-  o.serial = true;  // the programs are built the same way; the step runs on this thread
+  o.partition.serial = true;  // the programs are built the same way; the step runs on this thread
   o.pin = false;
   o.incremental_plans = incremental;
   std::vector<std::vector<double>> samples(f.changes.size()), lowering(f.changes.size());
@@ -155,7 +155,7 @@ void BM_FallingPlanRebuild(benchmark::State& state, bool incremental) {
       w.set_step(f.trace.steps[s - 1]);
       ex->run_step(f.trace.steps[s - 1], &tp.assignment.steps[s - 1], w);
       w.set_step(f.trace.steps[s]);
-      const tgraph::replay::StepStats st =
+      const tgraph::replay::ExecStepStats st =
           ex->run_step(f.trace.steps[s], &tp.assignment.steps[s], w);
       samples[i].push_back(static_cast<double>(st.rebuild_ns));
       lowering[i].push_back(static_cast<double>(st.build_ns - st.rebuild_ns));
@@ -208,7 +208,7 @@ void BM_FallingRebuild(benchmark::State& state, bool incremental) {
   auto strategy = tgraph::partition::make_strategy(incremental ? "sticky" : "metis");
   tgraph::replay::ExecOptions o;
   o.threads = k;
-  o.serial = true;  // the programs are built the same way; the step runs on this thread
+  o.partition.serial = true;  // the programs are built the same way; the step runs on this thread
   o.pin = false;
   o.incremental_plans = incremental;
   tgraph::replay::SyntheticWorkload w({.cost_scale = 0.0});
@@ -240,7 +240,7 @@ void BM_FallingRebuild(benchmark::State& state, bool incremental) {
       const tgraph::partition::Result r = strategy->partition(g, k, previous, {});
       const double p = ns_since(t0);
       w.set_step(g);
-      const tgraph::replay::StepStats st = ex->run_step(g, &r.assignment, w);
+      const tgraph::replay::ExecStepStats st = ex->run_step(g, &r.assignment, w);
       const auto b = static_cast<double>(st.build_ns);
       edges[i].push_back(e);
       part[i].push_back(p);

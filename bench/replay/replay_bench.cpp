@@ -161,12 +161,12 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   std::unique_ptr<Executor> ex = make_executor(policy, o);
   SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
   w.set_step(g);
-  const StepStats first = ex->run_step(g, &a, w);
+  const ExecStepStats first = ex->run_step(g, &a, w);
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : first.threads) instances += c.tasks;
   std::uint64_t signals = 0, blocked = 0, parks = 0;
   for (auto _ : state) {
-    const StepStats s = ex->run_step(g, &a, w);
+    const ExecStepStats s = ex->run_step(g, &a, w);
     signals += s.signals();
     blocked += s.blocked_waits();
     parks += s.parks();
@@ -187,7 +187,7 @@ void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
   ExecOptions o;
   o.threads = k;
   o.reduce_scope = mutex ? ReduceScope::kNone : ReduceScope::kPerWriter;
-  o.omp_iteration_wait = iteration_wait;
+  o.omp_tasks.iteration_wait = iteration_wait;
   auto ex = make_executor(Policy::kOmpTasks, o);
   SyntheticWorkload w;
   w.set_step(g);

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "fd_write.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph {
@@ -71,6 +72,34 @@ std::string read_file_text(const std::string& path) {
   return std::string(bytes.begin(), bytes.end());
 }
 
+namespace detail {
+
+void write_all(int fd, std::string_view bytes, const std::string& name) {
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ::ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw Error(name + ": cannot write: " + errno_text(errno));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+}
+
+void sync_close_rename(int fd, const std::string& from, const std::string& to,
+                       const std::string& name, const std::string& from_label) {
+  if (::fsync(fd) != 0 && errno != EINVAL) {
+    const int err = errno;
+    ::close(fd);
+    throw Error(name + ": cannot sync: " + errno_text(err));
+  }
+  if (::close(fd) != 0) throw Error(name + ": cannot close: " + errno_text(errno));
+  if (::rename(from.c_str(), to.c_str()) != 0)
+    throw Error(to + ": cannot rename " + from_label + " into place: " + errno_text(errno));
+}
+
+}  // namespace detail
+
 void write_file_atomic(const std::string& path, std::string_view content) {
   namespace fs = std::filesystem;
   const fs::path target(path);
@@ -80,32 +109,13 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   if (fd < 0)
     throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));
   FdGuard guard(fd);
-  const auto fail = [&](const std::string& what, int err) {
-    ::close(guard.release());
-    ::unlink(tmp.c_str());
-    throw Error(path + ": " + what + ": " + errno_text(err));
-  };
   ::fchmod(fd, 0644);  // mkstemp creates 0600; outputs are ordinary readable files
-  std::size_t done = 0;
-  while (done < content.size()) {
-    const ::ssize_t n = ::write(fd, content.data() + done, content.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      fail("cannot write", errno);
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  // Flush the data before the rename so that a crash never exposes an empty new file.
-  if (::fsync(fd) != 0 && errno != EINVAL) fail("cannot sync", errno);
-  if (::close(guard.release()) != 0) {
-    const int err = errno;
+  try {
+    detail::write_all(fd, content, path);
+    detail::sync_close_rename(guard.release(), tmp, path, path, "the temporary file");
+  } catch (...) {
     ::unlink(tmp.c_str());
-    throw Error(path + ": cannot close: " + errno_text(err));
-  }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(tmp.c_str());
-    throw Error(path + ": cannot rename the temporary file into place: " + errno_text(err));
+    throw;
   }
 }
 

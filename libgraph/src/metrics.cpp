@@ -3,28 +3,36 @@
 #include "tgraph/graph/metrics.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace tgraph {
 namespace {
 
-// Predecessor lists in CSR form.
+// Predecessor lists in CSR form: from[begin[t]..begin[t + 1]) are the sources of t's edges.
 struct Preds {
   std::vector<std::uint32_t> begin;
   std::vector<TaskId> from;
 };
 
 Preds build_preds(std::size_t n, const std::vector<Edge>& edges) {
-  Preds p;
-  p.begin.assign(n + 1, 0);
-  for (const Edge& e : edges) ++p.begin[e.to + 1];
-  for (std::size_t i = 0; i < n; ++i) p.begin[i + 1] += p.begin[i];
-  p.from.resize(edges.size());
-  std::vector<std::uint32_t> fill(p.begin.begin(), p.begin.end() - 1);
-  for (const Edge& e : edges) p.from[fill[e.to]++] = e.from;
+  IncomingEdges in = incoming_edges(n, edges);
+  Preds p{std::move(in.begin), std::move(in.edge)};
+  for (TaskId& f : p.from) f = edges[f].from;
   return p;
 }
 
 }  // namespace
+
+IncomingEdges incoming_edges(std::size_t tasks, const std::vector<Edge>& edges) {
+  IncomingEdges in;
+  in.begin.assign(tasks + 1, 0);
+  for (const Edge& e : edges) ++in.begin[e.to + 1];
+  for (std::size_t i = 0; i < tasks; ++i) in.begin[i + 1] += in.begin[i];
+  in.edge.resize(edges.size());
+  std::vector<std::uint32_t> fill(in.begin.begin(), in.begin.end() - 1);
+  for (std::uint32_t i = 0; i < edges.size(); ++i) in.edge[fill[edges[i].to]++] = i;
+  return in;
+}
 
 std::vector<std::uint64_t> earliest_finish(const StepGraph& g) {
   const std::size_t n = g.tasks.size();

@@ -194,7 +194,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
       ref = tr::make_executor(tr::Policy::kSequential, ro);
       res.check_reference = "sequential executor, program order";
     } else if (partition) {
-      ro.serial = true;
+      ro.partition.serial = true;
       ref = tr::make_executor(tr::Policy::kPartition, ro);
       po.fixed = &first.assignments;
       res.check_reference =

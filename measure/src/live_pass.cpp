@@ -92,7 +92,7 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
       }
       const std::int64_t t2 = replay::now_ns();
       w.set_program(cur.bodies, cur.conditions, cur.accumulators);
-      const replay::StepStats ss = ex.run_step(cur.graph, partition ? &assignment : nullptr, w);
+      const replay::ExecStepStats ss = ex.run_step(cur.graph, partition ? &assignment : nullptr, w);
       const std::int64_t t3 = replay::now_ns();
       m.record_ns = t1 - t0;
       m.partition_ns = t2 - t1;

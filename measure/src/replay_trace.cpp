@@ -125,7 +125,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
         const StepGraph& g = trace.steps[o.first_step + i];
         ws.set_step(g);
         const std::int64_t host = ws.run_host(g);
-        const StepStats s = seq->run_step(g, nullptr, ws);
+        const ExecStepStats s = seq->run_step(g, nullptr, ws);
         seq_walls.add(i, host + s.wall_ns);
       }
       seq_walls.end_pass();
@@ -134,7 +134,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       const StepGraph& g = trace.steps[o.first_step + i];
       w.set_step(g);
       const std::int64_t host = w.run_host(g);
-      const StepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
+      const ExecStepStats s = ex->run_step(g, assignment_of(o.first_step + i), w);
       walls.add(i, host + s.wall_ns);
       runs.add(i, host + s.wall_ns - s.build_ns);
       if (pass == 0) {

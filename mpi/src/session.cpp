@@ -7,8 +7,15 @@ namespace tgraph::mpi {
 
 Session::Session(int& argc, char**& argv) {
   int provided = MPI_THREAD_SINGLE;
-  MPI_Init_thread(&argc, &argv, MPI_THREAD_MULTIPLE, &provided);
-  if (provided < MPI_THREAD_MULTIPLE) {
+#ifdef TGRAPH_SMPI
+  // SimGrid's SMPI provides MPI_THREAD_SINGLE; its replay makes every MPI call from the
+  // rank's main thread (mpi/src/replay.cpp).
+  constexpr int kRequired = MPI_THREAD_SINGLE;
+#else
+  constexpr int kRequired = MPI_THREAD_MULTIPLE;
+#endif
+  MPI_Init_thread(&argc, &argv, kRequired, &provided);
+  if (provided < kRequired) {
     MPI_Finalize();
     throw std::runtime_error("the MPI library does not provide MPI_THREAD_MULTIPLE");
   }

@@ -2,6 +2,7 @@
 // The graph files of gpmetis and scotch_gpart, and `tgraph export`'s choice of format.
 #include <sstream>
 
+#include "tgraph/graph/enum_names.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/step_json.hpp"
 #include "tgraph/partition/export.hpp"
@@ -48,10 +49,8 @@ std::string_view to_string(GraphFileFormat f) {
 }
 
 GraphFileFormat parse_graph_file_format(std::string_view name) {
-  for (GraphFileFormat f :
-       {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch})
-    if (to_string(f) == name) return f;
-  throw UsageError("--format " + std::string(name) + ": expected json, metis or scotch");
+  return parse_enum(name, {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch},
+                    "--format");
 }
 
 std::string graph_file(const Trace& trace, std::size_t step, const std::string& trace_name,

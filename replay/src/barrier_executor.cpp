@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
@@ -35,22 +36,14 @@ struct BarrierPlan {
   std::vector<Phase> phases;
 };
 
-class BarrierExecutor final : public Executor {
+class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
  public:
-  explicit BarrierExecutor(const ExecOptions& o) : Executor(Policy::kBarrier, o) {
-    counters_ = std::make_unique<Slot[]>(o.threads);
-  }
-  ~BarrierExecutor() override {
-    if (pinned_main_) detail::restore_binding(main_binding_);
-  }
+  explicit BarrierExecutor(const ExecOptions& o)
+      : PlannedExecutor(Policy::kBarrier, o), counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
-  std::shared_ptr<void> build(const ExecGraph& x) override {
-    switch (options_.barrier_rule) {
+  std::unique_ptr<BarrierPlan> build_plan(const ExecGraph& x) override {
+    switch (options().barrier.rule) {
       case BarrierRule::kLevel:
         return build_by_level(x);
       case BarrierRule::kOperation:
@@ -68,9 +61,9 @@ class BarrierExecutor final : public Executor {
   // decision is read. The CW writers of one datum have no edges among each other (per-writer
   // temporaries) and share a phase when nothing else separates them; the reducer that adds
   // them is one level later.
-  std::shared_ptr<void> build_by_level(const ExecGraph& x) {
+  std::unique_ptr<BarrierPlan> build_by_level(const ExecGraph& x) {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<BarrierPlan>();
+    auto plan = std::make_unique<BarrierPlan>();
     const auto n = static_cast<TaskId>(g.tasks.size());
     const detail::Csr pred = detail::build_csr(n, g.edges, true);
     std::vector<std::uint32_t> level(n, 0);
@@ -104,9 +97,9 @@ class BarrierExecutor final : public Executor {
   // on a task of the current phase. Reducers (CW groups lowered per writer) do not cut the
   // run they follow: they gather in a reduction phase that runs right after it, as an
   // OpenMP user writes a parallel loop with a reduction (the loop, then the combine).
-  std::shared_ptr<void> build_by_operation(const ExecGraph& x) {
+  std::unique_ptr<BarrierPlan> build_by_operation(const ExecGraph& x) {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<BarrierPlan>();
+    auto plan = std::make_unique<BarrierPlan>();
     const auto n = static_cast<TaskId>(g.tasks.size());
     const detail::Csr pred = detail::build_csr(n, g.edges, true);
     constexpr std::uint32_t kNone = UINT32_MAX, kPending = UINT32_MAX - 1;
@@ -167,17 +160,12 @@ class BarrierExecutor final : public Executor {
     return plan;
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
-    const BarrierPlan& plan = *static_cast<BarrierPlan*>(plan_ptr);
+  void run(BarrierPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    const auto k = static_cast<int>(options_.threads);
-    if (options_.pin && !saved_) {
-      saved_ = true;
-      detail::save_binding(main_binding_);
-      pinned_main_ = true;
-    }
-    for (int p = 0; p < k; ++p) counters_[p].c = {};
+    const auto k = static_cast<int>(options().threads);
+    if (options().pin) main_binding_.save_once();
+    counters_.reset();
     std::vector<std::uint32_t> iterations(g.loops.size(), 0);
     // Decision of iteration i of a loop lives in slot i % 2: a fast thread may write the
     // next iteration's decision while a slow one still reads this one's.
@@ -185,9 +173,9 @@ class BarrierExecutor final : public Executor {
     std::atomic<bool> abort{false};
     std::exception_ptr error;
     std::mutex error_mutex;
-    const bool observe = !observers_.empty();
-    const std::uint32_t stride = observe_stride_;
-    const bool pin = options_.pin;
+    const bool observe = !observers().empty();
+    const std::uint32_t stride = observe_stride();
+    const bool pin = options().pin;
     std::vector<std::uint8_t> is_break(g.tasks.size(), 0);
     for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
 
@@ -198,7 +186,7 @@ class BarrierExecutor final : public Executor {
       TGRAPH_TSAN_ACQUIRE(&token);
       const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
       if (pin) detail::pin_current_thread(thread);
-      ThreadCounters& tc = counters_[thread].c;
+      ThreadCounters& tc = counters_[thread];
       if (fresh) {
 #pragma omp for schedule(static) nowait
         for (DatumId d = 0; d < g.data.size(); ++d)
@@ -219,9 +207,9 @@ class BarrierExecutor final : public Executor {
           const bool aborted = abort.load(std::memory_order_relaxed);
           if (!aborted) {
             try {
-              if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers_, thread, t, iter);
+              if (observe && detail::sampled(iter, stride)) detail::notify_begin(observers(), thread, t, iter);
               w.run(TaskRun{&x, t, x.origin[t], iter, thread});
-              if (observe && detail::sampled(iter, stride)) detail::notify_end(observers_, thread, t, iter);
+              if (observe && detail::sampled(iter, stride)) detail::notify_end(observers(), thread, t, iter);
               ++tc.tasks;
             } catch (...) {
               std::lock_guard<std::mutex> lock(error_mutex);
@@ -261,16 +249,13 @@ class BarrierExecutor final : public Executor {
       TGRAPH_TSAN_RELEASE(&token);
     }
     TGRAPH_TSAN_ACQUIRE(&token);
-    stats.threads.resize(options_.threads);
-    for (int p = 0; p < k; ++p) stats.threads[static_cast<std::size_t>(p)] = counters_[p].c;
+    counters_.copy_to(stats);
     stats.loop_iterations = iterations;
     if (error) std::rethrow_exception(error);
   }
 
-  std::unique_ptr<Slot[]> counters_;
-  bool saved_ = false;
-  bool pinned_main_ = false;
-  detail::SavedBinding main_binding_;
+  detail::ThreadSlots counters_;
+  detail::MainThreadBinding main_binding_;
 };
 
 }  // namespace

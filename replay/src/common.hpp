@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "tgraph/replay/executor.hpp"
@@ -34,6 +35,58 @@ inline std::uint32_t unrolled_count(const Loop& loop, std::uint32_t known) {
 /// it disagrees. Returns the condition.
 bool check_unrolled(const ExecGraph& x, LoopId l, std::uint32_t i, std::uint32_t count,
                     Workload& w);
+
+/// Per-thread counters of a step, each thread's on its own cache line.
+class ThreadSlots {
+ public:
+  explicit ThreadSlots(std::uint32_t threads)
+      : slots_(std::make_unique<Slot[]>(threads)), threads_(threads) {}
+  /// Thread p's counters (written by thread p only during a step).
+  ThreadCounters& operator[](std::uint32_t p) { return slots_[p].c; }
+  /// Zeroes every thread's counters (before a step).
+  void reset() {
+    for (std::uint32_t p = 0; p < threads_; ++p) slots_[p].c = {};
+  }
+  /// Copies them into `stats.threads` (after a step, the threads joined).
+  void copy_to(ExecStepStats& stats) const {
+    stats.threads.resize(threads_);
+    for (std::uint32_t p = 0; p < threads_; ++p) stats.threads[p] = slots_[p].c;
+  }
+
+ private:
+  struct alignas(64) Slot {
+    ThreadCounters c;
+  };
+  std::unique_ptr<Slot[]> slots_;
+  std::uint32_t threads_;
+};
+
+/// Before the first step of a plan: the calling thread first-touches every datum the
+/// workload wants touched (the policies without data affinity).
+inline void touch_all(const StepGraph& g, Workload& w) {
+  for (DatumId d = 0; d < g.data.size(); ++d)
+    if (w.needs_touch(d)) w.first_touch(d);
+}
+
+/// Walks step `g` in program order for the executors that submit or run it from one thread:
+/// `task(t)` for each task outside loops, `loop(l)` once for each loop (at its first task;
+/// the loop's body is then skipped). Stops before the next task or loop once `stop()`.
+template <class Stop, class TaskFn, class LoopFn>
+void walk_step(const StepGraph& g, Stop stop, TaskFn task, LoopFn loop) {
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  std::size_t next_loop = 0;
+  for (TaskId t = 0; t < n;) {
+    if (stop()) return;
+    if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
+      const auto l = static_cast<LoopId>(next_loop++);
+      loop(l);
+      t = g.loops[l].last;
+      continue;
+    }
+    task(t);
+    ++t;
+  }
+}
 
 /// Whether observers see loop iteration `it` under Executor::set_observe_stride(stride):
 /// iterations 0 and 1 and every stride-th one (every instance outside loops).

@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::replay {
@@ -68,27 +69,27 @@ std::vector<std::uint32_t> first_accessor_owner(const ExecGraph& x) {
 
 }  // namespace detail
 
-std::uint64_t StepStats::signals() const {
+std::uint64_t ExecStepStats::signals() const {
   std::uint64_t s = 0;
   for (const auto& t : threads) s += t.signals;
   return s;
 }
-std::uint64_t StepStats::waits() const {
+std::uint64_t ExecStepStats::waits() const {
   std::uint64_t s = 0;
   for (const auto& t : threads) s += t.waits;
   return s;
 }
-std::uint64_t StepStats::blocked_waits() const {
+std::uint64_t ExecStepStats::blocked_waits() const {
   std::uint64_t s = 0;
   for (const auto& t : threads) s += t.blocked_waits;
   return s;
 }
-std::uint64_t StepStats::parks() const {
+std::uint64_t ExecStepStats::parks() const {
   std::uint64_t s = 0;
   for (const auto& t : threads) s += t.parks;
   return s;
 }
-std::int64_t StepStats::wait_ns() const {
+std::int64_t ExecStepStats::wait_ns() const {
   std::int64_t s = 0;
   for (const auto& t : threads) s += t.wait_ns;
   return s;
@@ -101,22 +102,16 @@ struct Executor::CacheEntry {
   bool has_assignment = false;
   std::vector<bool> reducible;  // Workload::reducible() the plan was lowered with
   ExecGraph exec;
-  std::shared_ptr<void> plan;
+  std::unique_ptr<detail::ExecPlan> plan;
   std::uint64_t bound = 0;  // Workload::instance() holding this plan's buffers
 };
 
 Executor::Executor(Policy policy, ExecOptions options) : options_(options), policy_(policy) {}
 Executor::~Executor() = default;
 
-std::shared_ptr<void> Executor::rebuild(const ExecGraph& x, const ExecGraph&, const void*) {
-  return build(x);
-}
+CwMode Executor::cw() const { return options_.cw.value_or(CwMode::kReduce); }
 
-std::uint32_t Executor::rebuilt_procs(const void*) const { return options_.threads; }
-
-CwMode Executor::cw_mode() const { return options_.cw.value_or(CwMode::kReduce); }
-
-ReduceScope Executor::reduce_scope() const {
+ReduceScope Executor::scope() const {
   if (options_.reduce_scope) return *options_.reduce_scope;
   switch (policy_) {
     case Policy::kSequential:
@@ -204,16 +199,16 @@ void validate_assignment(const StepGraph& g, const Assignment& a, std::uint32_t 
 
 }  // namespace
 
-StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& w) {
-  StepStats stats;
+ExecStepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& w) {
+  ExecStepStats stats;
   const std::int64_t t0 = now_ns();
   const bool use_assignment = policy_ == Policy::kPartition;
   if (use_assignment && a == nullptr) throw UsageError("the partition policy needs an assignment");
-  const CwMode mode = cw_mode();
-  const ReduceScope scope = reduce_scope();
+  const CwMode mode = cw();
+  const ReduceScope reduce = scope();
   const std::vector<bool>* reducible = w.reducible();
   std::uint64_t key = structure_key(g) * 31 + static_cast<std::uint64_t>(mode) * 7 +
-                      static_cast<std::uint64_t>(scope);
+                      static_cast<std::uint64_t>(reduce);
   if (use_assignment) key ^= hash_assignment(*a) * 0x9e3779b97f4a7c15ull;
   if (reducible != nullptr) key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;
 
@@ -238,16 +233,14 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
       entry->assignment = *a;
       entry->has_assignment = true;
     }
-    entry->exec = lower(g, use_assignment ? a : nullptr, mode, scope, reducible,
+    entry->exec = lower(g, use_assignment ? a : nullptr, mode, reduce, reducible,
                         options_.incremental_plans ? &exec_edges_ : nullptr);
     const std::int64_t t_lowered = now_ns();
-    if (last_entry_ && options_.incremental_plans) {
-      entry->plan = rebuild(entry->exec, last_entry_->exec, last_entry_->plan.get());
-    } else {
-      entry->plan = build(entry->exec);
-    }
+    entry->plan = build(entry->exec, last_entry_ && options_.incremental_plans
+                                         ? last_entry_->plan.get()
+                                         : nullptr);
     stats.rebuild_ns = now_ns() - t_lowered;
-    stats.rebuilt_procs = rebuilt_procs(entry->plan.get());
+    stats.rebuilt_procs = rebuilt_procs(*entry->plan);
     ++plans_built_;
     stats.rebuilt = true;
     if (cache_.size() >= 16) cache_.erase(cache_.begin());
@@ -266,7 +259,7 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
   last_entry_ = entry;
   for (Observer* o : observers_) o->on_step_begin(entry->exec, options_.threads, t_built);
   try {
-    execute(entry->plan.get(), entry->exec, w, fresh, stats);
+    execute(*entry->plan, entry->exec, w, fresh, stats);
   } catch (...) {
     const std::int64_t t_end = now_ns();
     for (Observer* o : observers_) o->on_step_end(t_end);
@@ -280,48 +273,46 @@ StepStats Executor::run_step(const StepGraph& g, const Assignment* a, Workload& 
 
 namespace {
 
+/// The sequential executor needs nothing beyond the exec graph: it runs program order.
+struct SequentialPlan {};
+
 /// One thread, program order: the reference every other policy is compared with.
-class SequentialExecutor final : public Executor {
+class SequentialExecutor final : public detail::PlannedExecutor<SequentialPlan> {
  public:
-  explicit SequentialExecutor(ExecOptions o) : Executor(Policy::kSequential, o) {}
+  explicit SequentialExecutor(ExecOptions o) : PlannedExecutor(Policy::kSequential, o) {}
 
  private:
-  std::shared_ptr<void> build(const ExecGraph&) override { return std::make_shared<int>(0); }
+  std::unique_ptr<SequentialPlan> build_plan(const ExecGraph&) override {
+    return std::make_unique<SequentialPlan>();
+  }
 
-  void execute(void*, const ExecGraph& x, Workload& w, bool fresh, StepStats& stats) override {
+  void run(SequentialPlan&, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);
+    if (fresh) detail::touch_all(g, w);
     stats.threads.assign(1, {});
     stats.loop_iterations.assign(g.loops.size(), 0);
     ThreadCounters& c = stats.threads[0];
-    const bool observe = !observers_.empty();
-    const std::uint32_t stride = observe_stride_;
-    auto run = [&](TaskId t, std::uint32_t it) {
-      if (observe && detail::sampled(it, stride)) detail::notify_begin(observers_, 0, t, it);
+    const std::vector<Observer*>& obs = observers();
+    const bool observe = !obs.empty();
+    const std::uint32_t stride = observe_stride();
+    auto run_task = [&](TaskId t, std::uint32_t it) {
+      if (observe && detail::sampled(it, stride)) detail::notify_begin(obs, 0, t, it);
       w.run(TaskRun{&x, t, x.origin[t], it, 0});
-      if (observe && detail::sampled(it, stride)) detail::notify_end(observers_, 0, t, it);
+      if (observe && detail::sampled(it, stride)) detail::notify_end(obs, 0, t, it);
       ++c.tasks;
     };
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        std::uint32_t it = 0;
-        for (;; ++it) {
-          for (TaskId u = loop.first; u < loop.last; ++u) run(u, it);
-          if (detail::leave_loop(x, l, it, w)) break;
-        }
-        stats.loop_iterations[l] = it + 1;
-        t = loop.last;
-        continue;
-      }
-      run(t, 0);
-      ++t;
-    }
+    detail::walk_step(
+        g, [] { return false; }, [&](TaskId t) { run_task(t, 0); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          std::uint32_t it = 0;
+          for (;; ++it) {
+            for (TaskId u = loop.first; u < loop.last; ++u) run_task(u, it);
+            if (detail::leave_loop(x, l, it, w)) break;
+          }
+          stats.loop_iterations[l] = it + 1;
+        });
   }
 };
 

@@ -16,7 +16,7 @@
 // thread: they are not used.
 //
 // Loops: a loop whose iteration count the workload knows (a replay) is unrolled at
-// submission, with a `taskwait` after each iteration when ExecOptions::omp_iteration_wait
+// submission, with a `taskwait` after each iteration when OmpTasksOptions::iteration_wait
 // (as an OpenMP program testing convergence must do; it also keeps libgomp's dependence
 // lists short). Otherwise (live physics) one iteration is submitted, the submitting thread
 // waits for it and reads the break task's decision. A loop task that writes none of its data
@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
@@ -60,22 +61,15 @@ enum class Check : std::uint8_t {
   kUnrolled = 2,  ///< unrolled: the condition must agree with the known count
 };
 
-class OmpTasksExecutor final : public Executor {
+class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
  public:
   explicit OmpTasksExecutor(const ExecOptions& o)
-      : Executor(Policy::kOmpTasks, o), counters_(std::make_unique<Slot[]>(o.threads)) {}
-  ~OmpTasksExecutor() override {
-    if (pinned_main_) detail::restore_binding(main_binding_);
-  }
+      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<OmpPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<OmpPlan>();
+    auto plan = std::make_unique<OmpPlan>();
     plan->objects = static_cast<std::uint32_t>(g.data.size());
     const auto n = static_cast<TaskId>(g.tasks.size());
     plan->deps.resize(n);
@@ -136,7 +130,7 @@ class OmpTasksExecutor final : public Executor {
 
   /// Body of one task instance (runs on whichever thread of the team libgomp picks).
   void run_instance(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
-    const OmpPlan& p = *plan_;
+    const OmpPlan& p = *step_.plan;
     const TaskDeps& d = p.deps[t];
     const std::uint32_t nd = d.in + d.out + d.inout + d.mutex;
     // TSan: libgomp's dependence release is not instrumented; each object stands for it.
@@ -146,17 +140,17 @@ class OmpTasksExecutor final : public Executor {
     // relaxed: only skips work after a failure; the error itself is passed under a mutex.
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
-        const ExecGraph& x = *exec_;
-        const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
-        if (observe) detail::notify_begin(observers_, thread, t, it);
-        workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
-        if (observe) detail::notify_end(observers_, thread, t, it);
-        ++counters_[thread].c.tasks;
+        const ExecGraph& x = *step_.exec;
+        const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
+        if (observe) detail::notify_begin(observers(), thread, t, it);
+        step_.workload->run(TaskRun{&x, t, x.origin[t], it, thread});
+        if (observe) detail::notify_end(observers(), thread, t, it);
+        ++counters_[thread].tasks;
         const LoopId l = x.graph.tasks[t].loop;
         if (check == Check::kDecide)
-          decision_ = detail::leave_loop(x, l, it, *workload_) ? 1 : 0;
+          decision_ = detail::leave_loop(x, l, it, *step_.workload) ? 1 : 0;
         else if (check == Check::kUnrolled)
-          detail::check_unrolled(x, l, it, count, *workload_);
+          detail::check_unrolled(x, l, it, count, *step_.workload);
       } catch (...) {
         fail(std::current_exception());
       }
@@ -167,7 +161,7 @@ class OmpTasksExecutor final : public Executor {
 
   /// Creates the OpenMP task of instance (t, it), its dependences from the plan.
   void submit(TaskId t, std::uint32_t it, Check check, std::uint32_t count) {
-    const OmpPlan& p = *plan_;
+    const OmpPlan& p = *step_.plan;
     const TaskDeps& d = p.deps[t];
     char* obj = p.object.get();
     const std::uint32_t* in = p.ids.data() + d.first;
@@ -188,65 +182,50 @@ class OmpTasksExecutor final : public Executor {
   /// Submits the whole step from the `single` thread; returns early on failure.
   void submit_step(const ExecGraph& x, Workload& w) {
     const StepGraph& g = x.graph;
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
-          const std::uint32_t count = detail::unrolled_count(loop, *known);
-          for (std::uint32_t it = 0; it < count; ++it) {
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
-            if (options_.omp_iteration_wait) {
+    detail::walk_step(
+        g, [this] { return failed_.load(std::memory_order_relaxed); },  // relaxed: see fail()
+        [this](TaskId t) { submit(t, 0, Check::kNone, 0); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
+            const std::uint32_t count = detail::unrolled_count(loop, *known);
+            for (std::uint32_t it = 0; it < count; ++it) {
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
+              if (options().omp_tasks.iteration_wait) {
+#pragma omp taskwait
+                TGRAPH_TSAN_ACQUIRE(&join_token_);
+                if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+              }
+            }
+            iterations_[l] = count;
+          } else {
+            for (std::uint32_t it = 0;; ++it) {
+              decision_ = -1;
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
 #pragma omp taskwait
               TGRAPH_TSAN_ACQUIRE(&join_token_);
-              if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
+              iterations_[l] = it + 1;
+              if (decision_ != 0) break;  // leave, or the break task did not run (failure)
             }
           }
-          iterations_[l] = count;
-        } else {
-          for (std::uint32_t it = 0;; ++it) {
-            decision_ = -1;
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
-#pragma omp taskwait
-            TGRAPH_TSAN_ACQUIRE(&join_token_);
-            iterations_[l] = it + 1;
-            if (decision_ != 0) break;  // leave, or the break task did not run (failure)
-          }
-        }
-        t = loop.last;
-        continue;
-      }
-      submit(t, 0, Check::kNone, 0);
-      ++t;
-    }
+        });
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
+  void run(OmpPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    if (options_.pin && !saved_) {
-      saved_ = true;
-      detail::save_binding(main_binding_);
-      pinned_main_ = true;
-    }
-    plan_ = static_cast<OmpPlan*>(plan_ptr);
-    exec_ = &x;
-    workload_ = &w;
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    if (options().pin) main_binding_.save_once();
+    step_ = {&plan, &x, &w};
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
-    const bool pin = options_.pin;
+    counters_.reset();
+    const bool pin = options().pin;
     TGRAPH_TSAN_RELEASE(&submit_token_);
-#pragma omp parallel num_threads(static_cast<int>(options_.threads))
+#pragma omp parallel num_threads(static_cast<int>(options().threads))
     {
       TGRAPH_TSAN_ACQUIRE(&submit_token_);
       if (pin) detail::pin_current_thread(static_cast<std::uint32_t>(omp_get_thread_num()));
@@ -262,8 +241,7 @@ class OmpTasksExecutor final : public Executor {
     }
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);
@@ -272,18 +250,14 @@ class OmpTasksExecutor final : public Executor {
     if (error) std::rethrow_exception(error);
   }
 
-  std::unique_ptr<Slot[]> counters_;
-  OmpPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::ThreadSlots counters_;
+  detail::StepContext<OmpPlan> step_;
   std::vector<std::uint32_t> iterations_;
   int decision_ = -1;  // the live loop's break: 1 leave, 0 continue (read after taskwait)
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
-  bool saved_ = false;
-  bool pinned_main_ = false;
-  detail::SavedBinding main_binding_;
+  detail::MainThreadBinding main_binding_;
   char submit_token_ = 0;  // TSan: address standing for libgomp's task creation hand-off
   char join_token_ = 0;    // TSan: address standing for taskwait and the region's end
 };

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "tsan.hpp"
 
 namespace tgraph::replay {
@@ -151,18 +152,18 @@ class ScopedEnv {
   std::optional<std::string> old_;
 };
 
-class StarpuExecutor final : public Executor {
+class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
  public:
   explicit StarpuExecutor(const ExecOptions& o)
-      : Executor(Policy::kStarpu, o),
+      : PlannedExecutor(Policy::kStarpu, o),
         registry_(std::make_shared<Registry>()),
-        counters_(std::make_unique<Slot[]>(o.threads)) {
+        counters_(o.threads) {
     if (o.threads > STARPU_MAXCPUS)
       throw UsageError("--policy starpu: --threads " + std::to_string(o.threads) +
                        ": this StarPU build has at most " + std::to_string(STARPU_MAXCPUS) +
                        " CPU workers (STARPU_MAXCPUS)");
-    if (!known_scheduler(o.starpu_sched))
-      throw UsageError("--starpu-sched " + o.starpu_sched +
+    if (!known_scheduler(o.starpu.sched))
+      throw UsageError("--starpu-sched " + o.starpu.sched +
                        ": not a StarPU scheduler; expected one of " + scheduler_names());
     if (g_starpu_in_use.exchange(true))
       throw UsageError(
@@ -177,7 +178,7 @@ class StarpuExecutor final : public Executor {
     conf.nopencl = 0;
     conf.nmic = 0;
     conf.nmpi_ms = 0;
-    conf.sched_policy_name = options_.starpu_sched.c_str();
+    conf.sched_policy_name = options().starpu.sched.c_str();
     conf.catch_signals = 0;  // leave SIGINT/SIGSEGV to the application
     conf.calibrate = 0;
     conf.bus_calibrate = 0;
@@ -219,13 +220,9 @@ class StarpuExecutor final : public Executor {
   }
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<StarpuPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<StarpuPlan>();
+    auto plan = std::make_unique<StarpuPlan>();
     plan->handles.resize(g.data.size());
     for (starpu_data_handle_t& h : plan->handles) starpu_void_data_register(&h);
     plan->registry = registry_;
@@ -277,8 +274,8 @@ class StarpuExecutor final : public Executor {
 
   void run_instance(Instance& in) {
     const int id = starpu_worker_get_id();
-    const auto thread = static_cast<std::uint32_t>(id < 0 ? 0 : id) % options_.threads;
-    const StarpuPlan& p = *plan_;
+    const auto thread = static_cast<std::uint32_t>(id < 0 ? 0 : id) % options().threads;
+    const StarpuPlan& p = *step_.plan;
     if constexpr (kTsan) {
       // StarPU's queues and dependency release are not instrumented: make the hand-off from
       // the previous accessors of each handle visible to TSan (the submitter's: see body).
@@ -288,19 +285,19 @@ class StarpuExecutor final : public Executor {
     // relaxed: only skips work after a failure; the error itself is passed under a mutex.
     if (!failed_.load(std::memory_order_relaxed)) {
       try {
-        const ExecGraph& x = *exec_;
-        ThreadCounters& tc = counters_[thread].c;
-        if (!observers_.empty()) detail::notify_begin(observers_, thread, in.task, in.iteration);
-        workload_->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
-        if (!observers_.empty()) detail::notify_end(observers_, thread, in.task, in.iteration);
+        const ExecGraph& x = *step_.exec;
+        ThreadCounters& tc = counters_[thread];
+        if (!observers().empty()) detail::notify_begin(observers(), thread, in.task, in.iteration);
+        step_.workload->run(TaskRun{&x, in.task, x.origin[in.task], in.iteration, thread});
+        if (!observers().empty()) detail::notify_end(observers(), thread, in.task, in.iteration);
         ++tc.tasks;
         const LoopId l = x.graph.tasks[in.task].loop;
         if (in.check == Check::kDecide) {
-          in.decision = detail::leave_loop(x, l, in.iteration, *workload_) ? 1 : 0;
+          in.decision = detail::leave_loop(x, l, in.iteration, *step_.workload) ? 1 : 0;
         } else if (in.check != Check::kNone) {
           // The count is only compared with: any count past the next iteration continues.
           const std::uint32_t count = in.iteration + (in.check == Check::kStop ? 1 : 2);
-          in.decision = detail::check_unrolled(x, l, in.iteration, count, *workload_) ? 1 : 0;
+          in.decision = detail::check_unrolled(x, l, in.iteration, count, *step_.workload) ? 1 : 0;
         }
       } catch (...) {
         fail(std::current_exception());
@@ -322,7 +319,7 @@ class StarpuExecutor final : public Executor {
 
   /// Submits instance (t, it); returns the task when `wait` (not detached), else nullptr.
   starpu_task* submit(TaskId t, std::uint32_t it, Check check, bool wait) {
-    const StarpuPlan& p = *plan_;
+    const StarpuPlan& p = *step_.plan;
     instances_.push_back(Instance{this, t, it, check, -1});
     starpu_task* task = starpu_task_create();
     if (task == nullptr) throw std::bad_alloc();
@@ -356,58 +353,49 @@ class StarpuExecutor final : public Executor {
   }
 
   /// Submits the whole step (loops unrolled or host-synchronised); returns early on failure.
-  void submit_step(const ExecGraph& x, Workload& w, StepStats& stats) {
+  void submit_step(const ExecGraph& x, Workload& w, ExecStepStats& stats) {
     const StepGraph& g = x.graph;
-    const auto n = static_cast<TaskId>(g.tasks.size());
-    std::size_t next_loop = 0;
-    for (TaskId t = 0; t < n;) {
-      if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
-      if (next_loop < g.loops.size() && g.loops[next_loop].first == t) {
-        const auto l = static_cast<LoopId>(next_loop++);
-        const Loop& loop = g.loops[l];
-        if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
-          // Unrolled: the break tasks still evaluate the condition, which must agree.
-          const std::uint32_t count = detail::unrolled_count(loop, *known);
-          for (std::uint32_t it = 0; it < count; ++it)
-            for (TaskId u = loop.first; u < loop.last; ++u)
-              submit(u, it,
-                     u + 1 < loop.last ? Check::kNone
-                                       : (it + 1 == count ? Check::kStop : Check::kContinue),
-                     false);
-          stats.loop_iterations[l] = count;
-        } else {
-          for (std::uint32_t it = 0;; ++it) {
-            for (TaskId u = loop.first; u + 1 < loop.last; ++u) submit(u, it, Check::kNone, false);
-            starpu_task* brk = submit(loop.last - 1, it, Check::kDecide, true);
-            const Instance& in = instances_.back();
-            if (const int rc = starpu_task_wait(brk); rc != 0)
-              throw Error("--policy starpu: starpu_task_wait failed (" + std::to_string(rc) + ")");
-            TGRAPH_TSAN_ACQUIRE(&join_token_);
-            stats.loop_iterations[l] = it + 1;
-            if (in.decision != 0) break;  // leave, or the break task did not run (failure)
+    detail::walk_step(
+        g, [this] { return failed_.load(std::memory_order_relaxed); },  // relaxed: see fail()
+        [this](TaskId t) { submit(t, 0, Check::kNone, false); },
+        [&](LoopId l) {
+          const Loop& loop = g.loops[l];
+          if (const std::optional<std::uint32_t> known = w.known_iterations(l)) {
+            // Unrolled: the break tasks still evaluate the condition, which must agree.
+            const std::uint32_t count = detail::unrolled_count(loop, *known);
+            for (std::uint32_t it = 0; it < count; ++it)
+              for (TaskId u = loop.first; u < loop.last; ++u)
+                submit(u, it,
+                       u + 1 < loop.last ? Check::kNone
+                                         : (it + 1 == count ? Check::kStop : Check::kContinue),
+                       false);
+            stats.loop_iterations[l] = count;
+          } else {
+            for (std::uint32_t it = 0;; ++it) {
+              for (TaskId u = loop.first; u + 1 < loop.last; ++u)
+                submit(u, it, Check::kNone, false);
+              starpu_task* brk = submit(loop.last - 1, it, Check::kDecide, true);
+              const Instance& in = instances_.back();
+              if (const int rc = starpu_task_wait(brk); rc != 0)
+                throw Error("--policy starpu: starpu_task_wait failed (" + std::to_string(rc) +
+                            ")");
+              TGRAPH_TSAN_ACQUIRE(&join_token_);
+              stats.loop_iterations[l] = it + 1;
+              if (in.decision != 0) break;  // leave, or the break task did not run (failure)
+            }
           }
-        }
-        t = loop.last;
-        continue;
-      }
-      submit(t, 0, Check::kNone, false);
-      ++t;
-    }
+        });
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
+  void run(StarpuPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    plan_ = static_cast<StarpuPlan*>(plan_ptr);
-    exec_ = &x;
-    workload_ = &w;
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    step_ = {&plan, &x, &w};
     instances_.clear();
     error_ = nullptr;
     failed_.store(false, std::memory_order_relaxed);  // relaxed: no task runs now
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    counters_.reset();
     stats.loop_iterations.assign(g.loops.size(), 0);
     starpu_resume();
     try {
@@ -418,8 +406,7 @@ class StarpuExecutor final : public Executor {
     starpu_task_wait_for_all();  // never leave a submitted task behind, even on error
     starpu_pause();
     TGRAPH_TSAN_ACQUIRE(&join_token_);
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     std::exception_ptr error;
     {
       std::lock_guard lock(error_mutex_);
@@ -429,11 +416,9 @@ class StarpuExecutor final : public Executor {
   }
 
   std::shared_ptr<Registry> registry_;
-  std::unique_ptr<Slot[]> counters_;
+  detail::ThreadSlots counters_;
   starpu_codelet codelet_{};
-  StarpuPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::StepContext<StarpuPlan> step_;
   std::deque<Instance> instances_;  // this step's instances (stable addresses)
   std::atomic<bool> failed_{false};
   std::mutex error_mutex_;

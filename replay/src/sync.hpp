@@ -120,6 +120,28 @@ struct SavedBinding {
 void save_binding(SavedBinding& s);
 void restore_binding(SavedBinding& s);
 
+/// The calling thread's binding before an executor first pinned it (as thread 0), restored
+/// when the executor is destroyed.
+class MainThreadBinding {
+ public:
+  MainThreadBinding() = default;
+  ~MainThreadBinding() {
+    if (saved_) restore_binding(binding_);
+  }
+  MainThreadBinding(const MainThreadBinding&) = delete;
+  MainThreadBinding& operator=(const MainThreadBinding&) = delete;
+  /// Saves the calling thread's binding the first time; later calls do nothing.
+  void save_once() {
+    if (saved_) return;
+    saved_ = true;
+    save_binding(binding_);
+  }
+
+ private:
+  bool saved_ = false;
+  SavedBinding binding_;
+};
+
 /// Number of processing units.
 unsigned hardware_pus();
 

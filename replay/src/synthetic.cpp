@@ -56,8 +56,8 @@ void write_pass(AccessMode mode, std::uint64_t* w, std::uint64_t n, std::uint64_
   }
 }
 
-Calibration measure() {
-  Calibration c;
+SyntheticCalibration measure() {
+  SyntheticCalibration c;
   // The median of several ~1 ms runs: the sustained rate a replay sees (the best of short
   // runs catches a briefly higher clock and makes every task spin too long).
   std::vector<double> rates;
@@ -87,8 +87,8 @@ Calibration measure() {
 
 }  // namespace
 
-const Calibration& SyntheticWorkload::calibration() {
-  static const Calibration c = measure();
+const SyntheticCalibration& SyntheticWorkload::calibration() {
+  static const SyntheticCalibration c = measure();
   return c;
 }
 
@@ -172,7 +172,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
   const auto acc_list = x.graph.accesses_of(r.task);
   const auto orig = step_ ? step_->accesses_of(r.origin) : acc_list;
   const std::size_t na = std::min(acc_list.size(), orig.size());
-  const Calibration& c = calibration();
+  const SyntheticCalibration& c = calibration();
   const double recorded = static_cast<double>(step_ ? step_->tasks[r.origin].cost_ns : 0);
   const double cost = recorded * options_.cost_scale;
   // A task whose recorded time is shorter than a pass over all its data at in-cache speed

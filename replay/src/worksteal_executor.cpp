@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "common.hpp"
+#include "planned_executor.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 #include "worksteal_task.hpp"
@@ -46,22 +47,18 @@ struct WsPlan {
   std::unique_ptr<std::atomic<std::uint32_t>[]> count0;  // non-loop tasks
 };
 
-class WorkstealExecutor final : public Executor {
+class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
  public:
   explicit WorkstealExecutor(const ExecOptions& o)
-      : Executor(Policy::kWorksteal, o),
+      : PlannedExecutor(Policy::kWorksteal, o),
         control_(tbb::global_control::max_allowed_parallelism, o.threads),
         arena_(static_cast<int>(o.threads)),
-        counters_(std::make_unique<Slot[]>(o.threads)) {}
+        counters_(o.threads) {}
 
  private:
-  struct alignas(64) Slot {
-    ThreadCounters c;
-  };
-
-  std::shared_ptr<void> build(const ExecGraph& x) override {
+  std::unique_ptr<WsPlan> build_plan(const ExecGraph& x) override {
     const StepGraph& g = x.graph;
-    auto plan = std::make_shared<WsPlan>();
+    auto plan = std::make_unique<WsPlan>();
     const auto n = g.tasks.size();
     plan->n = n;
     plan->succ = detail::build_csr(n, g.edges, false);
@@ -117,7 +114,7 @@ class WorkstealExecutor final : public Executor {
     // relaxed: the block is published afterwards by a release store of its table entry (or
     // before any spawn, which TBB orders), so these initial values are seen by all users.
     for (std::size_t j = 0; j < size; ++j)
-      b->count[j].store(first ? plan_->init0[ls.first + j] : ls.init_next[j],
+      b->count[j].store(first ? step_.plan->init0[ls.first + j] : ls.init_next[j],
                         std::memory_order_relaxed);
     b->remaining.store(static_cast<std::uint32_t>(size), std::memory_order_relaxed);
     return b;
@@ -144,11 +141,11 @@ class WorkstealExecutor final : public Executor {
 
   // A dependency of task s on an instance outside its loop (or s outside loops) is met.
   void release_first(TaskId s, ThreadCounters& tc) {
-    const LoopId ls = exec_->graph.tasks[s].loop;
+    const LoopId ls = step_.exec->graph.tasks[s].loop;
     if (ls == kNoLoop) {
-      dec(plan_->count0[s], s, 0, tc);
+      dec(step_.plan->count0[s], s, 0, tc);
     } else {
-      LoopState& st = plan_->loops[ls];
+      LoopState& st = step_.plan->loops[ls];
       // acquire: the block was published with release before any instance could see it.
       Block* b = st.table[0].load(std::memory_order_acquire);
       dec(b->count[s - st.first], s, 0, tc);
@@ -157,21 +154,21 @@ class WorkstealExecutor final : public Executor {
 
   void run_instance(TaskId t, std::uint32_t it) {
     const int idx = tbb::this_task_arena::current_thread_index();
-    const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options_.threads;
-    ThreadCounters& tc = counters_[thread].c;
-    const ExecGraph& x = *exec_;
-    const bool observe = !observers_.empty() && detail::sampled(it, observe_stride_);
-    if (observe) detail::notify_begin(observers_, thread, t, it);
-    workload_->run(TaskRun{&x, t, x.origin[t], it, thread});
-    if (observe) detail::notify_end(observers_, thread, t, it);
+    const auto thread = static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % options().threads;
+    ThreadCounters& tc = counters_[thread];
+    const ExecGraph& x = *step_.exec;
+    const bool observe = !observers().empty() && detail::sampled(it, observe_stride());
+    if (observe) detail::notify_begin(observers(), thread, t, it);
+    step_.workload->run(TaskRun{&x, t, x.origin[t], it, thread});
+    if (observe) detail::notify_end(observers(), thread, t, it);
     ++tc.tasks;
     const LoopId l = x.graph.tasks[t].loop;
-    const WsPlan& p = *plan_;
+    const WsPlan& p = *step_.plan;
     if (l == kNoLoop) {
       for (auto i = p.succ.begin[t]; i < p.succ.begin[t + 1]; ++i) release_first(p.succ.ids[i], tc);
       return;
     }
-    LoopState& ls = plan_->loops[l];
+    LoopState& ls = step_.plan->loops[l];
     // acquire: blocks are published with release before the instances that use them run.
     Block* cur = ls.table[it].load(std::memory_order_acquire);
     Block* next = ls.table[it + 1].load(std::memory_order_acquire);
@@ -185,7 +182,7 @@ class WorkstealExecutor final : public Executor {
     }
     dec(next->count[t - ls.first], t, it + 1, tc);
     if (t + 1 == ls.last) {
-      const bool stop = detail::leave_loop(x, l, it, *workload_);
+      const bool stop = detail::leave_loop(x, l, it, *step_.workload);
       // relaxed: published by the release of the remaining-count decrement below.
       cur->decision.store(stop ? 1 : 0, std::memory_order_relaxed);
       if (stop) {
@@ -205,18 +202,13 @@ class WorkstealExecutor final : public Executor {
     }
   }
 
-  void execute(void* plan_ptr, const ExecGraph& x, Workload& w, bool fresh,
-               StepStats& stats) override {
-    WsPlan& plan = *static_cast<WsPlan*>(plan_ptr);
+  void run(WsPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+           ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
-    if (fresh)
-      for (DatumId d = 0; d < g.data.size(); ++d)
-        if (w.needs_touch(d)) w.first_touch(d);  // no affinity: touched by the calling thread
-    plan_ = &plan;
-    exec_ = &x;
-    workload_ = &w;
+    if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    step_ = {&plan, &x, &w};
     iterations_.assign(g.loops.size(), 0);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) counters_[p].c = {};
+    counters_.reset();
     for (TaskId t = 0; t < plan.n; ++t)
       plan.count0[t].store(plan.init0[t], std::memory_order_relaxed);  // relaxed: before any spawn
     for (LoopState& ls : plan.loops) {
@@ -244,18 +236,15 @@ class WorkstealExecutor final : public Executor {
         delete b;
         e.store(nullptr, std::memory_order_relaxed);  // relaxed: no task runs now
       }
-    stats.threads.resize(options_.threads);
-    for (std::uint32_t p = 0; p < options_.threads; ++p) stats.threads[p] = counters_[p].c;
+    counters_.copy_to(stats);
     stats.loop_iterations = iterations_;
     if (error) std::rethrow_exception(error);
   }
 
   tbb::global_control control_;
   tbb::task_arena arena_;
-  std::unique_ptr<Slot[]> counters_;
-  WsPlan* plan_ = nullptr;
-  const ExecGraph* exec_ = nullptr;
-  Workload* workload_ = nullptr;
+  detail::ThreadSlots counters_;
+  detail::StepContext<WsPlan> step_;
   tbb::task_group* tg_ = nullptr;
   std::vector<std::uint32_t> iterations_;
   char spawn_token_ = 0;  // TSan: address standing for TBB's spawn hand-off

@@ -149,6 +149,19 @@ void prepare(const Scene& scene, Scene::Impl& m) {
   for (std::size_t f = 0; f < m.floors.size(); ++f) c.floor_slots.push_back(std::make_unique<ContactSlot>());
 }
 
+// What detection works on: the collision state (sized by prepare()), the settings, the bodies.
+struct Detection {
+  CollisionState& c;
+  const CollisionSettings& cs;
+  const std::vector<std::unique_ptr<Body>>& bodies;
+  std::size_t n;  // bodies.size()
+};
+
+Detection detection_of(Scene& scene, Scene::Impl& m) {
+  prepare(scene, m);
+  return {m.collide, scene.collision(), scene.bodies(), scene.bodies().size()};
+}
+
 ContactSlot& pair_slot(CollisionState& c, int i, int j) {
   auto& slot = c.pair_slots[{i, j}];
   if (!slot) slot = std::make_unique<ContactSlot>();
@@ -158,11 +171,7 @@ ContactSlot& pair_slot(CollisionState& c, int i, int j) {
 }  // namespace
 
 void detect_collisions(Scene& scene, Scene::Impl& m) {
-  prepare(scene, m);
-  CollisionState& c = m.collide;
-  const CollisionSettings& cs = scene.collision();
-  const auto& bodies = scene.bodies();
-  const std::size_t n = bodies.size();
+  const auto [c, cs, bodies, n] = detection_of(scene, m);
   // Results stamped with the last program's epoch were computed from the positions it left.
   const auto fresh = [&c](std::uint64_t epoch) { return c.epoch != 0 && epoch == c.epoch; };
   c.host_narrow = 0;
@@ -221,11 +230,7 @@ void detect_collisions(Scene& scene, Scene::Impl& m) {
 }
 
 void plan_detection(Scene& scene, Scene::Impl& m) {
-  prepare(scene, m);
-  CollisionState& c = m.collide;
-  const CollisionSettings& cs = scene.collision();
-  const auto& bodies = scene.bodies();
-  const std::size_t n = bodies.size();
+  const auto [c, cs, bodies, n] = detection_of(scene, m);
   c.planned_pairs.clear();
   c.planned_floors.clear();
   // How far each body may move in this step: twice what it moved in the last one. A body that

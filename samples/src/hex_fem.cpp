@@ -176,57 +176,60 @@ std::uint64_t HexFemForceField::state_bytes() const { return rotations_.size() *
 namespace {
 constexpr int kBatch = HexFemForceField::kBatch;
 using Batch = Eigen::Matrix<double, 24, kBatch>;
+
+// For each batch of up to kBatch elements of one matrix K_e: gather(e, column) writes element
+// e's 24 local values into its column of `in`, out = K_e in, then scatter(e, column) reads
+// element e's 24 results from its column of `out`.
+template <class Matrices, class Gather, class Scatter>
+void for_each_batch(const std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>>& batches,
+                    const Matrices& ke, Gather&& gather, Scatter&& scatter) {
+  Batch in, out;
+  for (const auto& [k, elems] : batches) {
+    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
+      const int n = static_cast<int>(std::min<std::size_t>(kBatch, elems.size() - start));
+      for (int c = 0; c < n; ++c) gather(elems[start + static_cast<std::size_t>(c)], in.col(c).data());
+      out.leftCols(n).noalias() = ke[k] * in.leftCols(n);
+      for (int c = 0; c < n; ++c) scatter(elems[start + static_cast<std::size_t>(c)], out.col(c).data());
+    }
+  }
+}
 }  // namespace
 
 void HexFemForceField::add_force() {
   const StateVec& x = body_->vec(VecId::kX);
   StateVec& f = body_->vec(VecId::kF);
-  Batch u, fe;
-  for (const auto& [ke, elems] : batches_) {
-    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
-      const int n = static_cast<int>(std::min<std::size_t>(kBatch, elems.size() - start));
-      for (int c = 0; c < n; ++c) {
-        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+  for_each_batch(
+      batches_, ke_,
+      [&](std::uint32_t e, double* u) {
         const auto& nodes = elements_[e];
         Mat38 xe;
         for (int i = 0; i < 8; ++i) xe.col(i) = x.col(nodes[static_cast<std::size_t>(i)]);
         rotations_[e] = extract_rotation(xe * grad_[e].transpose(), quats_[e]);
-        Eigen::Map<Mat38>(u.col(c).data()) = rotations_[e].transpose() * xe - rest_[e];
-      }
-      fe.leftCols(n).noalias() = ke_[ke] * u.leftCols(n);
-      for (int c = 0; c < n; ++c) {
-        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        Eigen::Map<Mat38>{u} = rotations_[e].transpose() * xe - rest_[e];
+      },
+      [&](std::uint32_t e, const double* fe) {
         const auto& nodes = elements_[e];
-        const Mat38 fw = -(rotations_[e] * Eigen::Map<const Mat38>(fe.col(c).data()));
+        const Mat38 fw = -(rotations_[e] * Eigen::Map<const Mat38>(fe));
         for (int i = 0; i < 8; ++i) f.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
-      }
-    }
-  }
+      });
 }
 
 void HexFemForceField::add_dforce(VecId df, VecId dx, double k_factor, double /*b_factor*/) {
   const StateVec& in = body_->vec(dx);
   StateVec& out = body_->vec(df);
-  Batch local, fe;
-  for (const auto& [ke, elems] : batches_) {
-    for (std::size_t start = 0; start < elems.size(); start += kBatch) {
-      const int n = static_cast<int>(std::min<std::size_t>(kBatch, elems.size() - start));
-      for (int c = 0; c < n; ++c) {
-        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+  for_each_batch(
+      batches_, ke_,
+      [&](std::uint32_t e, double* local) {
         const auto& nodes = elements_[e];
         Mat38 de;
         for (int i = 0; i < 8; ++i) de.col(i) = in.col(nodes[static_cast<std::size_t>(i)]);
-        Eigen::Map<Mat38>(local.col(c).data()) = rotations_[e].transpose() * de;
-      }
-      fe.leftCols(n).noalias() = ke_[ke] * local.leftCols(n);
-      for (int c = 0; c < n; ++c) {
-        const std::uint32_t e = elems[start + static_cast<std::size_t>(c)];
+        Eigen::Map<Mat38>{local} = rotations_[e].transpose() * de;
+      },
+      [&](std::uint32_t e, const double* fe) {
         const auto& nodes = elements_[e];
-        const Mat38 fw = (-k_factor) * (rotations_[e] * Eigen::Map<const Mat38>(fe.col(c).data()));
+        const Mat38 fw = (-k_factor) * (rotations_[e] * Eigen::Map<const Mat38>(fe));
         for (int i = 0; i < 8; ++i) out.col(nodes[static_cast<std::size_t>(i)]) += fw.col(i);
-      }
-    }
-  }
+      });
 }
 
 std::vector<std::vector<std::array<Index, 8>>> HexFemForceField::element_batches() const {

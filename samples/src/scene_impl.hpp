@@ -166,6 +166,11 @@ void declare_detection(Scene& scene, Scene::Impl& impl, capture::Recorder& rec);
 /// write the contact set). `x_of(body)` is the datum of a body's positions.
 void record_detection(Scene& scene, Scene::Impl& impl, capture::Recorder& rec,
                       const std::function<DatumId(int)>& x_of);
+/// Collision groups: the connected components of the interactions (permanent and contact
+/// fields; one group under Coupling::kShared) into `impl.groups` and `impl.body_group`, each
+/// with its bodies' fields and constraints, its interactions and its solver (samples/src/scene.cpp).
+/// Returns the interactions, permanent first.
+std::vector<ForceField*> form_groups(const Scene& scene, Scene::Impl& impl);
 /// Divergence checks of the state the last executed step left (samples/src/divergence.cpp):
 /// throws DivergenceError; the first call records the reference energies.
 void check_divergence(const Scene& scene, Scene::Impl& impl);

@@ -52,6 +52,13 @@ class Cli : public ::testing::Test {
     r.err = slurp(err);
     return r;
   }
+  // Runs `tgraph ARGS` expecting exit 0 and parses its standard output as JSON; null when the
+  // run failed (the failure recorded), so that a caller's non-const j["key"] fails its checks.
+  nlohmann::json run_json(const std::string& args) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 0) << args << ": " << r.err;
+    return r.code == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+  }
   static bool one_line(const std::string& s) {
     return !s.empty() && s.back() == '\n' && std::count(s.begin(), s.end(), '\n') == 1;
   }
@@ -116,9 +123,7 @@ TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {
 // updateVelocity -> updatePosition (RAW on v, 2): 12 edges, no loops.
 TEST_F(Cli, Fig2CaptureInfoReportsTheFigure2Graph) {
   ASSERT_EQ(run("capture --scene fig2 --steps 10 -o f.tgt").code, 0);
-  const Result r = run("info f.tgt --json");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  auto j = run_json("info f.tgt --json");
   EXPECT_EQ(j["steps"], 10);
   EXPECT_EQ(j["tasks"], 90);
   EXPECT_EQ(j["edges"], 120);
@@ -183,9 +188,7 @@ TEST_F(Cli, ExportWritesNothingOnBadInput) {
 }
 
 TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
-  const Result r = run("demo --scene fig2 --steps 3 --repeat 1 --threads 2 --out d --json");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  auto j = run_json("demo --scene fig2 --steps 3 --repeat 1 --threads 2 --out d --json");
   std::vector<std::string> names;
   for (const auto& row : j["rows"]) {
     names.push_back(row["method"]);
@@ -299,9 +302,7 @@ TEST_F(Cli, InfoUnitCostGivesTheSpanInTasks) {
 
 TEST_F(Cli, SequentialReplayIsItsOwnBaselineWithSpeedupOne) {
   ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
-  const Result r = run("replay f.tgt --policy sequential --repeat 1 --json");
-  ASSERT_EQ(r.code, 0) << r.err;
-  const auto j = nlohmann::json::parse(r.out);
+  auto j = run_json("replay f.tgt --policy sequential --repeat 1 --json");
   EXPECT_EQ(j["speedup"], 1.0);
   EXPECT_EQ(j["sequential_wall_ns"], j["wall_ns"]);
 }

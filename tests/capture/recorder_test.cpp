@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstring>
+#include <functional>
 #include <ranges>
 #include <span>
 #include <vector>
@@ -21,6 +22,20 @@ void busy_wait(std::chrono::nanoseconds d) {
   const auto until = std::chrono::steady_clock::now() + d;
   while (std::chrono::steady_clock::now() < until) {
   }
+}
+
+// One step holding one loop on datum "c" whose break never fires, so that it runs
+// `iterations` times (its maximum); each iteration records one task writing c that runs `body`.
+StepGraph loop_of_one_task(Recorder& rec, std::uint32_t iterations, const std::function<void()>& body) {
+  const DatumId c = rec.datum("c", kNoObject, 1);
+  const KindId k = rec.kind("k");
+  rec.begin_step();
+  const LoopId l = rec.begin_loop(c, iterations);
+  do {
+    rec.task(k, kNoObject, {{c, M::W}}, [&body] { body(); });
+  } while (!rec.conditional_break(l, [] { return false; }));
+  rec.end_loop(l);
+  return rec.end_step();
 }
 
 struct Scene {
@@ -199,16 +214,8 @@ TEST(Recorder, DeferredModeKeepsBodiesAndRunsNothing) {
 
 TEST(Recorder, LoopStopsAtMaxIterations) {
   Recorder rec(Mode::kCapture);
-  const DatumId c = rec.datum("c", kNoObject, 1);
-  const KindId k = rec.kind("k");
-  rec.begin_step();
-  const LoopId l = rec.begin_loop(c, 7);
   int n = 0;
-  do {
-    rec.task(k, kNoObject, {{c, M::W}}, [&] { ++n; });
-  } while (!rec.conditional_break(l, [] { return false; }));
-  rec.end_loop(l);
-  const StepGraph g = rec.end_step();
+  const StepGraph g = loop_of_one_task(rec, 7, [&] { ++n; });
   EXPECT_EQ(n, 7);
   EXPECT_EQ(g.loops[0].iterations, 7u);
 }
@@ -244,28 +251,12 @@ TEST(Recorder, ScopeRecordsOneTimedTask) {
   EXPECT_GT(g.tasks[0].cost_ns, 0u);
 }
 
-}  // namespace
-}  // namespace tgraph::capture
-
-namespace tgraph::capture {
-namespace {
-
 TEST(Recorder, LoopTaskCostLeavesOutItsLongestIteration) {
   Recorder rec(Mode::kCapture);
-  const DatumId c = rec.datum("c", kNoObject, 1);
-  const KindId k = rec.kind("k");
-  rec.begin_step();
-  const LoopId l = rec.begin_loop(c, 5);
   int it = 0;
-  do {
-    rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
-      if (it++ == 2) {  // one iteration "preempted" for 20 ms
-        busy_wait(std::chrono::milliseconds(20));
-      }
-    });
-  } while (!rec.conditional_break(l, [] { return false; }));
-  rec.end_loop(l);
-  const StepGraph g = rec.end_step();
+  const StepGraph g = loop_of_one_task(rec, 5, [&] {
+    if (it++ == 2) busy_wait(std::chrono::milliseconds(20));  // one iteration "preempted" for 20 ms
+  });
   ASSERT_EQ(g.loops[0].iterations, 5u);
   // With the outlier the mean would be >= 4 ms; without it, the empty body's cost.
   EXPECT_LT(g.tasks[0].cost_ns, 1'000'000u);
@@ -284,39 +275,19 @@ TEST(Recorder, TaskCostsAreInNanoseconds) {
   EXPECT_LT(g.tasks[0].cost_ns, 2'000'000'000u);  // not µs, not ps: a loaded machine may stretch it
 }
 
-}  // namespace
-}  // namespace tgraph::capture
-
-namespace tgraph::capture {
-namespace {
-
 TEST(Recorder, SampledLoopTimingEstimatesThePerIterationCost) {
   Recorder rec(Mode::kCapture);
-  const DatumId c = rec.datum("c", kNoObject, 1);
-  const KindId k = rec.kind("k");
-  rec.begin_step();
-  const LoopId l = rec.begin_loop(c, 20);
   int runs = 0;
-  do {
-    rec.task(k, kNoObject, {{c, AccessMode::W}}, [&] {
-      ++runs;
-      busy_wait(std::chrono::microseconds(200));
-    });
-  } while (!rec.conditional_break(l, [] { return false; }));
-  rec.end_loop(l);
-  const StepGraph g = rec.end_step();
+  const StepGraph g = loop_of_one_task(rec, 20, [&] {
+    ++runs;
+    busy_wait(std::chrono::microseconds(200));
+  });
   EXPECT_EQ(runs, 20);  // every iteration ran, timed or not
   ASSERT_EQ(g.loops[0].iterations, 20u);
   // Timed: iterations 0, 1, 2, 4, 8, 12, 16; each cost at least 200 us.
   EXPECT_GE(g.tasks[0].cost_ns, 200'000u);
   EXPECT_LT(g.tasks[0].cost_ns, 2'000'000u);
 }
-
-}  // namespace
-}  // namespace tgraph::capture
-
-namespace tgraph::capture {
-namespace {
 
 // Cost passes: the ball scene's state after every step equals a run with one pass, bit for
 // bit (the written data are restored between passes), and bodies run `passes` times.

@@ -8,26 +8,17 @@ import csv
 import json
 import os
 import re
-import subprocess
 import sys
 import tempfile
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from experiment_check import check, problems, run_experiment  # noqa: E402
+
 tgraph, name = sys.argv[1], sys.argv[2]
-problems = []
-
-
-def check(ok, what):
-    if not ok:
-        problems.append(what)
-    return ok
-
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "results")
-    run = subprocess.run([tgraph, "experiment", name, "--quick", "--out", out],
-                         capture_output=True, text=True, timeout=850)
-    if run.returncode != 0:
-        sys.exit(f"exit {run.returncode}\nstdout:\n{run.stdout}\nstderr:\n{run.stderr}")
+    run = run_experiment(tgraph, [name, "--quick", "--out", out], timeout=850)
     j = json.load(open(os.path.join(out, "results.json")))
     cores = j["machine"]["cores"]
     plan = j["plan"]

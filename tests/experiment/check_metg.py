@@ -6,26 +6,17 @@
 #   check_metg.py TGRAPH
 import json
 import os
-import subprocess
 import sys
 import tempfile
 
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+from experiment_check import check, problems, run_experiment  # noqa: E402
+
 tgraph = sys.argv[1]
-problems = []
-
-
-def check(ok, what):
-    if not ok:
-        problems.append(what)
-    return ok
-
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "metg")
-    run = subprocess.run([tgraph, "experiment", "metg", "--quick", "--out", out, "--json"],
-                         capture_output=True, text=True, timeout=600)
-    if run.returncode != 0:
-        sys.exit(f"exit {run.returncode}\nstdout:\n{run.stdout}\nstderr:\n{run.stderr}")
+    run = run_experiment(tgraph, ["metg", "--quick", "--out", out, "--json"], timeout=600)
     printed = json.loads(run.stdout)
     j = json.load(open(os.path.join(out, "results.json")))
     check(printed["metg"] == j["metg"], "--json and results.json disagree on metg")
@@ -59,14 +50,14 @@ with tempfile.TemporaryDirectory() as tmp:
                (r["policy"], r["shape"], r["threads"])]
         ok = [p["granularity_ns"] for p in pts if p["efficiency"] >= 0.5]
         check(ok and r["metg_ns"] == min(ok), f"metg_ns of {r} is not the smallest at >= 50 %")
-    # The sequential policy is the reference (efficiency 1): it reaches 50 % on every shape,
-    # at the smallest duration swept there, its granularity at least that duration's.
+    # The sequential policy is the reference (efficiency 1 up to the noise between two timed
+    # runs of it): it reaches 50 % on every shape, with a granularity at least half the task
+    # duration there. (Not required at the smallest duration: on a loaded machine two
+    # sequential runs of 1 us tasks can differ by more than 2x.)
     for s in shapes:
         r = seen.get(("sequential", s, 1), {})
         check("metg_ns" in r, f"sequential {s} has no METG")
-        pts = [p for p in j["points"] if p["policy"] == "sequential" and p["shape"] == s]
-        if "metg_ns" in r and pts:
-            check(r["task_ns"] == min(p["task_ns"] for p in pts), f"sequential {s}: {r}")
+        if "metg_ns" in r:
             check(r["metg_ns"] >= 0.5 * r["task_ns"], f"sequential {s}: granularity {r}")
     for p in j["points"]:
         check(p["wall_ns"] > 0 and p["instances"] > 0, f"point {p}")

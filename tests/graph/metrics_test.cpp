@@ -95,5 +95,12 @@ TEST(Metrics, EmptyGraphHasZeroParallelism) {
   EXPECT_EQ(m.parallelism, 0.0);
 }
 
+TEST(IncomingEdges, ListsTheEdgesIntoEachTaskInListOrder) {
+  const std::vector<Edge> edges = {{0, 2, 0}, {1, 2, 0}, {0, 1, 0}, {2, 3, 0}, {0, 3, 0}};
+  const IncomingEdges in = incoming_edges(5, edges);
+  EXPECT_EQ(in.begin, (std::vector<std::uint32_t>{0, 0, 1, 3, 5, 5}));
+  EXPECT_EQ(in.edge, (std::vector<std::uint32_t>{2, 0, 1, 3, 4}));
+}
+
 }  // namespace
 }  // namespace tgraph

@@ -341,6 +341,21 @@ TEST(TraceIo, WriteTraceTraceWriterAndEncodeTraceGiveTheSameBytes) {
   EXPECT_EQ(slurp(streamed), encoded);
 }
 
+// Reads an unclosed trace with --recover: `header` and more than `at_least` steps, step i
+// being make_step(i % 3, i) (what the writers in these tests append).
+void expect_recovered_steps(const Bytes& bytes, const TraceHeader& header, std::size_t at_least) {
+  ReadOptions recover;
+  recover.recover = true;
+  const Trace back = read_trace_bytes(bytes, "unclosed", recover);
+  EXPECT_EQ(back.header, header);
+  ASSERT_GT(back.steps.size(), at_least);
+  for (std::size_t i = 0; i < back.steps.size(); ++i) {
+    StepGraph expected = make_step(static_cast<int>(i % 3), static_cast<int>(i));
+    expected.derive_edges();
+    ASSERT_EQ(back.steps[i], expected) << "step " << i;
+  }
+}
+
 TEST(TraceWriter, StoresRepeatedStructureAsReferenceFrames) {
   const Trace trace = make_trace({0, 1, 0, 0, 1, 2});
   const Bytes bytes = encode_trace(trace);
@@ -439,16 +454,7 @@ TEST(TraceWriter, CaptureKilledBySigkillLeavesItsCompleteStepsReadable) {
   const Bytes bytes = slurp(p.string() + ".partial");
   EXPECT_FALSE(fs::exists(p));
   EXPECT_READ_ERROR(bytes, "capture interrupted?) — read with --recover");
-  ReadOptions recover;
-  recover.recover = true;
-  const Trace back = read_trace_bytes(bytes, p.string(), recover);
-  EXPECT_EQ(back.header, header);
-  ASSERT_GT(back.steps.size(), 10u);
-  for (std::size_t i = 0; i < back.steps.size(); ++i) {
-    StepGraph expected = make_step(static_cast<int>(i % 3), static_cast<int>(i));
-    expected.derive_edges();
-    ASSERT_EQ(back.steps[i], expected) << "step " << i;
-  }
+  expect_recovered_steps(bytes, header, 10);
 }
 
 TEST(TraceWriter, DestroyedWithoutCloseLeavesAnUnclosedTrace) {
@@ -529,16 +535,7 @@ TEST(TraceWriter, AFailedWriteLeavesTheCompleteFramesReadable) {
   EXPECT_LE(bytes.size(), 20000u);
   // Cut back to a frame boundary: the reader sees a clean end without an end frame.
   EXPECT_READ_ERROR(bytes, "trace not closed (");
-  ReadOptions recover;
-  recover.recover = true;
-  const Trace back = read_trace_bytes(bytes, "fsize", recover);
-  EXPECT_EQ(back.header, header);
-  ASSERT_GT(back.steps.size(), 5u);
-  for (std::size_t i = 0; i < back.steps.size(); ++i) {
-    StepGraph expected = make_step(static_cast<int>(i % 3), static_cast<int>(i));
-    expected.derive_edges();
-    ASSERT_EQ(back.steps[i], expected) << "step " << i;
-  }
+  expect_recovered_steps(bytes, header, 5);
 }
 
 // ---- hand-made files and the reference encoder in the test agree ------------------------

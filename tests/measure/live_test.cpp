@@ -41,7 +41,6 @@ LiveResult live(const std::string& scene, Policy policy, const std::string& meth
   o.exec.threads = k;
   o.exec.spin_ns = 20'000;
   o.exec.cw = cw;
-  o.exec.verify_plans = true;  // every incrementally updated plan equals a full build
   o.steps = steps;
   o.baseline = false;
   o.observe = false;

@@ -49,11 +49,12 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   ASSERT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0) << read_file_text((dir / "out.txt").string());
   const partition::CostModel m = partition::load_calibration(file);
   EXPECT_DOUBLE_EQ(m.sync_latency_ns, 85.5);  // kept
-  // Measured between two processes: above zero, below a millisecond and 1 ns/byte (1 GB/s).
+  // Measured between two processes, in nanoseconds: above zero, below a second and 1 us/byte
+  // (the units, not the speed: a loaded machine measured 5.8 ns/byte where a quiet one 0.09).
   EXPECT_GT(m.mpi_latency_ns, 0.0);
-  EXPECT_LT(m.mpi_latency_ns, 1e6);
+  EXPECT_LT(m.mpi_latency_ns, 1e9);
   EXPECT_GT(m.mpi_per_byte_ns, 0.0);
-  EXPECT_LT(m.mpi_per_byte_ns, 1.0);
+  EXPECT_LT(m.mpi_per_byte_ns, 1e3);
   // No file to add to: exit 2.
   const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
                               dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +

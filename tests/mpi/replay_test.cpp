@@ -172,6 +172,21 @@ TEST(MpiReplay, WatchdogNamesTheStuckRankAndWhatItWaitsFor) {
   fs::remove_all(dir);
 }
 
+// --host-work: rank 0 runs each step's host work before any task, every rank waiting at a
+// barrier; the run stays bit-identical and sends exactly what was predicted.
+TEST(MpiReplay, HostWorkKeepsTheRunIdenticalAndAsPredicted) {
+  const fs::path dir = scratch();
+  const fs::path trace = dir / "falling.tgt";
+  const Outcome cap = run(
+      std::string(TGRAPH_BIN) + " capture --scene falling --steps 2 -o " + trace.string(), dir);
+  ASSERT_EQ(cap.status, 0) << cap.err;
+  const nlohmann::json j =
+      replay_json(trace.string() + " --threads-per-rank 1 --host-work", 2, dir);
+  expect_exact(j, 2);
+  EXPECT_EQ(j["per_step"].size(), 2u);
+  fs::remove_all(dir);
+}
+
 TEST(MpiReplay, RejectsAnAssignmentForAnotherProcessorCount) {
   const fs::path dir = scratch();
   write_random(dir / "random.tgt", dir / "random.tga", 3);

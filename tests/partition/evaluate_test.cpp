@@ -27,15 +27,21 @@ TraceAssignment one_step(std::uint32_t k, std::vector<ProcId> proc) {
   return a;
 }
 
-TEST(Evaluate, CountsCutSignalsReducersAndImbalance) {
+// Four tasks of 10 ns: 0 writes x (100 bytes); 1 and 2 read x and reduce into f (40 bytes);
+// 3 reads f. The tests put 0, 1 and 3 on p0 and 2 on p1.
+StepGraph writer_two_reducers_reader() {
   Builder b;
   const DatumId x = b.datum("x", 100), f = b.datum("f", 40);
-  b.task({{x, M::W}}, 10);             // 0 p0
-  b.task({{x, M::R}, {f, M::CW}}, 10); // 1 p0
-  b.task({{x, M::R}, {f, M::CW}}, 10); // 2 p1
-  b.task({{f, M::R}}, 10);             // 3 p0
+  b.task({{x, M::W}}, 10);              // 0
+  b.task({{x, M::R}, {f, M::CW}}, 10);  // 1
+  b.task({{x, M::R}, {f, M::CW}}, 10);  // 2
+  b.task({{f, M::R}}, 10);              // 3
+  return b.done();
+}
+
+TEST(Evaluate, CountsCutSignalsReducersAndImbalance) {
   Trace tr;
-  tr.steps = {b.done()};
+  tr.steps = {writer_two_reducers_reader()};
   const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), CostModel::ideal());
   const StepReport& s = r.steps[0];
   // Cross edges: 0->2 (x, 100 bytes) and 2->3 (f, 40 bytes).
@@ -165,13 +171,7 @@ TEST(Evaluate, EvaluatesATracePartitionedByEveryMethod) {
 }
 
 TEST(StepQuotient, SplitsTheCutAndTheSignalsByProcessorPair) {
-  Builder b;
-  const DatumId x = b.datum("x", 100), f = b.datum("f", 40);
-  b.task({{x, M::W}}, 10);              // 0 p0
-  b.task({{x, M::R}, {f, M::CW}}, 10);  // 1 p0
-  b.task({{x, M::R}, {f, M::CW}}, 10);  // 2 p1
-  b.task({{f, M::R}}, 10);              // 3 p0
-  const StepGraph g = b.done();
+  const StepGraph g = writer_two_reducers_reader();
   const QuotientGraph q = step_quotient(g, Assignment{2, {0, 0, 1, 0}, {}});
   EXPECT_EQ(q.load_ns, (std::vector<std::uint64_t>{30, 10}));
   ASSERT_EQ(q.edges.size(), 2u);

@@ -61,12 +61,20 @@ TEST(ParseCluster, RejectsAnythingButTwoPositiveCounts) {
   EXPECT_THROW(cluster_shape(4, kMaxCores + 1), UsageError);
 }
 
-TEST(PlatformXml, TakesLinkLatencyAndBandwidthFromTheCostModel) {
+// A cost model with these links: between two cores of a node (signal latency, ns per byte)
+// and between nodes (MPI latency, ns per byte).
+CostModel links(double sync_latency_ns, double per_byte_ns, double mpi_latency_ns,
+                double mpi_per_byte_ns) {
   CostModel m;
-  m.sync_latency_ns = 100;
-  m.per_byte_ns = 0.05;
-  m.mpi_latency_ns = 1500;
-  m.mpi_per_byte_ns = 0.08;
+  m.sync_latency_ns = sync_latency_ns;
+  m.per_byte_ns = per_byte_ns;
+  m.mpi_latency_ns = mpi_latency_ns;
+  m.mpi_per_byte_ns = mpi_per_byte_ns;
+  return m;
+}
+
+TEST(PlatformXml, TakesLinkLatencyAndBandwidthFromTheCostModel) {
+  const CostModel m = links(100, 0.05, 1500, 0.08);
   const std::string xml = platform_xml({4, 16}, m);
   EXPECT_NE(xml.find("radical=\"0-3\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("core=\"16\""), std::string::npos) << xml;
@@ -139,11 +147,7 @@ TraceAssignment split(std::uint32_t k, std::vector<ProcId> proc) {
 }
 
 TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
-  CostModel m;
-  m.sync_latency_ns = 100;
-  m.per_byte_ns = 0.05;
-  m.mpi_latency_ns = 2000;
-  m.mpi_per_byte_ns = 0.5;
+  const CostModel m = links(100, 0.05, 2000, 0.5);
   const Trace t = writer_reader(1 << 20, 300);
   const TraceAssignment a = split(2, {0, 1});
   // One node of two cores: the loopback link, the bytes paid by the reader or the link.

@@ -228,31 +228,24 @@ TEST(Metis, BalancesEachPhaseInMultiConstraintMode) {
   }
 }
 
-TEST(Metis, IsReproducibleAndSafeFromSeveralThreads) {
-  const StepGraph g = testing::random_graph(99, 300, 40, true);
-  const Result serial = make_strategy("metis")->partition(g, 4, {}, {});
+// Strategy `name` on a random graph of `seed` gives, on 4 threads partitioning 10 times each,
+// the assignment of a serial call (the library keeps no unguarded global state).
+void expect_reproducible_from_threads(const char* name, std::uint64_t seed) {
+  const StepGraph g = testing::random_graph(seed, 300, 40, true);
+  const Result serial = make_strategy(name)->partition(g, 4, {}, {});
   std::vector<std::future<Result>> futures;
   for (int i = 0; i < 4; ++i)
-    futures.push_back(std::async(std::launch::async, [&g] {
+    futures.push_back(std::async(std::launch::async, [&g, name] {
       Result last;
-      for (int j = 0; j < 10; ++j) last = make_strategy("metis")->partition(g, 4, {}, {});
+      for (int j = 0; j < 10; ++j) last = make_strategy(name)->partition(g, 4, {}, {});
       return last;
     }));
-  for (auto& f : futures) EXPECT_EQ(f.get().assignment.proc, serial.assignment.proc);
+  for (auto& f : futures) EXPECT_EQ(f.get().assignment.proc, serial.assignment.proc) << name;
 }
 
-TEST(Scotch, IsReproducibleAndSafeFromSeveralThreads) {
-  const StepGraph g = testing::random_graph(98, 300, 40, true);
-  const Result serial = make_strategy("scotch")->partition(g, 4, {}, {});
-  std::vector<std::future<Result>> futures;
-  for (int i = 0; i < 4; ++i)
-    futures.push_back(std::async(std::launch::async, [&g] {
-      Result last;
-      for (int j = 0; j < 10; ++j) last = make_strategy("scotch")->partition(g, 4, {}, {});
-      return last;
-    }));
-  for (auto& f : futures) EXPECT_EQ(f.get().assignment.proc, serial.assignment.proc);
-}
+TEST(Metis, IsReproducibleAndSafeFromSeveralThreads) { expect_reproducible_from_threads("metis", 99); }
+
+TEST(Scotch, IsReproducibleAndSafeFromSeveralThreads) { expect_reproducible_from_threads("scotch", 98); }
 
 TEST(Scotch, AcceptsEveryStrategyFlavour) {
   const StepGraph g = testing::two_halves(30);
@@ -315,31 +308,39 @@ TEST(Sticky, KeepsExistingTasksAndPlacesNewOnesByAffinity) {
   EXPECT_TRUE(p == p2 || p == p5);
 }
 
-TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
-  // Costs in microseconds: moving a task pays off against the cost model's sync + transfer.
+// Two steps of 16 objects, the second with new heavy tasks on object 0's data only (affinity
+// placement overloads its processor); costs in microseconds, so that moving a task pays off
+// against the cost model's sync + transfer.
+std::pair<StepGraph, StepGraph> overloaded_step() {
   StepGraph g0 = objects_scene(16, {});
-  // New heavy tasks on object 0's data only: affinity placement overloads its processor.
   StepGraph g1 = objects_scene(16, {}, 8);
   for (Task& t : g0.tasks) t.cost_ns *= 1000;
   for (Task& t : g1.tasks) t.cost_ns *= 1000;
+  return {std::move(g0), std::move(g1)};
+}
+
+// Max/mean load of `a` over 4 processors.
+double imbalance_on_4(const StepGraph& g, const Assignment& a) {
+  const auto l = loads_of(g, a);
+  const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
+  return static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total);
+}
+
+TEST(Sticky, RebalancesWithFewMovesWhenImbalanceExceedsTheThreshold) {
+  const auto [g0, g1] = overloaded_step();
   Options o;
   o.sticky_threshold = 1.2;
   auto s = make_strategy("sticky");
   const Result r0 = s->partition(g0, 4, {}, o);
   const Result r1 = s->partition(g1, 4, {&g0, &r0.assignment}, o);
   EXPECT_TRUE(r1.stats.rebalanced);
-  const auto l = loads_of(g1, r1.assignment);
-  const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
-  EXPECT_LE(static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total), 1.2);
+  EXPECT_LE(imbalance_on_4(g1, r1.assignment), 1.2);
   // Greedy rebalancing moves the heavy new tasks first: few of the 32 existing tasks move.
   EXPECT_LE(r1.stats.moved_tasks, 8u);
 }
 
 TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTasksThanMetisRelabel) {
-  StepGraph g0 = objects_scene(16, {});
-  StepGraph g1 = objects_scene(16, {}, 8);
-  for (Task& t : g0.tasks) t.cost_ns *= 1000;
-  for (Task& t : g1.tasks) t.cost_ns *= 1000;
+  const auto [g0, g1] = overloaded_step();
   Options o;
   o.sticky_threshold = 1.2;
   o.rebalance = Rebalance::kScotch;
@@ -355,15 +356,28 @@ TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTask
     EXPECT_FALSE(r.stats.fallback) << emraval;
     ASSERT_EQ(r.assignment.proc.size(), g1.tasks.size());
     for (ProcId p : r.assignment.proc) ASSERT_LT(p, 4u);
-    const auto l = loads_of(g1, r.assignment);
-    const std::uint64_t total = l[0] + l[1] + l[2] + l[3];
-    const double imbalance = static_cast<double>(*std::max_element(l.begin(), l.end())) * 4 / static_cast<double>(total);
-    EXPECT_LE(imbalance, 1.2) << emraval;
+    EXPECT_LE(imbalance_on_4(g1, r.assignment), 1.2) << emraval;
     EXPECT_EQ(r.stats.matched_tasks, g0.tasks.size());
     EXPECT_LT(r.stats.moved_tasks, fresh.stats.moved_tasks) << emraval;
   }
   EXPECT_EQ(parse_rebalance("scotch"), Rebalance::kScotch);
   EXPECT_THROW(parse_rebalance("magic"), UsageError);
+}
+
+// Sticky with `o` on `apart` (r0), then on `merged` from it (r1): the groups merge, so r1
+// falls back (checked here).
+struct StickyMerge {
+  std::unique_ptr<Strategy> s;
+  Result r0, r1;
+};
+
+StickyMerge sticky_merge(const StepGraph& apart, const StepGraph& merged, std::uint32_t k,
+                         const Options& o) {
+  StickyMerge m{make_strategy("sticky"), {}, {}};
+  m.r0 = m.s->partition(apart, k, {}, o);
+  m.r1 = m.s->partition(merged, k, {&apart, &m.r0.assignment}, o);
+  EXPECT_TRUE(m.r1.stats.fallback) << k;
+  return m;
 }
 
 TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
@@ -375,10 +389,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
   Options fresh;
   fresh.sticky_fallback = StickyFallback::kFresh;
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, fresh);
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, fresh);
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, fresh);
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_FALSE(r1.stats.reused);
     // What metis-relabel gives from the same previous step: METIS afresh, optimally renamed.
@@ -412,10 +423,7 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   Options o;
   o.sticky_fallback = StickyFallback::kRepartition;
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, o);
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, o);
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, o);
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
     // Balanced within the tolerance METIS gets, with fewer moves than a fresh partition
@@ -439,10 +447,7 @@ TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeByDefault) {
   const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
   EXPECT_EQ(Options{}.sticky_fallback, StickyFallback::kRefine);
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    auto s = make_strategy("sticky");
-    const Result r0 = s->partition(apart, k, {}, {});
-    const Result r1 = s->partition(merged, k, {&apart, &r0.assignment}, {});
-    EXPECT_TRUE(r1.stats.fallback) << k;
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, {});
     EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
     // Fewer moves than METIS afresh relabelled, at a predicted makespan no worse than 5 %
     // above METIS's, and every processor keeps work.

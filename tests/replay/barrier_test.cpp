@@ -44,11 +44,11 @@ std::uint64_t phases(const StepGraph& g, BarrierRule rule) {
   ExecOptions o;
   o.threads = 2;
   o.pin = false;
-  o.barrier_rule = rule;
+  o.barrier.rule = rule;
   auto ex = make_executor(Policy::kBarrier, o);
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
-  const StepStats s = ex->run_step(g, nullptr, w);
+  const ExecStepStats s = ex->run_step(g, nullptr, w);
   EXPECT_EQ(s.threads.size(), 2u);
   EXPECT_EQ(s.threads[0].waits, s.threads[1].waits);
   return s.threads[0].waits;

@@ -37,19 +37,12 @@ const Variant kVariants[] = {
 };
 
 ExecOptions opts(std::uint32_t k, bool serial = false, std::int64_t spin_ns = kDefaultSpinNs) {
-  ExecOptions o;
-  o.threads = k;
-  o.serial = serial;
-  o.spin_ns = spin_ns;
-  return o;
+  return test::partition_options(k, serial, spin_ns);
 }
 
 ExecOptions options_for(const Variant& v, std::uint32_t k) {
-  ExecOptions o;
-  o.threads = k;
-  o.serial = v.serial;
-  o.spin_ns = 20'000;
-  o.barrier_rule = v.rule;
+  ExecOptions o = test::partition_options(k, v.serial, 20'000);
+  o.barrier.rule = v.rule;
   return o;
 }
 
@@ -67,14 +60,15 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
     SyntheticWorkload w({.cost_scale = 0.2});
     w.set_step(g);
     for (int step = 0; step < 2; ++step) {
-      const StepStats s = ex->run_step(g, &a, w);
+      const ExecStepStats s = ex->run_step(g, &a, w);
       EXPECT_EQ(s.rebuilt, step == 0);
       for (LoopId l = 0; l < g.loops.size(); ++l)
         EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
       ASSERT_NE(ex->last_exec(), nullptr);
       test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
-                               static_cast<std::uint32_t>(step), true);
-      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step), false, true);
+                               static_cast<std::uint32_t>(step), {.exec = true});
+      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step),
+                               {.raw_only = true});
     }
     EXPECT_EQ(ex->plans_built(), 1u);
     const auto got = final_state(w, g), want = sequential_state(g, 2);
@@ -200,18 +194,7 @@ TEST(CwReduction, IsDeterministicAcrossRunsAndEqualsTheSerialTwin) {
   EXPECT_NEAR(expected, plain, 1e-12);
 }
 
-class Throwing : public Workload {
- public:
-  explicit Throwing(TaskId bad) : bad_(bad) {}
-  void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
-  }
-  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
-
- private:
-  TaskId bad_;
-};
+using test::Throwing;
 
 TEST(Executor, RethrowsATaskExceptionAfterJoiningAndStaysUsable) {
   const StepGraph g = test::random_graph(42);
@@ -241,7 +224,7 @@ TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
   auto ex = make_executor(Policy::kPartition, opts(2));
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
-  const StepStats first = ex->run_step(g, &a, w);
+  const ExecStepStats first = ex->run_step(g, &a, w);
   EXPECT_TRUE(first.rebuilt);
   EXPECT_GT(first.build_ns, 0);
   EXPECT_GE(first.wall_ns, first.build_ns);
@@ -249,7 +232,7 @@ TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
   for (Task& t : g2.tasks) t.cost_ns += 7;
   g2.loops[0].iterations = 1;
   w.set_step(g2);
-  const StepStats second = ex->run_step(g2, &a, w);
+  const ExecStepStats second = ex->run_step(g2, &a, w);
   EXPECT_FALSE(second.rebuilt);
   EXPECT_EQ(second.build_ns, 0);
   EXPECT_EQ(second.loop_iterations[0], 1u);

@@ -122,7 +122,7 @@ TEST(FairReduction, BarrierRunsACwGroupAsOnePhase) {
   auto ex = make_executor(Policy::kBarrier, o);
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
-  const StepStats s = ex->run_step(g, nullptr, w);
+  const ExecStepStats s = ex->run_step(g, nullptr, w);
   // init | 16 writers | reducer | reader: 4 phases, one barrier each per thread.
   for (const ThreadCounters& t : s.threads) EXPECT_EQ(t.waits, 4u);
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The partition executor's incremental plan update: on every structure or assignment change
-// the updated plan equals a from-scratch build (ExecOptions::verify_plans throws otherwise),
+// The partition executor's incremental plan update (replay/src/partition_update.cpp): on
+// every structure or assignment change the updated plan equals a from-scratch build,
 // processors whose tasks and waits did not change keep their program, and the steps run
 // in dependency order and give the sequential state.
 #include <gtest/gtest.h>
@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "partition_plan.hpp"
 #include "random_graph.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
@@ -112,21 +113,46 @@ Sequence random_sequence(std::uint32_t seed, std::uint32_t k, int steps) {
 }
 
 TEST(IncrementalPlan, EqualsAFullBuildOnRandomSequences) {
+  std::uint64_t updates = 0, partial = 0;
+  for (std::uint32_t k : {2u, 3u, 5u, 8u}) {
+    for (std::uint32_t seed = 1; seed <= 8; ++seed) {
+      const Sequence s = random_sequence(seed * 31 + k, k, 12);
+      for (const bool elide : {true, false}) {
+        detail::PartitionPlan previous;
+        for (std::size_t i = 0; i < s.graphs.size(); ++i) {
+          const ExecGraph x = lower(s.graphs[i], &s.assignments[i], CwMode::kReduce);
+          detail::PartitionPlan full = detail::build_plan(x, k, true, elide);
+          if (i > 0) {
+            detail::PartitionPlan updated = detail::update_plan(x, previous, k, true, elide);
+            EXPECT_TRUE(detail::same_programs(updated, full))
+                << "k " << k << " seed " << seed << " step " << i << " elide " << elide;
+            EXPECT_LE(updated.rebuilt_procs, k);
+            partial += updated.rebuilt_procs < k ? 1 : 0;
+            ++updates;
+            full = std::move(updated);  // the executor updates its previous updated plan
+          }
+          previous = std::move(full);
+        }
+      }
+    }
+  }
+  // Small changes leave some processors' programs as they were (new random orders rebuild
+  // every processor whose order changed).
+  EXPECT_GT(partial, updates / 8);
+}
+
+TEST(IncrementalPlan, RunsRandomSequencesInDependencyOrder) {
   std::uint64_t steps = 0, partial = 0;
   for (std::uint32_t k : {2u, 3u, 5u, 8u}) {
     for (std::uint32_t seed = 1; seed <= 8; ++seed) {
       const Sequence s = random_sequence(seed * 31 + k, k, 12);
-      ExecOptions o;
-      o.threads = k;
-      o.serial = true;
-      o.verify_plans = true;
-      auto ex = make_executor(Policy::kPartition, o);
+      auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
       TimelineObserver timeline;
       ex->add_observer(timeline);
       SyntheticWorkload w({.cost_scale = 0.0});
       for (std::size_t i = 0; i < s.graphs.size(); ++i) {
         w.set_step(s.graphs[i]);
-        StepStats st;
+        ExecStepStats st;
         ASSERT_NO_THROW(st = ex->run_step(s.graphs[i], &s.assignments[i], w))
             << "k " << k << " seed " << seed << " step " << i;
         if (st.rebuilt) {  // (a step that changed nothing reuses the cached plan)
@@ -135,7 +161,7 @@ TEST(IncrementalPlan, EqualsAFullBuildOnRandomSequences) {
           ++steps;
         }
         test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
-                                 static_cast<std::uint32_t>(i), true);
+                                 static_cast<std::uint32_t>(i), {.exec = true});
         if (::testing::Test::HasFailure()) return;
       }
     }
@@ -165,17 +191,13 @@ TEST(IncrementalPlan, MovingASinkTaskRebuildsOnlyTheTwoProcessorsInvolved) {
   ASSERT_NE(t, kNoTask);
   const std::uint32_t k = 4;
   const Assignment a = test::random_assignment(g, k, 5);
-  ExecOptions o;
-  o.threads = k;
-  o.serial = true;
-  o.verify_plans = true;
-  auto ex = make_executor(Policy::kPartition, o);
+  auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
   EXPECT_EQ(ex->run_step(g, &a, w).rebuilt_procs, k);  // first plan: from scratch
   Assignment b = a;
   b.proc[t] = (a.proc[t] + 1) % k;
-  const StepStats s = ex->run_step(g, &b, w);
+  const ExecStepStats s = ex->run_step(g, &b, w);
   EXPECT_TRUE(s.rebuilt);
   EXPECT_EQ(s.rebuilt_procs, 2u);
   EXPECT_GT(s.rebuild_ns, 0);
@@ -186,7 +208,7 @@ TEST(IncrementalPlan, OffBuildsEveryProcessor) {
   const Sequence s = random_sequence(77, 3, 6);
   ExecOptions o;
   o.threads = 3;
-  o.serial = true;
+  o.partition.serial = true;
   o.incremental_plans = false;
   auto ex = make_executor(Policy::kPartition, o);
   SyntheticWorkload w({.cost_scale = 0.0});

@@ -117,11 +117,7 @@ TEST_P(CrossingReducers, RunWithTheExplicitOrderAndMatchTheSequentialState) {
     }
   }
   for (bool serial : {true, false}) {
-    ExecOptions o;
-    o.threads = 2;
-    o.serial = serial;
-    o.spin_ns = 20'000;
-    auto ex = make_executor(Policy::kPartition, o);
+    auto ex = make_executor(Policy::kPartition, test::partition_options(2, serial, 20'000));
     SyntheticWorkload w({.cost_scale = 0.0});
     w.set_step(g);
     ASSERT_NO_THROW(ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
@@ -176,14 +172,10 @@ TEST(CwReduction, ReducerStaysInItsLoopBlockBehindTheExitOfEarlierLoops) {
   ASSERT_EQ(x.origin[r], kNoTask);
   EXPECT_EQ(x.assignment.order[0], (std::vector<TaskId>{x.exec_of[2], r, x.exec_of[3]}));
   for (bool serial : {true, false}) {
-    ExecOptions o;
-    o.threads = 2;
-    o.serial = serial;
-    o.spin_ns = 20'000;
-    auto ex = make_executor(Policy::kPartition, o);
+    auto ex = make_executor(Policy::kPartition, test::partition_options(2, serial, 20'000));
     SyntheticWorkload w({.cost_scale = 0.0});
     w.set_step(g);
-    StepStats s;
+    ExecStepStats s;
     ASSERT_NO_THROW(s = ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
     EXPECT_EQ(ex->order_fallbacks(), 0u);
     EXPECT_EQ(s.loop_iterations, (std::vector<std::uint32_t>{2, 2}));
@@ -201,10 +193,7 @@ TEST(CwReduction, ListScheduleOrdersRunWithReducersOnRandomPrograms) {
     for (std::uint32_t k : {2u, 3u, 4u}) {
       const Assignment a = list->partition(g, k, {}, partition::Options{}).assignment;
       ASSERT_FALSE(a.order.empty());
-      ExecOptions o;
-      o.threads = k;
-      o.serial = true;
-      auto ex = make_executor(Policy::kPartition, o);
+      auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
       SyntheticWorkload w({.cost_scale = 0.0});
       w.set_step(g);
       ASSERT_NO_THROW(ex->run_step(g, &a, w)) << "seed " << seed << " k " << k;
@@ -239,10 +228,7 @@ TEST(CwReduction, OrdersRunWithoutDeadlockOnRandomProgramsOfEveryShape) {
                                              4 + static_cast<int>(seed % 8));
       for (std::uint32_t k : {2u, 3u, 4u, 6u}) {
         const Assignment a = strategy->partition(g, k, {}, partition::Options{}).assignment;
-        ExecOptions o;
-        o.threads = k;
-        o.serial = true;
-        auto ex = make_executor(Policy::kPartition, o);
+        auto ex = make_executor(Policy::kPartition, test::partition_options(k, true));
         SyntheticWorkload w({.cost_scale = 0.0});
         w.set_step(g);
         ASSERT_NO_THROW(ex->run_step(g, &a, w)) << name << " seed " << seed << " k " << k;
@@ -260,10 +246,7 @@ TEST(CwReduction, AnOrderThatNeedsATaskBehindAnotherProcessorsLoopBlockFallsBack
   const Assignment a =
       partition::make_strategy("list")->partition(g, 4, {}, partition::Options{}).assignment;
   ASSERT_FALSE(a.order.empty());
-  ExecOptions o;
-  o.threads = 4;
-  o.serial = true;
-  auto ex = make_executor(Policy::kPartition, o);
+  auto ex = make_executor(Policy::kPartition, test::partition_options(4, true));
   SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
   ASSERT_NO_THROW(ex->run_step(g, &a, w));

@@ -44,7 +44,7 @@ std::vector<std::vector<std::uint64_t>> omp_state(const StepGraph& g, const Exec
   auto ex = make_executor(Policy::kOmpTasks, o);
   w.set_step(g);
   for (int s = 0; s < steps; ++s) {
-    const StepStats st = ex->run_step(g, nullptr, w);
+    const ExecStepStats st = ex->run_step(g, nullptr, w);
     for (LoopId l = 0; l < g.loops.size(); ++l)
       EXPECT_EQ(st.loop_iterations[l], g.loops[l].iterations) << "loop " << l;
   }
@@ -72,7 +72,7 @@ TEST(OmpTasks, WithoutATaskwaitPerIterationTheUnrolledStepStillMatches) {
   for (std::uint32_t seed = 1; seed <= 4; ++seed) {
     const StepGraph g = test::random_graph(seed * 17);
     ExecOptions o = omp_options(2);
-    o.omp_iteration_wait = false;
+    o.omp_tasks.iteration_wait = false;
     SyntheticWorkload w({.cost_scale = 0.0});
     EXPECT_EQ(omp_state(g, o, w, 2), test::sequential_state(g, 2)) << "seed " << seed;
   }
@@ -102,7 +102,7 @@ TEST(OmpTasks, RethrowsALoopConditionExceptionAndStaysUsable) {
   }
   LiveLikeWorkload ok;
   ok.set_step(g);
-  const StepStats s = ex->run_step(g, nullptr, ok);
+  const ExecStepStats s = ex->run_step(g, nullptr, ok);
   EXPECT_EQ(s.loop_iterations[0], g.loops[0].iterations);
 }
 

@@ -58,45 +58,6 @@ class UnknownCounts : public SyntheticWorkload {
   std::optional<std::uint32_t> known_iterations(LoopId) const override { return std::nullopt; }
 };
 
-/// Every exec task ran g.runs(t) times, after its predecessors in the exec graph (intra-step
-/// and loop-carried edges) and after its own previous iteration. Unlike the other policies,
-/// an unrolled loop has no gate: iteration i + 1 may start before the break of iteration i.
-void expect_dataflow_order(const StepGraph& g, const std::vector<TimelineEvent>& events,
-                           std::uint32_t step) {
-  std::map<std::pair<TaskId, std::uint32_t>, std::pair<std::int64_t, std::int64_t>> when;
-  std::vector<std::uint32_t> count(g.tasks.size(), 0);
-  for (const TimelineEvent& e : events) {
-    if (e.step != step) continue;
-    ASSERT_LT(e.task, g.tasks.size());
-    ++count[e.task];
-    ASSERT_TRUE(
-        when.emplace(std::make_pair(e.task, e.iteration), std::make_pair(e.start_ns, e.end_ns))
-            .second)
-        << "task " << e.task << " iteration " << e.iteration << " ran twice";
-  }
-  for (TaskId t = 0; t < g.tasks.size(); ++t)
-    ASSERT_EQ(count[t], g.runs(t)) << "task " << t << " ran " << count[t] << " times";
-  auto end_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).second; };
-  auto start_of = [&](TaskId t, std::uint32_t i) { return when.at({t, i}).first; };
-  for (const Edge& e : g.edges) {
-    const LoopId lu = g.tasks[e.from].loop, lv = g.tasks[e.to].loop;
-    for (std::uint32_t i = 0; i < g.runs(e.to); ++i) {
-      const std::uint32_t iu =
-          (lu != kNoLoop && lu == lv) ? i : static_cast<std::uint32_t>(g.runs(e.from) - 1);
-      EXPECT_GE(start_of(e.to, i), end_of(e.from, iu))
-          << "edge " << e.from << " -> " << e.to << " violated at iteration " << i;
-    }
-  }
-  for (const Edge& e : g.carried_edges)
-    for (std::uint32_t i = 1; i < g.runs(e.to); ++i)
-      EXPECT_GE(start_of(e.to, i), end_of(e.from, i - 1))
-          << "carried edge " << e.from << " -> " << e.to << " violated at iteration " << i;
-  for (const Loop& l : g.loops)
-    for (TaskId v = l.first; v < l.last; ++v)
-      for (std::uint32_t i = 1; i < l.iterations; ++i)
-        EXPECT_GE(start_of(v, i), end_of(v, i - 1)) << "task " << v << " overtook itself";
-}
-
 class StarpuPolicy
     : public ::testing::TestWithParam<std::tuple<std::uint32_t, Cw, bool /*unknown*/>> {};
 
@@ -116,7 +77,7 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
     w->set_step(g);
     const std::uint64_t built = ex->plans_built();
     for (int step = 0; step < 2; ++step) {
-      const StepStats s = ex->run_step(g, nullptr, *w);
+      const ExecStepStats s = ex->run_step(g, nullptr, *w);
       EXPECT_EQ(s.rebuilt, step == 0);
       ASSERT_EQ(s.loop_iterations.size(), g.loops.size());
       for (LoopId l = 0; l < g.loops.size(); ++l)
@@ -131,7 +92,10 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
       EXPECT_EQ(counted, instances);
       EXPECT_EQ(observed, instances);
       const auto step_index = static_cast<std::uint32_t>(timeline.events().back().step);
-      expect_dataflow_order(xg, timeline.events(), step_index);
+      // Unlike the other policies, an unrolled loop has no gate: iteration i + 1 may start
+      // before the break of iteration i.
+      test::expect_valid_order(xg, timeline.events(), step_index,
+                               {.exec = true, .loop_gate = false});
     }
     EXPECT_EQ(ex->plans_built(), built + 1);
     const auto got = final_state(*w, g), want = sequential_state(g, 2);
@@ -180,25 +144,12 @@ TEST(Starpu, CommutingWritersWithManyHandlesMatchSequential) {
     ex->run_step(g, nullptr, w);
     ex->run_step(g, nullptr, w);
     EXPECT_EQ(final_state(w, g), sequential_state(g, 2)) << cw_name(cw);
-    expect_dataflow_order(ex->last_exec()->graph, timeline.events(), 1);
+    test::expect_valid_order(ex->last_exec()->graph, timeline.events(), 1,
+                             {.exec = true, .loop_gate = false});
   }
 }
 
-class Throwing : public Workload {
- public:
-  explicit Throwing(TaskId bad) : bad_(bad) {}
-  void run(const TaskRun& r) override {
-    if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
-  }
-  bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
-  std::optional<std::uint32_t> known_iterations(LoopId) const override { return known_; }
-  void set_known(std::optional<std::uint32_t> n) { known_ = n; }
-
- private:
-  TaskId bad_;
-  std::optional<std::uint32_t> known_;
-};
+using test::Throwing;
 
 TEST(Starpu, RethrowsATaskExceptionAfterWaitingAndStaysUsable) {
   TGRAPH_NEED_STARPU();
@@ -233,7 +184,7 @@ TEST(Starpu, RejectsKnownIterationsThatContradictTheCondition) {
   w.set_known(3);
   EXPECT_THROW(ex->run_step(g, nullptr, w), UsageError);
   w.set_known(2);
-  const StepStats s = ex->run_step(g, nullptr, w);
+  const ExecStepStats s = ex->run_step(g, nullptr, w);
   for (std::uint32_t it : s.loop_iterations) EXPECT_EQ(it, 2u);
 }
 
@@ -251,7 +202,7 @@ TEST(Starpu, AllowsOneRuntimePerProcessAndChecksItsOptions) {
   }
   EXPECT_NO_THROW(make_executor(Policy::kStarpu, starpu_options(1)));  // the first is gone
   ExecOptions bad = starpu_options(2);
-  bad.starpu_sched = "no-such-scheduler";
+  bad.starpu.sched = "no-such-scheduler";
   try {
     make_executor(Policy::kStarpu, bad);
     FAIL() << "unknown scheduler accepted";
@@ -261,7 +212,7 @@ TEST(Starpu, AllowsOneRuntimePerProcessAndChecksItsOptions) {
   EXPECT_THROW(make_executor(Policy::kStarpu, starpu_options(64)), UsageError);
   for (const char* sched : {"eager", "ws", "prio"}) {
     ExecOptions o = starpu_options(2);
-    o.starpu_sched = sched;
+    o.starpu.sched = sched;
     auto ex = make_executor(Policy::kStarpu, o);
     const StepGraph g = test::random_graph(3);
     SyntheticWorkload w({.cost_scale = 0.0});

@@ -15,14 +15,14 @@ extern "C" const char* __tsan_default_suppressions() {
       "race_top:worksteal_task.cpp\n"
       // libgomp hands the shared-variable block of `omp parallel` to its threads; the
       // region's own data is annotated (replay/src/tsan.hpp).
-      "race_top:BarrierExecutor::execute\n"
+      "race_top:BarrierExecutor::run\n"
       // omp-tasks: libgomp copies each task's firstprivate block into a task it allocates,
       // queues it and frees it after another thread ran it, all inside libgomp (not
       // instrumented): the outlined task body's read of its own arguments, the region's
       // shared block, and libgomp's malloc/free of those task objects. The task bodies'
       // data hand-off is annotated per dependence object (replay/src/omp_tasks_executor.cpp).
       "race_top:OmpTasksExecutor::submit\n"
-      "race_top:OmpTasksExecutor::execute\n"
+      "race_top:OmpTasksExecutor::run\n"
       "called_from_lib:libgomp.so.1\n"
       // libstarpu allocates its job structures in one thread and frees them in another after
       // a hand-off through its own (uninstrumented) locks; tgraph's side is annotated.

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "partition_testing.hpp"  // replay/src: the lost-signal fault
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -241,13 +242,12 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
     o.threads = k;
     o.pin = false;
     o.spin_ns = 1000;
-    o.timeout_ms = 200;
+    o.partition.timeout_ms = 200;
     // Every cross-processor producer gets its own wait (none is implied by a later one of
     // the same processor), so the lost signal is always waited for.
-    o.elide_waits = false;
-    o.test_lose_signal = lost;
+    o.partition.elide_waits = false;
     {
-      auto ex = make_executor(Policy::kPartition, o);
+      auto ex = detail::make_partition_executor_for_tests(o, {.lose_signal = lost});
       FaultyWorkload w;
       try {
         ex->run_step(g, &a, w);
@@ -269,7 +269,6 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
     }
     EXPECT_EQ(process_threads(), before) << "k=" << k;  // workers and watchdog joined
     // Without the lost signal the same step runs to its end under the same watchdog.
-    o.test_lose_signal.reset();
     auto ex = make_executor(Policy::kPartition, o);
     FaultyWorkload ok;
     EXPECT_NO_THROW(ex->run_step(g, &a, ok));
@@ -302,8 +301,8 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         ExecOptions o;
         o.threads = 2;
         o.pin = false;
-        o.timeout_ms = 200;
-        o.timeout_exits = true;
+        o.partition.timeout_ms = 200;
+        o.partition.timeout_exits = true;
         auto ex = make_executor(Policy::kPartition, o);
         HangingWorkload w(stuck);
         ex->run_step(g, &a, w);
@@ -319,7 +318,7 @@ TEST(Watchdog, IsOffWithTimeoutZero) {
   ExecOptions o;
   o.threads = 2;
   o.pin = false;
-  o.timeout_ms = 0;
+  o.partition.timeout_ms = 0;
   auto ex = make_executor(Policy::kPartition, o);
   FaultyWorkload w;
   EXPECT_NO_THROW(ex->run_step(g, &a, w));

@@ -27,6 +27,26 @@ const char* kTimeline = R"({"threads":2,"steps":2,"tasks":[
  {"step":1,"thread":1,"task":3,"origin":null,"kind":"reduce","iteration":0,"start_ns":100,"end_ns":300}],
  "waits":[{"step":0,"thread":1,"task":1,"start_ns":100,"end_ns":1100,"parked":false}]})";
 
+// The first `steps` steps of the fig2 scene, captured.
+Trace fig2_trace(int steps) {
+  auto scene = samples::make_scene("fig2", {});
+  capture::Recorder rec(capture::Mode::kCapture);
+  Trace trace;
+  for (int s = 0; s < steps; ++s) {
+    scene->step(rec);
+    trace.steps.push_back(rec.end_step());
+  }
+  return trace;
+}
+
+// Tasks of `g` alternately on processors 0 and 1.
+Assignment alternating(const StepGraph& g) {
+  Assignment a;
+  a.k = 2;
+  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
+  return a;
+}
+
 TEST(Timeline, ParsesAndLaysStepsEndToEnd) {
   const Timeline t = parse_timeline(kTimeline, "t.json");
   EXPECT_EQ(t.threads, 2u);
@@ -88,13 +108,8 @@ TEST(Timeline, FlowGoesFromTheReleasingTaskToTheWait) {
 
 // What `tgraph replay --chrome` writes: the replay observer's timeline through chrome_trace.
 TEST(Timeline, ConvertsAReplayObserversTimelineToChromeEvents) {
-  auto scene = samples::make_scene("fig2", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  scene->step(rec);
-  const StepGraph g = rec.end_step();
-  Assignment a;
-  a.k = 2;
-  for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
+  const StepGraph g = fig2_trace(1).steps[0];
+  const Assignment a = alternating(g);
   replay::ExecOptions eo;
   eo.threads = 2;
   eo.pin = false;
@@ -160,13 +175,7 @@ TEST(Timeline, RendersSvgAndPngWithCairo) {
 }
 
 TEST(Report, PageIsSelfContainedWithOneContainerPerChart) {
-  auto scene = samples::make_scene("fig2", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  for (int s = 0; s < 3; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
+  const Trace trace = fig2_trace(3);
   ReportContent c = report_content(trace, "fig2.tgt", nullptr, 1);
   MethodRow row;
   row.method = "metis";
@@ -202,22 +211,11 @@ TEST(Report, PageIsSelfContainedWithOneContainerPerChart) {
 }
 
 TEST(Report, FromFilesAddsTheComparisonAndReplaysAndFallsBackToStepZero) {
-  auto scene = samples::make_scene("fig2", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  for (int s = 0; s < 2; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
+  const Trace trace = fig2_trace(2);
   TraceAssignment as;
   as.method = "owner";
   as.k = 2;
-  for (const StepGraph& g : trace.steps) {
-    Assignment a;
-    a.k = 2;
-    for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
-    as.steps.push_back(a);
-  }
+  for (const StepGraph& g : trace.steps) as.steps.push_back(alternating(g));
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "viz_report";
   std::filesystem::create_directories(dir);
   const std::string compare = (dir / "c.json").string(), replay = (dir / "r.json").string();
@@ -244,16 +242,8 @@ TEST(Report, FromFilesAddsTheComparisonAndReplaysAndFallsBackToStepZero) {
 }
 
 TEST(Report, DrawsTheQuotientGraphBesideTheStepGraph) {
-  auto scene = samples::make_scene("fig2", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  for (int s = 0; s < 2; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
-  Assignment a;
-  a.k = 2;
-  for (TaskId t = 0; t < trace.steps[1].tasks.size(); ++t) a.proc.push_back(t % 2);
+  const Trace trace = fig2_trace(2);
+  const Assignment a = alternating(trace.steps[1]);
   ReportContent c = report_content(trace, "fig2.tgt", &a, 1, "alternate");
   EXPECT_EQ(c.graph_step, 1u);
   set_quotient(c, quotient_graph(trace.steps[1], a), "alternate");

@@ -8,26 +8,12 @@
 #include <algorithm>
 #include <limits>
 
+#include "tgraph/graph/metrics.hpp"
+
 namespace tgraph::viz {
 namespace {
 
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
-
-struct Preds {
-  std::vector<std::uint32_t> begin;
-  std::vector<std::uint32_t> edge;  // index into the edge list
-};
-
-Preds build_preds(std::size_t n, const std::vector<Edge>& edges) {
-  Preds p;
-  p.begin.assign(n + 1, 0);
-  for (const Edge& e : edges) ++p.begin[e.to + 1];
-  for (std::size_t i = 0; i < n; ++i) p.begin[i + 1] += p.begin[i];
-  p.edge.resize(edges.size());
-  std::vector<std::uint32_t> fill(p.begin.begin(), p.begin.end() - 1);
-  for (std::uint32_t i = 0; i < edges.size(); ++i) p.edge[fill[edges[i].to]++] = i;
-  return p;
-}
 
 struct Origin {
   std::uint64_t from = kNone;  // predecessor instance
@@ -64,8 +50,8 @@ CriticalPath critical_path(const StepGraph& g) {
   const std::uint64_t instances = first[n];
   std::vector<std::uint64_t> finish(instances, 0);
   std::vector<Origin> origin(instances);
-  const Preds intra = build_preds(n, g.edges);
-  const Preds carried = build_preds(n, g.carried_edges);
+  const IncomingEdges intra = incoming_edges(n, g.edges);
+  const IncomingEdges carried = incoming_edges(n, g.carried_edges);
 
   // Instance of `from` that an intra edge into iteration `it` of `to` reads.
   auto source = [&](TaskId from, TaskId to, std::uint32_t it) -> std::uint64_t {

@@ -19,6 +19,7 @@
 #include "tgraph/viz/graph_view.hpp"
 #include "tgraph/viz/graphviz.hpp"
 #include "tgraph/viz/palette.hpp"
+#include "chart_util.hpp"
 #include "report_specs.hpp"
 #include "web_assets.hpp"
 
@@ -26,7 +27,12 @@ namespace tgraph::viz {
 namespace {
 
 using nlohmann::json;
+using detail::escape;
+using detail::fixed;
+using detail::kRenderScript;
 using detail::methods_spec;
+using detail::page_head;
+using detail::script_json;
 using detail::series_spec;
 using detail::speedup_spec;
 using detail::timeline_spec;
@@ -43,51 +49,10 @@ std::uint64_t get_count(const json& j, const char* key, std::uint64_t max = UINT
   return v.get<std::uint64_t>();
 }
 
-std::string escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
 // The Graphviz SVG without its XML prolog and doctype (inline SVG in HTML).
 std::string inline_svg(const std::string& svg) {
   const auto at = svg.find("<svg");
   return at == std::string::npos ? svg : svg.substr(at);
-}
-
-// JSON to embed in a <script>: "</" is written "<\/" so no text can close the element.
-std::string script_json(const json& j) {
-  std::string s = j.dump();
-  std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    out += s[i];
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += '\\';
-  }
-  return out;
 }
 
 std::string number_cell(const std::optional<double>& v, int decimals) {
@@ -143,39 +108,6 @@ const char* kStyle =
     "#graph-quotient svg{max-width:100%;height:auto}"
     ".graph-tools{font-size:0.85em;color:#555;margin-bottom:4px}"
     ".graph-tools button{font-size:1em;min-width:2.2em;margin-right:4px}";
-
-// First script of the page: records uncaught errors, rejected promises and console.error
-// calls on <html data-js-errors> (what the browser test reads; visible in the inspector).
-const char* kErrorHook = R"js(
-(function () {
-  var root = document.documentElement;
-  function add(m) { root.dataset.jsErrors = (root.dataset.jsErrors ? root.dataset.jsErrors + ' | ' : '') + m; }
-  window.addEventListener('error', function (e) { add(String(e.message)); });
-  window.addEventListener('unhandledrejection', function (e) { add(String(e.reason)); });
-  var original = console.error;
-  console.error = function () { add(Array.prototype.join.call(arguments, ' ')); original.apply(console, arguments); };
-})();
-)js";
-
-// Renders every chart; a failure is shown in place and logged as a console error.
-const char* kRenderScript = R"js(
-(function () {
-  const specs = JSON.parse(document.getElementById('tgraph-specs').textContent);
-  const ids = Object.keys(specs);
-  let done = 0;
-  document.body.dataset.charts = String(ids.length);
-  for (const id of ids) {
-    vegaEmbed('#' + id, specs[id], {renderer: 'svg', actions: false})
-      .then(function () { done += 1; document.body.dataset.chartsRendered = String(done); })
-      .catch(function (err) {
-        const el = document.getElementById(id);
-        el.textContent = 'chart failed: ' + err;
-        el.className += ' chart-error';
-        console.error('tgraph chart ' + id + ': ' + err);
-      });
-  }
-})();
-)js";
 
 // Pan and zoom on the step graph (Panzoom, inlined). The first view shows the whole graph
 // when its labels stay readable (scale >= kReadable), else the left end at the scale that
@@ -424,17 +356,7 @@ std::string report_html(const ReportContent& c) {
   body += "<p><small>Charts and pan/zoom: " + escape(std::string(detail::web_asset_versions())) +
           ", inlined; the page uses no network.</small></p>";
 
-  std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
-                  escape(c.title) + "</title><style>" + kStyle + "</style><script>" + kErrorHook +
-                  "</script>";
-  for (const char* lib : {"vega", "vega-lite", "vega-embed", "panzoom"}) {
-    h += "<script>/* ";
-    h += lib;
-    h += " */\n";
-    h += detail::web_asset(lib);
-    h += "\n</script>";
-  }
-  h += "</head><body>" + body;
+  std::string h = page_head(c.title, kStyle, {"vega", "vega-lite", "vega-embed", "panzoom"}) + body;
   h += "<script type=\"application/json\" id=\"tgraph-specs\">" + script_json(specs) + "</script>";
   h += "<script>" + std::string(kRenderScript) + "</script>";
   if (!c.graph_svg.empty()) h += "<script>" + std::string(kPanZoomScript) + "</script>";

@@ -85,31 +85,26 @@ json speedup_spec(const ReportContent& c) {
                         {"type", "nominal"},
                         {"title", "reference"},
                         {"scale", {{"range", {{2, 2}, {6, 3}}}}}}}}}});
-  layers.push_back(
-      {{"transform", {{{"filter", "datum.series === 'predicted (simulated)'"}}}},
-       {"mark",
-        {{"type", "line"}, {"point", {{"filled", false}, {"size", 60}}}, {"strokeDash", {4, 2}}}},
-       {"encoding",
-        {{"x", x},
-         {"y", y},
-         {"color", colour},
-         {"tooltip",
-          {{{"field", "method"}},
-           {{"field", "threads"}},
-           {{"field", "speedup"}, {"format", ".2f"}},
-           {{"field", "series"}}}}}}});
-  layers.push_back(
-      {{"transform", {{{"filter", "datum.series === 'measured (replay)'"}}}},
-       {"mark", {{"type", "point"}, {"filled", true}, {"size", 110}, {"shape", "diamond"}}},
-       {"encoding",
-        {{"x", x},
-         {"y", y},
-         {"color", colour},
-         {"tooltip",
-          {{{"field", "method"}},
-           {{"field", "threads"}},
-           {{"field", "speedup"}, {"format", ".2f"}},
-           {{"field", "series"}}}}}}});
+  // The points of one series ("predicted (simulated)" or "measured (replay)") drawn as `mark`.
+  auto series_layer = [&](const char* series, json mark) {
+    return json{{"transform", {{{"filter", std::string("datum.series === '") + series + "'"}}}},
+                {"mark", std::move(mark)},
+                {"encoding",
+                 {{"x", x},
+                  {"y", y},
+                  {"color", colour},
+                  {"tooltip",
+                   {{{"field", "method"}},
+                    {{"field", "threads"}},
+                    {{"field", "speedup"}, {"format", ".2f"}},
+                    {{"field", "series"}}}}}}};
+  };
+  layers.push_back(series_layer(
+      "predicted (simulated)",
+      {{"type", "line"}, {"point", {{"filled", false}, {"size", 60}}}, {"strokeDash", {4, 2}}}));
+  layers.push_back(series_layer(
+      "measured (replay)",
+      {{"type", "point"}, {"filled", true}, {"size", 110}, {"shape", "diamond"}}));
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
           {"width", 520},
           {"height", 320},

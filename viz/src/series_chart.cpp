@@ -2,7 +2,6 @@
 // Line charts of numeric series: Vega-Lite specifications, cairo SVG/PNG, an HTML page.
 #include "tgraph/viz/series_chart.hpp"
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
@@ -13,59 +12,28 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "chart_util.hpp"
 #include "web_assets.hpp"
 
 namespace tgraph::viz {
 namespace {
 
 using nlohmann::json;
+using detail::decimals_for;
+using detail::escape;
+using detail::fixed;
+using detail::kRenderScript;
+using detail::page_head;
+using detail::script_json;
+using detail::set_colour;
+using detail::text_at;
+using detail::tick_step;
 
 // Okabe & Ito without yellow (too pale for lines on white), then Paul Tol's "muted".
 constexpr std::array<const char*, 15> kLines = {
     "#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#332288", "#117733",
     "#882255", "#44AA99", "#999933", "#AA4499", "#CC6677", "#DDCC77", "#88CCEE"};
 constexpr const char* kReferenceColour = "#000000";
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
-std::string escape(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-// JSON inside a <script>: "</" is written "<\/" so that no text closes the element.
-std::string script_json(const json& j) {
-  const std::string s = j.dump();
-  std::string out;
-  out.reserve(s.size());
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    out += s[i];
-    if (s[i] == '<' && i + 1 < s.size() && s[i + 1] == '/') out += '\\';
-  }
-  return out;
-}
 
 bool usable(const SeriesChart& c, const SeriesPoint& p) {
   return std::isfinite(p.x) && std::isfinite(p.y) && (!c.log2_x || p.x > 0) &&
@@ -81,20 +49,6 @@ std::string power_label(double v) {
 
 std::string colour_of(const Series& s) {
   return s.kind == SeriesKind::kReference ? kReferenceColour : series_colour(s.colour);
-}
-
-// A "nice" tick step (1, 2 or 5 x 10^n) giving about `target` ticks over `range`.
-double tick_step(double range, int target) {
-  if (range <= 0) return 1;
-  const double raw = range / target;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (raw <= m * mag) return m * mag;
-  return 10 * mag;
-}
-
-int decimals_for(double step) {
-  return step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
 }
 
 // The axes' extents and ticks, shared by both renderings.
@@ -158,26 +112,6 @@ Axes axes_of(const SeriesChart& c) {
 }
 
 // ---- cairo --------------------------------------------------------------------------------
-
-void set_colour(cairo_t* cr, const std::string& hex) {
-  unsigned r = 0, g = 0, b = 0;
-  if (hex.size() == 7) std::sscanf(hex.c_str() + 1, "%2x%2x%2x", &r, &g, &b);
-  cairo_set_source_rgb(cr, r / 255.0, g / 255.0, b / 255.0);
-}
-
-void text_at(cairo_t* cr, double x, double y, const std::string& s, double size,
-             double align = 0) {  // align: 0 left, 0.5 centre, 1 right
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t ext;
-  cairo_text_extents(cr, s.c_str(), &ext);
-  cairo_move_to(cr, x - ext.x_advance * align, y);
-  cairo_show_text(cr, s.c_str());
-}
-
-cairo_status_t append_bytes(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
 
 struct Layout {
   double width = 860, left = 64, right = 230, top = 64, plot_h = 330, bottom = 48;
@@ -447,26 +381,7 @@ std::string series_chart_spec(const SeriesChart& c) {
 std::string render_series_chart(const SeriesChart& c, TimelineFormat format) {
   const Layout L;
   const double h = L.height(c.series.size());
-  std::string out;
-  cairo_surface_t* surface =
-      format == TimelineFormat::kSvg
-          ? cairo_svg_surface_create_for_stream(append_bytes, &out, L.width, h)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(L.width),
-                                       static_cast<int>(std::ceil(h)));
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, c, L, h);
-  const cairo_status_t drawn = cairo_status(cr);
-  cairo_destroy(cr);
-  cairo_status_t written = CAIRO_STATUS_SUCCESS;
-  if (format == TimelineFormat::kPng)
-    written = cairo_surface_write_to_png_stream(surface, append_bytes, &out);
-  cairo_surface_finish(surface);  // the SVG surface writes its document here
-  const cairo_status_t finished = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  for (cairo_status_t s : {drawn, written, finished})
-    if (s != CAIRO_STATUS_SUCCESS)
-      throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(s));
-  return out;
+  return detail::render_cairo(format, L.width, h, [&](cairo_t* cr) { draw(cr, c, L, h); });
 }
 
 std::string series_page_html(const SeriesPage& p) {
@@ -478,34 +393,6 @@ std::string series_page_html(const SeriesPage& p) {
       "text-align:left}caption{text-align:left;font-weight:600;padding:4px 0}dl{display:grid;"
       "grid-template-columns:max-content auto;gap:2px 16px}dt{font-weight:600}dd{margin:0}"
       ".charts{display:flex;flex-wrap:wrap;gap:24px}.chart-error{color:#D55E00}";
-  static const char* kErrorHook = R"js(
-(function () {
-  var root = document.documentElement;
-  function add(m) { root.dataset.jsErrors = (root.dataset.jsErrors ? root.dataset.jsErrors + ' | ' : '') + m; }
-  window.addEventListener('error', function (e) { add(String(e.message)); });
-  window.addEventListener('unhandledrejection', function (e) { add(String(e.reason)); });
-  var original = console.error;
-  console.error = function () { add(Array.prototype.join.call(arguments, ' ')); original.apply(console, arguments); };
-})();
-)js";
-  static const char* kRender = R"js(
-(function () {
-  const specs = JSON.parse(document.getElementById('tgraph-specs').textContent);
-  const ids = Object.keys(specs);
-  let done = 0;
-  document.body.dataset.charts = String(ids.length);
-  for (const id of ids) {
-    vegaEmbed('#' + id, specs[id], {renderer: 'svg', actions: false})
-      .then(function () { done += 1; document.body.dataset.chartsRendered = String(done); })
-      .catch(function (err) {
-        const el = document.getElementById(id);
-        el.textContent = 'chart failed: ' + err;
-        el.className += ' chart-error';
-        console.error('tgraph chart ' + id + ': ' + err);
-      });
-  }
-})();
-)js";
   std::string body = "<h1>" + escape(p.title) + "</h1>";
   for (const std::string& n : p.notes) body += "<p>" + escape(n) + "</p>";
   if (!p.facts.empty()) {
@@ -540,19 +427,9 @@ std::string series_page_html(const SeriesPage& p) {
   }
   body += "<p><small>Charts: " + escape(std::string(detail::web_asset_versions())) +
           " (BSD-3-Clause), inlined; the page uses no network.</small></p>";
-  std::string h = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
-                  escape(p.title) + "</title><style>" + kStyle + "</style><script>" + kErrorHook +
-                  "</script>";
-  for (const char* lib : {"vega", "vega-lite", "vega-embed"}) {
-    h += "<script>/* ";
-    h += lib;
-    h += " */\n";
-    h += detail::web_asset(lib);
-    h += "\n</script>";
-  }
-  h += "</head><body>" + body;
+  std::string h = page_head(p.title, kStyle, {"vega", "vega-lite", "vega-embed"}) + body;
   h += "<script type=\"application/json\" id=\"tgraph-specs\">" + script_json(specs) + "</script>";
-  h += "<script>" + std::string(kRender) + "</script></body></html>\n";
+  h += "<script>" + std::string(kRenderScript) + "</script></body></html>\n";
   return h;
 }
 

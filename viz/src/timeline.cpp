@@ -2,7 +2,6 @@
 // Replay timelines: parsing, the cairo Gantt chart, Chrome trace events with flow arrows.
 #include "tgraph/viz/timeline.hpp"
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
@@ -14,54 +13,24 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <tuple>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/viz/palette.hpp"
+#include "chart_util.hpp"
 
 namespace tgraph::viz {
 namespace {
 
 using nlohmann::json;
-
-std::string fixed(double v, int decimals) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
+using detail::decimals_for;
+using detail::fixed;
+using detail::set_colour;
+using detail::text_at;
+using detail::tick_step;
 
 // ---- cairo helpers -----------------------------------------------------------------------
-
-struct Rgb {
-  double r, g, b;
-};
-
-Rgb rgb(const std::string& hex) {
-  unsigned r = 0, g = 0, b = 0;
-  if (hex.size() == 7) std::sscanf(hex.c_str() + 1, "%2x%2x%2x", &r, &g, &b);
-  return {r / 255.0, g / 255.0, b / 255.0};
-}
-
-void set_colour(cairo_t* cr, const std::string& hex, double alpha = 1.0) {
-  const Rgb c = rgb(hex);
-  cairo_set_source_rgba(cr, c.r, c.g, c.b, alpha);
-}
-
-void text_at(cairo_t* cr, double x, double y, const std::string& s, double size,
-             bool right_align = false, bool centre = false) {
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t ext;
-  cairo_text_extents(cr, s.c_str(), &ext);
-  if (right_align) x -= ext.x_advance;
-  if (centre) x -= ext.x_advance / 2;
-  cairo_move_to(cr, x, y);
-  cairo_show_text(cr, s.c_str());
-}
-
-cairo_status_t append_bytes(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
 
 // Grey diagonal hatching for waits.
 cairo_pattern_t* hatch_pattern() {
@@ -79,20 +48,6 @@ cairo_pattern_t* hatch_pattern() {
   cairo_pattern_set_extend(p, CAIRO_EXTEND_REPEAT);
   cairo_surface_destroy(tile);
   return p;
-}
-
-// A "nice" tick step (1, 2 or 5 x 10^n) giving about `target` ticks over `range`.
-double tick_step(double range, int target) {
-  if (range <= 0) return 1;
-  const double raw = range / target;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 5.0, 10.0})
-    if (raw <= m * mag) return m * mag;
-  return 10 * mag;
-}
-
-int decimals_for(double step) {
-  return step >= 1 ? 0 : static_cast<int>(std::ceil(-std::log10(step) - 1e-9));
 }
 
 // Draws the chart on `cr`; returns nothing, sizes come from ChartLayout.
@@ -139,7 +94,7 @@ void draw(cairo_t* cr, const Timeline& t, const ChartLayout& L, const std::strin
     cairo_rectangle(cr, L.left, y_of(th), plot_w, L.row);
     cairo_fill(cr);
     set_colour(cr, "#000000");
-    text_at(cr, L.left - 8, y_of(th) + L.row / 2 + 4, "thread " + std::to_string(th), 11, true);
+    text_at(cr, L.left - 8, y_of(th) + L.row / 2 + 4, "thread " + std::to_string(th), 11, 1);
   }
   // Tasks.
   std::map<std::string, std::string> colour;
@@ -180,7 +135,7 @@ void draw(cairo_t* cr, const Timeline& t, const ChartLayout& L, const std::strin
   cairo_set_dash(cr, nullptr, 0, 0);
   if (!iteration_start.empty()) {
     set_colour(cr, "#555555");
-    text_at(cr, L.width - L.right, L.top - 10, "dotted: start of a loop iteration", 9, true);
+    text_at(cr, L.width - L.right, L.top - 10, "dotted: start of a loop iteration", 9, 1);
   }
   // Step boundaries.
   std::vector<std::uint32_t> steps;
@@ -212,9 +167,9 @@ void draw(cairo_t* cr, const Timeline& t, const ChartLayout& L, const std::strin
     cairo_move_to(cr, x, L.plot_bottom());
     cairo_line_to(cr, x, L.plot_bottom() + 4);
     cairo_stroke(cr);
-    text_at(cr, x, L.plot_bottom() + 16, fixed(v, decimals), 10, false, true);
+    text_at(cr, x, L.plot_bottom() + 16, fixed(v, decimals), 10, 0.5);
   }
-  text_at(cr, L.left + plot_w / 2, L.plot_bottom() + 32, "time (ms)", 11, false, true);
+  text_at(cr, L.left + plot_w / 2, L.plot_bottom() + 32, "time (ms)", 11, 0.5);
   // Legend: kinds by time, then "other" and the waits.
   double lx = L.left, ly = L.plot_bottom() + 44;
   auto legend = [&](const std::string& label, cairo_pattern_t* pattern, const std::string& hex) {
@@ -332,6 +287,13 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
           &e);
     return th;
   };
+  // An event's start_ns and end_ns: not negative, the end not before the start.
+  const auto span_of = [](const json& e) {
+    const std::int64_t start = get_i64(e, "start_ns"), end = get_i64(e, "end_ns");
+    if (end < start || start < 0)
+      throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
+    return std::pair{start, end};
+  };
   try {
     t.threads = j.contains("threads") ? get_u32(j, "threads") : 0;
     for (const json& e : j["tasks"]) {
@@ -342,10 +304,7 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
       ev.origin = get_optional_u32(e, "origin");
       ev.kind = e.contains("kind") && e["kind"].is_string() ? e["kind"].get<std::string>() : "task";
       ev.iteration = e.contains("iteration") ? get_u32(e, "iteration") : 0;
-      ev.start_ns = get_i64(e, "start_ns");
-      ev.end_ns = get_i64(e, "end_ns");
-      if (ev.end_ns < ev.start_ns || ev.start_ns < 0)
-        throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
+      std::tie(ev.start_ns, ev.end_ns) = span_of(e);
       t.tasks.push_back(std::move(ev));
       ++index;
     }
@@ -359,11 +318,8 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
         w.step = step_of(e);
         w.thread = thread_of(e);
         w.task = get_optional_u32(e, "task");
-        w.start_ns = get_i64(e, "start_ns");
-        w.end_ns = get_i64(e, "end_ns");
+        std::tie(w.start_ns, w.end_ns) = span_of(e);
         w.parked = e.value("parked", false);
-        if (w.end_ns < w.start_ns || w.start_ns < 0)
-          throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
         t.waits.push_back(w);
         ++index;
       }
@@ -471,26 +427,8 @@ std::string render_timeline(const Timeline& t, TimelineFormat format, const std:
   L.legend_items =
       std::min<std::size_t>(kinds.size(), kKindColours + 1) + (t.waits.empty() ? 0 : 1);
   const double h = L.height();
-  std::string out;
-  cairo_surface_t* surface =
-      format == TimelineFormat::kSvg
-          ? cairo_svg_surface_create_for_stream(append_bytes, &out, L.width, h)
-          : cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(L.width),
-                                       static_cast<int>(std::ceil(h)));
-  cairo_t* cr = cairo_create(surface);
-  draw(cr, t, L, title, kinds);
-  const cairo_status_t drawn = cairo_status(cr);
-  cairo_destroy(cr);
-  cairo_status_t written = CAIRO_STATUS_SUCCESS;
-  if (format == TimelineFormat::kPng)
-    written = cairo_surface_write_to_png_stream(surface, append_bytes, &out);
-  cairo_surface_finish(surface);  // the SVG surface writes its document here
-  const cairo_status_t finished = cairo_surface_status(surface);
-  cairo_surface_destroy(surface);
-  for (cairo_status_t s : {drawn, written, finished})
-    if (s != CAIRO_STATUS_SUCCESS)
-      throw std::runtime_error(std::string("cairo: ") + cairo_status_to_string(s));
-  return out;
+  return detail::render_cairo(format, L.width, h,
+                              [&](cairo_t* cr) { draw(cr, t, L, title, kinds); });
 }
 
 std::vector<TimelineFlow> timeline_flows(const Timeline& t) {

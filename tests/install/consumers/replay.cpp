@@ -57,7 +57,7 @@ int main() {
     auto executor = tgraph::replay::make_executor(policy, options);
     for (int step = 0; step < 3; ++step) {
       Bodies bodies;
-      const tgraph::replay::StepStats s = executor->run_step(g, &a, bodies);
+      const tgraph::replay::ExecStepStats s = executor->run_step(g, &a, bodies);
       const std::string name(tgraph::replay::to_string(policy));
       expect(bodies.total.load() == consumer::kWidth * (consumer::kWidth + 1) / 2,
              name + ": the sum task saw every scale task");

@@ -36,6 +36,16 @@ Metrics compute_metrics(const StepGraph& g);
 /// unlimited processors; the span is the maximum. Same rules as compute_metrics.
 std::vector<std::uint64_t> earliest_finish(const StepGraph& g);
 
+/// The edges into every task in CSR form: for i in [begin[t], begin[t + 1]), edges[edge[i]]
+/// ends at task t (in the order of the list).
+struct IncomingEdges {
+  std::vector<std::uint32_t> begin;  ///< tasks + 1 offsets into `edge`
+  std::vector<std::uint32_t> edge;   ///< indices into the edge list
+};
+
+/// The incoming edges of each of `tasks` tasks (earliest_finish and viz's critical path).
+IncomingEdges incoming_edges(std::size_t tasks, const std::vector<Edge>& edges);
+
 /// The step counted in tasks rather than time: every task run costs 1.
 struct UnitMetrics {
   std::uint64_t work_tasks = 0;  ///< task runs (a loop body task counts once per iteration)

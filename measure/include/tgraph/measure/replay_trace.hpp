@@ -67,7 +67,7 @@ struct ReplayResult {
   /// What the caller was warned of (a partitioner's fallback, processors without tasks);
   /// filled by the caller, "warnings" in the JSON.
   std::vector<std::string> warnings;
-  replay::Calibration calibration;
+  replay::SyntheticCalibration calibration;  ///< the synthetic bodies' speed on this machine
   double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
   std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data
   std::uint64_t signals() const;

@@ -29,6 +29,8 @@ class RankWorkload : public replay::Workload {
   bool needs_touch(DatumId d) const override { return inner_.needs_touch(d); }
   void first_touch(DatumId d) override { inner_.first_touch(d); }
   void run(const replay::TaskRun& r) override;
+  /// The step's serial host work (spun; charged to the simulated host in an SMPI build).
+  void run_host(const StepGraph& step);
   bool stop_after(LoopId loop, std::uint32_t iteration) override {
     return inner_.stop_after(loop, iteration);
   }
@@ -56,6 +58,10 @@ struct MpiReplayOptions {
   std::uint32_t threads_per_rank = 1;
   std::optional<std::uint32_t> steps;  ///< first N steps (default all)
   bool check = false;                  ///< also run the sequential replay on rank 0, compare
+  /// Each step's serial host work (StepGraph::host_ns) runs on rank 0 before any task, every
+  /// rank waiting for it (a barrier), as in `tgraph replay` and both simulators; the
+  /// sequential reference then includes it too.
+  bool host_work = false;
   double watchdog_s = 60;              ///< no progress this long: name the wait, MPI_Abort(1)
   /// Testing only: this message (index in the first step's schedule) is never sent, so its
   /// receiver waits until the watchdog fires.

@@ -17,15 +17,57 @@
 
 namespace tgraph::replay {
 
+namespace detail {
+class ExecPlan;  // one step structure's plan, of the executor's own type (replay/src)
+}  // namespace detail
+
 /// Default spin time before a waiting thread parks in the kernel (see docs/replay.md and
 /// bench/replay: a futex hand-off costs 9-36 µs on this machine, a spinning one 0.1 µs).
 inline constexpr std::int64_t kDefaultSpinNs = 50'000;
 
-/// Default watchdog timeout (ExecOptions::timeout_ms): generous, a step of a real trace
+/// Default watchdog timeout (PartitionOptions::timeout_ms): generous, a step of a real trace
 /// takes milliseconds.
 inline constexpr std::int64_t kDefaultTimeoutMs = 300'000;
 
-/// How an executor runs.
+/// Options of the partition executor (Policy::kPartition) only.
+struct PartitionOptions {
+  /// Drop the waits that program order on the producing processor already implies (a
+  /// reducer waits for the last of another processor's writers). Off: one wait per
+  /// cross-processor producer (for measuring what the reduction saves).
+  bool elide_waits = true;
+  /// Run the per-processor programs interleaved on the calling thread (deterministic, same
+  /// plans and waits; the serial twin of the threaded executor).
+  bool serial = false;
+  /// The watchdog. A step during which no thread finishes a task or passes a wait for this
+  /// long ends with std::runtime_error naming what each thread waits for or runs (0: no
+  /// watchdog). Every thread is joined before run_step throws.
+  std::int64_t timeout_ms = kDefaultTimeoutMs;
+  /// With the watchdog: a step that still has not ended one timeout after the watchdog
+  /// fired (a task body that never returns, which nothing can interrupt) prints the report
+  /// on stderr and ends the process with exit status 1. For command-line tools.
+  bool timeout_exits = false;
+};
+
+/// Options of the barrier baseline (Policy::kBarrier) only.
+struct BarrierOptions {
+  BarrierRule rule = BarrierRule::kLevel;  ///< what one phase holds
+};
+
+/// Options of the StarPU baseline (Policy::kStarpu) only.
+struct StarpuOptions {
+  std::string sched = "lws";  ///< the scheduling policy (StarPU's names: lws, ws, eager...)
+};
+
+/// Options of the OpenMP-tasks baseline (Policy::kOmpTasks) only.
+struct OmpTasksOptions {
+  /// A `taskwait` after each iteration of an unrolled loop (what an OpenMP program testing
+  /// convergence writes; libgomp's dependence lists stay short). Off: the whole step is
+  /// submitted at once, as the other dynamic baselines unroll it.
+  bool iteration_wait = true;
+};
+
+/// How an executor runs: the options every policy reads, then each policy's own (an
+/// executor reads only its own part; the others are ignored).
 struct ExecOptions {
   std::uint32_t threads = 1;  ///< threads (processors); partition: must equal Assignment::k
   bool pin = true;            ///< bind thread p to a core with hwloc (partition, barrier)
@@ -36,39 +78,14 @@ struct ExecOptions {
   /// with kNone leaves CW groups whole and declares them `mutexinoutset`. A sequential run
   /// given the scope of another policy reproduces that policy's reduction order.
   std::optional<ReduceScope> reduce_scope;
-  /// Partition only: drop the waits that program order on the producing processor already
-  /// implies (a reducer waits for the last of another processor's writers). Off: one wait
-  /// per cross-processor producer (for measuring what the reduction saves).
-  bool elide_waits = true;
-  /// Partition only: run the per-processor programs interleaved on the calling thread
-  /// (deterministic, same plans and waits; the serial twin of the threaded executor).
-  bool serial = false;
-  /// Partition only: on a structure or assignment change, update the previous step's plan
-  /// (only the processors whose task lists or wait points changed are rebuilt) instead of
-  /// building it from scratch. Both give the same plan.
+  /// On a structure or assignment change, update the previous step's lowered edges and (for
+  /// the partition policy) its plan: only the processors whose task lists or wait points
+  /// changed are rebuilt. Off: both are built from scratch. Both give the same result.
   bool incremental_plans = true;
-  /// Partition only: also build every incrementally updated plan from scratch and throw
-  /// std::logic_error when the two differ (tests).
-  bool verify_plans = false;
-  /// Barrier only: what one phase holds (default: one dependency level).
-  BarrierRule barrier_rule = BarrierRule::kLevel;
-  /// StarPU only: the scheduling policy (StarPU's names: lws, ws, eager, prio, dmda...).
-  std::string starpu_sched = "lws";
-  /// omp-tasks only: a `taskwait` after each iteration of an unrolled loop (what an OpenMP
-  /// program testing convergence writes; libgomp's dependence lists stay short). Off: the
-  /// whole step is submitted at once, as the other dynamic baselines unroll it.
-  bool omp_iteration_wait = true;
-  /// Partition only: the watchdog. A step during which no thread finishes a task or passes
-  /// a wait for this long ends with std::runtime_error naming what each thread waits for or
-  /// runs (0: no watchdog). Every thread is joined before run_step throws.
-  std::int64_t timeout_ms = kDefaultTimeoutMs;
-  /// With the watchdog: a step that still has not ended one timeout after the watchdog
-  /// fired (a task body that never returns, which nothing can interrupt) prints the report
-  /// on stderr and ends the process with exit status 1. For command-line tools.
-  bool timeout_exits = false;
-  /// Testing only: the completion of this task (original id) is never published, as if a
-  /// wake-up were lost; its readers on other processors wait until the watchdog fires.
-  std::optional<TaskId> test_lose_signal;
+  PartitionOptions partition;  ///< Policy::kPartition only
+  BarrierOptions barrier;      ///< Policy::kBarrier only
+  StarpuOptions starpu;        ///< Policy::kStarpu only
+  OmpTasksOptions omp_tasks;   ///< Policy::kOmpTasks only
 };
 
 /// Counters of one thread in one step, kept by the executor itself.
@@ -81,8 +98,8 @@ struct ThreadCounters {
   std::int64_t wait_ns = 0;         ///< time in blocked waits
 };
 
-/// What one step cost.
-struct StepStats {
+/// What one step of an executor cost (the engine's own step figures are samples::StepStats).
+struct ExecStepStats {
   std::int64_t wall_ns = 0;   ///< whole step, structure build included
   std::int64_t build_ns = 0;  ///< lowering + plan build (0 when the plan was reused)
   /// The plan build alone, without lowering (0 when the plan was reused): the per-processor
@@ -108,7 +125,7 @@ struct StepStats {
 ///   auto ex = make_executor(Policy::kPartition, {.threads = 2});
 ///   SyntheticWorkload w;
 ///   w.set_step(g);
-///   StepStats s = ex->run_step(g, &assignment, w);
+///   ExecStepStats s = ex->run_step(g, &assignment, w);
 ///
 /// An exception thrown by a task (or a loop condition) stops the step; every thread is
 /// joined and the first exception is rethrown by run_step.
@@ -125,9 +142,9 @@ class Executor {
   /// Options in force.
   const ExecOptions& options() const { return options_; }
   /// How CW groups are lowered ("reduce" or "serialize" in reports).
-  CwMode cw() const { return cw_mode(); }
+  CwMode cw() const;
   /// Where kReduce puts its temporaries.
-  ReduceScope scope() const { return reduce_scope(); }
+  ReduceScope scope() const;
   /// Adds an observer (not owned; must outlive the executor's use).
   void add_observer(Observer& observer) { observers_.push_back(&observer); }
   /// Removes every observer.
@@ -139,7 +156,7 @@ class Executor {
 
   /// Runs one step of `g` (edges derived). `a` is required by Policy::kPartition
   /// (a->k == threads()) and ignored by the others. Throws UsageError on a bad assignment.
-  StepStats run_step(const StepGraph& g, const Assignment* a, Workload& w);
+  ExecStepStats run_step(const StepGraph& g, const Assignment* a, Workload& w);
 
   /// Number of plans built so far.
   std::uint64_t plans_built() const { return plans_built_; }
@@ -151,29 +168,27 @@ class Executor {
 
  protected:
   Executor(Policy policy, ExecOptions options);
-  /// Builds the policy's plan for `x` (called on a cache miss). Returns an opaque plan.
-  virtual std::shared_ptr<void> build(const ExecGraph& x) = 0;
-  /// Builds the plan for `x` from `previous`, the plan this executor built for the exec
-  /// graph `previous_exec` (called on a cache miss after a step; the partition policy updates
-  /// it incrementally). Default: build(x).
-  virtual std::shared_ptr<void> rebuild(const ExecGraph& x, const ExecGraph& previous_exec,
-                                        const void* previous);
-  /// Processors whose program the build of `plan` computed (default: every thread).
-  virtual std::uint32_t rebuilt_procs(const void* plan) const;
+  /// The observers added (for the executors' hot loops).
+  const std::vector<Observer*>& observers() const { return observers_; }
+  /// The stride set by set_observe_stride().
+  std::uint32_t observe_stride() const { return observe_stride_; }
+
+ private:
+  struct CacheEntry;
+  /// Builds the policy's plan for `x` (called on a cache miss); from `previous`, the plan
+  /// this executor built for the previous step, when not null (the partition policy updates
+  /// it incrementally). Implemented by detail::PlannedExecutor with the policy's plan type.
+  virtual std::unique_ptr<detail::ExecPlan> build(const ExecGraph& x,
+                                                  const detail::ExecPlan* previous) = 0;
+  /// Processors whose program the build of `plan` computed.
+  virtual std::uint32_t rebuilt_procs(const detail::ExecPlan& plan) const = 0;
   /// Runs one step with a plan. Fills `stats.threads` and `stats.loop_iterations`.
-  virtual void execute(void* plan, const ExecGraph& x, Workload& w, bool fresh,
-                       StepStats& stats) = 0;
-  /// The CW mode this executor uses.
-  CwMode cw_mode() const;
-  /// The reduction scope this executor uses with CwMode::kReduce.
-  ReduceScope reduce_scope() const;
+  virtual void execute(detail::ExecPlan& plan, const ExecGraph& x, Workload& w, bool fresh,
+                       ExecStepStats& stats) = 0;
 
   std::vector<Observer*> observers_;
   std::uint32_t observe_stride_ = 1;
   ExecOptions options_;
-
- private:
-  struct CacheEntry;
   Policy policy_;
   std::vector<std::shared_ptr<CacheEntry>> cache_;
   std::shared_ptr<CacheEntry> last_entry_;  // the plan of the previous step

@@ -15,7 +15,7 @@
 namespace tgraph::replay {
 
 /// Speed of this machine for the synthetic bodies, measured once per process.
-struct Calibration {
+struct SyntheticCalibration {
   double spin_iterations_per_ns = 0;  ///< iterations of the busy loop per nanosecond
   double touch_ns_per_byte = 0;       ///< reading + writing data already in cache
 };
@@ -64,7 +64,7 @@ class SyntheticWorkload : public Workload {
   std::uint64_t allocated_bytes() const;
 
   /// The calibration in use (measured on first call, about 20 ms).
-  static const Calibration& calibration();
+  static const SyntheticCalibration& calibration();
   /// Measures the memory pass at a working set of `bytes` (the step's data: beyond the
   /// caches it costs more per byte) and uses that from now on, so that a task run where
   /// the sequential program ran it costs its recorded time; returns the ns per byte.

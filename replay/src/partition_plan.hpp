@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: MIT
+// Internal: the partition executor's plan (paper section 3.2): one program per processor,
+// its tasks in order with the wait points (which completion count of which producer a task
+// needs) and signal flags, built from an exec graph (partition_plan.cpp) or updated from the
+// previous step's plan (partition_update.cpp). The threaded runtime (partition_executor.cpp)
+// and the serial twin (partition_serial.cpp) run the same plans under one readiness rule
+// (needed_executions).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "common.hpp"
+#include "tgraph/replay/lowering.hpp"
+
+namespace tgraph::replay::detail {
+
+/// Which execution of a producer a wait needs.
+enum class WaitKind : std::uint8_t {
+  kOnce,       ///< producer outside loops: its single execution
+  kSameIter,   ///< producer in the same loop: the same iteration
+  kPrevIter,   ///< loop-carried: the previous iteration (nothing in iteration 0)
+  kAfterLoop,  ///< producer in an earlier loop: its last iteration
+};
+
+/// One wait of a task: the producer's completion count it needs.
+struct WaitPoint {
+  TaskId producer = 0;
+  LoopId loop = kNoLoop;  // kAfterLoop: the producer's loop
+  WaitKind kind = WaitKind::kOnce;
+  friend bool operator==(const WaitPoint&, const WaitPoint&) = default;
+};
+
+/// What an op of a processor's program does.
+enum class OpKind : std::uint8_t { kTask, kLoopBegin, kLoopEnd };
+
+/// One op of a processor's program: 32 bytes, aligned, so that a record never straddles two
+/// cache lines and the hot loop indexes ops with a shift. Everything the loop needs for a
+/// task is here (its original id too), not in the exec graph's arrays.
+struct alignas(32) Op {
+  OpKind kind = OpKind::kTask;
+  bool signal = false;    // publish done[task] after running
+  bool is_break = false;  // evaluate and publish the loop decision after running
+  TaskId task = 0;
+  LoopId loop = kNoLoop;
+  std::uint32_t wait_begin = 0, wait_end = 0;
+  std::uint32_t jump = 0;       // kLoopEnd: first op of the body
+  TaskId origin = kNoTask;      // kTask: the original task (ExecGraph::origin)
+  friend bool operator==(const Op&, const Op&) = default;
+};
+static_assert(sizeof(Op) == 32);
+
+/// One processor's program: its ops, their wait points, the data it first touches.
+struct ProcPlan {
+  std::vector<Op> ops;
+  std::vector<WaitPoint> waits;
+  std::vector<DatumId> owned;
+  friend bool operator==(const ProcPlan&, const ProcPlan&) = default;
+};
+
+/// The partition executor's plan: one program per processor, and what the next incremental
+/// update compares with.
+struct PartitionPlan {
+  std::vector<ProcPlan> procs;
+  bool program_order = true;  // false: the assignment's explicit order is followed
+  std::size_t tasks = 0;
+  std::size_t loops = 0;
+  // What the next incremental build compares with (by exec task of this plan).
+  bool elide = true;
+  std::vector<StableKey> keys;
+  std::vector<LoopId> task_loop;
+  std::vector<ProcId> proc;
+  std::vector<std::int64_t> pos;    // position in its processor's ops
+  std::vector<TaskId> breaks;       // by loop: its break task
+  Csr intra, carried;              // predecessors along intra-step and loop-carried edges
+  std::uint32_t rebuilt_procs = 0;  // processors whose wait points this build computed
+};
+
+
+/// The one wait-readiness rule: how many executions of `w.producer` (this step) a task in
+/// iteration `iter` of its loop (0 outside loops) needs before it runs; 0: none.
+/// `loop_iterations` is, for kAfterLoop, the iterations the producer's loop ran (known once
+/// its break task decided to stop; the wait also needs that decision).
+constexpr std::uint32_t needed_executions(const WaitPoint& w, std::uint32_t iter,
+                                          std::uint32_t loop_iterations) {
+  switch (w.kind) {
+    case WaitKind::kOnce:
+      return 1;
+    case WaitKind::kSameIter:
+      return iter + 1;
+    case WaitKind::kPrevIter:
+      return iter;  // nothing in iteration 0
+    case WaitKind::kAfterLoop:
+      return loop_iterations;
+  }
+  return 1;
+}
+
+/// The programs of two plans are the same (ops, waits, owned data, order mode).
+bool same_programs(const PartitionPlan& a, const PartitionPlan& b);
+
+/// Builds the per-processor programs of `x` on `k` processors from scratch: each processor
+/// runs its tasks in the assignment's explicit order when `use_order` and the assignment has
+/// one (program order otherwise); `elide`: PartitionOptions::elide_waits.
+PartitionPlan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide);
+
+/// Builds the same plan as build_plan() from `prev`, the plan of an earlier exec graph,
+/// keeping the wait points of every processor whose program and dependencies did not change
+/// (PartitionPlan::rebuilt_procs counts the others).
+PartitionPlan update_plan(const ExecGraph& x, const PartitionPlan& prev, std::uint32_t k,
+                          bool use_order, bool elide);
+
+/// The steps of build_plan(), which update_plan() also uses. Step 1: the ops of every
+/// processor, each task's position, and what a later update compares with.
+void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide,
+               PartitionPlan& plan);
+/// Step 2: processor p's wait points (needs plan.intra and plan.carried).
+void build_waits(const ExecGraph& x, ProcId p, PartitionPlan& plan);
+/// Step 3: signal flags and first-touch owners.
+void finish_plan(const ExecGraph& x, PartitionPlan& plan);
+
+}  // namespace tgraph::replay::detail

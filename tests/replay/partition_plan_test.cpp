@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: MIT
+// The partition executor's plans, built directly (replay/src/partition_plan.hpp): each
+// processor's program, the wait points it keeps after elision, which tasks signal, the one
+// readiness rule, and the serial twin's deadlock check of an explicit order.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "partition_plan.hpp"
+#include "partition_serial.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/replay/lowering.hpp"
+
+namespace tgraph::replay {
+namespace {
+
+using detail::OpKind;
+using detail::PartitionPlan;
+using detail::WaitKind;
+using detail::WaitPoint;
+
+// Tasks of kind "t" on one object, each with the given accesses, in program order.
+StepGraph chain_graph(const std::vector<std::vector<Access>>& tasks, std::size_t data) {
+  StepGraph g;
+  const KindId kind = g.intern_kind("t");
+  g.objects.push_back({"o"});
+  for (std::size_t d = 0; d < data; ++d) g.data.push_back({"d" + std::to_string(d), 0, 8});
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    g.add_task(kind, 0, tasks[i], 0, static_cast<StableKey>(i + 1));
+  g.derive_edges();
+  return g;
+}
+
+// t0 writes d0; t1 reads d0, writes d1; t2 reads d1.
+StepGraph three_task_chain() {
+  return chain_graph(
+      {{{0, AccessMode::W}}, {{0, AccessMode::R}, {1, AccessMode::W}}, {{1, AccessMode::R}}}, 2);
+}
+
+Assignment on(std::vector<ProcId> proc, std::uint32_t k) {
+  Assignment a;
+  a.k = k;
+  a.proc = std::move(proc);
+  return a;
+}
+
+// The tasks of processor p's program, in order.
+std::vector<TaskId> tasks_of(const PartitionPlan& plan, ProcId p) {
+  std::vector<TaskId> out;
+  for (const detail::Op& op : plan.procs[p].ops)
+    if (op.kind == OpKind::kTask) out.push_back(op.task);
+  return out;
+}
+
+// The waits of task t in plan (on whichever processor runs it).
+std::vector<WaitPoint> waits_of(const PartitionPlan& plan, TaskId t) {
+  for (const auto& pp : plan.procs)
+    for (const detail::Op& op : pp.ops)
+      if (op.kind == OpKind::kTask && op.task == t)
+        return {pp.waits.begin() + op.wait_begin, pp.waits.begin() + op.wait_end};
+  return {};
+}
+
+bool signals(const PartitionPlan& plan, TaskId t) {
+  for (const auto& pp : plan.procs)
+    for (const detail::Op& op : pp.ops)
+      if (op.kind == OpKind::kTask && op.task == t) return op.signal;
+  return false;
+}
+
+TEST(PartitionPlan, WaitsOnlyForProducersOnOtherProcessors) {
+  // t0 and t2 on processor 0, t1 on 1.
+  const StepGraph g = three_task_chain();
+  const Assignment a = on({0, 1, 0}, 2);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  const PartitionPlan plan = detail::build_plan(x, 2, true, true);
+  EXPECT_TRUE(plan.program_order);
+  EXPECT_EQ(plan.rebuilt_procs, 2u);
+  EXPECT_EQ(tasks_of(plan, 0), (std::vector<TaskId>{0, 2}));
+  EXPECT_EQ(tasks_of(plan, 1), (std::vector<TaskId>{1}));
+  EXPECT_TRUE(waits_of(plan, 0).empty());
+  EXPECT_EQ(waits_of(plan, 1), (std::vector<WaitPoint>{{0, kNoLoop, WaitKind::kOnce}}));
+  EXPECT_EQ(waits_of(plan, 2), (std::vector<WaitPoint>{{1, kNoLoop, WaitKind::kOnce}}));
+  EXPECT_TRUE(signals(plan, 0));
+  EXPECT_TRUE(signals(plan, 1));
+  EXPECT_FALSE(signals(plan, 2));  // nobody waits for it
+}
+
+TEST(PartitionPlan, ElisionKeepsOnlyTheLastWaitOnEachProcessor) {
+  // t0 and t1 on processor 1 write d0 and d1; t2 on processor 0 reads both. Program order on
+  // processor 1 makes the wait for t1 imply the one for t0.
+  const StepGraph g = chain_graph(
+      {{{0, AccessMode::W}}, {{1, AccessMode::W}}, {{0, AccessMode::R}, {1, AccessMode::R}}}, 2);
+  const Assignment a = on({1, 1, 0}, 2);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  const PartitionPlan elided = detail::build_plan(x, 2, true, true);
+  EXPECT_EQ(waits_of(elided, 2), (std::vector<WaitPoint>{{1, kNoLoop, WaitKind::kOnce}}));
+  EXPECT_FALSE(signals(elided, 0));
+  EXPECT_TRUE(signals(elided, 1));
+  const PartitionPlan every = detail::build_plan(x, 2, true, false);
+  EXPECT_EQ(waits_of(every, 2), (std::vector<WaitPoint>{{1, kNoLoop, WaitKind::kOnce},
+                                                         {0, kNoLoop, WaitKind::kOnce}}));
+  EXPECT_TRUE(signals(every, 0));
+  EXPECT_FALSE(detail::same_programs(elided, every));
+}
+
+TEST(PartitionPlan, ReadinessRuleCountsExecutionsByWaitKind) {
+  const WaitPoint once{0, kNoLoop, WaitKind::kOnce};
+  const WaitPoint same{0, 0, WaitKind::kSameIter};
+  const WaitPoint prev{0, 0, WaitKind::kPrevIter};
+  const WaitPoint after{0, 0, WaitKind::kAfterLoop};
+  EXPECT_EQ(detail::needed_executions(once, 0, 0), 1u);
+  EXPECT_EQ(detail::needed_executions(once, 5, 0), 1u);
+  EXPECT_EQ(detail::needed_executions(same, 0, 0), 1u);
+  EXPECT_EQ(detail::needed_executions(same, 3, 0), 4u);
+  EXPECT_EQ(detail::needed_executions(prev, 0, 0), 0u);  // nothing before iteration 0
+  EXPECT_EQ(detail::needed_executions(prev, 3, 0), 3u);
+  EXPECT_EQ(detail::needed_executions(after, 0, 7), 7u);  // every iteration the loop ran
+}
+
+TEST(PartitionPlan, ExplicitOrderIsFollowedAndADeadlockingOneIsRejected) {
+  // t0 -> t1 -> t2 through d0, d1; t3 independent. t0, t2, t3 on processor 0, t1 on 1.
+  const StepGraph g = chain_graph({{{0, AccessMode::W}},
+                                   {{0, AccessMode::R}, {1, AccessMode::W}},
+                                   {{1, AccessMode::R}},
+                                   {{2, AccessMode::W}}},
+                                  3);
+  Assignment a = on({0, 1, 0, 0}, 2);
+  a.order = {{3, 0, 2}, {1}};
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  const PartitionPlan ok = detail::build_plan(x, 2, true, true);
+  EXPECT_FALSE(ok.program_order);
+  EXPECT_EQ(tasks_of(ok, 0), (std::vector<TaskId>{3, 0, 2}));
+  EXPECT_NO_THROW(detail::check_deadlock_free(ok, x));
+  EXPECT_EQ(tasks_of(detail::build_plan(x, 2, false, true), 0), (std::vector<TaskId>{0, 2, 3}));
+
+  // t2 before t0 on processor 0: t2 waits for t1, which waits for t0.
+  a.order = {{2, 0, 3}, {1}};
+  const ExecGraph y = lower(g, &a, CwMode::kReduce);
+  const PartitionPlan bad = detail::build_plan(y, 2, true, true);
+  try {
+    detail::check_deadlock_free(bad, y);
+    ADD_FAILURE() << "no deadlock reported";
+  } catch (const UsageError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("deadlocks"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("processor 0 cannot run task 2"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("processor 1 cannot run task 1"), std::string::npos) << msg;
+  }
+}
+
+TEST(PartitionPlan, SerialTwinRunsEveryTaskAndCountsItsWaits) {
+  const StepGraph g = three_task_chain();
+  const Assignment a = on({0, 1, 0}, 2);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  const PartitionPlan plan = detail::build_plan(x, 2, true, true);
+  struct Order : Workload {
+    std::vector<TaskId> ran;
+    void run(const TaskRun& r) override { ran.push_back(r.task); }
+    bool stop_after(LoopId, std::uint32_t) override { return true; }
+  } w;
+  ExecStepStats stats;
+  detail::run_interleaved(plan, x, &w, nullptr, &stats);
+  EXPECT_EQ(w.ran, (std::vector<TaskId>{0, 1, 2}));
+  ASSERT_EQ(stats.threads.size(), 2u);
+  EXPECT_EQ(stats.threads[0].tasks, 2u);
+  EXPECT_EQ(stats.threads[1].tasks, 1u);
+  EXPECT_EQ(stats.waits(), 2u);
+  EXPECT_EQ(stats.signals(), 2u);
+}
+
+}  // namespace
+}  // namespace tgraph::replay
