@@ -24,7 +24,7 @@ void add_export(CLI::App& app) {
   cmd->callback([a] {
     const std::string text =
         a->format == "chrome"
-            ? viz::chrome_trace(viz::read_timeline(a->input))
+            ? viz::chrome_trace(read_timeline(a->input))
             : partition::graph_file(read_trace(a->input), a->step, a->input,
                                     partition::parse_graph_file_format(a->format));
     if (a->output.empty() || a->output == "-") {

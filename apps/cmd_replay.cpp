@@ -81,10 +81,8 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
   meas::ReplayResult r = meas::replay_trace(
       trace, as ? &*as : nullptr, o, as ? &predicted : nullptr, observe ? &timeline : nullptr);
   r.warnings = notes.warnings;
-  if (!a.timeline.empty()) write_file_atomic(a.timeline, timeline.to_json());
-  if (!a.chrome.empty())
-    write_file_atomic(a.chrome,
-                      viz::chrome_trace(viz::parse_timeline(timeline.to_json(), a.chrome)));
+  if (!a.timeline.empty()) write_file_atomic(a.timeline, timeline_json(timeline.timeline()));
+  if (!a.chrome.empty()) write_file_atomic(a.chrome, viz::chrome_trace(timeline.timeline()));
   // Where the assignment came from: the file, or the strategy that placed the steps, and why
   // that one when the user named none or the named one fell back.
   std::string label = a.assignment;

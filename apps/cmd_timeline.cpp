@@ -15,7 +15,7 @@ void add_timeline(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output file: .svg or .png")->required();
   cmd->callback([a] {
     const viz::TimelineFormat format = viz::timeline_format_of(a->output);
-    viz::Timeline t = viz::read_timeline(a->input);
+    Timeline t = read_timeline(a->input);
     if (!a->range.empty()) {
       const auto [first, last] = viz::parse_step_range(a->range);
       t = viz::select_steps(t, first, last);

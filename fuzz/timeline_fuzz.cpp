@@ -16,10 +16,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string_view text = tgraph::fuzz::as_text(data, size);
   namespace viz = tgraph::viz;
   try {
-    const viz::Timeline t = viz::parse_timeline(text, "fuzz.json");
+    const tgraph::Timeline t = tgraph::parse_timeline(text, "fuzz.json");
     // What the pictures compute from it: steps end to end, flows, the Gantt chart.
     const std::vector<std::int64_t> offsets = t.step_offsets();
-    for (const viz::TimelineTask& e : t.tasks)
+    for (const tgraph::TimelineTask& e : t.tasks)
       if (e.step >= offsets.size() || e.thread >= t.threads) tgraph::fuzz::invariant_failed();
     if (viz::chrome_trace(t).empty()) tgraph::fuzz::invariant_failed();
     if (viz::render_timeline(t, viz::TimelineFormat::kSvg, "fuzz").empty())

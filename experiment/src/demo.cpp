@@ -45,7 +45,7 @@ void fill_measured(viz::MethodRow& row, const meas::ReplayResult& r) {
 }
 
 // Replays the chosen method once more on its first steps, observed, for the report's timeline.
-viz::Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
+Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
                                 const DemoOptions& o) {
   meas::ReplayOptions ro;
   ro.exec.threads = o.threads;
@@ -54,7 +54,7 @@ viz::Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
   ro.sequential_baseline = false;
   tr::TimelineObserver t;
   meas::replay_trace(trace, &a, ro, nullptr, &t);
-  return viz::parse_timeline(t.to_json(), "demo timeline");
+  return t.timeline();
 }
 
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));

@@ -8,17 +8,12 @@
 #include <set>
 
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/fixed.hpp"
 
 namespace tgraph::experiment {
 namespace {
 
 using nlohmann::json;
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 

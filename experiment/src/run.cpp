@@ -13,6 +13,7 @@
 #include "output.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/fixed.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/cost_model.hpp"
@@ -32,12 +33,6 @@ namespace tr = tgraph::replay;
 namespace meas = tgraph::measure;
 
 double ms(double ns) { return ns / 1e6; }
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 std::string utc_now() {
   const std::time_t t = std::time(nullptr);

@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Built-in observers: per-thread stats, locality, timeline (JSON; viz draws and converts it).
 #include <algorithm>
-#include <nlohmann/json.hpp>
 
 #include "tgraph/replay/observer.hpp"
 
@@ -112,14 +111,12 @@ void LocalityObserver::on_step_end(std::int64_t) {
 void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads,
                                      std::int64_t t_ns) {
   exec_ = &exec;
-  recording_ = step_ < max_steps_;
-  threads_ = std::max(threads_, threads);
+  recording_ = timeline_.steps < max_steps_;
+  timeline_.threads = std::max(timeline_.threads, threads);
   per_thread_.resize(threads);
   waits_per_thread_.resize(threads);
   open_.assign(threads * 8, 0);  // one slot per 64 bytes
   step_begin_ = t_ns;
-  labels_.clear();
-  for (TaskId t = 0; t < exec.graph.tasks.size(); ++t) labels_.push_back(exec.graph.kind_name(t));
 }
 
 void TimelineObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t_ns) {
@@ -129,56 +126,41 @@ void TimelineObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std
 void TimelineObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
                               std::int64_t t_ns) {
   if (!recording_) return;
-  per_thread_[thread].push_back({step_, thread, task, exec_->origin[task], iteration,
-                                 open_[thread * 8] - step_begin_, t_ns - step_begin_});
+  per_thread_[thread].push_back(
+      {task, iteration, open_[thread * 8] - step_begin_, t_ns - step_begin_});
 }
 
 void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
                                bool parked) {
   if (!recording_) return;
   waits_per_thread_[thread].push_back(
-      {step_, thread, task, t0 - step_begin_, t1 - step_begin_, parked});
+      {timeline_.steps, thread, task == kNoTask ? std::nullopt : std::optional<TaskId>(task),
+       t0 - step_begin_, t1 - step_begin_, parked});
 }
 
 void TimelineObserver::on_step_end(std::int64_t) {
   if (recording_) {
-    const std::size_t first = events_.size();
-    for (auto& v : per_thread_) {
-      events_.insert(events_.end(), v.begin(), v.end());
-      v.clear();
+    const std::uint32_t step = timeline_.steps;
+    const std::size_t first = timeline_.tasks.size();
+    for (std::uint32_t th = 0; th < per_thread_.size(); ++th) {
+      for (const Instance& i : per_thread_[th]) {
+        const TaskId origin = exec_->origin[i.task];
+        timeline_.tasks.push_back(
+            {step, th, i.task, origin == kNoTask ? std::nullopt : std::optional<TaskId>(origin),
+             std::string(exec_->graph.kind_name(i.task)), i.iteration, i.start_ns, i.end_ns});
+      }
+      per_thread_[th].clear();
     }
-    std::sort(
-        events_.begin() + static_cast<std::ptrdiff_t>(first), events_.end(),
-        [](const TimelineEvent& a, const TimelineEvent& b) { return a.start_ns < b.start_ns; });
+    std::stable_sort(timeline_.tasks.begin() + static_cast<std::ptrdiff_t>(first),
+                     timeline_.tasks.end(), [](const TimelineTask& a, const TimelineTask& b) {
+                       return a.start_ns < b.start_ns;
+                     });
     for (auto& v : waits_per_thread_) {
-      waits_.insert(waits_.end(), v.begin(), v.end());
+      timeline_.waits.insert(timeline_.waits.end(), v.begin(), v.end());
       v.clear();
     }
   }
-  ++step_;
-}
-
-std::string TimelineObserver::to_json() const {
-  nlohmann::json tasks = nlohmann::json::array(), waits = nlohmann::json::array();
-  for (const TimelineEvent& e : events_)
-    tasks.push_back(
-        {{"step", e.step},
-         {"thread", e.thread},
-         {"task", e.task},
-         {"origin", e.origin == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(e.origin)},
-         {"kind", e.task < labels_.size() ? labels_[e.task] : std::string()},
-         {"iteration", e.iteration},
-         {"start_ns", e.start_ns},
-         {"end_ns", e.end_ns}});
-  for (const TimelineWait& w : waits_)
-    waits.push_back({{"step", w.step},
-                     {"thread", w.thread},
-                     {"task", w.task == kNoTask ? nlohmann::json(nullptr) : nlohmann::json(w.task)},
-                     {"start_ns", w.start_ns},
-                     {"end_ns", w.end_ns},
-                     {"parked", w.parked}});
-  nlohmann::json j = {{"threads", threads_}, {"steps", step_}, {"tasks", tasks}, {"waits", waits}};
-  return j.dump();
+  ++timeline_.steps;
 }
 
 }  // namespace tgraph::replay

@@ -307,6 +307,37 @@ TEST_F(Cli, SequentialReplayIsItsOwnBaselineWithSpeedupOne) {
   EXPECT_EQ(j["sequential_wall_ns"], j["wall_ns"]);
 }
 
+// `replay --timeline` and `--chrome` write the same observed pass: one Chrome slice per task
+// instance (named by its kind, on its thread, of its duration) and per wait, in order.
+TEST_F(Cli, ReplayChromeTraceHasOneSlicePerTimelineEvent) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
+  const Result r = run("replay f.tgt --threads 2 --repeat 1 --timeline r.json --chrome c.json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const nlohmann::json t = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  const nlohmann::json c = nlohmann::json::parse(slurp(dir_ / "c.json"));
+  EXPECT_EQ(t.at("threads"), 2u);
+  EXPECT_EQ(t.at("steps"), 3u);
+  ASSERT_FALSE(t.at("tasks").empty());
+  std::size_t slices = 0, waits = 0, names = 0;
+  for (const auto& e : c.at("traceEvents")) {
+    if (e["ph"] == "X" && e["cat"] == "wait") ++waits;
+    else if (e["ph"] == "X") {
+      ASSERT_LT(slices, t["tasks"].size());
+      const nlohmann::json& task = t["tasks"][slices++];
+      EXPECT_EQ(e["name"], task["kind"]);
+      EXPECT_EQ(e["tid"], task["thread"]);
+      EXPECT_EQ(e["cat"], task["origin"].is_null() ? "reducer" : "task");
+      EXPECT_DOUBLE_EQ(e["dur"].get<double>(),
+                       static_cast<double>(task["end_ns"].get<std::int64_t>() -
+                                           task["start_ns"].get<std::int64_t>()) / 1000);
+    }
+    if (e["ph"] == "M") ++names;
+  }
+  EXPECT_EQ(slices, t["tasks"].size());
+  EXPECT_EQ(waits, t["waits"].size());
+  EXPECT_EQ(names, 2u);
+}
+
 TEST_F(Cli, BarrierRuleFlagChoosesThePhasesAndRejectsUnknownRules) {
   ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
   for (const char* rule : {"level", "operation"}) {

@@ -71,9 +71,9 @@ TEST(ReplayTrace, PartitionPolicyTimesBothAndCarriesThePredictionAndTheTimeline)
   for (const StepGraph& g : trace.steps)
     for (TaskId t = 0; t < g.tasks.size(); ++t) instances += g.runs(t);
   std::size_t original = 0;
-  for (const TimelineEvent& e : timeline.events()) original += e.origin != kNoTask ? 1 : 0;
+  for (const TimelineTask& e : timeline.timeline().tasks) original += e.origin.has_value() ? 1 : 0;
   EXPECT_EQ(original, instances);
-  EXPECT_EQ(timeline.events().back().step, 1u);
+  EXPECT_EQ(timeline.timeline().tasks.back().step, 1u);
 }
 
 TEST(ReplayTrace, RejectsMissingAssignmentsAndZeroThreads) {

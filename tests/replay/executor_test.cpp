@@ -65,9 +65,9 @@ TEST_P(EveryPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) {
       for (LoopId l = 0; l < g.loops.size(); ++l)
         EXPECT_EQ(s.loop_iterations[l], g.loops[l].iterations);
       ASSERT_NE(ex->last_exec(), nullptr);
-      test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
+      test::expect_valid_order(ex->last_exec()->graph, timeline.timeline().tasks,
                                static_cast<std::uint32_t>(step), {.exec = true});
-      test::expect_valid_order(g, timeline.events(), static_cast<std::uint32_t>(step),
+      test::expect_valid_order(g, timeline.timeline().tasks, static_cast<std::uint32_t>(step),
                                {.raw_only = true});
     }
     EXPECT_EQ(ex->plans_built(), 1u);
@@ -324,22 +324,23 @@ TEST(Timeline, ExportsEveryTaskInstanceToJson) {
   std::size_t instances = 0;
   for (TaskId t = 0; t < g.tasks.size(); ++t) instances += g.runs(t);
   std::size_t original = 0;
-  for (const TimelineEvent& e : tl.events()) original += e.origin != kNoTask ? 1 : 0;
+  for (const TimelineTask& e : tl.timeline().tasks) original += e.origin.has_value() ? 1 : 0;
   EXPECT_EQ(original, instances);
   // One record per event, in the same order, with the kind of its exec task (viz reads this
   // file back: tests/viz/timeline_test.cpp).
-  const nlohmann::json j = nlohmann::json::parse(tl.to_json());
+  const nlohmann::json j = nlohmann::json::parse(timeline_json(tl.timeline()));
   EXPECT_EQ(j.at("threads"), 2u);
   EXPECT_EQ(j.at("steps"), 1u);
-  ASSERT_EQ(j.at("tasks").size(), tl.events().size());
-  ASSERT_EQ(j.at("waits").size(), tl.waits().size());
-  for (std::size_t i = 0; i < tl.events().size(); ++i) {
-    const TimelineEvent& e = tl.events()[i];
+  ASSERT_EQ(j.at("tasks").size(), tl.timeline().tasks.size());
+  ASSERT_EQ(j.at("waits").size(), tl.timeline().waits.size());
+  for (std::size_t i = 0; i < tl.timeline().tasks.size(); ++i) {
+    const TimelineTask& e = tl.timeline().tasks[i];
     const nlohmann::json& r = j["tasks"][i];
     EXPECT_EQ(r.at("thread"), e.thread);
     EXPECT_EQ(r.at("task"), e.task);
-    EXPECT_EQ(r.at("kind"), tl.labels()[e.task]);
-    EXPECT_EQ(r.at("origin").is_null(), e.origin == kNoTask);
+    EXPECT_EQ(r.at("kind"), e.kind);
+    EXPECT_EQ(e.kind, ex->last_exec()->graph.kind_name(e.task));
+    EXPECT_EQ(r.at("origin").is_null(), !e.origin);
     EXPECT_EQ(r.at("start_ns"), e.start_ns);
     EXPECT_EQ(r.at("end_ns"), e.end_ns);
   }

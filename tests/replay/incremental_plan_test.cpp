@@ -160,7 +160,7 @@ TEST(IncrementalPlan, RunsRandomSequencesInDependencyOrder) {
           if (i > 0 && st.rebuilt_procs < k) ++partial;
           ++steps;
         }
-        test::expect_valid_order(ex->last_exec()->graph, timeline.events(),
+        test::expect_valid_order(ex->last_exec()->graph, timeline.timeline().tasks,
                                  static_cast<std::uint32_t>(i), {.exec = true});
         if (::testing::Test::HasFailure()) return;
       }

@@ -122,14 +122,14 @@ struct OrderCheck {
 /// Checks from a timeline (one step) that every task ran exactly runs(t) times and after
 /// all its predecessors: intra-step and loop-carried edges, the loop gate and its own
 /// previous iteration.
-inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineEvent>& events,
+inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineTask>& events,
                                std::uint32_t step, OrderCheck check = {}) {
   const bool exec = check.exec, raw_only = check.raw_only;
   std::map<std::pair<TaskId, std::uint32_t>, std::pair<std::int64_t, std::int64_t>> when;
   std::vector<std::uint32_t> count(g.tasks.size(), 0);
-  for (const TimelineEvent& e : events) {
-    if (e.step != step || (!exec && e.origin == kNoTask)) continue;
-    const TaskId id = exec ? e.task : e.origin;
+  for (const TimelineTask& e : events) {
+    if (e.step != step || (!exec && !e.origin)) continue;
+    const TaskId id = exec ? e.task : *e.origin;
     ASSERT_LT(id, g.tasks.size());
     ++count[id];
     ASSERT_TRUE(

@@ -91,10 +91,10 @@ TEST_P(StarpuPolicy, RunsEachTaskAfterItsPredecessorsAndMatchesSequentialState) 
       EXPECT_EQ(s.threads.size(), k);
       EXPECT_EQ(counted, instances);
       EXPECT_EQ(observed, instances);
-      const auto step_index = static_cast<std::uint32_t>(timeline.events().back().step);
+      const auto step_index = static_cast<std::uint32_t>(timeline.timeline().tasks.back().step);
       // Unlike the other policies, an unrolled loop has no gate: iteration i + 1 may start
       // before the break of iteration i.
-      test::expect_valid_order(xg, timeline.events(), step_index,
+      test::expect_valid_order(xg, timeline.timeline().tasks, step_index,
                                {.exec = true, .loop_gate = false});
     }
     EXPECT_EQ(ex->plans_built(), built + 1);
@@ -144,7 +144,7 @@ TEST(Starpu, CommutingWritersWithManyHandlesMatchSequential) {
     ex->run_step(g, nullptr, w);
     ex->run_step(g, nullptr, w);
     EXPECT_EQ(final_state(w, g), sequential_state(g, 2)) << cw_name(cw);
-    test::expect_valid_order(ex->last_exec()->graph, timeline.events(), 1,
+    test::expect_valid_order(ex->last_exec()->graph, timeline.timeline().tasks, 1,
                              {.exec = true, .loop_gate = false});
   }
 }

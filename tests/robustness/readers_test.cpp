@@ -40,10 +40,10 @@ TEST(CalibrationReader, RefusesANumberBeyondDoubleRange) {
 
 #if defined(TGRAPH_HAVE_VIZ)
 // The replay timeline reader (`tgraph export --format chrome`, `replay --chrome`,
-// `timeline`, `report`): viz::parse_timeline, then the Chrome trace made from it.
+// `timeline`, `report`): parse_timeline, then the Chrome trace made from it.
 std::string timeline_error(const std::string& tasks) {
   try {
-    viz::chrome_trace(viz::parse_timeline("{\"tasks\": [" + tasks + "]}", "t.json"));
+    viz::chrome_trace(parse_timeline("{\"tasks\": [" + tasks + "]}", "t.json"));
   } catch (const InputError& e) {
     return e.what();
   }
@@ -89,7 +89,7 @@ TEST(TimelineReader, RefusesFieldsOutOfRangeInsteadOfConvertingThem) {
 // unsigned integer.
 std::string viz_timeline_error(const std::string& tasks) {
   try {
-    viz::parse_timeline("{\"tasks\": [" + tasks + "]}", "t.json");
+    parse_timeline("{\"tasks\": [" + tasks + "]}", "t.json");
   } catch (const InputError& e) {
     return e.what();
   }
@@ -110,8 +110,8 @@ TEST(VizTimelineReader, BoundsStepsThreadsAndTimesBeforeSizingAnythingByThem) {
             "t.json: the steps laid end to end or the tasks' total time exceed 2^63-1 ns "
             "(expected a replay timeline's nanoseconds)");
   // The largest times that fit are kept and laid end to end.
-  const viz::Timeline t =
-      viz::parse_timeline("{\"tasks\": [" + event("0", "0", "0", "0", "4611686018427387904") + "," +
+  const Timeline t =
+      parse_timeline("{\"tasks\": [" + event("0", "0", "0", "0", "4611686018427387904") + "," +
                               event("1", "1", "1", "0", "4611686018427387903") + "]}",
                           "t.json");
   EXPECT_EQ(t.threads, 2u);

@@ -15,13 +15,12 @@
 #include <sstream>
 
 #include "../partition/test_graphs.hpp"
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
-#include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/critical_path.hpp"
 #include "tgraph/viz/graphviz.hpp"
+#include "scene_traces.hpp"
 
 namespace tgraph::viz {
 namespace {
@@ -30,14 +29,7 @@ using partition::testing::Builder;
 using M = AccessMode;
 
 StepGraph capture_step(const std::string& scene_name, int step) {
-  auto scene = samples::make_scene(scene_name, {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  StepGraph g;
-  for (int s = 0; s <= step; ++s) {
-    scene->step(rec);
-    g = rec.end_step();
-  }
-  return g;
+  return testing::scene_step(scene_name, step);
 }
 
 // fig2's step 1 with costs replaced by 10 ns x (task + 1): captured costs are measured times,

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Timelines (parsing, Gantt rendering, Chrome flows) and the HTML report.
+// Timelines (Gantt rendering, Chrome flows, step ranges) and the HTML report; the model and
+// its JSON are tested in tests/graph/timeline_test.cpp.
 #include "tgraph/viz/timeline.hpp"
 
 #include <gtest/gtest.h>
@@ -7,13 +8,10 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/synthetic.hpp"
-#include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/report.hpp"
+#include "scene_traces.hpp"
 
 namespace tgraph::viz {
 namespace {
@@ -27,17 +25,8 @@ const char* kTimeline = R"({"threads":2,"steps":2,"tasks":[
  {"step":1,"thread":1,"task":3,"origin":null,"kind":"reduce","iteration":0,"start_ns":100,"end_ns":300}],
  "waits":[{"step":0,"thread":1,"task":1,"start_ns":100,"end_ns":1100,"parked":false}]})";
 
-// The first `steps` steps of the fig2 scene, captured.
-Trace fig2_trace(int steps) {
-  auto scene = samples::make_scene("fig2", {});
-  capture::Recorder rec(capture::Mode::kCapture);
-  Trace trace;
-  for (int s = 0; s < steps; ++s) {
-    scene->step(rec);
-    trace.steps.push_back(rec.end_step());
-  }
-  return trace;
-}
+// The first `steps` steps of the fig2 scene.
+Trace fig2_trace(int steps) { return testing::scene_trace("fig2", steps); }
 
 // Tasks of `g` alternately on processors 0 and 1.
 Assignment alternating(const StepGraph& g) {
@@ -45,29 +34,6 @@ Assignment alternating(const StepGraph& g) {
   a.k = 2;
   for (TaskId t = 0; t < g.tasks.size(); ++t) a.proc.push_back(t % 2);
   return a;
-}
-
-TEST(Timeline, ParsesAndLaysStepsEndToEnd) {
-  const Timeline t = parse_timeline(kTimeline, "t.json");
-  EXPECT_EQ(t.threads, 2u);
-  ASSERT_EQ(t.tasks.size(), 5u);
-  EXPECT_FALSE(t.tasks[4].origin.has_value());
-  EXPECT_EQ(t.step_offsets(), (std::vector<std::int64_t>{0, 2000}));
-}
-
-TEST(Timeline, RejectsMalformedInputNamingTheFile) {
-  for (const char* bad :
-       {"", "[]", R"({"tasks":3})", R"({"tasks":[{"step":0}]})",
-        R"({"threads":1,"tasks":[{"step":0,"thread":3,"task":0,"start_ns":0,"end_ns":1}]})",
-        R"({"tasks":[{"step":0,"thread":0,"task":0,"start_ns":5,"end_ns":1}]})",
-        R"({"tasks":[{"step":-1,"thread":0,"task":0,"start_ns":0,"end_ns":1}]})"}) {
-    try {
-      parse_timeline(bad, "bad.json");
-      ADD_FAILURE() << "accepted: " << bad;
-    } catch (const InputError& e) {
-      EXPECT_EQ(std::string(e.what()).rfind("bad.json: ", 0), 0u) << e.what();
-    }
-  }
 }
 
 TEST(Timeline, SelectsAStepRange) {
@@ -106,31 +72,20 @@ TEST(Timeline, FlowGoesFromTheReleasingTaskToTheWait) {
   EXPECT_EQ(waits, 1);
 }
 
-// What `tgraph replay --chrome` writes: the replay observer's timeline through chrome_trace.
-TEST(Timeline, ConvertsAReplayObserversTimelineToChromeEvents) {
-  const StepGraph g = fig2_trace(1).steps[0];
-  const Assignment a = alternating(g);
-  replay::ExecOptions eo;
-  eo.threads = 2;
-  eo.pin = false;
-  auto ex = replay::make_executor(replay::Policy::kPartition, eo);
-  replay::TimelineObserver observer;
-  ex->add_observer(observer);
-  replay::SyntheticWorkload w({.cost_scale = 0.0});
-  w.set_step(g);
-  ex->run_step(g, &a, w);
-
-  const Timeline t = parse_timeline(observer.to_json(), "r.json");
-  ASSERT_EQ(t.tasks.size(), observer.events().size());
-  ASSERT_EQ(t.waits.size(), observer.waits().size());
+// One Chrome slice per task instance (its kind, thread, duration) and per wait, in order,
+// thread names, and one flow arrow pair per timeline_flows() entry (`tgraph replay --chrome`:
+// tests/apps/cli_test.cpp).
+TEST(Timeline, ConvertsEveryEventToChromeSlices) {
+  const Timeline t = parse_timeline(kTimeline, "t.json");
   const nlohmann::json chrome = nlohmann::json::parse(chrome_trace(t));
   std::size_t slices = 0, wait_slices = 0, names = 0, starts = 0, finishes = 0;
   for (const auto& e : chrome.at("traceEvents")) {
     if (e["ph"] == "X" && e["cat"] != "wait") {
-      const replay::TimelineEvent& ev = observer.events()[slices++];
-      EXPECT_EQ(e["name"], observer.labels()[ev.task]);
+      ASSERT_LT(slices, t.tasks.size());
+      const TimelineTask& ev = t.tasks[slices++];
+      EXPECT_EQ(e["name"], ev.kind);
       EXPECT_EQ(e["tid"], ev.thread);
-      EXPECT_EQ(e["cat"], ev.origin == kNoTask ? "reducer" : "task");
+      EXPECT_EQ(e["cat"], !ev.origin ? "reducer" : "task");
       EXPECT_DOUBLE_EQ(e["dur"].get<double>(), static_cast<double>(ev.end_ns - ev.start_ns) / 1000);
     }
     if (e["ph"] == "X" && e["cat"] == "wait") ++wait_slices;
@@ -140,10 +95,11 @@ TEST(Timeline, ConvertsAReplayObserversTimelineToChromeEvents) {
     starts += e["ph"] == "s" ? 1 : 0;
     finishes += e["ph"] == "f" ? 1 : 0;
   }
-  EXPECT_EQ(slices, observer.events().size());
-  EXPECT_EQ(wait_slices, observer.waits().size());
+  EXPECT_EQ(slices, t.tasks.size());
+  EXPECT_EQ(wait_slices, t.waits.size());
   EXPECT_EQ(names, 2u);
   EXPECT_EQ(starts, timeline_flows(t).size());
+  EXPECT_EQ(starts, 1u);
   EXPECT_EQ(finishes, starts);
 }
 

@@ -47,12 +47,6 @@ std::string script_json(const nlohmann::json& j) {
   return out;
 }
 
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
 const char* const kErrorHookScript = R"js(
 (function () {
   var root = document.documentElement;

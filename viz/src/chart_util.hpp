@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "tgraph/graph/fixed.hpp"
 #include "tgraph/viz/timeline.hpp"
 
 // cairo's own declaration (cairo.h), so that users of these helpers need not see cairo.
@@ -20,8 +21,6 @@ namespace tgraph::viz::detail {
 std::string escape(std::string_view s);
 /// JSON to embed in a <script>: "</" is written "<\/" so no text can close the element.
 std::string script_json(const nlohmann::json& j);
-/// `v` with `decimals` digits after the point ("%.*f").
-std::string fixed(double v, int decimals);
 
 /// First script of a page: records uncaught errors, rejected promises and console.error
 /// calls on <html data-js-errors> (what the browser tests read; visible in the inspector).

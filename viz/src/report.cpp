@@ -28,7 +28,6 @@ namespace {
 
 using nlohmann::json;
 using detail::escape;
-using detail::fixed;
 using detail::kRenderScript;
 using detail::methods_spec;
 using detail::page_head;

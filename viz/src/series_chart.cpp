@@ -21,7 +21,6 @@ namespace {
 using nlohmann::json;
 using detail::decimals_for;
 using detail::escape;
-using detail::fixed;
 using detail::kRenderScript;
 using detail::page_head;
 using detail::script_json;

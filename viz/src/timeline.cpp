@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Replay timelines: parsing, the cairo Gantt chart, Chrome trace events with flow arrows.
+// Replay timelines: the cairo Gantt chart, Chrome trace events with flow arrows.
 #include "tgraph/viz/timeline.hpp"
 
 #include <cairo.h>
@@ -25,7 +25,6 @@ namespace {
 
 using nlohmann::json;
 using detail::decimals_for;
-using detail::fixed;
 using detail::set_colour;
 using detail::text_at;
 using detail::tick_step;
@@ -207,156 +206,12 @@ std::vector<std::string> rank_kinds(const Timeline& t) {
   return out;
 }
 
-// Threads a timeline may have (rows of the picture).
-constexpr std::uint32_t kMaxThreads = 4096;
-
-std::uint32_t get_u32(const json& e, const char* key) {
-  const json& v = e.at(key);
-  if (!v.is_number_unsigned() || v.get<std::uint64_t>() > 0xffffffffu)
-    throw json::type_error::create(
-        302, std::string("\"") + key + "\" must be an unsigned 32-bit integer", &v);
-  return v.get<std::uint32_t>();
-}
-
-std::int64_t get_i64(const json& e, const char* key) {
-  const json& v = e.at(key);
-  if (!v.is_number_integer())
-    throw json::type_error::create(302, std::string("\"") + key + "\" must be an integer", &v);
-  return v.get<std::int64_t>();
-}
-
-std::optional<std::uint32_t> get_optional_u32(const json& e, const char* key) {
-  if (!e.contains(key) || e.at(key).is_null()) return std::nullopt;
-  return get_u32(e, key);
-}
-
 }  // namespace
-
-std::vector<std::int64_t> Timeline::step_offsets() const {
-  std::uint32_t last = 0;
-  for (const TimelineTask& e : tasks) last = std::max(last, e.step);
-  for (const TimelineWait& w : waits) last = std::max(last, w.step);
-  std::vector<std::int64_t> end(last + 1, 0);
-  for (const TimelineTask& e : tasks) end[e.step] = std::max(end[e.step], e.end_ns);
-  for (const TimelineWait& w : waits) end[w.step] = std::max(end[w.step], w.end_ns);
-  std::vector<std::int64_t> offsets(last + 1, 0);
-  for (std::size_t s = 1; s <= last; ++s) offsets[s] = offsets[s - 1] + end[s - 1];
-  return offsets;
-}
-
-Timeline read_timeline(const std::string& path) {
-  return parse_timeline(read_file_text(path), path);
-}
 
 std::string timeline_title(const Timeline& t, const std::string& path) {
   return std::filesystem::path(path).filename().string() + ": " + std::to_string(t.threads) +
          " threads, " + std::to_string(t.tasks.size()) + " task instances, " +
          std::to_string(t.waits.size()) + " blocking waits";
-}
-
-Timeline parse_timeline(std::string_view text, const std::string& name) {
-  const json j = json::parse(text, nullptr, false);
-  if (j.is_discarded())
-    throw InputError(name, std::nullopt,
-                     "not JSON (expected a replay timeline from tgraph replay --timeline)");
-  if (!j.is_object() || !j.contains("tasks") || !j["tasks"].is_array())
-    throw InputError(name, std::nullopt,
-                     "not a replay timeline (expected a JSON object with a \"tasks\" array)");
-  Timeline t;
-  std::size_t index = 0;
-  const char* what = "tasks";
-  // Ceilings before anything is sized by a value read: every step of a replay has task
-  // events, so step numbers stay below the number of events (step_offsets() allocates by
-  // step number); threads below kMaxThreads.
-  const std::size_t events = j["tasks"].size() + (j.contains("waits") ? j["waits"].size() : 0);
-  const auto step_of = [&](const json& e) {
-    const std::uint32_t s = get_u32(e, "step");
-    if (s >= events)
-      throw json::other_error::create(501,
-                                      "\"step\": " + std::to_string(s) + " (expected < " +
-                                          std::to_string(events) + ", the number of events)",
-                                      &e);
-    return s;
-  };
-  const auto thread_of = [&](const json& e) {
-    const std::uint32_t th = get_u32(e, "thread");
-    if (th >= kMaxThreads)
-      throw json::other_error::create(
-          501,
-          "\"thread\": " + std::to_string(th) + " (expected < " + std::to_string(kMaxThreads) + ")",
-          &e);
-    return th;
-  };
-  // An event's start_ns and end_ns: not negative, the end not before the start.
-  const auto span_of = [](const json& e) {
-    const std::int64_t start = get_i64(e, "start_ns"), end = get_i64(e, "end_ns");
-    if (end < start || start < 0)
-      throw json::other_error::create(501, "end_ns before start_ns, or a negative time", &e);
-    return std::pair{start, end};
-  };
-  try {
-    t.threads = j.contains("threads") ? get_u32(j, "threads") : 0;
-    for (const json& e : j["tasks"]) {
-      TimelineTask ev;
-      ev.step = step_of(e);
-      ev.thread = thread_of(e);
-      ev.task = get_u32(e, "task");
-      ev.origin = get_optional_u32(e, "origin");
-      ev.kind = e.contains("kind") && e["kind"].is_string() ? e["kind"].get<std::string>() : "task";
-      ev.iteration = e.contains("iteration") ? get_u32(e, "iteration") : 0;
-      std::tie(ev.start_ns, ev.end_ns) = span_of(e);
-      t.tasks.push_back(std::move(ev));
-      ++index;
-    }
-    what = "waits";
-    index = 0;
-    if (j.contains("waits")) {
-      if (!j["waits"].is_array())
-        throw json::type_error::create(302, "\"waits\" must be an array", &j);
-      for (const json& e : j["waits"]) {
-        TimelineWait w;
-        w.step = step_of(e);
-        w.thread = thread_of(e);
-        w.task = get_optional_u32(e, "task");
-        std::tie(w.start_ns, w.end_ns) = span_of(e);
-        w.parked = e.value("parked", false);
-        t.waits.push_back(w);
-        ++index;
-      }
-    }
-  } catch (const json::exception& e) {
-    std::string why = e.what();
-    if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
-    throw InputError(name, std::nullopt,
-                     std::string(what) + "[" + std::to_string(index) + "]: " + why);
-  }
-  std::uint32_t seen = 0;
-  for (const TimelineTask& e : t.tasks) seen = std::max(seen, e.thread + 1);
-  for (const TimelineWait& w : t.waits) seen = std::max(seen, w.thread + 1);
-  if (t.threads == 0) t.threads = seen;
-  if (seen > t.threads)
-    throw InputError(name, std::nullopt,
-                     "thread " + std::to_string(seen - 1) +
-                         " out of range (\"threads\": " + std::to_string(t.threads) + ")");
-  if (t.threads > kMaxThreads)
-    throw InputError(name, std::nullopt,
-                     "\"threads\": " + std::to_string(t.threads) + " (expected at most " +
-                         std::to_string(kMaxThreads) + ")");
-  // The pictures add step offsets to times and sum durations in 64-bit integers: the steps
-  // laid end to end, and the tasks' total time, must fit (292 years of nanoseconds).
-  std::vector<std::int64_t> end(events, 0);
-  for (const TimelineTask& e : t.tasks) end[e.step] = std::max(end[e.step], e.end_ns);
-  for (const TimelineWait& w : t.waits) end[w.step] = std::max(end[w.step], w.end_ns);
-  std::int64_t sum = 0, busy = 0;
-  bool overflow = false;
-  for (const std::int64_t ns : end) overflow |= __builtin_add_overflow(sum, ns, &sum);
-  for (const TimelineTask& e : t.tasks)
-    overflow |= __builtin_add_overflow(busy, e.end_ns - e.start_ns, &busy);
-  if (overflow)
-    throw InputError(name, std::nullopt,
-                     "the steps laid end to end or the tasks' total time exceed 2^63-1 ns "
-                     "(expected a replay timeline's nanoseconds)");
-  return t;
 }
 
 std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text) {
@@ -386,6 +241,7 @@ std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text) 
 Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last) {
   Timeline out;
   out.threads = t.threads;
+  out.steps = t.steps;
   for (const TimelineTask& e : t.tasks)
     if (e.step >= first && e.step <= last) out.tasks.push_back(e);
   for (const TimelineWait& w : t.waits)

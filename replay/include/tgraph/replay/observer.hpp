@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/timeline.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
@@ -23,7 +24,7 @@ std::int64_t now_ns();
 ///   TimelineObserver timeline;
 ///   executor->add_observer(timeline);
 ///   executor->run_step(g, &a, workload);
-///   write_file_atomic("r.json", timeline.to_json());
+///   write_file_atomic("r.json", timeline_json(timeline.timeline()));
 class Observer {
  public:
   virtual ~Observer() = default;
@@ -105,27 +106,6 @@ class LocalityObserver : public Observer {
   std::uint64_t migrated_ = 0;
 };
 
-/// One task instance in a timeline.
-struct TimelineEvent {
-  std::uint32_t step = 0;
-  std::uint32_t thread = 0;
-  TaskId task = 0;          ///< exec task
-  TaskId origin = kNoTask;  ///< original task (kNoTask: reducer)
-  std::uint32_t iteration = 0;
-  std::int64_t start_ns = 0;  ///< from the start of the step
-  std::int64_t end_ns = 0;
-};
-
-/// One blocking wait in a timeline.
-struct TimelineWait {
-  std::uint32_t step = 0;
-  std::uint32_t thread = 0;
-  TaskId task = 0;
-  std::int64_t start_ns = 0;
-  std::int64_t end_ns = 0;
-  bool parked = false;
-};
-
 /// Records every task instance (thread, start, end) and every blocking wait.
 class TimelineObserver : public Observer {
  public:
@@ -138,32 +118,27 @@ class TimelineObserver : public Observer {
                bool parked) override;
   void on_step_end(std::int64_t t_ns) override;
 
-  /// Every event recorded so far, step by step, sorted by start time within a step.
-  const std::vector<TimelineEvent>& events() const { return events_; }
-  const std::vector<TimelineWait>& waits() const { return waits_; }
-  /// Kind names by exec task of the last step (for labels).
-  const std::vector<std::string>& labels() const { return labels_; }
-  /// Number of threads seen.
-  std::uint32_t threads() const { return threads_; }
+  /// What was recorded so far: every task instance (its kind named from the step it ran in),
+  /// step by step, sorted by start time within a step, and every blocking wait.
+  /// timeline_json() writes it; viz draws it and converts it to Chrome / Perfetto trace
+  /// events (`tgraph replay --timeline`, `--chrome`).
+  const Timeline& timeline() const { return timeline_; }
   /// Keeps at most this many steps (older steps are not recorded); default unlimited.
   void set_max_steps(std::uint32_t n) { max_steps_ = n; }
-  /// The timeline as JSON: {"threads", "steps", "tasks": [{step, thread, task, origin,
-  /// kind, iteration, start_ns, end_ns}], "waits": [...]}.
-  /// viz::parse_timeline reads it back; viz::chrome_trace turns it into Chrome / Perfetto
-  /// trace events (`tgraph replay --chrome`, `tgraph export R.json --format chrome`).
-  std::string to_json() const;
 
  private:
-  std::vector<std::vector<TimelineEvent>> per_thread_;
+  // What a thread records in its callbacks (no string: the kind is named at step end).
+  struct Instance {
+    TaskId task = 0;
+    std::uint32_t iteration = 0;
+    std::int64_t start_ns = 0, end_ns = 0;
+  };
+  std::vector<std::vector<Instance>> per_thread_;
   std::vector<std::vector<TimelineWait>> waits_per_thread_;
-  std::vector<TimelineEvent> events_;
-  std::vector<TimelineWait> waits_;
   std::vector<std::int64_t> open_;  // start of the running task, per thread (8 apart)
-  std::vector<std::string> labels_;
+  Timeline timeline_;
   const ExecGraph* exec_ = nullptr;
   std::int64_t step_begin_ = 0;
-  std::uint32_t step_ = 0;
-  std::uint32_t threads_ = 0;
   std::uint32_t max_steps_ = 0xffffffffu;
   bool recording_ = false;
 };

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Replay timelines (`tgraph replay --timeline R.json`): reading them, drawing them as a Gantt
-// chart with cairo (SVG, PNG), and converting them to Chrome / Perfetto trace events.
+// Replay timelines (tgraph::Timeline, `tgraph replay --timeline R.json`): drawing them as a
+// Gantt chart with cairo (SVG, PNG), and converting them to Chrome / Perfetto trace events.
 #pragma once
 
 #include <cstdint>
@@ -10,48 +10,9 @@
 #include <utility>
 #include <vector>
 
+#include "tgraph/graph/timeline.hpp"
+
 namespace tgraph::viz {
-
-/// One task instance of a timeline (times from the start of its step).
-struct TimelineTask {
-  std::uint32_t step = 0;
-  std::uint32_t thread = 0;
-  std::uint32_t task = 0;               ///< executed task (reducers included)
-  std::optional<std::uint32_t> origin;  ///< task of the step graph (empty: a reducer)
-  std::string kind;
-  std::uint32_t iteration = 0;
-  std::int64_t start_ns = 0;
-  std::int64_t end_ns = 0;
-};
-
-/// One blocking wait of a timeline.
-struct TimelineWait {
-  std::uint32_t step = 0;
-  std::uint32_t thread = 0;
-  std::optional<std::uint32_t> task;  ///< the task that waited
-  std::int64_t start_ns = 0;
-  std::int64_t end_ns = 0;
-  bool parked = false;
-};
-
-/// A replay timeline; steps are laid end to end by step_offsets().
-///
-///   const Timeline t = parse_timeline(read_text("r.json"), "r.json");
-///   write_file_atomic("r.svg", render_timeline(t, TimelineFormat::kSvg, {}));
-struct Timeline {
-  std::uint32_t threads = 0;
-  std::vector<TimelineTask> tasks;
-  std::vector<TimelineWait> waits;
-  /// Start of each step on the common time axis (step s begins where step s-1's last
-  /// task or wait ended), indexed by step number; size = highest step + 1.
-  std::vector<std::int64_t> step_offsets() const;
-};
-
-/// Parses TimelineObserver::to_json text; throws InputError naming `name` and what is
-/// wrong (not JSON, missing field, thread out of range, end before start).
-Timeline parse_timeline(std::string_view json, const std::string& name);
-/// parse_timeline of the file at `path` (InputError naming it when unreadable or malformed).
-Timeline read_timeline(const std::string& path);
 
 /// Steps [first, last] (inclusive) of `t`; throws UsageError when none is in range.
 Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last);
