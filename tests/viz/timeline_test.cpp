@@ -16,14 +16,9 @@
 namespace tgraph::viz {
 namespace {
 
-// Two threads, two steps: thread 1 waits for thread 0's "a" in step 0.
-const char* kTimeline = R"({"threads":2,"steps":2,"tasks":[
- {"step":0,"thread":0,"task":0,"origin":0,"kind":"a","iteration":0,"start_ns":0,"end_ns":1000},
- {"step":0,"thread":1,"task":1,"origin":1,"kind":"b","iteration":0,"start_ns":1200,"end_ns":2000},
- {"step":0,"thread":0,"task":2,"origin":2,"kind":"c","iteration":1,"start_ns":1000,"end_ns":1500},
- {"step":1,"thread":0,"task":0,"origin":0,"kind":"a","iteration":0,"start_ns":0,"end_ns":500},
- {"step":1,"thread":1,"task":3,"origin":null,"kind":"reduce","iteration":0,"start_ns":100,"end_ns":300}],
- "waits":[{"step":0,"thread":1,"task":1,"start_ns":100,"end_ns":1100,"parked":false}]})";
+// Two threads, two steps: thread 1 waits for thread 0's "a" in step 0 (tests/graph reads it too).
+const std::string kTimeline =
+    read_file_text(std::string(TGRAPH_TEST_DATA) + "/timelines/two_steps.json");
 
 // The first `steps` steps of the fig2 scene.
 Trace fig2_trace(int steps) { return testing::scene_trace("fig2", steps); }
