@@ -173,7 +173,11 @@ ContactSlot& pair_slot(CollisionState& c, int i, int j) {
 void detect_collisions(Scene& scene, Scene::Impl& m) {
   const auto [c, cs, bodies, n] = detection_of(scene, m);
   // Results stamped with the last program's epoch were computed from the positions it left.
-  const auto fresh = [&c](std::uint64_t epoch) { return c.epoch != 0 && epoch == c.epoch; };
+  // (The epoch is copied: clang 14 cannot capture a structured binding.)
+  const std::uint64_t last_epoch = c.epoch;
+  const auto fresh = [last_epoch](std::uint64_t epoch) {
+    return last_epoch != 0 && epoch == last_epoch;
+  };
   c.host_narrow = 0;
   for (std::size_t i = 0; i < n; ++i)
     if (!fresh(c.proxies[i].epoch)) update_proxy(*bodies[i], c.proxies[i], 0);
