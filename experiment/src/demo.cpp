@@ -45,8 +45,7 @@ void fill_measured(viz::MethodRow& row, const meas::ReplayResult& r) {
 }
 
 // Replays the chosen method once more on its first steps, observed, for the report's timeline.
-Timeline observed_timeline(const Trace& trace, const TraceAssignment& a,
-                                const DemoOptions& o) {
+Timeline observed_timeline(const Trace& trace, const TraceAssignment& a, const DemoOptions& o) {
   meas::ReplayOptions ro;
   ro.exec.threads = o.threads;
   ro.repeat = 1;

@@ -157,11 +157,15 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
                      std::string(what) + "[" + std::to_string(index) + "]: " + why);
   }
   std::uint32_t seen = 0;
-  for (const TimelineTask& e : t.tasks) seen = std::max(seen, e.thread + 1);
-  for (const TimelineWait& w : t.waits) seen = std::max(seen, w.thread + 1);
+  for (const TimelineTask& e : t.tasks) {
+    seen = std::max(seen, e.thread + 1);
+    t.steps = std::max(t.steps, e.step + 1);
+  }
+  for (const TimelineWait& w : t.waits) {
+    seen = std::max(seen, w.thread + 1);
+    t.steps = std::max(t.steps, w.step + 1);
+  }
   if (t.threads == 0) t.threads = seen;
-  for (const TimelineTask& e : t.tasks) t.steps = std::max(t.steps, e.step + 1);
-  for (const TimelineWait& w : t.waits) t.steps = std::max(t.steps, w.step + 1);
   if (seen > t.threads)
     throw InputError(name, std::nullopt,
                      "thread " + std::to_string(seen - 1) +

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Built-in observers: per-thread stats, locality, timeline (JSON; viz draws and converts it).
+// Built-in observers: per-thread stats, locality, timeline (a tgraph::Timeline; viz draws it).
 #include <algorithm>
+#include <optional>
 
 #include "tgraph/replay/observer.hpp"
 
@@ -108,6 +109,13 @@ void LocalityObserver::on_step_end(std::int64_t) {
   prev_owner_ = std::move(owner);
 }
 
+namespace {
+
+// A timeline's task: empty for kNoTask (a reducer's origin, a wait on no task).
+std::optional<TaskId> known(TaskId t) { return t == kNoTask ? std::nullopt : std::optional(t); }
+
+}  // namespace
+
 void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads,
                                      std::int64_t t_ns) {
   exec_ = &exec;
@@ -134,8 +142,7 @@ void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t
                                bool parked) {
   if (!recording_) return;
   waits_per_thread_[thread].push_back(
-      {timeline_.steps, thread, task == kNoTask ? std::nullopt : std::optional<TaskId>(task),
-       t0 - step_begin_, t1 - step_begin_, parked});
+      {timeline_.steps, thread, known(task), t0 - step_begin_, t1 - step_begin_, parked});
 }
 
 void TimelineObserver::on_step_end(std::int64_t) {
@@ -144,10 +151,9 @@ void TimelineObserver::on_step_end(std::int64_t) {
     const std::size_t first = timeline_.tasks.size();
     for (std::uint32_t th = 0; th < per_thread_.size(); ++th) {
       for (const Instance& i : per_thread_[th]) {
-        const TaskId origin = exec_->origin[i.task];
-        timeline_.tasks.push_back(
-            {step, th, i.task, origin == kNoTask ? std::nullopt : std::optional<TaskId>(origin),
-             std::string(exec_->graph.kind_name(i.task)), i.iteration, i.start_ns, i.end_ns});
+        timeline_.tasks.push_back({step, th, i.task, known(exec_->origin[i.task]),
+                                   exec_->graph.kind_name(i.task), i.iteration, i.start_ns,
+                                   i.end_ns});
       }
       per_thread_[th].clear();
     }
