@@ -31,32 +31,41 @@
 
 namespace tgraph::mpi {
 
+replay::SyntheticOptions RankWorkload::options(double touch_ns_per_byte) {
+  replay::SyntheticOptions o;
+  o.fraction_ns_per_byte = touch_ns_per_byte;
+  o.spin = false;  // run() spins to the task's deadline by the clock
+  return o;
+}
+
 void RankWorkload::set_step(const StepGraph& step) {
   step_ = &step;
-  uncosted_ = step;
-  for (Task& t : uncosted_.tasks) t.cost_ns = 0;
-  inner_.set_step(uncosted_);
+  inner_.set_step(step);
 }
 
 void RankWorkload::run(const replay::TaskRun& r) {
   const std::int64_t t0 = replay::now_ns();
   inner_.run(r);
   if (r.origin == kNoTask || step_ == nullptr) return;
+  const double cost = static_cast<double>(step_->tasks[r.origin].cost_ns) * scale_;
 #ifdef TGRAPH_SMPI
   // The data pass above is real work that SMPI does not time (smpirun
   // --cfg=smpi/simulate-computation:no); the task's recorded cost is what the host executes.
   (void)t0;
-  const double flops = static_cast<double>(step_->tasks[r.origin].cost_ns) * scale_;
-  if (flops > 0) smpi_execute_flops(flops);
-  return;
-#endif
-  const double left = static_cast<double>(step_->tasks[r.origin].cost_ns) * scale_ -
-                      static_cast<double>(replay::now_ns() - t0);
-  if (left <= 0) return;
+  if (cost > 0) smpi_execute_flops(cost);
+#else
+  // By the clock, in slices of at most 1 us at the calibrated rate: a task takes its recorded
+  // time (or its data pass, when that is longer) whatever this process's spin rate does
+  // meanwhile (another rank's load, a misjudged calibration).
+  const std::int64_t deadline = t0 + static_cast<std::int64_t>(cost);
   const double rate = replay::SyntheticWorkload::calibration().spin_iterations_per_ns;
-  volatile std::uint64_t sink =
-      replay::spin_iterations(static_cast<std::uint64_t>(left * rate), r.origin + 1);
-  (void)sink;
+  for (std::int64_t now = replay::now_ns(); now < deadline; now = replay::now_ns()) {
+    const double slice = std::min(static_cast<double>(deadline - now), 1000.0);
+    volatile std::uint64_t sink =
+        replay::spin_iterations(static_cast<std::uint64_t>(slice * rate) + 1, r.origin + 1);
+    (void)sink;
+  }
+#endif
 }
 
 void RankWorkload::run_host(const StepGraph& step) {
@@ -129,7 +138,11 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   MpiReplayResult result;
   result.ranks = layout.ranks;
   result.threads_per_rank = layout.threads_per_rank;
-  RankWorkload w;
+  // One in-cache touch rate for every rank (rank 0's): the words each task touches, and so
+  // the final state, must not depend on which process runs it.
+  double touch_ns_per_byte = replay::SyntheticWorkload::calibration().touch_ns_per_byte;
+  MPI_Bcast(&touch_ns_per_byte, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  RankWorkload w(touch_ns_per_byte);
   std::vector<std::unique_ptr<Plan>> plans;
   Plan* bound = nullptr;
   Holders holders = everywhere(0, layout.ranks);
@@ -256,7 +269,7 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   {  // the sequential replay of the same steps and bodies, on rank 0 (speed-up and check)
     if (me == 0) {
       auto seq = replay::make_executor(replay::Policy::kSequential, {});
-      RankWorkload sw;
+      RankWorkload sw(touch_ns_per_byte);
       for (std::size_t si = 0; si < steps; ++si) {
         sw.set_step(trace.steps[si]);
         const std::int64_t t0 = now_ns();

@@ -12,6 +12,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "tgraph/replay/observer.hpp"
+
 namespace tgraph::mpi {
 
 StepRun::StepRun(Plan& plan, const StepSchedule& s, RankWorkload& w, std::uint32_t me,
@@ -43,20 +45,24 @@ StepRun::StepRun(Plan& plan, const StepSchedule& s, RankWorkload& w, std::uint32
   queue_.assign(nc, {});
   next_.assign(nc, 0);
   sending_.assign(nc, false);
+  receiving_.assign(nc, false);
+  decision_channel_.assign(s.decisions.size(), kNone);
   for (std::uint32_t m = 0; m < s.messages.size(); ++m)
     if (s.messages[m].to == me) queue_[s.messages[m].channel].push_back(m);
   for (std::uint32_t k = 0; k < s.decisions.size(); ++k)
     for (std::size_t j = 0; j < s.decisions[k].to.size(); ++j)
-      if (s.decisions[k].to[j] == me) queue_[s.decisions[k].channels[j]].push_back(k);
+      if (s.decisions[k].to[j] == me) {
+        queue_[s.decisions[k].channels[j]].push_back(k);
+        decision_channel_[k] = s.decisions[k].channels[j];
+      }
   for (std::uint32_t c = 0; c < nc; ++c) make_request(c);
 }
 
 Counters StepRun::run(std::int64_t watchdog_ns) {
-  last_progress_.store(now_ns(), std::memory_order_relaxed);
   {
     std::lock_guard lock(mu_);
     for (std::uint32_t c = 0; c < queue_.size(); ++c)
-      if (!queue_[c].empty()) MPI_Start(&plan_.requests[c]);
+      if (!queue_[c].empty()) start_receive(c);
   }
   for (std::uint32_t m : s_.entering)
     if (s_.messages[m].from == me_) send(m);
@@ -79,11 +85,17 @@ Counters StepRun::run(std::int64_t watchdog_ns) {
   std::condition_variable stop_cv;
   std::thread watchdog([&] {
     std::unique_lock lock(stop_mu);
+    std::uint64_t seen = progress_.load(std::memory_order_relaxed);
+    std::int64_t since = now_ns();
     while (running) {
       stop_cv.wait_for(lock, std::chrono::milliseconds(20));
-      if (running && watchdog_ns > 0 &&
-          now_ns() - last_progress_.load(std::memory_order_relaxed) > watchdog_ns)
+      const std::uint64_t now_seen = progress_.load(std::memory_order_relaxed);
+      if (now_seen != seen) {
+        seen = now_seen;
+        since = now_ns();
+      } else if (running && watchdog_ns > 0 && now_ns() - since > watchdog_ns) {
         stuck(watchdog_ns);
+      }
     }
   });
   for (std::uint32_t t = 0; t < T; ++t)
@@ -138,7 +150,36 @@ Counters StepRun::sum(const std::vector<Counters>& counters) const {
 }
 
 void StepRun::progress() {
-  if constexpr (!kSingleThreaded) last_progress_.store(now_ns(), std::memory_order_relaxed);
+  // No clock read per task: the watchdog sees the count change. Threads may overwrite each
+  // other's increment; the count still moves, which is all the watchdog asks.
+  if constexpr (!kSingleThreaded)
+    progress_.store(progress_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
+void StepRun::start_receive(std::uint32_t c) {
+  MPI_Start(&plan_.requests[c]);
+  receiving_[c] = true;
+}
+
+void StepRun::complete(std::uint32_t c) {
+  const Channel& ch = plan_.channels.channels()[c];
+  if (ch.from == me_) {
+    sending_[c] = false;
+    return;
+  }
+  receiving_[c] = false;
+  const std::uint32_t use = queue_[c][next_[c]];
+  if (ch.decision) {
+    const auto& buf = plan_.buffers[c];
+    decided_[use].store(buf[0] != 0 ? 1 : 0, std::memory_order_release);
+    ++decisions_received_;
+    decision_latency_ns_ += now_ns() - static_cast<std::int64_t>(buf[1]);
+    if (++next_[c] < queue_[c].size()) start_receive(c);
+  } else {
+    arrived_[use].store(1, std::memory_order_relaxed);
+    ++received_;
+  }
+  progress();
 }
 
 void StepRun::poll(bool block) {
@@ -154,33 +195,26 @@ void StepRun::poll(bool block) {
     if (block) throw std::logic_error("a rank waits with no message in flight");
     return;
   }
-  for (int i = 0; i < out; ++i) {
-    const auto c = static_cast<std::uint32_t>(indices_[i]);
-    const Channel& ch = plan_.channels.channels()[c];
-    if (ch.from == me_) {
-      sending_[c] = false;
-      continue;
-    }
-    const std::uint32_t use = queue_[c][next_[c]];
-    if (ch.decision) {
-      const auto& buf = plan_.buffers[c];
-      decided_[use].store(buf[0] != 0 ? 1 : 0, std::memory_order_release);
-      ++decisions_received_;
-      decision_latency_ns_ += now_ns() - static_cast<std::int64_t>(buf[1]);
-      if (++next_[c] < queue_[c].size()) MPI_Start(&plan_.requests[c]);
-    } else {
-      arrived_[use].store(1, std::memory_order_relaxed);
-      ++received_;
-    }
-    progress();
+  for (int i = 0; i < out; ++i) complete(static_cast<std::uint32_t>(indices_[i]));
+}
+
+void StepRun::test_channel(std::uint32_t c) {
+  if constexpr (kSingleThreaded) {
+    poll();
+    return;
   }
+  // An inactive persistent request tests as complete: only one in flight is tested.
+  if (!sending_[c] && !receiving_[c]) return;
+  int flag = 0;
+  MPI_Test(&plan_.requests[c], &flag, MPI_STATUS_IGNORE);
+  if (flag != 0) complete(c);
 }
 
 bool StepRun::try_install(std::uint32_t m) {
   if (installed_[m].load(std::memory_order_acquire)) return true;
-  if (!arrived_[m].load(std::memory_order_relaxed)) poll();
-  if (!arrived_[m].load(std::memory_order_relaxed)) return false;
   const Message& msg = s_.messages[m];
+  if (!arrived_[m].load(std::memory_order_relaxed)) test_channel(msg.channel);
+  if (!arrived_[m].load(std::memory_order_relaxed)) return false;
   for (std::uint32_t h : msg.hazards)
     if (!done_[h].load(std::memory_order_acquire)) return false;
   const auto dst = w_.mutable_words(msg.datum);
@@ -189,7 +223,7 @@ bool StepRun::try_install(std::uint32_t m) {
   // release: the words written above are visible to whoever sees installed_.
   installed_[m].store(1, std::memory_order_release);
   const std::uint32_t c = msg.channel;
-  if (++next_[c] < queue_[c].size()) MPI_Start(&plan_.requests[c]);
+  if (++next_[c] < queue_[c].size()) start_receive(c);
   progress();
   return true;
 }
@@ -200,7 +234,8 @@ void StepRun::wait_channel_free(std::unique_lock<std::mutex>& lock, std::uint32_
       poll(true);
       continue;
     }
-    poll();
+    test_channel(c);
+    if (!sending_[c]) break;
     lock.unlock();
     sched_yield();
     lock.lock();
@@ -254,8 +289,11 @@ bool StepRun::ready(const Wait& w) {
     }
     case WaitKind::kDecision: {
       if (decided_[w.index].load(std::memory_order_acquire) >= 0) return true;
+      // A decision made on this rank (another thread of it) comes through decided_ alone.
+      const std::uint32_t c = decision_channel_[w.index];
+      if (c == kNone) return false;
       std::lock_guard lock(mu_);
-      poll();
+      test_channel(c);
       return decided_[w.index].load(std::memory_order_acquire) >= 0;
     }
   }
@@ -289,12 +327,15 @@ std::string StepRun::describe(const Wait& w, const Instance* for_inst) const {
   return o.str();
 }
 
-void StepRun::idle() {
+void StepRun::idle(std::uint32_t& polls) {
   if constexpr (kSingleThreaded) {
     std::lock_guard lock(mu_);
     poll(true);
+  } else if (++polls <= kPollsBeforeYield) {
+    // The next poll at once: a yield is a system call, and this thread usually has its core.
+    replay::cpu_relax();
   } else {
-    sched_yield();
+    sched_yield();  // a long wait: let a rank or thread sharing this core run
   }
 }
 
@@ -330,7 +371,8 @@ void StepRun::wait_for(const Wait& w, const Instance* inst, std::uint32_t slot, 
   if (w.kind == WaitKind::kMessage) checked_[w.index].store(1);
   const std::int64_t t0 = now_ns();
   set_waiting(slot, describe(w, inst));
-  while (!ready(w)) idle();
+  std::uint32_t polls = 0;
+  while (!ready(w)) idle(polls);
   set_waiting(slot, {});
   const std::int64_t dt = now_ns() - t0;
   switch (w.kind) {

@@ -39,6 +39,11 @@ constexpr bool kSingleThreaded = false;
 // Plans (lowered structure + assignment, channels, persistent requests) kept at once.
 constexpr std::size_t kMaxPlans = 16;
 
+// Polls of a waiting thread before it yields between polls (each a lock and an MPI_Test:
+// 0.1-0.2 us here, so about 100 us; a rank sharing its core with another one waits for
+// that one's time slice, milliseconds, either way).
+constexpr std::uint32_t kPollsBeforeYield = 1000;
+
 // A lowered structure + assignment with its channels and persistent requests.
 struct Plan {
   StepGraph structure;
@@ -86,6 +91,13 @@ class StepRun {
   // Completes what MPI has finished; `block`: waits until at least one request completes
   // (the single-threaded SMPI rank, which has nothing else to do). Caller holds mu_.
   void poll(bool block = false);
+  // Tests channel c's request alone when it is in flight: a waiting thread does not scan
+  // every request of the plan (an SMPI rank tests them all, as poll()). Caller holds mu_.
+  void test_channel(std::uint32_t c);
+  // What a completed request on channel c means: a send's buffer is free, a datum version
+  // arrived, a loop decision is known (then the next receive on c starts). Holds mu_.
+  void complete(std::uint32_t c);
+  void start_receive(std::uint32_t c);
 
   // Installs message m when it arrived and this rank's older readers are done. Holds mu_.
   bool try_install(std::uint32_t m);
@@ -103,9 +115,10 @@ class StepRun {
 
   std::string describe(const Wait& w, const Instance* for_inst) const;
 
-  // A thread whose next item is not ready lets the others run; a single-threaded (SMPI) rank
-  // blocks in MPI until one of its requests completes.
-  void idle();
+  // A thread whose next item is not ready (its `polls`-th try) polls again at once for the
+  // first kPollsBeforeYield tries, then lets the others run between tries; a single-threaded
+  // (SMPI) rank blocks in MPI until one of its requests completes.
+  void idle(std::uint32_t& polls);
 
   void set_waiting(std::uint32_t slot, std::string what);
 
@@ -134,11 +147,13 @@ class StepRun {
   std::mutex mu_;                                  // MPI calls and the channel state below
   std::vector<std::vector<std::uint32_t>> queue_;  // by channel: this rank's receives in order
   std::vector<std::size_t> next_;
-  std::vector<bool> sending_;
+  std::vector<bool> sending_, receiving_;           // by channel: a request in flight
+  std::vector<std::uint32_t> decision_channel_;      // by decision: its channel to this rank
+                                                     // (kNone: decided on this rank)
   std::vector<int> indices_;
   std::int64_t received_ = 0, decisions_received_ = 0, decision_latency_ns_ = 0;
   Traffic measured_;
-  std::atomic<std::int64_t> last_progress_{0};  // relaxed: only the watchdog's estimate
+  std::atomic<std::uint64_t> progress_{0};  // relaxed: counts progress for the watchdog
   std::mutex waiting_mu_;
   std::vector<std::string> waiting_;
 };

@@ -13,7 +13,7 @@
 
 namespace tgraph::partition {
 
-CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal", 0.0, 0.0}; }
+CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal", 0.0, 0.0, 0.0}; }
 
 // Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
 // servers (`tgraph calibrate` measures it) and 0.05 ns/byte (20 GB/s cross-core).
@@ -89,6 +89,7 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   // Inter-node fields are optional: files written before they existed keep their meaning.
   if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
   if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
+  if (j.contains("task_overhead_ns")) m.task_overhead_ns = number("task_overhead_ns");
   m.source = name;
   return m;
 }

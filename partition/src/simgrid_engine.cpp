@@ -52,12 +52,14 @@ struct InFlight {
 
 /// Runs the steps of a trace one after the other on the given hosts (host of processor p);
 /// `read_ns_per_byte[p]`: what reading a byte written by another core of its node costs
-/// processor p (its host's loopback link) when the reader pays for transfers in a node.
+/// processor p (its host's loopback link) when the reader pays for transfers in a node;
+/// `overhead_ns`: the runtime's own time per task instance (CostModel::task_overhead_ns).
 class Driver {
  public:
   Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts,
-         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node)
+         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node, double overhead_ns)
       : trace_(trace), a_(a), hosts_(std::move(hosts)), read_ns_per_byte_(std::move(read_ns_per_byte)),
+        overhead_(static_cast<std::uint64_t>(std::llround(overhead_ns))),
         reader_pays_(intra_node == IntraNodeTransfer::reader),
         steps_(std::min(trace.steps.size(), a.steps.size())) {}
 
@@ -275,7 +277,7 @@ class Driver {
         const TaskId t = it.task != kNoTask ? it.task : it.body[st.pos];
         const std::uint32_t i = it.task != kNoTask ? 0 : st.iter;
         if (!ready(p, t, i)) return;
-        const std::uint64_t cost = g_->tasks[t].cost_ns + read_cost(p, t, i);
+        const std::uint64_t cost = g_->tasks[t].cost_ns + overhead_ + read_cost(p, t, i);
         if (cost == 0) {  // nothing to simulate: it finishes when it starts
           step_forward(p);
           finish_instance(t, i, p);
@@ -364,6 +366,7 @@ class Driver {
   const TraceAssignment& a_;
   const std::vector<sg::Host*> hosts_;
   const std::vector<double> read_ns_per_byte_;
+  const std::uint64_t overhead_;
   const bool reader_pays_;
   const std::size_t steps_;
   std::size_t step_ = 0;
@@ -452,7 +455,8 @@ PlatformRun run_on_loaded_platform(const Trace& trace, const TraceAssignment& a,
       bandwidth = bandwidth == 0 ? l->get_bandwidth() : std::min(bandwidth, l->get_bandwidth());
     read_ns_per_byte.push_back(bandwidth > 0 ? 1e9 / bandwidth : 0.0);
   }
-  Driver driver(trace, a, proc_hosts, std::move(read_ns_per_byte), platform.intra_node);
+  Driver driver(trace, a, proc_hosts, std::move(read_ns_per_byte), platform.intra_node,
+                platform.model.task_overhead_ns);
   sg::Activity::on_completion_cb([&](const sg::Activity& act) { driver.on_completion(act); });
   sg::Engine::on_time_advance_cb([&](double) { driver.on_time_advance(); });
   driver.start();

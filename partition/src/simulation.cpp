@@ -81,6 +81,7 @@ Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, Simulati
       break;
   }
   r.intra_node = platform.intra_node;
+  r.task_overhead_ns = platform.model.task_overhead_ns;
   r.simulation_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   r.makespan_ns = 0;
@@ -107,6 +108,7 @@ std::string prediction_json(const Prediction& p) {
                             {"cores", p.cores},
                             {"makespan_ns", p.makespan_ns},
                             {"simulation_ms", p.simulation_ms},
+                            {"task_overhead_ns", p.task_overhead_ns},
                             {"per_step", steps}};
   return j.dump();
 }

@@ -28,7 +28,8 @@ class Simulator {
  public:
   Simulator(const StepGraph& g, const Assignment& a, const CostModel& m)
       : g_(g), a_(a), k_(a.k), latency_(static_cast<std::uint64_t>(std::llround(m.sync_latency_ns))),
-        per_byte_(m.per_byte_ns) {
+        per_byte_(m.per_byte_ns),
+        overhead_(static_cast<std::uint64_t>(std::llround(m.task_overhead_ns))) {
     s_.first_instance = detail::first_instances(g);
     const std::uint64_t total = s_.first_instance.back();
     s_.start_ns.assign(total, 0);
@@ -101,7 +102,8 @@ class Simulator {
       ready = std::max(ready, arrival);
     }
     const std::uint64_t duration =
-        g_.tasks[t].cost_ns + static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
+        g_.tasks[t].cost_ns + overhead_ +
+        static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
     const std::uint64_t inst = s_.first_instance[t] + i;
     s_.start_ns[inst] = ready;
     s_.end_ns[inst] = ready + duration;
@@ -160,6 +162,7 @@ class Simulator {
   const std::uint32_t k_;
   const std::uint64_t latency_;
   const double per_byte_;
+  const std::uint64_t overhead_;  // CostModel::task_overhead_ns, per instance
   Schedule s_;
   std::vector<std::vector<Dep>> deps_;
   std::vector<std::vector<Item>> items_;

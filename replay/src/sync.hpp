@@ -11,14 +11,7 @@
 
 namespace tgraph::replay::detail {
 
-/// One CPU relaxation hint.
-inline void cpu_relax() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
-}
+using replay::cpu_relax;
 
 /// A 64-bit counter alone on its cache line.
 struct alignas(64) PaddedCounter {

@@ -178,17 +178,25 @@ void SyntheticWorkload::run(const TaskRun& r) {
   // A task whose recorded time is shorter than a pass over all its data at in-cache speed
   // cannot have touched all of it: a force field reads a few nodes of a body's whole
   // position vector. Its pass covers the leading fraction of each datum that such a pass
-  // could cover in the recorded time. The fraction depends only on the recorded cost and
-  // the process's calibration (not on cost_scale or calibrate_touch), so every run of a
-  // step in a process touches the same words and final states stay comparable. A zero
-  // cost (a hand-made graph without costs) keeps the whole pass.
-  std::uint64_t all_bytes = 0;
+  // could cover in the recorded time, after the whole of its W data (a W task makes the
+  // whole new version). The fraction depends only on the recorded cost and the touch rate
+  // (the process's calibration, or SyntheticOptions::fraction_ns_per_byte; not cost_scale
+  // or calibrate_touch), so every run of a step touches the same words and final states
+  // stay comparable. A zero cost (a hand-made graph without costs) keeps the whole pass.
+  std::uint64_t overwritten = 0, partial = 0;  // bytes of W data; of every other pass
   for (std::size_t i = 0; i < na; ++i) {
     const Buffer* b = buffers_[acc_list[i].datum].get();
-    if (b) all_bytes += b->words * 8 * ((reads(orig[i].mode) ? 1 : 0) + (writes(orig[i].mode) ? 1 : 0));
+    if (!b) continue;
+    if (orig[i].mode == AccessMode::W)
+      overwritten += b->words * 8;
+    else
+      partial += b->words * 8 * ((reads(orig[i].mode) ? 1 : 0) + (writes(orig[i].mode) ? 1 : 0));
   }
-  const double pass_ns = static_cast<double>(all_bytes) * c.touch_ns_per_byte;
-  const double fraction = recorded > 0 && pass_ns > recorded ? recorded / pass_ns : 1.0;
+  const double rate = options_.fraction_ns_per_byte.value_or(c.touch_ns_per_byte);
+  const double budget = recorded - static_cast<double>(overwritten) * rate;
+  const double pass_ns = static_cast<double>(partial) * rate;
+  const double fraction =
+      recorded > 0 && partial > 0 && pass_ns > budget ? std::max(0.0, budget) / pass_ns : 1.0;
   auto words_of = [fraction](const Buffer& b) {
     if (fraction >= 1.0) return b.words;
     const auto w = static_cast<std::uint64_t>(static_cast<double>(b.words) * fraction + 0.5);
@@ -207,11 +215,14 @@ void SyntheticWorkload::run(const TaskRun& r) {
     if (!writes(orig[i].mode)) continue;
     Buffer* b = buffers_[acc_list[i].datum].get();
     if (!b) continue;
-    const std::uint64_t words = words_of(*b);
+    // A W task makes the whole new version (nothing of the old one survives it, so a process
+    // that did not receive the old one holds the same words); RW and CW keep a tail that
+    // their reader received.
+    const std::uint64_t words = orig[i].mode == AccessMode::W ? b->words : words_of(*b);
     write_pass(orig[i].mode, b->w.get(), words, acc);
     bytes += words * 8;
   }
-  spin_ns(cost - static_cast<double>(bytes) * touch_ns_per_byte_, acc);
+  if (options_.spin) spin_ns(cost - static_cast<double>(bytes) * touch_ns_per_byte_, acc);
 }
 
 void SyntheticWorkload::spin_ns(double ns, std::uint64_t seed) {

@@ -29,6 +29,11 @@ TEST(MpiLinkFile, AddsTheMpiFieldsAndKeepsTheOthers) {
   EXPECT_DOUBLE_EQ(m.mpi_latency_ns, 310);
   EXPECT_DOUBLE_EQ(m.mpi_per_byte_ns, 0.09);
   EXPECT_NE(out.find("\"cpus\""), std::string::npos);
+  EXPECT_EQ(m.task_overhead_ns, 0.0);  // not measured: not written
+  link.task_overhead_ns = 64.5;
+  EXPECT_EQ(partition::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
+                .task_overhead_ns,
+            64.5);
 }
 
 TEST(MpiLinkFile, RejectsAFileThatIsNotACalibration) {
@@ -55,6 +60,9 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   EXPECT_LT(m.mpi_latency_ns, 1e9);
   EXPECT_GT(m.mpi_per_byte_ns, 0.0);
   EXPECT_LT(m.mpi_per_byte_ns, 1e3);
+  // The replay's own time per task instance: measured (a replay has some), in nanoseconds.
+  EXPECT_GT(m.task_overhead_ns, 0.0);
+  EXPECT_LT(m.task_overhead_ns, 1e6);
   // No file to add to: exit 2.
   const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
                               dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +

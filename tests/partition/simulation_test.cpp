@@ -99,6 +99,18 @@ TEST(Calibration, InterNodeFieldsAreOptionalWithDefaults) {
                InputError);
 }
 
+TEST(Calibration, TaskOverheadIsOptionalAndZeroByDefault) {
+  EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03})", "c").task_overhead_ns,
+            0.0);
+  EXPECT_EQ(CostModel::ideal().task_overhead_ns, 0.0);
+  EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "task_overhead_ns": 61.5})",
+                              "c")
+                .task_overhead_ns,
+            61.5);
+  EXPECT_THROW(parse_calibration(R"({"sync_latency_ns": 1, "per_byte_ns": 0, "task_overhead_ns": "x"})", "c"),
+               InputError);
+}
+
 TEST(SimulateTrace, BuiltinEngineIsTheScheduleSimulator) {
   Trace trace;
   trace.steps = {testing::random_graph(3, 30, 6, true), testing::random_graph(4, 30, 6, true)};
@@ -246,7 +258,10 @@ TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
 // control, latencies and transfer costs, so the makespans agree to SimGrid's 1 ns timing
 // precision per event, with the ideal model and with the default one.
 TEST(SimgridEngine, EqualsTheBuiltinSimulatorOnOneHostOnRandomGraphs) {
-  for (const CostModel& model : {CostModel::ideal(), CostModel::defaults()})
+  CostModel with_overhead = CostModel::defaults();
+  with_overhead.task_overhead_ns = 37;
+  with_overhead.source = "defaults + task overhead";
+  for (const CostModel& model : {CostModel::ideal(), CostModel::defaults(), with_overhead})
   for (std::uint32_t k : {1u, 2u, 3u, 5u}) {
     Trace trace;
     for (std::uint64_t seed = 0; seed < 40; ++seed)

@@ -47,6 +47,19 @@ TEST(Simulator, RunsAChainOnOneProcessorBackToBack) {
   EXPECT_EQ(s.end_ns, (std::vector<std::uint64_t>{3, 7, 12}));
 }
 
+TEST(Simulator, ChargesTheRuntimesOverheadOncePerTaskInstance) {
+  CostModel m = model(10, 0);
+  m.task_overhead_ns = 2;
+  // One processor: 3 + 2, 4 + 2, 5 + 2 back to back.
+  EXPECT_EQ(simulate(chain(), assign(1, {0, 0, 0}), m).end_ns,
+            (std::vector<std::uint64_t>{5, 11, 18}));
+  // Two: p0 t0 [0,5]; p1 t1 waits 5 + 10 -> [15,21]; p0 t2 waits 21 + 10 -> [31,38].
+  const Schedule s = simulate(chain(), assign(2, {0, 1, 0}), m);
+  EXPECT_EQ(s.start_ns, (std::vector<std::uint64_t>{0, 15, 31}));
+  EXPECT_EQ(s.makespan_ns, 38u);
+  EXPECT_EQ(s.busy_ns, (std::vector<std::uint64_t>{12, 6}));
+}
+
 TEST(Simulator, ChargesLatencyForEachCrossProcessorWait) {
   // p0: t0 [0,3]; p1: t1 waits 3 + 10 -> [13,17]; p0: t2 waits 17 + 10 -> [27,32].
   const Schedule s = simulate(chain(), assign(2, {0, 1, 0}), model(10, 0));

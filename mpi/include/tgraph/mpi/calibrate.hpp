@@ -15,6 +15,9 @@ struct MpiLink {
   double per_byte_ns = 0;           ///< extra one-way time per byte of a large message (median)
   int rounds = 0;                   ///< small round trips measured
   std::uint64_t message_bytes = 0;  ///< size of the large message
+  /// The MPI replay's own time per task instance beyond its recorded cost (0: not measured;
+  /// then the file's "task_overhead_ns" is left as it was).
+  double task_overhead_ns = 0;
 };
 
 /// Ping-pong between ranks 0 and 1 of MPI_COMM_WORLD (other ranks wait); every rank calls
@@ -22,9 +25,16 @@ struct MpiLink {
 MpiLink measure_mpi_link(int rounds = 4000, std::uint64_t message_bytes = 1 << 20,
                          int repeats = 15);
 
+/// The MPI replay's own time per task instance (ns): every rank replays, through
+/// replay_distributed() with one thread per rank, a chain of `tasks` tasks of `cost_ns` each
+/// on a datum of its own (no message), `steps` times; rank 0's median over the steps after
+/// the first of (wall - tasks x cost_ns) / tasks. Every rank calls it; the result is rank 0's.
+double measure_task_overhead(std::uint32_t tasks = 20000, std::uint64_t cost_ns = 300,
+                             int steps = 6);
+
 /// The calibration file `text` (named `name` in errors; what `tgraph calibrate` wrote) with
 /// "mpi_latency_ns" and "mpi_per_byte_ns" set from `link` (and "mpi_calibration" saying how),
-/// every other key kept. Throws InputError naming `name` when `text` is not a calibration.
+/// "task_overhead_ns" when `link` measured it, every other key kept. Throws InputError naming `name` when `text` is not a calibration.
 std::string with_mpi_link(std::string_view text, const std::string& name, const MpiLink& link);
 
 }  // namespace tgraph::mpi

@@ -18,11 +18,14 @@ namespace tgraph::mpi {
 
 /// Replay's synthetic bodies with the data pass made independent of the process's own
 /// calibration (SyntheticWorkload sizes a short task's pass from it, and every rank is its
-/// own process): every task passes over all of its data, then spins for what is left of its
-/// recorded cost. The distributed run and the sequential reference both use it.
+/// own process): a task passes over the part of its data that the in-cache touch rate
+/// `touch_ns_per_byte` (one value for every rank: rank 0's, broadcast) lets fit in its
+/// recorded cost, as the threaded replay's bodies do, then spins by the clock until that
+/// cost has passed since the task began. The distributed run and the sequential reference
+/// both use it.
 class RankWorkload : public replay::Workload {
  public:
-  explicit RankWorkload(replay::SyntheticOptions options = {}) : inner_(options) {}
+  explicit RankWorkload(double touch_ns_per_byte) : inner_(options(touch_ns_per_byte)) {}
   /// The step the next run replays (kept by pointer).
   void set_step(const StepGraph& step);
   void bind(const replay::ExecGraph& exec) override { inner_.bind(exec); }
@@ -43,9 +46,9 @@ class RankWorkload : public replay::Workload {
   std::span<std::uint64_t> mutable_words(DatumId d);
 
  private:
+  static replay::SyntheticOptions options(double touch_ns_per_byte);
   replay::SyntheticWorkload inner_;
   const StepGraph* step_ = nullptr;
-  StepGraph uncosted_;  // the step with zero costs: the inner workload's full data pass
   double scale_ = 1.0;
 };
 

@@ -28,6 +28,11 @@ struct CostModel {
   /// Cost per byte (ns) of an MPI message between two nodes (1 / bandwidth): default 0.08
   /// (12.5 GB/s, a 100 Gb/s InfiniBand EDR link), from "mpi_per_byte_ns" when present.
   double mpi_per_byte_ns = 0.08;
+  /// Time the runtime itself spends per task instance beyond the instance's recorded cost
+  /// (dispatching it, its bookkeeping, the body's clock), charged to the instance's
+  /// processor by both simulation engines. 0 unless the calibration file has
+  /// "task_overhead_ns" (`mpirun -np 2 tgraph-mpi calibrate` measures the MPI replay's).
+  double task_overhead_ns = 0.0;
 
   /// Zero synchronisation and transfer cost: pure precedence and load.
   static CostModel ideal();

@@ -71,6 +71,7 @@ struct Prediction {
   std::string platform;           ///< the platform file, "NxC", or "one machine"
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: as asked
   double simulation_ms = 0;       ///< wall time of the simulation itself
+  double task_overhead_ns = 0;    ///< CostModel::task_overhead_ns charged per task instance
 };
 
 /// Simulates every step of `trace` under `a` with `engine`. Steps run one after the other

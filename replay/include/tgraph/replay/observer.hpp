@@ -17,6 +17,15 @@ namespace tgraph::replay {
 /// Nanoseconds on the steady clock (the time base of every callback).
 std::int64_t now_ns();
 
+/// One CPU relaxation hint (a spinning thread's pause between two polls).
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
 /// Receives the events of an executor. Callbacks for different `thread` values may come
 /// concurrently; callbacks for one thread come in order from that thread. Instances of one
 /// task (its loop iterations) never overlap.

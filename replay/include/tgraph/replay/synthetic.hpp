@@ -25,6 +25,13 @@ struct SyntheticOptions {
   double cost_scale = 1.0;                      ///< multiplies every recorded cost
   bool touch = true;                            ///< read/write the data buffers
   std::uint64_t max_datum_bytes = 64ull << 20;  ///< larger data are touched only this far
+  /// In-cache touch rate (ns per byte) that sizes a short task's partial pass (below);
+  /// default: this process's calibration. Processes that must touch the same words (the
+  /// ranks of an MPI replay and its sequential reference) share one value.
+  std::optional<double> fraction_ns_per_byte = std::nullopt;
+  /// Spin for the rest of the recorded cost after the data pass (false: the caller does,
+  /// e.g. by the clock).
+  bool spin = true;
 };
 
 /// Bodies that cost what the trace recorded and move the memory the data would.
