@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "tgraph/measure/lowered.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulation.hpp"
@@ -16,6 +17,7 @@ void add_simulate(CLI::App& app) {
   struct Flags {
     std::string engine = "builtin", platform, cluster, model = "calibrated", calibration;
     std::string intra_node = "reader";
+    bool lower = false;
   };
   auto a = std::make_shared<Args>();
   auto f = std::make_shared<Flags>();
@@ -38,6 +40,10 @@ void add_simulate(CLI::App& app) {
       ->check(CLI::IsMember({"ideal", "calibrated"}));
   cmd->add_option("--calibration", f->calibration,
                   "Calibration file (default: " + tp::default_calibration_path() + " if present)");
+  cmd->add_flag("--lower", f->lower,
+                "Simulate the graph the partition executors run: each cumulative-write group "
+                "that spans processors reduced through a reducer task on its first writer's "
+                "processor (two hops), each processor in program order");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a, f] {
     tp::SimulatedPlatform p;
@@ -52,7 +58,14 @@ void add_simulate(CLI::App& app) {
       throw UsageError("--platform: the builtin engine has no platform model (use --engine simgrid)");
     const Trace trace = read_trace(a->input);
     const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
-    const tp::Prediction r = tp::simulate_trace(trace, as, engine, p);
+    tp::Prediction r;
+    if (f->lower) {
+      const measure::LoweredTrace low = measure::lower_trace(trace, as);
+      r = tp::simulate_trace(low.trace, low.assignment, engine, p);
+      r.lowered = true;
+    } else {
+      r = tp::simulate_trace(trace, as, engine, p);
+    }
     std::cout << (a->json ? tp::prediction_json(r) + "\n" : tp::prediction_text(r));
   });
 }

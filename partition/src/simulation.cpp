@@ -109,6 +109,7 @@ std::string prediction_json(const Prediction& p) {
                             {"makespan_ns", p.makespan_ns},
                             {"simulation_ms", p.simulation_ms},
                             {"task_overhead_ns", p.task_overhead_ns},
+                            {"lowered", p.lowered},
                             {"per_step", steps}};
   return j.dump();
 }

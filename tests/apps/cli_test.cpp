@@ -375,6 +375,12 @@ TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {
   const auto jb = nlohmann::json::parse(b.out);
   EXPECT_EQ(jb["engine"], "builtin");
   EXPECT_EQ(jb["per_step"].size(), 3u);
+  EXPECT_EQ(jb["lowered"], false);
+  const Result l = run("simulate f.tgt f.tga --engine builtin --lower --json");
+  ASSERT_EQ(l.code, 0) << l.err;
+  const auto jl = nlohmann::json::parse(l.out);
+  EXPECT_EQ(jl["lowered"], true);
+  EXPECT_EQ(jl["per_step"].size(), 3u);
   for (const char* bad : {"--cluster 4", "--cluster 0x4", "--cluster 1x3"}) {
     const Result r = run(std::string("simulate f.tgt f.tga --engine simgrid ") + bad);
     EXPECT_EQ(r.code, 2) << bad;
