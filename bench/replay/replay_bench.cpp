@@ -24,6 +24,7 @@
 
 #include "bench_main.hpp"
 #include "tgraph/replay/executor.hpp"
+#include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay {
@@ -193,14 +194,6 @@ void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
   w.set_step(g);
   ex->run_step(g, nullptr, w);
   for (auto _ : state) ex->run_step(g, nullptr, w);
-}
-
-void cpu_relax() {
-#if defined(__x86_64__) || defined(__i386__)
-  __builtin_ia32_pause();
-#elif defined(__aarch64__)
-  asm volatile("yield");
-#endif
 }
 
 /// Two threads, one counter: the main thread publishes odd values, the partner answers each

@@ -109,13 +109,18 @@ void advise_huge_pages(void* p, std::size_t bytes) {
 }
 
 void group_accesses(const StepGraph& g, AccessesByDatum& out) {
+  std::vector<std::uint32_t> fill;
+  group_accesses(g, out, fill);
+}
+
+void group_accesses(const StepGraph& g, AccessesByDatum& out, std::vector<std::uint32_t>& fill) {
   out.begin.assign(g.data.size() + 1, 0);
   for (const Access& a : g.accesses) ++out.begin[a.datum + 1];
   for (std::size_t d = 0; d < g.data.size(); ++d) out.begin[d + 1] += out.begin[d];
   reserve_huge(out.entries, g.accesses.size());
   out.entries.resize(g.accesses.size());
   // Each datum's next free entry; begin[d] again once every access is placed.
-  std::vector<std::uint32_t> fill(out.begin.begin(), out.begin.end() - 1);
+  fill.assign(out.begin.begin(), out.begin.end() - 1);
   const auto n = static_cast<TaskId>(g.tasks.size());
   for (TaskId t = 0; t < n; ++t) {
     const Task& task = g.tasks[t];
@@ -228,35 +233,51 @@ bool StepGraph::derive_edges(std::size_t max_edges) {
   return true;
 }
 
+namespace {
+
+// derive_edges' temporaries, kept per thread from one call to the next: a step of 10^7
+// tasks needs about 1 GB of them, and memory fresh from the kernel is zeroed page by page
+// on first touch (44 % of a 10^7-task derivation here when every call allocated anew). What
+// the largest step derived on a thread needed stays allocated for the next one.
+struct DeriveScratch {
+  detail::AccessesByDatum by_datum;
+  std::vector<std::uint32_t> fill, intra_begin, carried_begin;
+  std::vector<Edge> intra, carried;
+  detail::DatumState state, second_state;
+};
+
+}  // namespace
+
 // Datum by datum (each datum's edges depend on its own access sequence only): the accesses
 // grouped by datum, one state machine run per datum over its sequence, then the edges put
 // in target order. Every pass is linear in tasks, data, accesses and edges, and works on
-// contiguous arrays (the state machine's scratch is reused from datum to datum).
+// contiguous arrays (the state machine's scratch is reused from datum to datum, the arrays
+// from call to call on one thread).
 void StepGraph::derive_edges_unchecked(std::size_t max_edges) {
-  detail::AccessesByDatum by_datum;
-  detail::group_accesses(*this, by_datum);
-  std::vector<Edge> intra, carried;
+  thread_local DeriveScratch s;
+  detail::group_accesses(*this, s.by_datum, s.fill);
+  s.intra.clear();
+  s.carried.clear();
   // Most steps have one to two edges per access: reserved (address space only) so that
   // the list rarely grows by copying.
-  detail::reserve_huge(intra, 2 * accesses.size() + 16);
-  detail::DatumState state, second_state;
+  detail::reserve_huge(s.intra, 2 * accesses.size() + 16);
   // Edges per target, counted while each datum's edges are still in cache.
-  std::vector<std::uint32_t> intra_begin(tasks.size() + 1, 0), carried_begin(tasks.size() + 1, 0);
-  const detail::AccessEntry* entries = by_datum.entries.data();
+  s.intra_begin.assign(tasks.size() + 1, 0);
+  s.carried_begin.assign(tasks.size() + 1, 0);
+  const detail::AccessEntry* entries = s.by_datum.entries.data();
   for (DatumId d = 0; d < data.size(); ++d) {
-    const std::uint32_t b = by_datum.begin[d], e = by_datum.begin[d + 1];
+    const std::uint32_t b = s.by_datum.begin[d], e = s.by_datum.begin[d + 1];
     if (b == e) continue;
-    const std::size_t intra_at = intra.size(), carried_at = carried.size();
-    detail::derive_datum(*this, d, entries + b, entries + e, intra, carried, state, second_state,
-                         max_edges);
-    for (std::size_t i = intra_at; i < intra.size(); ++i) ++intra_begin[intra[i].to + 1];
-    for (std::size_t i = carried_at; i < carried.size(); ++i) ++carried_begin[carried[i].to + 1];
+    const std::size_t intra_at = s.intra.size(), carried_at = s.carried.size();
+    detail::derive_datum(*this, d, entries + b, entries + e, s.intra, s.carried, s.state,
+                         s.second_state, max_edges);
+    for (std::size_t i = intra_at; i < s.intra.size(); ++i) ++s.intra_begin[s.intra[i].to + 1];
+    for (std::size_t i = carried_at; i < s.carried.size(); ++i)
+      ++s.carried_begin[s.carried[i].to + 1];
   }
-  by_datum = {};  // released before the edges are assembled
-  detail::assemble_counted(intra, intra_begin, edges);
-  intra = {};
-  intra_begin = {};
-  detail::assemble_counted(carried, carried_begin, carried_edges);
+  s.by_datum = {};  // released before the edges are assembled: the peak stays one copy
+  detail::assemble_counted(s.intra, s.intra_begin, edges);
+  detail::assemble_counted(s.carried, s.carried_begin, carried_edges);
 }
 
 }  // namespace tgraph

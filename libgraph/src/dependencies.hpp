@@ -60,6 +60,8 @@ void reserve_huge(std::vector<T>& v, std::size_t n) {
 
 /// `g`'s accesses grouped by datum (a counting sort: linear in tasks, data and accesses).
 void group_accesses(const StepGraph& g, AccessesByDatum& out);
+/// The same with the per-datum fill cursors in `fill` (scratch, reused by the caller).
+void group_accesses(const StepGraph& g, AccessesByDatum& out, std::vector<std::uint32_t>& fill);
 
 /// The edges of datum `d` from its access sequence [first, last) (program order), as
 /// StepGraph::derive_edges() finds them: loop bodies get their second pass over the same
