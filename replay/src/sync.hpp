@@ -11,8 +11,6 @@
 
 namespace tgraph::replay::detail {
 
-using replay::cpu_relax;
-
 /// A 64-bit counter alone on its cache line.
 struct alignas(64) PaddedCounter {
   std::atomic<std::uint64_t> v{0};
