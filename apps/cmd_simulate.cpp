@@ -58,14 +58,7 @@ void add_simulate(CLI::App& app) {
       throw UsageError("--platform: the builtin engine has no platform model (use --engine simgrid)");
     const Trace trace = read_trace(a->input);
     const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
-    tp::Prediction r;
-    if (f->lower) {
-      const measure::LoweredTrace low = measure::lower_trace(trace, as);
-      r = tp::simulate_trace(low.trace, low.assignment, engine, p);
-      r.lowered = true;
-    } else {
-      r = tp::simulate_trace(trace, as, engine, p);
-    }
+    const tp::Prediction r = measure::simulate(trace, as, engine, p, f->lower);
     std::cout << (a->json ? tp::prediction_json(r) + "\n" : tp::prediction_text(r));
   });
 }

@@ -28,4 +28,14 @@ LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment) 
   return out;
 }
 
+partition::Prediction simulate(const Trace& trace, const TraceAssignment& assignment,
+                               partition::SimulationEngine engine,
+                               const partition::SimulatedPlatform& platform, bool lower) {
+  if (!lower) return partition::simulate_trace(trace, assignment, engine, platform);
+  const LoweredTrace low = lower_trace(trace, assignment);
+  partition::Prediction r = partition::simulate_trace(low.trace, low.assignment, engine, platform);
+  r.lowered = true;
+  return r;
+}
+
 }  // namespace tgraph::measure

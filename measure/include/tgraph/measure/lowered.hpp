@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
-// The graph the partition executors run, as a trace the simulators take: `tgraph simulate
-// --lower`.
+// The graph the partition executors run, as a trace the simulators take, and `tgraph
+// simulate [--lower]` on it.
 #pragma once
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
+#include "tgraph/partition/simulation.hpp"
 
 namespace tgraph::measure {
 
@@ -24,5 +25,11 @@ struct LoweredTrace {
 /// where the step graph has one (each reader after each writer). Steps keep their host
 /// time; steps beyond the assignment's are dropped.
 LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment);
+
+/// `tgraph simulate`: partition::simulate_trace of `trace` under `assignment`, lowered first
+/// when `lower` (then Prediction::lowered is set).
+partition::Prediction simulate(const Trace& trace, const TraceAssignment& assignment,
+                               partition::SimulationEngine engine,
+                               const partition::SimulatedPlatform& platform, bool lower);
 
 }  // namespace tgraph::measure
