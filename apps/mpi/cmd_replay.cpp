@@ -19,7 +19,7 @@ namespace tgraph::mpi_app {
 namespace {
 
 struct ReplayArgs {
-  std::string trace, assignment;
+  std::string trace, assignment, policy = "partition";
   std::uint32_t threads_per_rank = 1;
   std::optional<std::uint32_t> steps, drop;
   bool check = false, json = false, host_work = false;
@@ -41,6 +41,7 @@ void replay(const ReplayArgs& a) {
   // No file: the strategy `tgraph replay` uses by default (owner with objects, else list).
   const TraceAssignment as = partition::load_or_partition(trace, a.trace, a.assignment, "", k);
   mpi::MpiReplayOptions o;
+  o.policy = a.policy == "starpu-mpi" ? mpi::MpiPolicy::kStarpuMpi : mpi::MpiPolicy::kPartition;
   o.threads_per_rank = a.threads_per_rank;
   o.steps = a.steps;
   o.check = a.check;
@@ -71,6 +72,10 @@ void add_replay_verb(CLI::App& app) {
   cmd->add_option("--threads-per-rank", a->threads_per_rank, "Threads (processors) per rank")
       ->required();
   cmd->add_option("--steps", a->steps, "Replay the first N steps");
+  cmd->add_option("--policy", a->policy,
+                  "partition: tgraph's schedule over MPI; starpu-mpi: the same graph, bodies "
+                  "and ownership submitted through StarPU-MPI")
+      ->check(CLI::IsMember({"partition", "starpu-mpi"}));
   cmd->add_flag("--check", a->check, "Compare the final state with the sequential replay");
   cmd->add_flag("--host-work", a->host_work,
                 "Run each step's serial host work (recorded outside the tasks) on rank 0 "
@@ -82,7 +87,6 @@ void add_replay_verb(CLI::App& app) {
   cmd->add_option("--test-drop-message", a->drop, "Testing: never send this message of step 0")
       ->group("");
   cmd->callback([a] { replay(*a); });
-
 }
 
 }  // namespace tgraph::mpi_app

@@ -27,6 +27,7 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/observer.hpp"
+#include "run_common.hpp"
 #include "step_run.hpp"
 
 namespace tgraph::mpi {
@@ -89,99 +90,35 @@ std::uint64_t datum_hash(DatumId d, std::span<const std::uint64_t> words) {
   return h ^ (h >> 29);
 }
 
-namespace {
-
-void sum_to_root(std::vector<std::uint64_t>& v) {
-  std::vector<std::uint64_t> out(v.size(), 0);
-  MPI_Reduce(v.data(), out.data(), static_cast<int>(v.size()), MPI_UINT64_T, MPI_SUM, 0,
-             MPI_COMM_WORLD);
-  v = std::move(out);
-}
-
-// Waits at a barrier without spinning (ranks idle while rank 0 runs the sequential replay).
-void quiet_barrier() {
-  if constexpr (kSingleThreaded) {
-    MPI_Barrier(MPI_COMM_WORLD);
-    return;
-  }
-  MPI_Request r;
-  MPI_Ibarrier(MPI_COMM_WORLD, &r);
-  int flag = 0;
-  for (;;) {
-    MPI_Test(&r, &flag, MPI_STATUS_IGNORE);
-    if (flag) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  }
-}
-
-}  // namespace
-
 MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& assignment,
                                    const MpiReplayOptions& options) {
-  int rank = 0, size = 1;
+  if (options.policy == MpiPolicy::kStarpuMpi)
+    return replay_starpu_mpi(trace, assignment, options);
+  int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
   const auto me = static_cast<std::uint32_t>(rank);
-  Layout layout{static_cast<std::uint32_t>(size), options.threads_per_rank};
-  if (kSingleThreaded && layout.threads_per_rank != 1)
-    throw UsageError("--threads-per-rank: an SMPI build runs one processor per rank (found " +
-                     std::to_string(layout.threads_per_rank) + ")");
-  if (assignment.k != layout.processors())
-    throw UsageError(
-        "the assignment has " + std::to_string(assignment.k) +
-        " processors; ranks x --threads-per-rank = " + std::to_string(layout.processors()));
-  const std::size_t steps =
-      std::min<std::size_t>(trace.steps.size(), options.steps.value_or(trace.steps.size()));
-  if (assignment.steps.size() < steps)
-    throw UsageError("the assignment has fewer steps than the trace");
+  std::size_t steps = 0;
+  const Layout layout = checked_layout(trace, assignment, options, steps);
 
   MpiReplayResult result;
   result.ranks = layout.ranks;
   result.threads_per_rank = layout.threads_per_rank;
-  // One in-cache touch rate for every rank (rank 0's): the words each task touches, and so
-  // the final state, must not depend on which process runs it.
-  double touch_ns_per_byte = replay::SyntheticWorkload::calibration().touch_ns_per_byte;
-  MPI_Bcast(&touch_ns_per_byte, 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+  const double touch_ns_per_byte = shared_touch_rate();
   RankWorkload w(touch_ns_per_byte);
-  std::vector<std::unique_ptr<Plan>> plans;
-  Plan* bound = nullptr;
+  PlanCache plans;
   Holders holders = everywhere(0, layout.ranks);
-  // The previous step's processor of each task, by stable key (a repartition moves a task
-  // that both steps have; a new structure alone is not one).
-  std::unordered_map<StableKey, ProcId> previous_owner;
+  RepartitionWatch watch;
   for (std::size_t si = 0; si < steps; ++si) {
     const StepGraph& step = trace.steps[si];
-    Assignment a = assignment.steps[si];
-    if (std::string why = validate(step, a, layout.processors()); !why.empty())
-      throw UsageError("step " + std::to_string(si) + ": " + why);
-    a.order.clear();  // each processor runs its tasks in program order
-    const std::uint64_t hash = step.structural_hash();
-    Plan* plan = nullptr;
-    for (auto& p : plans)
-      if (p->hash == hash && p->proc == a.proc && p->structure.same_structure(step)) plan = p.get();
-    if (plan == nullptr) {
-      // At most kMaxPlans kept (every rank evicts the same ones: they see the same steps);
-      // between steps no request is active, so freeing a plan's requests is safe.
-      if (plans.size() >= kMaxPlans) {
-        const auto victim = std::find_if(plans.begin(), plans.end(),
-                                         [&](const auto& q) { return q.get() != bound; });
-        if (victim != plans.end()) plans.erase(victim);
-      }
-      auto p = std::make_unique<Plan>();
-      p->structure = step;
-      p->proc = a.proc;
-      p->hash = hash;
-      p->exec =
-          replay::lower(step, &a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
-      plan = p.get();
-      plans.push_back(std::move(p));
-    }
+    const Assignment a = step_assignment(trace, assignment, si, layout);
+    bool created = false;
+    Plan* plan = &plans.get(step, a, created);
     w.set_step(step);
     const std::size_t known = holders.has.size() / layout.ranks;
     holders.grow(std::max(known, step.data.size()), known);
-    if (plan != bound) {
+    if (plan != plans.bound) {
       w.bind(plan->exec);
-      bound = plan;
+      plans.bound = plan;
     }
     for (DatumId d = 0; d < plan->exec.graph.data.size(); ++d)
       if (w.needs_touch(d)) {
@@ -193,14 +130,7 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
     StepSchedule s = schedule_step(plan->exec, step, layout, holders, plan->channels);
     MpiStepResult sr;
     sr.predicted = s.traffic;
-    std::unordered_map<StableKey, ProcId> owner;
-    for (TaskId t = 0; t < step.tasks.size(); ++t) {
-      owner[step.tasks[t].key] = a.proc[t];
-      const auto it = previous_owner.find(step.tasks[t].key);
-      sr.repartitioned =
-          sr.repartitioned || (it != previous_owner.end() && it->second != a.proc[t]);
-    }
-    previous_owner = std::move(owner);
+    sr.repartitioned = watch.moved(step, a);
     MPI_Barrier(MPI_COMM_WORLD);
     const std::int64_t t0 = now_ns();
     if (options.host_work) {
@@ -266,25 +196,7 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   sum_to_root(sum);
   result.checksum = sum[0];
 
-  {  // the sequential replay of the same steps and bodies, on rank 0 (speed-up and check)
-    if (me == 0) {
-      auto seq = replay::make_executor(replay::Policy::kSequential, {});
-      RankWorkload sw(touch_ns_per_byte);
-      for (std::size_t si = 0; si < steps; ++si) {
-        sw.set_step(trace.steps[si]);
-        const std::int64_t t0 = now_ns();
-        if (options.host_work) sw.run_host(trace.steps[si]);
-        seq->run_step(trace.steps[si], nullptr, sw);
-        result.steps[si].sequential_ns = now_ns() - t0;
-        result.sequential_ns += result.steps[si].sequential_ns;
-      }
-      std::uint64_t h = 0;
-      for (DatumId d = 0; d < n_orig; ++d) h += datum_hash(d, sw.words(d));
-      result.sequential_checksum = h;
-      if (options.check) result.identical = h == result.checksum;
-    }
-    quiet_barrier();
-  }
+  sequential_reference(trace, steps, options, touch_ns_per_byte, result);
   return result;
 }
 

@@ -14,6 +14,7 @@
 
 #include "replay/random_graph.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/mpi/replay.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 
 namespace tgraph::mpi {
@@ -112,12 +113,13 @@ INSTANTIATE_TEST_SUITE_P(Scenes, SceneOverRanks,
 
 // 100 random steps with CW groups and loops (tests/replay/random_graph.hpp), each on a new
 // random assignment (data move between ranks at every step), written as a trace.
-void write_random(const fs::path& trace, const fs::path& tga, std::uint32_t k) {
+void write_random(const fs::path& trace, const fs::path& tga, std::uint32_t k,
+                  std::uint32_t steps = 100) {
   Trace t;
   TraceAssignment a;
   a.method = "random";
   a.k = k;
-  for (std::uint32_t s = 0; s < 100; ++s) {
+  for (std::uint32_t s = 0; s < steps; ++s) {
     StepGraph g = replay::test::random_graph(1000 + s);
     for (DatumId d = 0; d < g.data.size(); ++d) g.data[d].bytes = 8 + 40 * (d % 5);  // stable
     a.steps.push_back(replay::test::random_assignment(g, k, 7 * s + k));
@@ -184,6 +186,75 @@ TEST(MpiReplay, HostWorkKeepsTheRunIdenticalAndAsPredicted) {
       replay_json(trace.string() + " --threads-per-rank 1 --host-work", 2, dir);
   expect_exact(j, 2);
   EXPECT_EQ(j["per_step"].size(), 2u);
+  fs::remove_all(dir);
+}
+
+// --policy starpu-mpi: the same lowered graph, bodies and ownership through StarPU-MPI. Its
+// transfers are StarPU-MPI's own (bytes per destination from STARPU_COMM_STATS, no message
+// counts); the final state must be the sequential replay's.
+class StarpuMpiOverRanks : public ::testing::TestWithParam<std::tuple<int, int>> {};
+
+TEST_P(StarpuMpiOverRanks, RandomGraphsWithMovingOwnersAreIdentical) {
+  if (!have_starpu_mpi()) GTEST_SKIP() << "built without StarPU-MPI";
+  const auto& [np, threads] = GetParam();
+  const fs::path dir = scratch();
+  const auto k = static_cast<std::uint32_t>(np * threads);
+  write_random(dir / "random.tgt", dir / "random.tga", k, 20);
+  const nlohmann::json j =
+      replay_json((dir / "random.tgt").string() + " " + (dir / "random.tga").string() +
+                      " --policy starpu-mpi --threads-per-rank " + std::to_string(threads),
+                  np, dir);
+  EXPECT_EQ(j["check"], "identical");
+  EXPECT_EQ(j["policy"], "starpu-mpi");
+  EXPECT_TRUE(j["messages"].is_null());  // StarPU-MPI counts bytes only
+  EXPECT_TRUE(j["bytes_match"].is_null());
+  EXPECT_EQ(j["per_step"].size(), 20u);
+  EXPECT_GT(j["speedup"].get<double>(), 0.0);
+  if (np == 1) {
+    EXPECT_EQ(j["bytes"], 0);
+  } else {
+    // A new random assignment every step: data change owners (starpu_mpi_data_migrate).
+    EXPECT_GT(j["bytes"].get<std::uint64_t>(), 0u);
+    EXPECT_GT(j["migrated_bytes"].get<std::uint64_t>(), 0u);
+    EXPECT_GT(j["predicted_bytes"].get<std::uint64_t>(), 0u);
+  }
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, StarpuMpiOverRanks,
+                         ::testing::Values(std::make_tuple(1, 2), std::make_tuple(2, 1)),
+                         [](const auto& p) {
+                           return "np" + std::to_string(std::get<0>(p.param)) + "_threads" +
+                                  std::to_string(std::get<1>(p.param));
+                         });
+
+TEST(StarpuMpi, FallingIsIdenticalToTheSequentialReplay) {
+  if (!have_starpu_mpi()) GTEST_SKIP() << "built without StarPU-MPI";
+  const fs::path dir = scratch();
+  const fs::path trace = dir / "falling.tgt";
+  const Outcome cap = run(
+      std::string(TGRAPH_BIN) + " capture --scene falling --steps 2 -o " + trace.string(), dir);
+  ASSERT_EQ(cap.status, 0) << cap.err;
+  const nlohmann::json j =
+      replay_json(trace.string() + " --policy starpu-mpi --threads-per-rank 1", 2, dir);
+  EXPECT_EQ(j["check"], "identical");
+  EXPECT_EQ(j["per_step"].size(), 2u);
+  // Both ranks send: contacts read the other rank's objects, CG scalars cross.
+  ASSERT_EQ(j["per_pair"].size(), 2u);
+  for (const auto& p : j["per_pair"]) EXPECT_GT(p["bytes"].get<std::uint64_t>(), 0u);
+  fs::remove_all(dir);
+}
+
+TEST(StarpuMpi, RefusedWithOneLineWhereNotBuilt) {
+  if (have_starpu_mpi()) GTEST_SKIP() << "built with StarPU-MPI";
+  const fs::path dir = scratch();
+  write_random(dir / "random.tgt", dir / "random.tga", 1, 1);
+  const Outcome r = run(mpirun(1, dir) + " replay " + (dir / "random.tgt").string() + " " +
+                            (dir / "random.tga").string() +
+                            " --policy starpu-mpi --threads-per-rank 1",
+                        dir);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("--policy starpu-mpi"), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
 

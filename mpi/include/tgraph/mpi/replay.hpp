@@ -56,8 +56,20 @@ class RankWorkload : public replay::Workload {
 /// add their parts).
 std::uint64_t datum_hash(DatumId d, std::span<const std::uint64_t> words);
 
+/// Who runs the graph across the ranks.
+enum class MpiPolicy : std::uint8_t {
+  /// tgraph's own schedule: persistent channels per (datum version, receiving rank), threads
+  /// that poll, reductions summed in processor order.
+  kPartition,
+  /// The peer: StarPU-MPI (starpu_mpi_task_insert on every rank, the task on its processor's
+  /// rank and worker, each datum owned by the rank of its first writer in the step,
+  /// starpu_mpi_data_migrate when that changes). Built when pkg-config starpumpi-1.3 is found.
+  kStarpuMpi,
+};
+
 /// Options of a distributed replay.
 struct MpiReplayOptions {
+  MpiPolicy policy = MpiPolicy::kPartition;
   std::uint32_t threads_per_rank = 1;
   std::optional<std::uint32_t> steps;  ///< first N steps (default all)
   bool check = false;                  ///< also run the sequential replay on rank 0, compare
@@ -89,7 +101,11 @@ struct MpiStepResult {
 
 /// The whole run (meaningful on rank 0).
 struct MpiReplayResult {
+  MpiPolicy policy = MpiPolicy::kPartition;
   std::uint32_t ranks = 1, threads_per_rank = 1;
+  /// Whether `measured` counts messages and loop decisions (StarPU-MPI reports bytes per
+  /// destination only, with STARPU_COMM_STATS).
+  bool messages_counted = true;
   std::vector<MpiStepResult> steps;
   std::optional<bool> identical;  ///< with check
   std::uint64_t checksum = 0, sequential_checksum = 0;
@@ -100,6 +116,9 @@ struct MpiReplayResult {
 /// Every rank calls it with the same arguments.
 MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& assignment,
                                    const MpiReplayOptions& options);
+
+/// Whether this build has `MpiPolicy::kStarpuMpi`.
+bool have_starpu_mpi();
 
 /// The result as one JSON object (keys in docs/distributed.md).
 std::string to_json(const MpiReplayResult& r, const std::string& trace_name);
