@@ -312,6 +312,31 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     return out;
   }
 
+  // A task op that waits for nothing and publishes nothing.
+  static bool plain(const Op& op) {
+    return op.kind == OpKind::kTask && op.wait_begin == op.wait_end && !op.signal &&
+           !op.is_break;
+  }
+
+  // Runs ops[pc] and the plain task ops after it; returns the first op past them. With
+  // `Watch`, the slot tells the watchdog what runs and that the thread progresses.
+  template <bool Watch>
+  static std::size_t run_plain(const Op* ops, std::size_t pc, std::size_t n_ops,
+                               const ExecGraph& x, Workload& w, std::uint32_t iter,
+                               std::uint32_t p, Slot& slot) {
+    const std::size_t first = pc;
+    do {
+      const Op& op = ops[pc];
+      if constexpr (Watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // a report
+      w.run(TaskRun{&x, op.task, op.origin, iter, p});
+      ++pc;
+    } while (pc < n_ops && plain(ops[pc]));
+    if constexpr (Watch)  // relaxed: compared between two samples of the watchdog only
+      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + (pc - first),
+                          std::memory_order_relaxed);
+    return pc;
+  }
+
   void run_proc(std::uint32_t p) {
     ThreadCounters tc{};
     const PartitionPlan& plan = *plan_;
@@ -374,6 +399,14 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
             break;
           }
           case OpKind::kTask: {
+            if (!observe && plain(op)) {
+              // A run of tasks that neither wait nor publish: the sequential loop.
+              const std::size_t first = pc;
+              pc = watch ? run_plain<true>(ops, pc, n_ops, x, w, iter, p, slot)
+                         : run_plain<false>(ops, pc, n_ops, x, w, iter, p, slot);
+              tasks += pc - first;
+              break;
+            }
             for (auto i = op.wait_begin; i < op.wait_end; ++i) {
               const WaitPoint& wp = waits[i];
               std::uint32_t loop_ran = 0;
