@@ -31,7 +31,9 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--seed", o.seed, "METIS/Scotch/random seed (0: METIS's own, as gpmetis)");
   cmd->add_option("--objective", n.objective, "METIS objective: cut or vol")
       ->check(CLI::IsMember({"cut", "vol"}));
-  cmd->add_option("--phases", o.phases, "METIS: balance each of N graph phases (0 = off)");
+  cmd->add_option("--phases", o.phases,
+                  "METIS: balance each of N graph phases (0: the method's default: off for "
+                  "metis, 2 for sticky's partitions; 1: off)");
   cmd->add_option("--scotch-strategy", n.scotch, "Scotch flavour: default, quality, speed, balance")
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
   cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");
@@ -40,7 +42,7 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--rebalance", n.rebalance, "sticky: greedy (whole objects) or scotch")
       ->check(CLI::IsMember({"greedy", "scotch"}));
   cmd->add_option("--sticky-fallback", n.sticky_fallback,
-                  "sticky, when solver loops merge or split: refine (default; local search from the incremental placement), fresh (base method + relabel) or "
+                  "sticky, when solver loops merge or split: fresh (default; base method + relabel), refine (local search from the incremental placement) or "
                   "repartition (Scotch graphRepart from the incremental placement)")
       ->check(CLI::IsMember({"fresh", "repartition", "refine"}));
   cmd->add_option("--migration-cost", o.migration_cost,

@@ -221,8 +221,7 @@ class Sticky final : public Strategy {
                       const Options& options) override {
     const std::vector<std::uint64_t> work = task_work(g);
     if (prev.graph == nullptr || prev.assignment->k != k) {
-      const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
-      Result r = make_strategy(base)->partition(g, k, {}, options);
+      Result r = base_partition(g, k, options);
       r.assignment.order.clear();
       remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
       return r;
@@ -261,8 +260,7 @@ class Sticky final : public Strategy {
       // The shape changed too much to patch (solver loops merged or split, or over a quarter
       // of the tasks are new): partition afresh, then rename the parts so that as many
       // tasks as possible stay where they were (as `metis-relabel` does every step).
-      const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
-      r = make_strategy(base)->partition(g, k, {}, options);
+      r = base_partition(g, k, options);
       r.assignment.order.clear();
       relabel_to_previous(g, prev, r.assignment);
       r.stats.fallback = true;
@@ -311,6 +309,15 @@ class Sticky final : public Strategy {
     r.stats.rebalanced = true;
     remember(proc, imbalance(loads(work, proc, k)));
     return r;
+  }
+
+  // The base method's partition afresh (METIS by default), its phases balanced separately
+  // (Options::sticky_phases) unless Options::phases says otherwise.
+  static Result base_partition(const StepGraph& g, std::uint32_t k, const Options& options) {
+    const std::string base = options.sticky_base == "sticky" ? "metis" : options.sticky_base;
+    Options o = options;
+    if (o.phases == 0) o.phases = options.sticky_phases;
+    return make_strategy(base)->partition(g, k, {}, o);
   }
 
   void remember(const std::vector<ProcId>& proc, double baseline) {

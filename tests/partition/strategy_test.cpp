@@ -344,6 +344,7 @@ TEST(Sticky, RebalancesWithScotchRepartitioningWithinTheToleranceMovingFewerTask
   Options o;
   o.sticky_threshold = 1.2;
   o.rebalance = Rebalance::kScotch;
+  o.sticky_phases = 0;  // the first step's METIS partition as metis-relabel's (one constraint)
   auto s = make_strategy("sticky");
   const Result r0 = s->partition(g0, 4, {}, o);
   const Result fresh = make_strategy("metis-relabel")->partition(g1, 4, {&g0, &r0.assignment}, o);
@@ -380,20 +381,25 @@ StickyMerge sticky_merge(const StepGraph& apart, const StepGraph& merged, std::u
   return m;
 }
 
-TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplit) {
+TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplitByDefault) {
   using testing::grouped_scene;
   const StepGraph apart = grouped_scene(8, {{0, 1, 2, 3}, {4, 5, 6, 7}});
   const StepGraph merged = grouped_scene(8, {{0, 1, 2, 3, 4, 5, 6, 7}});
   ASSERT_EQ(apart.loops.size(), 2u);
   ASSERT_EQ(merged.loops.size(), 1u);
-  Options fresh;
-  fresh.sticky_fallback = StickyFallback::kFresh;
+  const Options fresh;
+  EXPECT_EQ(fresh.sticky_fallback, StickyFallback::kFresh);
+  EXPECT_EQ(fresh.sticky_phases, 2u);
+  // metis-relabel with the phases sticky's own METIS partitions balance.
+  Options phased;
+  phased.phases = fresh.sticky_phases;
   for (std::uint32_t k : {2u, 3u, 4u}) {
     const auto [s, r0, r1] = sticky_merge(apart, merged, k, fresh);
     EXPECT_FALSE(r1.stats.rebalanced);
     EXPECT_FALSE(r1.stats.reused);
     // What metis-relabel gives from the same previous step: METIS afresh, optimally renamed.
-    const Result m1 = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, {});
+    const Result m1 =
+        make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, phased);
     EXPECT_EQ(r1.assignment.proc, m1.assignment.proc) << k;
     EXPECT_EQ(r1.stats.moved_tasks, m1.stats.moved_tasks);
     EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
@@ -441,13 +447,15 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   EXPECT_THROW(parse_sticky_fallback("magic"), UsageError);
 }
 
-TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeByDefault) {
+TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   using testing::grouped_scene;
   const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
   const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
-  EXPECT_EQ(Options{}.sticky_fallback, StickyFallback::kRefine);
+  Options refine;
+  refine.sticky_fallback = StickyFallback::kRefine;
+  refine.sticky_phases = 0;  // METIS as metis-relabel runs it
   for (std::uint32_t k : {2u, 3u, 4u}) {
-    const auto [s, r0, r1] = sticky_merge(apart, merged, k, {});
+    const auto [s, r0, r1] = sticky_merge(apart, merged, k, refine);
     EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
     // Fewer moves than METIS afresh relabelled, at a predicted makespan no worse than 5 %
     // above METIS's, and every processor keeps work.
@@ -460,7 +468,7 @@ TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeByDefault) {
     const auto l = loads_of(merged, r1.assignment);
     EXPECT_EQ(std::count(l.begin(), l.end(), 0u), 0) << k;
     // The split back is a fallback too, and the whole trace's assignment fits.
-    EXPECT_TRUE(s->partition(apart, k, {&merged, &r1.assignment}, {}).stats.fallback) << k;
+    EXPECT_TRUE(s->partition(apart, k, {&merged, &r1.assignment}, refine).stats.fallback) << k;
   }
   EXPECT_EQ(parse_sticky_fallback("refine"), StickyFallback::kRefine);
   EXPECT_EQ(to_string(StickyFallback::kRefine), "refine");

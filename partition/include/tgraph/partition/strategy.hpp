@@ -59,11 +59,15 @@ struct Options {
   std::uint64_t seed = 0;           ///< METIS / Scotch / random seed (0: METIS's own default, as gpmetis)
   Objective objective = Objective::kCut;  ///< METIS objective
   std::uint32_t phases = 0;         ///< METIS multi-constraint: phases balanced separately (<2: off)
+  /// sticky: the phases its METIS partitions (first step, fresh fallback) balance separately
+  /// when `phases` is 0 (a solver step's CG phases synchronise every object of a collision
+  /// group: balanced as a whole they leave each phase unbalanced; docs/partitioning.md)
+  std::uint32_t sticky_phases = 2;
   ScotchFlavour scotch = ScotchFlavour::kQuality;
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
   Rebalance rebalance = Rebalance::kGreedy;  ///< sticky: how to rebalance
-  StickyFallback sticky_fallback = StickyFallback::kRefine;  ///< sticky: when the shape changed
+  StickyFallback sticky_fallback = StickyFallback::kFresh;  ///< sticky: when the shape changed
   /// sticky, Scotch repartitioning (rebalance or fallback): emraval, the weight of migrated
   /// load against the cut (quantised to 0.01 by Scotch)
   double migration_cost = 1.0;
@@ -77,7 +81,7 @@ struct NamedOptions {
   std::string objective = "cut";          ///< cut, vol
   std::string scotch = "quality";         ///< default, quality, speed, balance
   std::string rebalance = "greedy";       ///< greedy, scotch
-  std::string sticky_fallback = "refine";  ///< fresh, repartition, refine
+  std::string sticky_fallback = "fresh";  ///< fresh, repartition, refine
   std::string model = "calibrated";       ///< calibrated, ideal (select_cost_model)
   std::string calibration;                ///< calibration file ("": the default one if present)
 
