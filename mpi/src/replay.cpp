@@ -110,33 +110,14 @@ MpiReplayResult replay_distributed(const Trace& trace, const TraceAssignment& as
   RepartitionWatch watch;
   for (std::size_t si = 0; si < steps; ++si) {
     const StepGraph& step = trace.steps[si];
-    const Assignment a = step_assignment(trace, assignment, si, layout);
-    bool created = false;
-    Plan* plan = &plans.get(step, a, created);
-    w.set_step(step);
-    const std::size_t known = holders.has.size() / layout.ranks;
-    holders.grow(std::max(known, step.data.size()), known);
-    if (plan != plans.bound) {
-      w.bind(plan->exec);
-      plans.bound = plan;
-    }
-    for (DatumId d = 0; d < plan->exec.graph.data.size(); ++d)
-      if (w.needs_touch(d)) {
-        w.first_touch(d);
-        if (d < step.data.size())
-          for (std::uint32_t r = 0; r < layout.ranks; ++r) holders.has[d * layout.ranks + r] = 1;
-      }
+    PreparedStep prepared = prepare_step(trace, assignment, si, layout, plans, w, holders, watch);
+    Plan* plan = prepared.plan;
+    const StepSchedule& s = prepared.schedule;
     const std::optional<std::uint32_t> drop = si == 0 ? options.test_drop_message : std::nullopt;
-    StepSchedule s = schedule_step(plan->exec, step, layout, holders, plan->channels);
     MpiStepResult sr;
     sr.predicted = s.traffic;
-    sr.repartitioned = watch.moved(step, a);
-    MPI_Barrier(MPI_COMM_WORLD);
-    const std::int64_t t0 = now_ns();
-    if (options.host_work) {
-      if (me == 0) w.run_host(step);
-      MPI_Barrier(MPI_COMM_WORLD);
-    }
+    sr.repartitioned = prepared.repartitioned;
+    const std::int64_t t0 = start_step(step, options, w);
     StepRun run(*plan, s, w, me, layout, drop);
     const Counters c = run.run(static_cast<std::int64_t>(options.watchdog_s * 1e9));
     // SMPI's clock is one simulated clock for every rank: the step ends when the last rank's

@@ -71,6 +71,45 @@ bool RepartitionWatch::moved(const StepGraph& step, const Assignment& a) {
   return moved;
 }
 
+PreparedStep prepare_step(const Trace& trace, const TraceAssignment& assignment, std::size_t si,
+                          const Layout& layout, PlanCache& plans, RankWorkload& w,
+                          Holders& holders, RepartitionWatch& watch) {
+  const StepGraph& step = trace.steps[si];
+  const Assignment a = step_assignment(trace, assignment, si, layout);
+  bool created = false;
+  PreparedStep p;
+  p.plan = &plans.get(step, a, created);
+  w.set_step(step);
+  const std::size_t known = holders.has.size() / layout.ranks;
+  holders.grow(std::max(known, step.data.size()), known);
+  p.rebound = p.plan != plans.bound;
+  if (p.rebound) {
+    w.bind(p.plan->exec);
+    plans.bound = p.plan;
+  }
+  for (DatumId d = 0; d < p.plan->exec.graph.data.size(); ++d)
+    if (w.needs_touch(d)) {
+      w.first_touch(d);
+      if (d < step.data.size())
+        for (std::uint32_t r = 0; r < layout.ranks; ++r) holders.has[d * layout.ranks + r] = 1;
+    }
+  p.schedule = schedule_step(p.plan->exec, step, layout, holders, p.plan->channels);
+  p.repartitioned = watch.moved(step, a);
+  return p;
+}
+
+std::int64_t start_step(const StepGraph& step, const MpiReplayOptions& options, RankWorkload& w) {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Barrier(MPI_COMM_WORLD);
+  const std::int64_t t0 = now_ns();
+  if (options.host_work) {
+    if (rank == 0) w.run_host(step);
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
+  return t0;
+}
+
 void sum_to_root(std::vector<std::uint64_t>& v) {
   std::vector<std::uint64_t> out(v.size(), 0);
   MPI_Reduce(v.data(), out.data(), static_cast<int>(v.size()), MPI_UINT64_T, MPI_SUM, 0,

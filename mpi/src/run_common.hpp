@@ -48,6 +48,24 @@ class RepartitionWatch {
   std::unordered_map<StableKey, ProcId> previous_;
 };
 
+/// One step's start, the same for both policies: its plan (lowered now or found again) bound
+/// to the workload, every buffer of it touched, `holders` grown to the step's data, tgraph's
+/// schedule of the step (the traffic it predicts; `holders` is not advanced) and whether a
+/// task moved since the previous step.
+struct PreparedStep {
+  Plan* plan = nullptr;
+  bool rebound = false;  ///< the workload holds another plan's buffers than last step
+  StepSchedule schedule;
+  bool repartitioned = false;
+};
+PreparedStep prepare_step(const Trace& trace, const TraceAssignment& assignment, std::size_t si,
+                          const Layout& layout, PlanCache& plans, RankWorkload& w,
+                          Holders& holders, RepartitionWatch& watch);
+
+/// Every rank at a barrier, then (options.host_work) the step's host work on rank 0 and a
+/// barrier; returns when the step began (after the first barrier).
+std::int64_t start_step(const StepGraph& step, const MpiReplayOptions& options, RankWorkload& w);
+
 /// Element-wise sum over the ranks, left on rank 0 (the others get zeros).
 void sum_to_root(std::vector<std::uint64_t>& v);
 

@@ -426,34 +426,15 @@ MpiReplayResult replay_starpu_mpi(const Trace& trace, const TraceAssignment& ass
     StarpuMpiRun run(layout, w);
     for (std::size_t si = 0; si < steps; ++si) {
       const StepGraph& step = trace.steps[si];
-      const Assignment a = step_assignment(trace, assignment, si, layout);
-      bool created = false;
-      Plan* plan = &plans.get(step, a, created);
-      w.set_step(step);
-      const bool rebound = plan != plans.bound;
-      if (rebound) {
-        w.bind(plan->exec);
-        plans.bound = plan;
-      }
-      const std::size_t known = holders.has.size() / layout.ranks;
-      holders.grow(std::max(known, step.data.size()), known);
-      for (DatumId d = 0; d < plan->exec.graph.data.size(); ++d)
-        if (w.needs_touch(d)) {
-          w.first_touch(d);
-          if (d < step.data.size())
-            for (std::uint32_t r = 0; r < layout.ranks; ++r) holders.has[d * layout.ranks + r] = 1;
-        }
-      const StepSchedule s = schedule_step(plan->exec, step, layout, holders, plan->channels);
-      holders = s.holders_after;
+      const PreparedStep prepared =
+          prepare_step(trace, assignment, si, layout, plans, w, holders, watch);
+      holders = prepared.schedule.holders_after;
       MpiStepResult sr;
-      sr.predicted = s.traffic;
-      sr.repartitioned = watch.moved(step, a);
-      MPI_Barrier(MPI_COMM_WORLD);
-      const std::int64_t t0 = now_ns();
-      if (options.host_work) {
-        if (rank == 0) w.run_host(step);
-        MPI_Barrier(MPI_COMM_WORLD);
-      }
+      sr.predicted = prepared.schedule.traffic;
+      sr.repartitioned = prepared.repartitioned;
+      const std::int64_t t0 = start_step(step, options, w);
+      const Plan* plan = prepared.plan;
+      const bool rebound = prepared.rebound;
       const std::uint64_t migrated = run.prepare(*plan, step, rebound);
       run.run_step(*plan, step, si, options.watchdog_s);
       const std::vector<std::uint64_t> sent = run.sent_bytes();

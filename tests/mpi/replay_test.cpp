@@ -65,6 +65,16 @@ nlohmann::json replay_json(const std::string& args, int np, const fs::path& dir)
   return nlohmann::json::parse(r.out);
 }
 
+// `tgraph capture --scene S --steps N` into dir; an empty path (and a failure) if it failed.
+fs::path capture(const std::string& scene, int steps, const fs::path& dir) {
+  const fs::path trace = dir / (scene + ".tgt");
+  const Outcome cap = run(std::string(TGRAPH_BIN) + " capture --scene " + scene + " --steps " +
+                              std::to_string(steps) + " -o " + trace.string(),
+                          dir);
+  EXPECT_EQ(cap.status, 0) << cap.err;
+  return cap.status == 0 ? trace : fs::path();
+}
+
 void expect_exact(const nlohmann::json& j, int np) {
   EXPECT_EQ(j["check"], "identical");
   EXPECT_EQ(j["bytes_match"], true);
@@ -89,11 +99,8 @@ class SceneOverRanks : public ::testing::TestWithParam<std::tuple<std::string, i
 TEST_P(SceneOverRanks, IsIdenticalToTheSequentialReplayAndSendsWhatWasPredicted) {
   const auto& [scene, np] = GetParam();
   const fs::path dir = scratch();
-  const fs::path trace = dir / (scene + ".tgt");
-  const Outcome cap =
-      run(std::string(TGRAPH_BIN) + " capture --scene " + scene + " --steps 3 -o " + trace.string(),
-          dir);
-  ASSERT_EQ(cap.status, 0) << cap.err;
+  const fs::path trace = capture(scene, 3, dir);
+  ASSERT_FALSE(trace.empty());
   const nlohmann::json j = replay_json(trace.string() + " --threads-per-rank 1", np, dir);
   expect_exact(j, np);
   EXPECT_EQ(j["per_step"].size(), 3u);
@@ -178,10 +185,8 @@ TEST(MpiReplay, WatchdogNamesTheStuckRankAndWhatItWaitsFor) {
 // barrier; the run stays bit-identical and sends exactly what was predicted.
 TEST(MpiReplay, HostWorkKeepsTheRunIdenticalAndAsPredicted) {
   const fs::path dir = scratch();
-  const fs::path trace = dir / "falling.tgt";
-  const Outcome cap = run(
-      std::string(TGRAPH_BIN) + " capture --scene falling --steps 2 -o " + trace.string(), dir);
-  ASSERT_EQ(cap.status, 0) << cap.err;
+  const fs::path trace = capture("falling", 2, dir);
+  ASSERT_FALSE(trace.empty());
   const nlohmann::json j =
       replay_json(trace.string() + " --threads-per-rank 1 --host-work", 2, dir);
   expect_exact(j, 2);
@@ -231,10 +236,8 @@ INSTANTIATE_TEST_SUITE_P(Layouts, StarpuMpiOverRanks,
 TEST(StarpuMpi, FallingIsIdenticalToTheSequentialReplay) {
   if (!have_starpu_mpi()) GTEST_SKIP() << "built without StarPU-MPI";
   const fs::path dir = scratch();
-  const fs::path trace = dir / "falling.tgt";
-  const Outcome cap = run(
-      std::string(TGRAPH_BIN) + " capture --scene falling --steps 2 -o " + trace.string(), dir);
-  ASSERT_EQ(cap.status, 0) << cap.err;
+  const fs::path trace = capture("falling", 2, dir);
+  ASSERT_FALSE(trace.empty());
   const nlohmann::json j =
       replay_json(trace.string() + " --policy starpu-mpi --threads-per-rank 1", 2, dir);
   EXPECT_EQ(j["check"], "identical");
