@@ -92,7 +92,7 @@ MpiStepResult total(const MpiReplayResult& r) {
 
 std::string to_json(const MpiReplayResult& r, const std::string& trace_name) {
   const MpiStepResult t = total(r);
-  nlohmann::json j = common(t, r.messages_counted);
+  nlohmann::json j = common(t, r.messages_counted());
   j["trace"] = trace_name;
   j["policy"] = r.policy == MpiPolicy::kStarpuMpi ? "starpu-mpi" : "partition";
   j["ranks"] = r.ranks;
@@ -102,10 +102,10 @@ std::string to_json(const MpiReplayResult& r, const std::string& trace_name) {
   j["checksum"] = r.checksum;
   j["sequential_ns"] = r.sequential_ns;
   j["speedup"] = ratio(r.sequential_ns, r.wall_ns);
-  j["per_pair"] = pairs(t.measured, t.predicted, r.messages_counted);
+  j["per_pair"] = pairs(t.measured, t.predicted, r.messages_counted());
   nlohmann::json steps = nlohmann::json::array();
   for (const MpiStepResult& s : r.steps) {
-    nlohmann::json js = common(s, r.messages_counted);
+    nlohmann::json js = common(s, r.messages_counted());
     js["sequential_ns"] = s.sequential_ns;
     js["speedup"] = ratio(s.sequential_ns, s.wall_ns);
     js["repartitioned"] = s.repartitioned;
@@ -118,13 +118,13 @@ std::string to_json(const MpiReplayResult& r, const std::string& trace_name) {
 std::string to_text(const MpiReplayResult& r, const std::string& trace_name) {
   const MpiStepResult t = total(r);
   std::ostringstream o;
-  const bool peer = r.policy == MpiPolicy::kStarpuMpi;
   o << trace_name << ": " << r.steps.size() << " steps on " << r.ranks << " ranks x "
-    << r.threads_per_rank << " threads" << (peer ? " (StarPU-MPI)" : "") << "\n";
+    << r.threads_per_rank << " threads" << (r.messages_counted() ? "" : " (StarPU-MPI)")
+    << "\n";
   o << "  wall " << static_cast<double>(t.wall_ns) / 1e6 << " ms, sequential "
     << static_cast<double>(r.sequential_ns) / 1e6 << " ms, speed-up "
     << ratio(r.sequential_ns, r.wall_ns) << "\n";
-  if (!r.messages_counted) {
+  if (!r.messages_counted()) {
     o << "  bytes " << t.measured.total_bytes() << " (tgraph's schedule: "
       << t.predicted.total_bytes() << " in " << t.predicted.total_messages()
       << " messages); migrated " << t.migrated_bytes << " bytes\n";

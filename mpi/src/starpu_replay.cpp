@@ -416,7 +416,6 @@ MpiReplayResult replay_starpu_mpi(const Trace& trace, const TraceAssignment& ass
   result.policy = MpiPolicy::kStarpuMpi;
   result.ranks = layout.ranks;
   result.threads_per_rank = layout.threads_per_rank;
-  result.messages_counted = false;
   const double touch_ns_per_byte = shared_touch_rate();
   RankWorkload w(touch_ns_per_byte);
   PlanCache plans;

@@ -103,9 +103,9 @@ struct MpiStepResult {
 struct MpiReplayResult {
   MpiPolicy policy = MpiPolicy::kPartition;
   std::uint32_t ranks = 1, threads_per_rank = 1;
-  /// Whether `measured` counts messages and loop decisions (StarPU-MPI reports bytes per
-  /// destination only, with STARPU_COMM_STATS).
-  bool messages_counted = true;
+  /// Whether `measured` counts messages and loop decisions: not under StarPU-MPI, which
+  /// reports bytes per destination only (STARPU_COMM_STATS).
+  bool messages_counted() const { return policy != MpiPolicy::kStarpuMpi; }
   std::vector<MpiStepResult> steps;
   std::optional<bool> identical;  ///< with check
   std::uint64_t checksum = 0, sequential_checksum = 0;
