@@ -90,6 +90,8 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
   if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
   if (j.contains("task_overhead_ns")) m.task_overhead_ns = number("task_overhead_ns");
+  if (j.contains("mpi_message_overhead_ns"))
+    m.mpi_message_overhead_ns = number("mpi_message_overhead_ns");
   m.source = name;
   return m;
 }

@@ -13,6 +13,7 @@
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 
 #include "schedule_program.hpp"
 #include "simgrid_engine.hpp"
@@ -36,6 +37,7 @@ struct Out {
   DatumId datum;
   bool raw;
   When when;
+  bool decision = false;  ///< a loop's break decision (datum: the loop's condition)
 };
 
 enum class Kind : std::uint8_t { host, exec, comm };
@@ -46,20 +48,25 @@ struct InFlight {
   Kind kind;
   TaskId task;
   std::uint32_t iteration;
-  ProcId proc;  ///< exec: where it runs
+  ProcId proc;  ///< exec: where it runs; comm: the sender
   std::vector<ProcId> receivers;  ///< comm: the processors that know the instance on arrival
+  std::uint32_t messages = 0;     ///< comm between nodes: the MPI messages it stands for
 };
 
 /// Runs the steps of a trace one after the other on the given hosts (host of processor p);
 /// `read_ns_per_byte[p]`: what reading a byte written by another core of its node costs
 /// processor p (its host's loopback link) when the reader pays for transfers in a node;
-/// `overhead_ns`: the runtime's own time per task instance (CostModel::task_overhead_ns).
+/// `overhead_ns`: the runtime's own time per task instance (CostModel::task_overhead_ns);
+/// `message_ns`: the processor time of one MPI message between nodes on each side
+/// (CostModel::mpi_message_overhead_ns).
 class Driver {
  public:
   Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts,
-         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node, double overhead_ns)
+         std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node, double overhead_ns,
+         double message_ns)
       : trace_(trace), a_(a), hosts_(std::move(hosts)), read_ns_per_byte_(std::move(read_ns_per_byte)),
         overhead_(static_cast<std::uint64_t>(std::llround(overhead_ns))),
+        message_(static_cast<std::uint64_t>(std::llround(message_ns))),
         reader_pays_(intra_node == IntraNodeTransfer::reader),
         steps_(std::min(trace.steps.size(), a.steps.size())) {}
 
@@ -89,6 +96,9 @@ class Driver {
         wake_proc(f.proc);
         break;
       case Kind::comm:
+        // The receiving rank's time for the messages (one thread of it: the first receiver)
+        // goes before that processor's next instance, where the MPI replay polls for them.
+        pending_[f.receivers.front()] += message_ * f.messages;
         for (ProcId q : f.receivers) {
           const std::uint64_t key = (first_[f.task] + f.iteration) * k_ + q;
           arrived_.insert(key);
@@ -139,6 +149,7 @@ class Driver {
     received_.clear();
     waiters_.clear();
     state_.assign(k_, State{});
+    pending_.assign(k_, 0);
     finished_ = 0;
     current_ = {};
     start_ = sg::Engine::get_clock();
@@ -189,7 +200,7 @@ class Driver {
         if (p == pa_->proc[brk]) continue;
         const bool holds = std::any_of(items_[p].begin(), items_[p].end(),
                                        [&](const Item& it) { return it.loop == l; });
-        if (holds) outs_[brk].push_back({p, loop.condition, false, When::every});
+        if (holds) outs_[brk].push_back({p, loop.condition, false, When::every, true});
       }
     }
     for (auto& o : outs_)
@@ -277,7 +288,8 @@ class Driver {
         const TaskId t = it.task != kNoTask ? it.task : it.body[st.pos];
         const std::uint32_t i = it.task != kNoTask ? 0 : st.iter;
         if (!ready(p, t, i)) return;
-        const std::uint64_t cost = g_->tasks[t].cost_ns + overhead_ + read_cost(p, t, i);
+        const std::uint64_t cost = g_->tasks[t].cost_ns + overhead_ + read_cost(p, t, i) +
+                                   send_cost(t, i, p) + std::exchange(pending_[p], 0);
         if (cost == 0) {  // nothing to simulate: it finishes when it starts
           step_forward(p);
           finish_instance(t, i, p);
@@ -315,16 +327,41 @@ class Driver {
     const std::uint64_t inst = first_[t] + i;
     done_[inst] = 1;
     wake(inst * k_ + owner);
+    for_each_transfer(t, i, owner, [&](std::uint64_t bytes, std::uint32_t messages) {
+      // The reader pays for the bytes inside a node (read_cost): the link carries the signal.
+      const bool in_node = hosts_[owner] == hosts_[receivers_.front()];
+      send(t, i, owner, reader_pays_ && in_node ? 0 : bytes, in_node ? 0 : messages);
+    });
+  }
+
+  // The sending processor's time for the MPI messages instance (t, i) sends to other nodes
+  // once it has run (charged to the instance itself).
+  std::uint64_t send_cost(TaskId t, std::uint32_t i, ProcId owner) {
+    if (message_ == 0) return 0;
+    std::uint64_t messages = 0;
+    for_each_transfer(t, i, owner, [&](std::uint64_t, std::uint32_t m) {
+      if (hosts_[owner] != hosts_[receivers_.front()]) messages += m;
+    });
+    return messages * message_;
+  }
+
+  // Calls fn(bytes, messages) for each transfer instance (t, i), run on `owner`, makes once
+  // it has run, with receivers_ set to its receivers: one transfer per receiver in the
+  // owner's node, one per other node. `messages`: what the MPI replay sends for it, one per
+  // datum version and one per loop decision (a dependency that carries no value is no
+  // message).
+  template <class Fn>
+  void for_each_transfer(TaskId t, std::uint32_t i, ProcId owner, Fn&& fn) {
     const std::uint64_t runs = g_->runs(t);
     const std::vector<Out>& outs = outs_[t];
-    // Receivers in the owner's node get one transfer each; another node gets one message
-    // for all its receivers (outs are sorted by processor, a node's processors contiguous).
+    // Outs are sorted by processor, a node's processors contiguous.
     auto same_group = [&](const Out& x, const Out& y) {
       return hosts_[x.to] == hosts_[owner] ? x.to == y.to : hosts_[x.to] == hosts_[y.to];
     };
     for (std::size_t b = 0; b < outs.size();) {
       std::size_t e = b;
       std::uint64_t bytes = 0;
+      std::uint32_t decisions = 0;
       sent_.clear();
       receivers_.clear();
       for (; e < outs.size() && same_group(outs[e], outs[b]); ++e) {
@@ -333,25 +370,25 @@ class Driver {
                              (o.when == When::not_last ? i + 1 < runs : i + 1 == runs);
         if (!applies) continue;
         if (receivers_.empty() || receivers_.back() != o.to) receivers_.push_back(o.to);
+        decisions = std::max<std::uint32_t>(decisions, o.decision ? 1 : 0);
         // Each datum version is sent once per receiving processor or node (reads only).
         if (o.raw && std::find(sent_.begin(), sent_.end(), o.datum) == sent_.end()) {
           sent_.push_back(o.datum);
           bytes += g_->data[o.datum].bytes;
         }
       }
-      // The reader pays for the bytes inside a node (read_cost): the link carries the signal.
       if (!receivers_.empty())
-        send(t, i, owner, reader_pays_ && hosts_[owner] == hosts_[outs[b].to] ? 0 : bytes);
+        fn(bytes, static_cast<std::uint32_t>(sent_.size()) + decisions);
       b = e;
     }
   }
 
   // One transfer of instance (t, i) from processor `from` to receivers_ (one node).
-  void send(TaskId t, std::uint32_t i, ProcId from, std::uint64_t bytes) {
+  void send(TaskId t, std::uint32_t i, ProcId from, std::uint64_t bytes, std::uint32_t messages) {
     const ProcId to = receivers_.front();
     sg::CommPtr c = sg::Comm::sendto_init(hosts_[from], hosts_[to]);
     c->set_payload_size(bytes);
-    live_.emplace(c.get(), InFlight{c, Kind::comm, t, i, to, receivers_});
+    live_.emplace(c.get(), InFlight{c, Kind::comm, t, i, from, receivers_, messages});
     ++outstanding_;
     ++current_.messages;
     current_.bytes += bytes;
@@ -367,6 +404,7 @@ class Driver {
   const std::vector<sg::Host*> hosts_;
   const std::vector<double> read_ns_per_byte_;
   const std::uint64_t overhead_;
+  const std::uint64_t message_;
   const bool reader_pays_;
   const std::size_t steps_;
   std::size_t step_ = 0;
@@ -382,6 +420,7 @@ class Driver {
   std::unordered_set<VersionOnProc, VersionOnProcHash> received_;  // the reader paid
   std::unordered_map<std::uint64_t, std::vector<ProcId>> waiters_;
   std::vector<State> state_;
+  std::vector<std::uint64_t> pending_;  // received messages' time, before p's next instance
   std::deque<ProcId> ready_;
   std::vector<DatumId> sent_;
   std::vector<ProcId> receivers_;
@@ -456,7 +495,7 @@ PlatformRun run_on_loaded_platform(const Trace& trace, const TraceAssignment& a,
     read_ns_per_byte.push_back(bandwidth > 0 ? 1e9 / bandwidth : 0.0);
   }
   Driver driver(trace, a, proc_hosts, std::move(read_ns_per_byte), platform.intra_node,
-                platform.model.task_overhead_ns);
+                platform.model.task_overhead_ns, platform.model.mpi_message_overhead_ns);
   sg::Activity::on_completion_cb([&](const sg::Activity& act) { driver.on_completion(act); });
   sg::Engine::on_time_advance_cb([&](double) { driver.on_time_advance(); });
   driver.start();

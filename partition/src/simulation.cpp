@@ -82,6 +82,8 @@ Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, Simulati
   }
   r.intra_node = platform.intra_node;
   r.task_overhead_ns = platform.model.task_overhead_ns;
+  if (engine == SimulationEngine::simgrid)
+    r.message_overhead_ns = platform.model.mpi_message_overhead_ns;
   r.simulation_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   r.makespan_ns = 0;
@@ -109,6 +111,7 @@ std::string prediction_json(const Prediction& p) {
                             {"makespan_ns", p.makespan_ns},
                             {"simulation_ms", p.simulation_ms},
                             {"task_overhead_ns", p.task_overhead_ns},
+                            {"message_overhead_ns", p.message_overhead_ns},
                             {"lowered", p.lowered},
                             {"per_step", steps}};
   return j.dump();

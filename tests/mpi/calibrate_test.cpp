@@ -34,6 +34,11 @@ TEST(MpiLinkFile, AddsTheMpiFieldsAndKeepsTheOthers) {
   EXPECT_EQ(partition::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
                 .task_overhead_ns,
             64.5);
+  EXPECT_EQ(m.mpi_message_overhead_ns, 0.0);  // not measured: not written
+  link.message_overhead_ns = 420;
+  EXPECT_EQ(partition::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
+                .mpi_message_overhead_ns,
+            420.0);
 }
 
 TEST(MpiLinkFile, RejectsAFileThatIsNotACalibration) {
@@ -63,6 +68,9 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   // The replay's own time per task instance: measured (a replay has some), in nanoseconds.
   EXPECT_GT(m.task_overhead_ns, 0.0);
   EXPECT_LT(m.task_overhead_ns, 1e6);
+  // And per message and side: sending and receiving take processor time.
+  EXPECT_GT(m.mpi_message_overhead_ns, 0.0);
+  EXPECT_LT(m.mpi_message_overhead_ns, 1e6);
   // No file to add to: exit 2.
   const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
                               dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +

@@ -107,6 +107,17 @@ TEST(Calibration, TaskOverheadIsOptionalAndZeroByDefault) {
                               "c")
                 .task_overhead_ns,
             61.5);
+  EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03})", "c")
+                .mpi_message_overhead_ns,
+            0.0);
+  EXPECT_EQ(parse_calibration(
+                R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "mpi_message_overhead_ns": 412.5})",
+                "c")
+                .mpi_message_overhead_ns,
+            412.5);
+  EXPECT_THROW(parse_calibration(
+                   R"({"sync_latency_ns": 1, "per_byte_ns": 0, "mpi_message_overhead_ns": -3})", "c"),
+               InputError);
   EXPECT_THROW(parse_calibration(R"({"sync_latency_ns": 1, "per_byte_ns": 0, "task_overhead_ns": "x"})", "c"),
                InputError);
 }
@@ -231,6 +242,35 @@ TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
   EXPECT_EQ(r.steps[0].inter_node_messages, 1u);
   EXPECT_EQ(r.steps[0].inter_node_bytes, 10000u);
   EXPECT_NEAR(static_cast<double>(r.steps[0].makespan_ns), 500 + 1000 + 10000 * 0.1 + 900, 2);
+}
+
+TEST(SimgridEngine, ChargesEachMessageBetweenNodesToTheSenderAndToOneReceiver) {
+  // As above, with 300 ns of processor time per message and side: the writer's instance
+  // takes 500 + 300, the message 1000 + 1000, and processor 2 (the node's first receiver,
+  // where the rank polls) 300 before its 700; processor 3 does not pay again.
+  CostModel m;
+  m.mpi_latency_ns = 1000;
+  m.mpi_per_byte_ns = 0.1;
+  m.mpi_message_overhead_ns = 300;
+  Builder b;
+  const DatumId d = b.datum("d", 10000);
+  b.task({{d, M::W}}, 500);
+  b.task({{d, M::R}}, 700);
+  b.task({{d, M::R}}, 900);
+  Trace t;
+  t.steps = {b.done()};
+  const Prediction r = simulate_trace(t, split(4, {0, 2, 3}), SimulationEngine::simgrid,
+                                      on_cluster(ClusterShape{2, 2}, m));
+  EXPECT_EQ(r.message_overhead_ns, 300);
+  EXPECT_NEAR(static_cast<double>(r.steps[0].makespan_ns), 500 + 300 + 2000 + 300 + 700, 2);
+  // Inside one node nothing is a message: the same as without the overhead.
+  CostModel none = m;
+  none.mpi_message_overhead_ns = 0;
+  const TraceAssignment in_node = split(2, {0, 1, 1});
+  EXPECT_EQ(simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, m))
+                .makespan_ns,
+            simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, none))
+                .makespan_ns);
 }
 
 TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {

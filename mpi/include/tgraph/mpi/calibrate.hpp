@@ -18,6 +18,9 @@ struct MpiLink {
   /// The MPI replay's own time per task instance beyond its recorded cost (0: not measured;
   /// then the file's "task_overhead_ns" is left as it was).
   double task_overhead_ns = 0;
+  /// The MPI replay's time per message on each side (sender and receiver), beyond the
+  /// instances' own (0: not measured; the file's "mpi_message_overhead_ns" left as it was).
+  double message_overhead_ns = 0;
 };
 
 /// Ping-pong between ranks 0 and 1 of MPI_COMM_WORLD (other ranks wait); every rank calls
@@ -32,9 +35,20 @@ MpiLink measure_mpi_link(int rounds = 4000, std::uint64_t message_bytes = 1 << 2
 double measure_task_overhead(std::uint32_t tasks = 20000, std::uint64_t cost_ns = 300,
                              int steps = 6);
 
+/// The MPI replay's processor time per message and side (ns, LogP's o): every rank r
+/// replays, with one thread per rank, steps of n tasks that each write an 8-byte datum, then
+/// n tasks that each read one of rank r - 1's (each rank sends and receives n messages),
+/// for n = `messages` / 4 and n = `messages`, `steps` steps each, 5 times; from rank 0's
+/// median step times, the median slope per message less two task instances
+/// (`task_overhead_ns` each), halved.
+/// Every rank calls it; the result is rank 0's. Throws UsageError with fewer than 2 ranks.
+double measure_message_overhead(double task_overhead_ns, std::uint32_t messages = 256,
+                                int steps = 16);
+
 /// The calibration file `text` (named `name` in errors; what `tgraph calibrate` wrote) with
 /// "mpi_latency_ns" and "mpi_per_byte_ns" set from `link` (and "mpi_calibration" saying how),
-/// "task_overhead_ns" when `link` measured it, every other key kept. Throws InputError naming `name` when `text` is not a calibration.
+/// "task_overhead_ns" and "mpi_message_overhead_ns" when `link` measured them, every other key
+/// kept. Throws InputError naming `name` when `text` is not a calibration.
 std::string with_mpi_link(std::string_view text, const std::string& name, const MpiLink& link);
 
 }  // namespace tgraph::mpi

@@ -33,6 +33,13 @@ struct CostModel {
   /// processor by both simulation engines. 0 unless the calibration file has
   /// "task_overhead_ns" (`mpirun -np 2 tgraph-mpi calibrate` measures the MPI replay's).
   double task_overhead_ns = 0.0;
+  /// Processor time one MPI message between two nodes costs on each side (LogP's o:
+  /// posting and completing the send, matching and installing the receive), charged by the
+  /// SimGrid engine to the sending instance and to the receiving processor's next instance,
+  /// per datum version and loop decision sent to another node. 0 unless the calibration
+  /// file has "mpi_message_overhead_ns" (`mpirun -np 2 tgraph-mpi calibrate` measures the
+  /// MPI replay's).
+  double mpi_message_overhead_ns = 0.0;
 
   /// Zero synchronisation and transfer cost: pure precedence and load.
   static CostModel ideal();

@@ -72,6 +72,7 @@ struct Prediction {
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: as asked
   double simulation_ms = 0;       ///< wall time of the simulation itself
   double task_overhead_ns = 0;    ///< CostModel::task_overhead_ns charged per task instance
+  double message_overhead_ns = 0;  ///< CostModel::mpi_message_overhead_ns (SimGrid engine)
   bool lowered = false;           ///< the steps were lowered first (`simulate --lower`)
 };
 
