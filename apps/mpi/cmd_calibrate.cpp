@@ -40,14 +40,14 @@ void calibrate(const std::string& path_flag, bool json) {
     std::cout << "{\"mpi_latency_ns\":" << link.latency_ns
               << ",\"mpi_per_byte_ns\":" << link.per_byte_ns
               << ",\"task_overhead_ns\":" << link.task_overhead_ns
-              << ",\"mpi_message_overhead_ns\":" << link.message_overhead_ns << ",\"output\":\"" << path
+              << ",\"mpi_message_overhead_ns\":" << *link.message_overhead_ns << ",\"output\":\"" << path
               << "\"}\n";
   } else {
     std::cout << "MPI between two local ranks: latency " << link.latency_ns << " ns, "
               << link.per_byte_ns << " ns/byte ("
               << (link.per_byte_ns > 0 ? 1.0 / link.per_byte_ns : 0)
               << " GB/s); the replay's own time per task instance " << link.task_overhead_ns
-              << " ns, per message and side " << link.message_overhead_ns << " ns -> " << path
+              << " ns, per message and side " << *link.message_overhead_ns << " ns -> " << path
               << "\n";
   }
 }

@@ -171,7 +171,7 @@ std::string with_mpi_link(std::string_view text, const std::string& name, const 
   j["mpi_latency_ns"] = link.latency_ns;
   j["mpi_per_byte_ns"] = link.per_byte_ns;
   if (link.task_overhead_ns > 0) j["task_overhead_ns"] = link.task_overhead_ns;
-  if (link.message_overhead_ns > 0) j["mpi_message_overhead_ns"] = link.message_overhead_ns;
+  if (link.message_overhead_ns) j["mpi_message_overhead_ns"] = *link.message_overhead_ns;
   j["mpi_calibration"] = {{"measured_by", "tgraph-mpi calibrate"},
                           {"between", "two MPI ranks on this machine"},
                           {"rounds", link.rounds},
@@ -179,7 +179,7 @@ std::string with_mpi_link(std::string_view text, const std::string& name, const 
                           {"task_overhead", link.task_overhead_ns > 0
                                                 ? "per task instance of tgraph-mpi replay"
                                                 : "not measured"},
-                          {"message_overhead", link.message_overhead_ns > 0
+                          {"message_overhead", link.message_overhead_ns
                                                    ? "per message and side of tgraph-mpi replay"
                                                    : "not measured"}};
   std::string out = j.dump(2) + "\n";

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -19,8 +20,9 @@ struct MpiLink {
   /// then the file's "task_overhead_ns" is left as it was).
   double task_overhead_ns = 0;
   /// The MPI replay's time per message on each side (sender and receiver), beyond the
-  /// instances' own (0: not measured; the file's "mpi_message_overhead_ns" left as it was).
-  double message_overhead_ns = 0;
+  /// instances' own (none: not measured; the file's "mpi_message_overhead_ns" left as it
+  /// was). Written even when 0: a loaded machine can measure no difference.
+  std::optional<double> message_overhead_ns;
 };
 
 /// Ping-pong between ranks 0 and 1 of MPI_COMM_WORLD (other ranks wait); every rank calls
