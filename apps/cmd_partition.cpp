@@ -47,6 +47,10 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
       ->check(CLI::IsMember({"fresh", "repartition", "refine"}));
   cmd->add_option("--migration-cost", o.migration_cost,
                   "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
+  cmd->add_option("--order", n.order,
+                  "Each processor's task order for every method but list: program (the step's) or list "
+                  "(a list schedule of the mapping, longest path to the end first)")
+      ->check(CLI::IsMember({"program", "list"}));
   add_model_flags(cmd, n);
 }
 

@@ -22,6 +22,13 @@ std::unique_ptr<Strategy> make_scotch();
 std::unique_ptr<Strategy> make_sticky();
 std::unique_ptr<Strategy> make_list();
 
+/// An execution order for the fixed mapping `a.proc` (Assignment::order): an event-driven
+/// list schedule in which each idle processor starts, of its tasks whose inputs have
+/// arrived, the one with the longest path to the end of the step; loops kept as blocks
+/// (list's rule). Empty for k = 1.
+std::vector<std::vector<TaskId>> list_order(const StepGraph& g, const Assignment& a,
+                                            const CostModel& model);
+
 /// Work of every task (cost x runs).
 std::vector<std::uint64_t> task_work(const StepGraph& g);
 /// Per-processor load of `proc`.

@@ -87,6 +87,22 @@ StickyFallback parse_sticky_fallback(std::string_view s) {
   throw UsageError("--sticky-fallback: expected fresh, repartition or refine, got '" + std::string(s) + "'");
 }
 
+std::string_view to_string(TaskOrder o) {
+  switch (o) {
+    case TaskOrder::kProgram:
+      return "program";
+    case TaskOrder::kList:
+      return "list";
+  }
+  return "?";
+}
+
+TaskOrder parse_task_order(std::string_view s) {
+  if (s == "program") return TaskOrder::kProgram;
+  if (s == "list") return TaskOrder::kList;
+  throw UsageError("--order: expected program or list, got '" + std::string(s) + "'");
+}
+
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
   return match_tasks_by_key(g, prev);
 }
@@ -105,6 +121,9 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
 
   const auto t0 = std::chrono::steady_clock::now();
   Result r = do_partition(g, k, prev, options);
+  r.assignment.k = k;
+  if (options.order == TaskOrder::kList && r.assignment.order.empty())
+    r.assignment.order = detail::list_order(g, r.assignment, options.model);
   const auto t1 = std::chrono::steady_clock::now();
   r.stats.partition_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
 
@@ -199,6 +218,7 @@ Options NamedOptions::options() const {
   o.scotch = parse_scotch_flavour(scotch);
   o.rebalance = parse_rebalance(rebalance);
   o.sticky_fallback = parse_sticky_fallback(sticky_fallback);
+  o.order = parse_task_order(order);
   o.model = cost_model();
   return o;
 }

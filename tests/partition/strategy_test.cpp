@@ -520,6 +520,62 @@ TEST(List, OrdersEachProcessorByStartTimeKeepingLoopsTogether) {
   EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults()));
 }
 
+TEST(TaskOrder, ListStartsFirstTheTaskAnotherProcessorWaitsFor) {
+  // roundrobin on 2: tasks 0 and 2 on processor 0, 1 and 3 on processor 1. In program order
+  // processor 0 runs B (1000) before A (100), and C (1000, on processor 1) waits for A:
+  // 2100 ns. The list order runs A first (longest path to the end: 1100): 1100 ns.
+  Builder b;
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8), a = b.datum("a", 8), c = b.datum("c", 8);
+  b.task({{x, M::W}}, 1000);           // 0: B
+  b.task({{y, M::W}}, 1);              // 1: D
+  b.task({{a, M::W}}, 100);            // 2: A
+  b.task({{a, M::R}, {c, M::W}}, 1000);  // 3: C
+  const StepGraph g = b.done();
+  Options o;
+  o.model = CostModel::ideal();
+  const Result program = make_strategy("roundrobin")->partition(g, 2, {}, o);
+  EXPECT_TRUE(program.assignment.order.empty());
+  EXPECT_EQ(simulate(g, program.assignment, CostModel::ideal()).makespan_ns, 2100u);
+  o.order = TaskOrder::kList;
+  const Result list = make_strategy("roundrobin")->partition(g, 2, {}, o);
+  EXPECT_EQ(list.assignment.proc, program.assignment.proc);  // the mapping is kept
+  const std::vector<std::vector<TaskId>> expected = {{2, 0}, {1, 3}};
+  EXPECT_EQ(list.assignment.order, expected);
+  EXPECT_EQ(simulate(g, list.assignment, CostModel::ideal()).makespan_ns, 1100u);
+  EXPECT_EQ(parse_task_order("list"), TaskOrder::kList);
+  EXPECT_THROW(parse_task_order("fifo"), UsageError);
+}
+
+TEST(TaskOrder, ListOrdersEveryStrategysMappingWithoutDeadlockLoopsTogether) {
+  for (std::uint64_t seed = 0; seed < 30; ++seed) {
+    const StepGraph g = testing::random_graph(700 + seed, 40, 5, seed % 2 == 0);
+    for (const char* method : {"roundrobin", "random", "metis", "scotch"})
+      for (std::uint32_t k : {2u, 3u}) {
+        Options o;
+        o.order = TaskOrder::kList;
+        const Result r = make_strategy(method)->partition(g, k, {}, o);
+        ASSERT_EQ(r.assignment.order.size(), k) << method << " seed " << seed;
+        for (ProcId p = 0; p < k; ++p) {
+          std::vector<TaskId> mine, ordered = r.assignment.order[p];
+          for (TaskId t = 0; t < g.tasks.size(); ++t)
+            if (r.assignment.proc[t] == p) mine.push_back(t);
+          std::sort(ordered.begin(), ordered.end());
+          EXPECT_EQ(ordered, mine) << method << " seed " << seed << " p " << p;
+          // Each loop's tasks of one processor are contiguous in its order.
+          std::set<LoopId> closed;
+          LoopId open = kNoLoop;
+          for (TaskId t : r.assignment.order[p]) {
+            const LoopId l = g.tasks[t].loop;
+            if (l != open && open != kNoLoop) closed.insert(open);
+            if (l != kNoLoop) EXPECT_EQ(closed.count(l), 0u) << method << " seed " << seed;
+            open = l;
+          }
+        }
+        EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults())) << method << " seed " << seed;
+      }
+  }
+}
+
 TEST(Strategy, CountsMovedTasksByStableKey) {
   const StepGraph g = objects_scene(4, {});
   Assignment prev;

@@ -53,6 +53,16 @@ std::string_view to_string(StickyFallback f);
 /// Parses a fallback name; throws UsageError.
 StickyFallback parse_sticky_fallback(std::string_view s);
 
+/// How each processor orders its tasks when the strategy gives no order of its own.
+enum class TaskOrder : std::uint8_t {
+  kProgram = 0,  ///< the step's program order (Assignment::order left empty)
+  kList = 1,     ///< a list schedule of the mapping: longest path to the end first (list_order)
+};
+/// "program" or "list".
+std::string_view to_string(TaskOrder o);
+/// Parses an order name; throws UsageError.
+TaskOrder parse_task_order(std::string_view s);
+
 /// Knobs of the strategies; each strategy reads the ones it understands.
 struct Options {
   double imbalance = 1.03;          ///< tolerated max load / mean load (METIS, Scotch)
@@ -72,6 +82,8 @@ struct Options {
   /// load against the cut (quantised to 0.01 by Scotch)
   double migration_cost = 1.0;
   CostModel model = CostModel::defaults();  ///< list: communication cost estimate
+  /// Every strategy but list (which orders itself): the order each processor runs its tasks
+  TaskOrder order = TaskOrder::kProgram;
 };
 
 /// Options with their enumerations and cost model by name, as the command line and scripts
@@ -82,6 +94,7 @@ struct NamedOptions {
   std::string scotch = "quality";         ///< default, quality, speed, balance
   std::string rebalance = "greedy";       ///< greedy, scotch
   std::string sticky_fallback = "fresh";  ///< fresh, repartition, refine
+  std::string order = "program";          ///< program, list
   std::string model = "calibrated";       ///< calibrated, ideal (select_cost_model)
   std::string calibration;                ///< calibration file ("": the default one if present)
 
