@@ -40,13 +40,43 @@ double one_way_ns(int rank, std::vector<char>& buf, int bytes, int n, int repeat
   return t[t.size() / 2];
 }
 
+struct World {
+  int rank = 0, size = 1;
+};
+
+// This process's rank and the job's size; UsageError below 2 ranks when `pair` is asked.
+World world(bool pair) {
+  World w;
+  MPI_Comm_rank(MPI_COMM_WORLD, &w.rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &w.size);
+  if (pair && w.size < 2)
+    throw UsageError("calibrate needs 2 ranks (mpirun -np 2 tgraph-mpi calibrate)");
+  return w;
+}
+
+// The median step wall time (ns) of replaying step `g` under `a` `steps` times through
+// replay_distributed() with one thread per rank, leaving out the first step (it touches the
+// data); every rank calls it.
+double median_step_ns(const StepGraph& g, const Assignment& a, int steps) {
+  Trace trace;
+  trace.steps.assign(static_cast<std::size_t>(steps), g);
+  TraceAssignment ta;
+  ta.method = "calibrate";
+  ta.k = a.k;
+  ta.steps.assign(static_cast<std::size_t>(steps), a);
+  const MpiReplayResult r = replay_distributed(trace, ta, MpiReplayOptions{});
+  std::vector<double> wall;
+  for (std::size_t s = 1; s < r.steps.size(); ++s)
+    wall.push_back(static_cast<double>(r.steps[s].wall_ns));
+  if (wall.empty()) return 0;
+  std::sort(wall.begin(), wall.end());
+  return wall[wall.size() / 2];
+}
+
 }  // namespace
 
 MpiLink measure_mpi_link(int rounds, std::uint64_t message_bytes, int repeats) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  if (size < 2) throw UsageError("calibrate needs 2 ranks (mpirun -np 2 tgraph-mpi calibrate)");
+  const int rank = world(true).rank;
   if (rounds < repeats || repeats < 1 || message_bytes < 1 || message_bytes > (1u << 30))
     throw UsageError("calibrate: bad rounds or message size");
   std::vector<char> buf(message_bytes, 1);
@@ -61,11 +91,9 @@ MpiLink measure_mpi_link(int rounds, std::uint64_t message_bytes, int repeats) {
 }
 
 double measure_task_overhead(std::uint32_t tasks, std::uint64_t cost_ns, int steps) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  const World w = world(false);
   if (tasks == 0 || steps < 2) throw UsageError("calibrate: bad task count or steps");
-  const auto ranks = static_cast<std::uint32_t>(size);
+  const auto ranks = static_cast<std::uint32_t>(w.size);
   StepGraph g;
   const KindId kind = g.intern_kind("calibrate");
   for (std::uint32_t r = 0; r < ranks; ++r)
@@ -78,27 +106,15 @@ double measure_task_overhead(std::uint32_t tasks, std::uint64_t cost_ns, int ste
     a.proc.push_back(i % ranks);
   }
   g.derive_edges();
-  Trace trace;
-  trace.steps.assign(static_cast<std::size_t>(steps), g);
-  TraceAssignment ta;
-  ta.method = "calibrate";
-  ta.k = ranks;
-  ta.steps.assign(static_cast<std::size_t>(steps), a);
-  const MpiReplayResult r = replay_distributed(trace, ta, MpiReplayOptions{});
-  std::vector<double> per_task;
-  for (std::size_t s = 1; s < r.steps.size(); ++s)  // the first one touches the data
-    per_task.push_back((static_cast<double>(r.steps[s].wall_ns) -
-                        static_cast<double>(tasks) * static_cast<double>(cost_ns)) /
-                       tasks);
-  if (rank != 0 || per_task.empty()) return 0;
-  std::sort(per_task.begin(), per_task.end());
-  return std::max(0.0, per_task[per_task.size() / 2]);
+  const double wall = median_step_ns(g, a, steps);
+  if (w.rank != 0) return 0;
+  return std::max(0.0, (wall - static_cast<double>(tasks) * static_cast<double>(cost_ns)) / tasks);
 }
 
 namespace {
 
-// Rank 0's median step wall time (ns, the steps after the first) of replaying, with one
-// thread per rank, `steps` steps in which every processor r writes `messages` data of 8
+// The median step wall time (ns, the steps after the first) of replaying, with one thread
+// per rank, `steps` steps in which every processor r writes `messages` data of 8
 // bytes, then reads those of processor r - 1 (all sent by then, or nearly): each rank sends
 // and receives `messages` messages and waits for almost nothing.
 double exchange_step_ns(std::uint32_t ranks, std::uint32_t messages, int steps) {
@@ -124,30 +140,15 @@ double exchange_step_ns(std::uint32_t ranks, std::uint32_t messages, int steps) 
       a.proc.push_back(r);
     }
   g.derive_edges();
-  Trace trace;
-  trace.steps.assign(static_cast<std::size_t>(steps), g);
-  TraceAssignment ta;
-  ta.method = "calibrate";
-  ta.k = ranks;
-  ta.steps.assign(static_cast<std::size_t>(steps), a);
-  const MpiReplayResult r = replay_distributed(trace, ta, MpiReplayOptions{});
-  std::vector<double> wall;
-  for (std::size_t s = 1; s < r.steps.size(); ++s)  // the first one touches the data
-    wall.push_back(static_cast<double>(r.steps[s].wall_ns));
-  if (wall.empty()) return 0;
-  std::sort(wall.begin(), wall.end());
-  return wall[wall.size() / 2];
+  return median_step_ns(g, a, steps);
 }
 
 }  // namespace
 
 double measure_message_overhead(double task_overhead_ns, std::uint32_t messages, int steps) {
-  int rank = 0, size = 1;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  if (size < 2) throw UsageError("calibrate needs 2 ranks (mpirun -np 2 tgraph-mpi calibrate)");
+  const World w = world(true);
   if (messages < 8 || steps < 2) throw UsageError("calibrate: bad message count or steps");
-  const auto ranks = static_cast<std::uint32_t>(size);
+  const auto ranks = static_cast<std::uint32_t>(w.size);
   // Two sizes: the slope leaves out what a step costs whatever its messages (the barrier,
   // starting the threads, the counters' reduction). Past a few hundred messages in flight a
   // message costs more (longer matching queues): the sizes stay below.
@@ -158,7 +159,7 @@ double measure_message_overhead(double task_overhead_ns, std::uint32_t messages,
     const double large = exchange_step_ns(ranks, messages, steps);
     slopes.push_back((large - small) / static_cast<double>(messages - few));
   }
-  if (rank != 0) return 0;
+  if (w.rank != 0) return 0;
   std::sort(slopes.begin(), slopes.end());
   // Per extra message: one send, one receive and two task instances on each rank.
   const double per_message = slopes[slopes.size() / 2];

@@ -224,12 +224,8 @@ TEST(SimgridEngine, TheReaderPaysInsideANodeUnlessTheLinkCarriesTheBytes) {
   EXPECT_EQ(link.steps[0].bytes, reader.steps[0].bytes);
 }
 
-TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
-  // Processor 0 (node 0) writes d; processors 2 and 3 (both on node 1) read it: one
-  // message between the nodes, its bytes once; each reader starts when it arrives.
-  CostModel m;
-  m.mpi_latency_ns = 1000;
-  m.mpi_per_byte_ns = 0.1;
+// One writer of a 10,000-byte datum (500 ns), two readers (700 and 900 ns).
+Trace one_writer_two_readers() {
   Builder b;
   const DatumId d = b.datum("d", 10000);
   b.task({{d, M::W}}, 500);
@@ -237,6 +233,16 @@ TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
   b.task({{d, M::R}}, 900);
   Trace t;
   t.steps = {b.done()};
+  return t;
+}
+
+TEST(SimgridEngine, SendsADatumVersionOnceToANodeForAllItsReaders) {
+  // Processor 0 (node 0) writes d; processors 2 and 3 (both on node 1) read it: one
+  // message between the nodes, its bytes once; each reader starts when it arrives.
+  CostModel m;
+  m.mpi_latency_ns = 1000;
+  m.mpi_per_byte_ns = 0.1;
+  const Trace t = one_writer_two_readers();
   const Prediction r = simulate_trace(t, split(4, {0, 2, 3}), SimulationEngine::simgrid,
                                       on_cluster(ClusterShape{2, 2}, m));
   EXPECT_EQ(r.steps[0].inter_node_messages, 1u);
@@ -252,13 +258,7 @@ TEST(SimgridEngine, ChargesEachMessageBetweenNodesToTheSenderAndToOneReceiver) {
   m.mpi_latency_ns = 1000;
   m.mpi_per_byte_ns = 0.1;
   m.mpi_message_overhead_ns = 300;
-  Builder b;
-  const DatumId d = b.datum("d", 10000);
-  b.task({{d, M::W}}, 500);
-  b.task({{d, M::R}}, 700);
-  b.task({{d, M::R}}, 900);
-  Trace t;
-  t.steps = {b.done()};
+  const Trace t = one_writer_two_readers();
   const Prediction r = simulate_trace(t, split(4, {0, 2, 3}), SimulationEngine::simgrid,
                                       on_cluster(ClusterShape{2, 2}, m));
   EXPECT_EQ(r.message_overhead_ns, 300);
