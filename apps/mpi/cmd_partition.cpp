@@ -3,10 +3,7 @@
 // [--json]`: every rank reads the trace; each step is partitioned by all ranks together
 // (tgraph::mpi::ptscotch_partition), and rank 0 writes the .tga and the report.
 #include <mpi.h>
-#include <sys/resource.h>
 
-#include <algorithm>
-#include <exception>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -17,6 +14,7 @@
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/strategy.hpp"
+#include "tgraph/mpi/session.hpp"
 #include "verbs.hpp"
 #if defined(TGRAPH_HAVE_PTSCOTCH)
 #include "tgraph/mpi/ptscotch.hpp"
@@ -35,39 +33,6 @@ struct PartitionArgs {
 };
 
 #if defined(TGRAPH_HAVE_PTSCOTCH)
-/// Reads and checks the input on every rank. When that fails somewhere, the lowest failing
-/// rank rethrows (main prints its one line and aborts the job) and the others wait for the
-/// abort: bad input gives one line, not one per rank.
-Trace read_input(const PartitionArgs& a, int rank, int ranks) {
-  Trace trace;
-  std::exception_ptr error;
-  try {
-    if (a.nodes == 0) throw UsageError("--nodes: expected at least 1");
-    if (a.cores == 0) throw UsageError("--cores: expected at least 1");
-    trace = read_trace(a.trace);
-    if (a.step && *a.step >= trace.steps.size())
-      throw UsageError("--step: " + std::to_string(*a.step) + " is past the trace's " +
-                       std::to_string(trace.steps.size()) + " steps");
-  } catch (...) {
-    error = std::current_exception();
-  }
-  int failing = error ? rank : ranks;
-  MPI_Allreduce(MPI_IN_PLACE, &failing, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
-  if (failing == rank) std::rethrow_exception(error);
-  if (failing < ranks)  // never sent: MPI_Abort from rank `failing` ends this wait
-    MPI_Recv(nullptr, 0, MPI_BYTE, failing, 0, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-  return trace;
-}
-
-/// The largest peak resident set of any rank, in MiB (a collective call).
-double max_rss_mib() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  double mib = static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
-  MPI_Allreduce(MPI_IN_PLACE, &mib, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-  return mib;
-}
-
 nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
   return {{"step", step},
           {"tasks", r.vertices},
@@ -87,36 +52,33 @@ void run(const PartitionArgs& a) {
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
   MPI_Comm_size(MPI_COMM_WORLD, &ranks);
   const double t0 = MPI_Wtime();
-  const Trace trace = read_input(a, rank, ranks);
+  Trace trace;
+  mpi::agree_on_input(
+      [&] {
+        if (a.nodes == 0) throw UsageError("--nodes: expected at least 1");
+        if (a.cores == 0) throw UsageError("--cores: expected at least 1");
+        trace = read_trace(a.trace);
+        if (a.step && *a.step >= trace.steps.size())
+          throw UsageError("--step: " + std::to_string(*a.step) + " is past the trace's " +
+                           std::to_string(trace.steps.size()) + " steps");
+      },
+      MPI_COMM_WORLD);
   double read_ms = (MPI_Wtime() - t0) * 1e3;
   MPI_Allreduce(MPI_IN_PLACE, &read_ms, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
   partition::Options options = a.options;
   options.scotch = partition::parse_scotch_flavour(a.scotch);
-
-  TraceAssignment out;
-  out.method = a.method;
-  out.k = a.nodes * a.cores;
-  std::vector<std::uint64_t> hashes;
-  nlohmann::json per_step = nlohmann::json::array();
-  std::int64_t cut = 0, node_cut = 0;
-  double imbalance = 1.0, partition_ms = 0.0;
   const std::size_t first = a.step.value_or(0);
   const std::size_t last = a.step ? *a.step + 1 : trace.steps.size();
-  for (std::size_t s = first; s < last; ++s) {
-    const StepGraph& g = trace.steps[s];
-    mpi::PtScotchResult r = mpi::ptscotch_partition(g, a.nodes, a.cores, options, MPI_COMM_WORLD);
-    cut += r.cut;
-    node_cut += r.node_cut;
-    imbalance = std::max(imbalance, r.imbalance);
-    partition_ms += r.total_ms;
-    per_step.push_back(step_json(s, r));
-    out.partition_ms.push_back(r.total_ms);
-    out.steps.push_back(std::move(r.assignment));
-    hashes.push_back(g.structural_hash());
-  }
-  const double rss_mib = max_rss_mib();
+  const mpi::PtScotchTraceResult r =
+      mpi::ptscotch_partition_trace(trace, first, last, a.nodes, a.cores, options, MPI_COMM_WORLD);
+  const TraceAssignment& out = r.assignment;
+  nlohmann::json per_step = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.steps.size(); ++i) per_step.push_back(step_json(first + i, r.steps[i]));
+  const std::int64_t cut = r.cut, node_cut = r.node_cut;
+  const double imbalance = r.imbalance, partition_ms = r.partition_ms;
+  const double rss_mib = mpi::max_rss_mib(MPI_COMM_WORLD);
   if (rank != 0) return;
-  if (!a.output.empty()) partition::write_assignment(a.output, out, hashes);
+  if (!a.output.empty()) partition::write_assignment(a.output, out, r.hashes);
   if (!a.json) {
     std::cout << "ptscotch on " << ranks << " rank(s): " << out.steps.size() << " step(s) over "
               << a.nodes << " nodes x " << a.cores << " cores (k = " << out.k << "): cut " << cut

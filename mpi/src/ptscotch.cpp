@@ -365,4 +365,27 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
   return r;
 }
 
+PtScotchTraceResult ptscotch_partition_trace(const Trace& trace, std::size_t first,
+                                             std::size_t last, std::uint32_t nodes,
+                                             std::uint32_t cores,
+                                             const partition::Options& options, MPI_Comm comm) {
+  PtScotchTraceResult out;
+  out.assignment.method = "ptscotch";
+  out.assignment.k = nodes * cores;
+  for (std::size_t s = first; s < last && s < trace.steps.size(); ++s) {
+    const StepGraph& g = trace.steps[s];
+    PtScotchResult r = ptscotch_partition(g, nodes, cores, options, comm);
+    out.cut += r.cut;
+    out.node_cut += r.node_cut;
+    out.imbalance = std::max(out.imbalance, r.imbalance);
+    out.partition_ms += r.total_ms;
+    out.assignment.partition_ms.push_back(r.total_ms);
+    out.assignment.steps.push_back(std::move(r.assignment));
+    r.assignment = {};
+    out.hashes.push_back(g.structural_hash());
+    out.steps.push_back(std::move(r));
+  }
+  return out;
+}
+
 }  // namespace tgraph::mpi

@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "tgraph/mpi/session.hpp"
 
+#include <sys/resource.h>
+
+#include <exception>
 #include <stdexcept>
 
 namespace tgraph::mpi {
@@ -24,5 +27,30 @@ Session::Session(int& argc, char**& argv) {
 }
 
 Session::~Session() { MPI_Finalize(); }
+
+void agree_on_input(const std::function<void()>& check, MPI_Comm comm) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  std::exception_ptr error;
+  try {
+    check();
+  } catch (...) {
+    error = std::current_exception();
+  }
+  int failing = error ? rank : ranks;
+  MPI_Allreduce(MPI_IN_PLACE, &failing, 1, MPI_INT, MPI_MIN, comm);
+  if (failing == rank) std::rethrow_exception(error);
+  if (failing < ranks)  // never sent: MPI_Abort from rank `failing` ends this wait
+    MPI_Recv(nullptr, 0, MPI_BYTE, failing, 0, comm, MPI_STATUS_IGNORE);
+}
+
+double max_rss_mib(MPI_Comm comm) {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  double mib = static_cast<double>(u.ru_maxrss) / 1024.0;  // Linux: kilobytes
+  MPI_Allreduce(MPI_IN_PLACE, &mib, 1, MPI_DOUBLE, MPI_MAX, comm);
+  return mib;
+}
 
 }  // namespace tgraph::mpi

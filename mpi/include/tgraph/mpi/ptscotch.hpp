@@ -13,6 +13,7 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::mpi {
@@ -45,5 +46,23 @@ struct PtScotchResult {
 /// Throws UsageError for 0 nodes or cores, std::runtime_error when PT-Scotch fails.
 PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::uint32_t cores,
                                   const partition::Options& options, MPI_Comm comm);
+
+/// Steps [first, last) of a trace partitioned one after the other by ptscotch_partition.
+struct PtScotchTraceResult {
+  TraceAssignment assignment;         ///< method "ptscotch", k = nodes x cores, one per step
+  std::vector<std::uint64_t> hashes;  ///< each partitioned step's structural hash (for the .tga)
+  /// Each step's figures (step first + i; their assignments are in `assignment`).
+  std::vector<PtScotchResult> steps;
+  std::int64_t cut = 0, node_cut = 0;  ///< summed over the steps
+  double imbalance = 1.0;              ///< the worst step's
+  double partition_ms = 0.0;           ///< summed over the steps
+};
+
+/// ptscotch_partition of every step of `trace` in [first, last) (within the trace); a
+/// collective call, the same result on every rank.
+PtScotchTraceResult ptscotch_partition_trace(const Trace& trace, std::size_t first,
+                                             std::size_t last, std::uint32_t nodes,
+                                             std::uint32_t cores,
+                                             const partition::Options& options, MPI_Comm comm);
 
 }  // namespace tgraph::mpi

@@ -5,6 +5,8 @@
 
 #include <mpi.h>
 
+#include <functional>
+
 namespace tgraph::mpi {
 
 /// MPI_Init_thread(MPI_THREAD_MULTIPLE) in the constructor, MPI_Finalize in the destructor.
@@ -23,5 +25,14 @@ class Session {
   int rank_ = 0;
   int size_ = 1;
 };
+
+/// Runs `check` (reading and checking a command's input) on every rank of `comm`, a
+/// collective call. When it throws on some rank, the lowest such rank rethrows (its caller
+/// prints the one line and aborts the job) and the others wait for that abort: bad input
+/// gives one line, not one per rank.
+void agree_on_input(const std::function<void()>& check, MPI_Comm comm);
+
+/// The largest peak resident set of any rank of `comm`, in MiB (a collective call).
+double max_rss_mib(MPI_Comm comm);
 
 }  // namespace tgraph::mpi
