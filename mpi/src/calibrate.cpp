@@ -113,17 +113,22 @@ double measure_task_overhead(std::uint32_t tasks, std::uint64_t cost_ns, int ste
 
 namespace {
 
-// The median step wall time (ns, the steps after the first) of replaying, with one thread
-// per rank, `steps` steps in which every processor r writes `messages` data of 8
-// bytes, then reads those of processor r - 1 (all sent by then, or nearly): each rank sends
-// and receives `messages` messages and waits for almost nothing.
-double exchange_step_ns(std::uint32_t ranks, std::uint32_t messages, int steps) {
+// A step and its assignment in which every processor r writes `messages` data of 8 bytes,
+// then reads those of processor r - 1 (all sent by then, or nearly): each rank sends and
+// receives `messages` messages and waits for almost nothing.
+struct Exchange {
   StepGraph g;
+  Assignment a;
+};
+
+Exchange exchange_step(std::uint32_t ranks, std::uint32_t messages) {
+  Exchange x;
+  StepGraph& g = x.g;
+  Assignment& a = x.a;
   const KindId kind = g.intern_kind("calibrate");
   for (std::uint32_t r = 0; r < ranks; ++r)
     for (std::uint32_t m = 0; m < messages; ++m)
       g.data.push_back({"d " + std::to_string(r) + " " + std::to_string(m), kNoObject, 8});
-  Assignment a;
   a.k = ranks;
   std::uint32_t seq = 0;
   for (std::uint32_t r = 0; r < ranks; ++r)
@@ -140,7 +145,7 @@ double exchange_step_ns(std::uint32_t ranks, std::uint32_t messages, int steps) 
       a.proc.push_back(r);
     }
   g.derive_edges();
-  return median_step_ns(g, a, steps);
+  return x;
 }
 
 }  // namespace
@@ -153,10 +158,11 @@ double measure_message_overhead(double task_overhead_ns, std::uint32_t messages,
   // starting the threads, the counters' reduction). Past a few hundred messages in flight a
   // message costs more (longer matching queues): the sizes stay below.
   const std::uint32_t few = messages / 4;
+  const Exchange small_step = exchange_step(ranks, few), large_step = exchange_step(ranks, messages);
   std::vector<double> slopes;
   for (int round = 0; round < 5; ++round) {
-    const double small = exchange_step_ns(ranks, few, steps);
-    const double large = exchange_step_ns(ranks, messages, steps);
+    const double small = median_step_ns(small_step.g, small_step.a, steps);
+    const double large = median_step_ns(large_step.g, large_step.a, steps);
     slopes.push_back((large - small) / static_cast<double>(messages - few));
   }
   if (w.rank != 0) return 0;

@@ -87,16 +87,6 @@ StickyFallback parse_sticky_fallback(std::string_view s) {
   throw UsageError("--sticky-fallback: expected fresh, repartition or refine, got '" + std::string(s) + "'");
 }
 
-std::string_view to_string(TaskOrder o) {
-  switch (o) {
-    case TaskOrder::kProgram:
-      return "program";
-    case TaskOrder::kList:
-      return "list";
-  }
-  return "?";
-}
-
 TaskOrder parse_task_order(std::string_view s) {
   if (s == "program") return TaskOrder::kProgram;
   if (s == "list") return TaskOrder::kList;
@@ -121,14 +111,13 @@ Result Strategy::partition(const StepGraph& g, std::uint32_t k, const Previous& 
 
   const auto t0 = std::chrono::steady_clock::now();
   Result r = do_partition(g, k, prev, options);
-  r.assignment.k = k;
-  if (options.order == TaskOrder::kList && r.assignment.order.empty())
-    r.assignment.order = detail::list_order(g, r.assignment, options.model);
+  Assignment& a = r.assignment;
+  a.k = k;
+  if (options.order == TaskOrder::kList && a.order.empty())
+    a.order = detail::list_order(g, a, options.model);
   const auto t1 = std::chrono::steady_clock::now();
   r.stats.partition_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
 
-  Assignment& a = r.assignment;
-  a.k = k;
   if (std::string why = validate(g, a, k); !why.empty())
     throw std::logic_error("strategy " + std::string(name()) + ": " + why);
   // Processors left without a task while there are tasks enough for all of them.

@@ -58,9 +58,7 @@ enum class TaskOrder : std::uint8_t {
   kProgram = 0,  ///< the step's program order (Assignment::order left empty)
   kList = 1,     ///< a list schedule of the mapping: longest path to the end first (list_order)
 };
-/// "program" or "list".
-std::string_view to_string(TaskOrder o);
-/// Parses an order name; throws UsageError.
+/// Parses an order name ("program" or "list"); throws UsageError.
 TaskOrder parse_task_order(std::string_view s);
 
 /// Knobs of the strategies; each strategy reads the ones it understands.
