@@ -83,16 +83,7 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
   r.warnings = notes.warnings;
   if (!a.timeline.empty()) write_file_atomic(a.timeline, timeline_json(timeline.timeline()));
   if (!a.chrome.empty()) write_file_atomic(a.chrome, viz::chrome_trace(timeline.timeline()));
-  // Where the assignment came from: the file, or the strategy that placed the steps, and why
-  // that one when the user named none or the named one fell back.
-  std::string label = a.assignment;
-  if (as && label.empty()) {
-    label = notes.placed_by + " (computed";
-    if (a.method.empty())
-      label += notes.method == "owner" ? ", default" : ", default for a trace without objects";
-    if (notes.placed_by != notes.method) label += ", fallback of " + notes.method;
-    label += ")";
-  }
+  const std::string label = as ? tp::assignment_label(a.assignment, a.method, notes) : a.assignment;
   std::cout << (a.json ? meas::to_json(r, a.input, label) + "\n" : meas::to_text(r, a.input, o.repeat));
 }
 

@@ -6,7 +6,6 @@
 
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
@@ -33,20 +32,6 @@ struct PartitionArgs {
 };
 
 #if defined(TGRAPH_HAVE_PTSCOTCH)
-nlohmann::json step_json(std::size_t step, const mpi::PtScotchResult& r) {
-  return {{"step", step},
-          {"tasks", r.vertices},
-          {"edges", r.edges},
-          {"cut", r.cut},
-          {"node_cut", r.node_cut},
-          {"imbalance", r.imbalance},
-          {"node_imbalance", r.node_imbalance},
-          {"build_ms", r.build_ms},
-          {"nodes_ms", r.nodes_ms},
-          {"cores_ms", r.cores_ms},
-          {"partition_ms", r.total_ms}};
-}
-
 void run(const PartitionArgs& a) {
   int rank = 0, ranks = 1;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
@@ -71,39 +56,19 @@ void run(const PartitionArgs& a) {
   const std::size_t last = a.step ? *a.step + 1 : trace.steps.size();
   const mpi::PtScotchTraceResult r =
       mpi::ptscotch_partition_trace(trace, first, last, a.nodes, a.cores, options, MPI_COMM_WORLD);
-  const TraceAssignment& out = r.assignment;
-  nlohmann::json per_step = nlohmann::json::array();
-  for (std::size_t i = 0; i < r.steps.size(); ++i) per_step.push_back(step_json(first + i, r.steps[i]));
-  const std::int64_t cut = r.cut, node_cut = r.node_cut;
-  const double imbalance = r.imbalance, partition_ms = r.partition_ms;
-  const double rss_mib = mpi::max_rss_mib(MPI_COMM_WORLD);
+  mpi::PtScotchRun about;
+  about.trace = a.trace;
+  about.output = a.output;
+  about.ranks = ranks;
+  about.nodes = a.nodes;
+  about.cores = a.cores;
+  about.first = first;
+  about.read_ms = read_ms;
+  about.max_rss_mib = mpi::max_rss_mib(MPI_COMM_WORLD);
   if (rank != 0) return;
-  if (!a.output.empty()) partition::write_assignment(a.output, out, r.hashes);
-  if (!a.json) {
-    std::cout << "ptscotch on " << ranks << " rank(s): " << out.steps.size() << " step(s) over "
-              << a.nodes << " nodes x " << a.cores << " cores (k = " << out.k << "): cut " << cut
-              << " (between nodes " << node_cut << "), imbalance " << imbalance << ", "
-              << partition_ms << " ms partitioning\n";
-    if (!a.output.empty()) std::cout << "wrote " << a.output << "\n";
-    return;
-  }
-  std::cout << nlohmann::json{{"method", a.method},
-                              {"trace", a.trace},
-                              {"output", a.output},
-                              {"ranks", ranks},
-                              {"nodes", a.nodes},
-                              {"cores", a.cores},
-                              {"k", out.k},
-                              {"steps", out.steps.size()},
-                              {"cut", cut},
-                              {"node_cut", node_cut},
-                              {"imbalance", imbalance},
-                              {"read_ms", read_ms},
-                              {"partition_ms", partition_ms},
-                              {"max_rss_mib", rss_mib},
-                              {"per_step", per_step}}
-                   .dump()
-            << std::endl;
+  if (!a.output.empty()) partition::write_assignment(a.output, r.assignment, r.hashes);
+  std::cout << (a.json ? mpi::ptscotch_json(r, about) + "\n" : mpi::ptscotch_text(r, about))
+            << std::flush;
 }
 #else
 void run(const PartitionArgs&) {

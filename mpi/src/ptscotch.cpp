@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <nlohmann/json.hpp>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -386,6 +388,50 @@ PtScotchTraceResult ptscotch_partition_trace(const Trace& trace, std::size_t fir
     out.steps.push_back(std::move(r));
   }
   return out;
+}
+
+std::string ptscotch_json(const PtScotchTraceResult& r, const PtScotchRun& run) {
+  nlohmann::json per_step = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.steps.size(); ++i) {
+    const PtScotchResult& s = r.steps[i];
+    per_step.push_back({{"step", run.first + i},
+                        {"tasks", s.vertices},
+                        {"edges", s.edges},
+                        {"cut", s.cut},
+                        {"node_cut", s.node_cut},
+                        {"imbalance", s.imbalance},
+                        {"node_imbalance", s.node_imbalance},
+                        {"build_ms", s.build_ms},
+                        {"nodes_ms", s.nodes_ms},
+                        {"cores_ms", s.cores_ms},
+                        {"partition_ms", s.total_ms}});
+  }
+  return nlohmann::json{{"method", r.assignment.method},
+                        {"trace", run.trace},
+                        {"output", run.output},
+                        {"ranks", run.ranks},
+                        {"nodes", run.nodes},
+                        {"cores", run.cores},
+                        {"k", r.assignment.k},
+                        {"steps", r.assignment.steps.size()},
+                        {"cut", r.cut},
+                        {"node_cut", r.node_cut},
+                        {"imbalance", r.imbalance},
+                        {"read_ms", run.read_ms},
+                        {"partition_ms", r.partition_ms},
+                        {"max_rss_mib", run.max_rss_mib},
+                        {"per_step", per_step}}
+      .dump();
+}
+
+std::string ptscotch_text(const PtScotchTraceResult& r, const PtScotchRun& run) {
+  std::ostringstream o;
+  o << "ptscotch on " << run.ranks << " rank(s): " << r.assignment.steps.size()
+    << " step(s) over " << run.nodes << " nodes x " << run.cores << " cores (k = "
+    << r.assignment.k << "): cut " << r.cut << " (between nodes " << r.node_cut
+    << "), imbalance " << r.imbalance << ", " << r.partition_ms << " ms partitioning\n";
+  if (!run.output.empty()) o << "wrote " << run.output << "\n";
+  return o.str();
 }
 
 }  // namespace tgraph::mpi

@@ -210,4 +210,14 @@ TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_n
   return a;
 }
 
+std::string assignment_label(const std::string& path, const std::string& method,
+                             const PartitionNotes& notes) {
+  if (!path.empty()) return path;
+  std::string label = notes.placed_by + " (computed";
+  if (method.empty())
+    label += notes.method == "owner" ? ", default" : ", default for a trace without objects";
+  if (notes.placed_by != notes.method) label += ", fallback of " + notes.method;
+  return label + ")";
+}
+
 }  // namespace tgraph::partition

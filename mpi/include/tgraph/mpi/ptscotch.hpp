@@ -9,6 +9,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
@@ -64,5 +65,22 @@ PtScotchTraceResult ptscotch_partition_trace(const Trace& trace, std::size_t fir
                                              std::size_t last, std::uint32_t nodes,
                                              std::uint32_t cores,
                                              const partition::Options& options, MPI_Comm comm);
+
+/// What `tgraph-mpi partition` reports beside a PtScotchTraceResult.
+struct PtScotchRun {
+  std::string trace, output;  ///< the files, as named on the command line
+  int ranks = 1;
+  std::uint32_t nodes = 1, cores = 1;
+  std::size_t first = 0;   ///< the first partitioned step
+  double read_ms = 0;      ///< reading the trace (slowest rank)
+  double max_rss_mib = 0;  ///< largest peak resident set of any rank
+};
+
+/// The report of `tgraph-mpi partition --json`: method, trace, output, ranks, nodes, cores,
+/// k, steps, cut, node_cut, imbalance, read_ms, partition_ms, max_rss_mib and per_step (each
+/// step's tasks, edges, cut, node_cut, imbalance, node_imbalance and times).
+std::string ptscotch_json(const PtScotchTraceResult& r, const PtScotchRun& run);
+/// The same as text (a line, and the output file when one was written).
+std::string ptscotch_text(const PtScotchTraceResult& r, const PtScotchRun& run);
 
 }  // namespace tgraph::mpi

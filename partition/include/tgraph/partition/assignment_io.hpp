@@ -55,4 +55,11 @@ TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_n
                                   const std::string& path, const std::string& method,
                                   std::uint32_t k, PartitionNotes* notes = nullptr);
 
+/// Where load_or_partition's assignment came from, as `tgraph replay` reports it: the file
+/// `path`, or the strategy that placed the steps and why that one ("owner (computed,
+/// default)", "list (computed, fallback of owner)"...); `method` is the one the user named
+/// (empty: none).
+std::string assignment_label(const std::string& path, const std::string& method,
+                             const PartitionNotes& notes);
+
 }  // namespace tgraph::partition
