@@ -34,6 +34,10 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--phases", o.phases,
                   "METIS: balance each of N graph phases (0: the method's default: off for "
                   "metis, 2 for sticky's partitions; 1: off)");
+  cmd->add_option("--loop-share", o.loop_share,
+                  "With phases on: each dynamic loop holding at least this share of the step's "
+                  "work is one more constraint, balanced on its own (default 0.1; 0: off)")
+      ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--scotch-strategy", n.scotch, "Scotch flavour: default, quality, speed, balance")
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
   cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");

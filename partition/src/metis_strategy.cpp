@@ -103,7 +103,7 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
   const UndirectedGraph pg = library_graph(g);
   std::vector<std::uint32_t> phase;
   std::uint32_t used = 1;
-  if (options.phases > 1) phase = task_phases(g, options.phases, used);
+  if (options.phases > 1) phase = task_phases(g, options.phases, used, options.loop_share);
   const LibraryWeights w = library_weights(pg, phase, used);
   std::vector<std::uint32_t> part;
   r.stats.edgecut = metis_kway(pg, w, k, options, part);

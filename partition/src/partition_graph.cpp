@@ -40,36 +40,59 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g) {
 }
 
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
-                                       std::uint32_t& used) {
+                                       std::uint32_t& used, double loop_share) {
   const std::vector<std::uint32_t> level = task_levels(g);
   used = 0;
   if (level.empty()) return {};
   nphases = std::max<std::uint32_t>(nphases, 1);
-  const std::uint32_t nlevels = *std::max_element(level.begin(), level.end()) + 1;
-  std::vector<std::uint64_t> work(nlevels, 0);
+  const std::size_t n = g.tasks.size();
+  std::vector<std::uint64_t> weight(n);
+  for (TaskId t = 0; t < n; ++t) weight[t] = std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
+  // Groups: 0 the tasks outside heavy loops, then one per heavy loop in loop order.
   std::uint64_t total = 0;
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    const std::uint64_t w = std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
-    work[level[t]] += w;
-    total += w;
+  std::vector<std::uint64_t> loop_work(g.loops.size(), 0);
+  for (TaskId t = 0; t < n; ++t) {
+    total += weight[t];
+    if (g.tasks[t].loop < g.loops.size()) loop_work[g.tasks[t].loop] += weight[t];
   }
-  // Level l goes to the phase holding the middle of its work in the cumulative order.
+  std::vector<std::uint32_t> loop_group(g.loops.size(), 0);
+  std::uint32_t groups = 1;
+  if (loop_share > 0.0)
+    for (LoopId l = 0; l < g.loops.size(); ++l)
+      if (static_cast<long double>(loop_work[l]) >= loop_share * static_cast<long double>(total))
+        loop_group[l] = groups++;
+  std::vector<std::uint32_t> group(n, 0);
+  for (TaskId t = 0; t < n; ++t)
+    if (g.tasks[t].loop < g.loops.size()) group[t] = loop_group[g.tasks[t].loop];
+  // Group 0: level l goes to the phase holding the middle of its work in the cumulative
+  // order. A heavy loop is one phase (nphases - 1 + its group): cutting it by levels too
+  // gives METIS more constraints than it balances on a small step (torso at K = 8: 6
+  // constraints, imbalance 4.1; docs/partitioning.md).
+  const std::uint32_t nlevels = *std::max_element(level.begin(), level.end()) + 1;
+  std::vector<std::uint64_t> work(nlevels, 0);  // group 0's, by level
+  std::vector<std::uint64_t> group_work(groups, 0);
+  for (TaskId t = 0; t < n; ++t) {
+    if (group[t] == 0) work[level[t]] += weight[t];
+    group_work[group[t]] += weight[t];
+  }
   std::vector<std::uint32_t> phase_of_level(nlevels, 0);
   std::uint64_t before = 0;
-  for (std::uint32_t l = 0; l < nlevels; ++l) {
+  for (std::uint32_t l = 0; l < nlevels && group_work[0] > 0; ++l) {
     const long double mid = static_cast<long double>(before) + static_cast<long double>(work[l]) / 2;
-    const auto p = static_cast<std::uint32_t>(mid * nphases / static_cast<long double>(total));
+    const auto p = static_cast<std::uint32_t>(mid * nphases / static_cast<long double>(group_work[0]));
     phase_of_level[l] = std::min(p, nphases - 1);
     before += work[l];
   }
-  std::vector<std::uint32_t> dense(nphases, 0);
-  std::vector<bool> seen(nphases, false);
-  for (std::uint32_t l = 0; l < nlevels; ++l)
-    if (work[l] > 0) seen[phase_of_level[l]] = true;
-  for (std::uint32_t p = 0; p < nphases; ++p)
+  std::vector<std::uint32_t> phase(n);
+  for (TaskId t = 0; t < n; ++t)
+    phase[t] = group[t] == 0 ? phase_of_level[level[t]] : nphases - 1 + group[t];
+  // Dense numbering of the non-empty phases, in phase order.
+  std::vector<bool> seen(nphases - 1 + groups, false);
+  for (const std::uint32_t p : phase) seen[p] = true;
+  std::vector<std::uint32_t> dense(seen.size(), 0);
+  for (std::uint32_t p = 0; p < seen.size(); ++p)
     if (seen[p]) dense[p] = used++;
-  std::vector<std::uint32_t> phase(g.tasks.size());
-  for (TaskId t = 0; t < g.tasks.size(); ++t) phase[t] = dense[phase_of_level[level[t]]];
+  for (std::uint32_t& p : phase) p = dense[p];
   return phase;
 }
 

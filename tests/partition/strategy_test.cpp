@@ -228,6 +228,50 @@ TEST(Metis, BalancesEachPhaseInMultiConstraintMode) {
   }
 }
 
+TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
+  // Outside loops: a chain of 8 tasks (24,000 ns). A loop run 10 times: 16 tasks of 100 ns
+  // on their own data, all reading one shared vector (16,000 ns), then its break. Balanced by
+  // levels only, the loop shares its level phase with the chain's head, and a part holding
+  // that head gets the smaller share of the loop: the loop's processors meet at every
+  // iteration, so the other waits for the larger share.
+  Builder b;
+  std::vector<DatumId> c;
+  for (int i = 0; i < 8; ++i) c.push_back(b.datum(testing::name("c", i), 4096));
+  for (int i = 0; i < 8; ++i) {
+    if (i == 0)
+      b.task({{c[0], M::W}}, 3000);
+    else
+      b.task({{c[static_cast<std::size_t>(i - 1)], M::R}, {c[static_cast<std::size_t>(i)], M::W}}, 3000);
+  }
+  const DatumId shared = b.datum("shared", 1 << 16);
+  const DatumId cond = b.datum("cond", 8);
+  b.task({{shared, M::W}}, 100);
+  const auto first = static_cast<TaskId>(b.g.tasks.size());
+  for (int i = 0; i < 16; ++i)
+    b.task({{shared, M::R}, {b.datum(testing::name("y", i), 64), M::RW}}, 100);
+  b.task({{cond, M::RW}}, 1);
+  b.loop(cond, first, static_cast<TaskId>(b.g.tasks.size()), 10);
+  const StepGraph g = b.done();
+
+  std::uint32_t used = 0;
+  const std::vector<std::uint32_t> phase = task_phases(g, 2, used, 0.1);
+  ASSERT_EQ(used, 3u);  // the rest in two level phases, the loop in its own
+  for (TaskId t = first; t < g.tasks.size(); ++t) EXPECT_EQ(phase[t], 2u) << t;
+  for (TaskId t = 0; t < first; ++t) EXPECT_LT(phase[t], 2u) << t;
+  std::uint32_t none = 0;
+  EXPECT_EQ(task_phases(g, 2, none, 0.0), task_phases(g, 2, used));  // 0: no loop phase
+  EXPECT_EQ(task_phases(g, 2, none, 0.9), task_phases(g, 2, used));  // 16/40.1 < 0.9
+
+  Options o;
+  o.phases = 2;
+  o.loop_share = 0.1;
+  const Result r = make_strategy("metis")->partition(g, 2, {}, o);
+  std::uint32_t on0 = 0;
+  for (TaskId t = first; t + 1 < g.tasks.size(); ++t) on0 += r.assignment.proc[t] == 0 ? 1 : 0;
+  EXPECT_GE(on0, 7u);
+  EXPECT_LE(on0, 9u);
+}
+
 // Strategy `name` on a random graph of `seed` gives, on 4 threads partitioning 10 times each,
 // the assignment of a serial call (the library keeps no unguarded global state).
 void expect_reproducible_from_threads(const char* name, std::uint64_t seed) {

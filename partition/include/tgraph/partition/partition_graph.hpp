@@ -37,10 +37,13 @@ LibraryWeights library_weights(const UndirectedGraph& u,
 /// Level of every task: longest path, in edges, from a source of the step's DAG (intra-step
 /// edges only, loops not unrolled).
 std::vector<std::uint32_t> task_levels(const StepGraph& g);
-/// Buckets consecutive levels into at most `nphases` phases of about equal work; returns
-/// the phase of every task and sets `used` to the number of non-empty phases.
+/// Buckets consecutive levels into at most `nphases` phases of about equal work; then each
+/// dynamic loop holding at least `loop_share` of the step's work (cost x iterations; 0: none,
+/// the default) becomes a phase of its own: a loop's processors meet at every iteration, so
+/// each processor must hold its share of that loop, not only of the whole step. Returns the
+/// phase of every task and sets `used` to the number of non-empty phases.
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
-                                       std::uint32_t& used);
+                                       std::uint32_t& used, double loop_share = 0.0);
 
 /// Scotch graph partitioning of `pg` (weights `w`, vertex constraints summed) into `k` parts
 /// with `options`' flavour, imbalance and seed: what the `scotch` strategy calls, serialised.

@@ -71,6 +71,10 @@ struct Options {
   /// when `phases` is 0 (a solver step's CG phases synchronise every object of a collision
   /// group: balanced as a whole they leave each phase unbalanced; docs/partitioning.md)
   std::uint32_t sticky_phases = 2;
+  /// With phases on (METIS multi-constraint): each dynamic loop holding at least this share
+  /// of the step's work (cost x iterations) is balanced on its own, as one more constraint
+  /// (task_phases; a loop's processors meet at every iteration). 0: off.
+  double loop_share = 0.1;
   ScotchFlavour scotch = ScotchFlavour::kQuality;
   std::string sticky_base = "metis";  ///< sticky: strategy for the first step
   double sticky_threshold = 1.20;   ///< sticky: rebalance above this x the baseline imbalance
