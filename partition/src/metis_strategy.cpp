@@ -104,9 +104,34 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
   std::vector<std::uint32_t> phase;
   std::uint32_t used = 1;
   if (options.phases > 1) phase = task_phases(g, options.phases, used, options.loop_share);
-  const LibraryWeights w = library_weights(pg, phase, used);
   std::vector<std::uint32_t> part;
-  r.stats.edgecut = metis_kway(pg, w, k, options, part);
+  r.stats.edgecut = metis_kway(pg, library_weights(pg, phase, used), k, options, part);
+  if (options.phases > 1 && options.loop_share > 0.0) {
+    // Heavy loops as constraints of their own can be more than METIS balances (torso at K = 8:
+    // four constraints, imbalance 1.67): the constraints with one phase for the other tasks,
+    // and the level phases alone, are partitioned too, and the partition whose phases run
+    // shortest one after the other (phase_makespan over the finest phases) is kept: up to
+    // three METIS calls, only on steps with a heavy loop.
+    std::uint32_t levels_used = 0;
+    const std::vector<std::uint32_t> levels = task_phases(g, options.phases, levels_used);
+    if (levels != phase) {
+      std::uint64_t best = phase_makespan(g, phase, used, part, k);
+      std::uint32_t rest_used = 0;
+      const std::vector<std::uint32_t> rest_one =
+          task_phases(g, options.phases, rest_used, options.loop_share, 1);
+      for (const auto* alt : {&rest_one, &levels}) {
+        const std::uint32_t n = alt == &levels ? levels_used : rest_used;
+        std::vector<std::uint32_t> p;
+        const std::int64_t cut = metis_kway(pg, library_weights(pg, *alt, n), k, options, p);
+        const std::uint64_t m = phase_makespan(g, phase, used, p, k);
+        if (m < best) {
+          best = m;
+          part = std::move(p);
+          r.stats.edgecut = cut;
+        }
+      }
+    }
+  }
   r.assignment.proc.assign(part.begin(), part.end());
   return r;
 }

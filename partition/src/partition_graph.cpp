@@ -2,6 +2,8 @@
 #include "tgraph/partition/partition_graph.hpp"
 
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 
 namespace tgraph::partition {
 
@@ -40,7 +42,8 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g) {
 }
 
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
-                                       std::uint32_t& used, double loop_share) {
+                                       std::uint32_t& used, double loop_share,
+                                       std::uint32_t rest_phases) {
   const std::vector<std::uint32_t> level = task_levels(g);
   used = 0;
   if (level.empty()) return {};
@@ -61,6 +64,7 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
     for (LoopId l = 0; l < g.loops.size(); ++l)
       if (static_cast<long double>(loop_work[l]) >= loop_share * static_cast<long double>(total))
         loop_group[l] = groups++;
+  if (groups > 1 && rest_phases > 0) nphases = rest_phases;
   std::vector<std::uint32_t> group(n, 0);
   for (TaskId t = 0; t < n; ++t)
     if (g.tasks[t].loop < g.loops.size()) group[t] = loop_group[g.tasks[t].loop];
@@ -94,6 +98,25 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
     if (seen[p]) dense[p] = used++;
   for (std::uint32_t& p : phase) p = dense[p];
   return phase;
+}
+
+std::uint64_t phase_makespan(const StepGraph& g, const std::vector<std::uint32_t>& phase,
+                             std::uint32_t nphases, const std::vector<std::uint32_t>& part,
+                             std::uint32_t k) {
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(nphases) * k, 0);
+  if (phase.size() != g.tasks.size() || part.size() != g.tasks.size())
+    throw std::invalid_argument("phase_makespan: one phase and one part per task");
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    if (phase[t] >= nphases || part[t] >= k)
+      throw std::invalid_argument("phase_makespan: task " + std::to_string(t) + " out of range");
+    load[static_cast<std::size_t>(phase[t]) * k + part[t]] +=
+        std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
+  }
+  std::uint64_t sum = 0;
+  for (std::uint32_t c = 0; c < nphases; ++c)
+    sum += *std::max_element(load.begin() + static_cast<std::ptrdiff_t>(c) * k,
+                             load.begin() + static_cast<std::ptrdiff_t>(c + 1) * k);
+  return sum;
 }
 
 std::int64_t edgecut(const UndirectedGraph& u, const std::vector<std::uint32_t>& part) {

@@ -258,9 +258,9 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   ASSERT_EQ(used, 3u);  // the rest in two level phases, the loop in its own
   for (TaskId t = first; t < g.tasks.size(); ++t) EXPECT_EQ(phase[t], 2u) << t;
   for (TaskId t = 0; t < first; ++t) EXPECT_LT(phase[t], 2u) << t;
-  std::uint32_t none = 0;
-  EXPECT_EQ(task_phases(g, 2, none, 0.0), task_phases(g, 2, used));  // 0: no loop phase
-  EXPECT_EQ(task_phases(g, 2, none, 0.9), task_phases(g, 2, used));  // 16/40.1 < 0.9
+  std::uint32_t none = 0, levels = 0;
+  EXPECT_EQ(task_phases(g, 2, none, 0.0), task_phases(g, 2, levels));  // 0: no loop phase
+  EXPECT_EQ(task_phases(g, 2, none, 0.9), task_phases(g, 2, levels));  // 16/40.1 < 0.9
 
   Options o;
   o.phases = 2;
@@ -270,6 +270,16 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   for (TaskId t = first; t + 1 < g.tasks.size(); ++t) on0 += r.assignment.proc[t] == 0 ? 1 : 0;
   EXPECT_GE(on0, 7u);
   EXPECT_LE(on0, 9u);
+
+  // Phases one after the other, each as long as its most loaded processor: everything on
+  // processor 0 takes the whole work (8 x 3000 + 100 + 10 x (16 x 100 + 1)); the loop
+  // alone moved to processor 1 overlaps nothing, since it is a phase of its own.
+  std::vector<std::uint32_t> part(g.tasks.size(), 0);
+  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 16010u);
+  for (TaskId t = first; t < g.tasks.size(); ++t) part[t] = 1;
+  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 16010u);
+  for (TaskId t = first; t < g.tasks.size(); t += 2) part[t] = 0;  // 8 + the break on 1
+  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 8010u);
 }
 
 // Strategy `name` on a random graph of `seed` gives, on 4 threads partitioning 10 times each,

@@ -40,10 +40,17 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g);
 /// Buckets consecutive levels into at most `nphases` phases of about equal work; then each
 /// dynamic loop holding at least `loop_share` of the step's work (cost x iterations; 0: none,
 /// the default) becomes a phase of its own: a loop's processors meet at every iteration, so
-/// each processor must hold its share of that loop, not only of the whole step. Returns the
-/// phase of every task and sets `used` to the number of non-empty phases.
+/// each processor must hold its share of that loop, not only of the whole step; with heavy
+/// loops, `rest_phases` (0: nphases) phases for the other tasks. Returns the phase of every
+/// task and sets `used` to the number of non-empty phases.
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
-                                       std::uint32_t& used, double loop_share = 0.0);
+                                       std::uint32_t& used, double loop_share = 0.0,
+                                       std::uint32_t rest_phases = 0);
+/// The makespan of a step whose phases run one after the other, each as long as its most
+/// loaded processor: the sum over phases of the largest load (cost x runs) of `part`.
+std::uint64_t phase_makespan(const StepGraph& g, const std::vector<std::uint32_t>& phase,
+                             std::uint32_t nphases, const std::vector<std::uint32_t>& part,
+                             std::uint32_t k);
 
 /// Scotch graph partitioning of `pg` (weights `w`, vertex constraints summed) into `k` parts
 /// with `options`' flavour, imbalance and seed: what the `scotch` strategy calls, serialised.
