@@ -9,6 +9,7 @@
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
+#include <utility>
 
 #include "strategies.hpp"
 
@@ -119,8 +120,10 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
       std::uint32_t rest_used = 0;
       const std::vector<std::uint32_t> rest_one =
           task_phases(g, options.phases, rest_used, options.loop_share, 1);
-      for (const auto* alt : {&rest_one, &levels}) {
-        const std::uint32_t n = alt == &levels ? levels_used : rest_used;
+      const std::pair<const std::vector<std::uint32_t>*, std::uint32_t> alternatives[] = {
+          {&rest_one, rest_used}, {&levels, levels_used}};
+      for (const auto& [alt, n] : alternatives) {
+        if (*alt == phase) continue;
         std::vector<std::uint32_t> p;
         const std::int64_t cut = metis_kway(pg, library_weights(pg, *alt, n), k, options, p);
         const std::uint64_t m = phase_makespan(g, phase, used, p, k);

@@ -41,6 +41,13 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g) {
   return level;
 }
 
+namespace {
+// A task's work in a step: its cost times its executions (at least 1).
+std::uint64_t task_work(const StepGraph& g, TaskId t) {
+  return std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
+}
+}  // namespace
+
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
                                        std::uint32_t& used, double loop_share,
                                        std::uint32_t rest_phases) {
@@ -50,7 +57,7 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
   nphases = std::max<std::uint32_t>(nphases, 1);
   const std::size_t n = g.tasks.size();
   std::vector<std::uint64_t> weight(n);
-  for (TaskId t = 0; t < n; ++t) weight[t] = std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
+  for (TaskId t = 0; t < n; ++t) weight[t] = task_work(g, t);
   // Groups: 0 the tasks outside heavy loops, then one per heavy loop in loop order.
   std::uint64_t total = 0;
   std::vector<std::uint64_t> loop_work(g.loops.size(), 0);
@@ -103,14 +110,13 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
 std::uint64_t phase_makespan(const StepGraph& g, const std::vector<std::uint32_t>& phase,
                              std::uint32_t nphases, const std::vector<std::uint32_t>& part,
                              std::uint32_t k) {
+  if (phase.size() != g.tasks.size() || part.size() != g.tasks.size() || k == 0)
+    throw std::invalid_argument("phase_makespan: one phase and one part per task, k >= 1");
   std::vector<std::uint64_t> load(static_cast<std::size_t>(nphases) * k, 0);
-  if (phase.size() != g.tasks.size() || part.size() != g.tasks.size())
-    throw std::invalid_argument("phase_makespan: one phase and one part per task");
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     if (phase[t] >= nphases || part[t] >= k)
       throw std::invalid_argument("phase_makespan: task " + std::to_string(t) + " out of range");
-    load[static_cast<std::size_t>(phase[t]) * k + part[t]] +=
-        std::max<std::uint64_t>(1, g.tasks[t].cost_ns * g.runs(t));
+    load[static_cast<std::size_t>(phase[t]) * k + part[t]] += task_work(g, t);
   }
   std::uint64_t sum = 0;
   for (std::uint32_t c = 0; c < nphases; ++c)
