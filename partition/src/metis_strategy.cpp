@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "strategies.hpp"
+#include "tgraph/partition/simulator.hpp"
 
 static_assert(sizeof(idx_t) == 4, "tgraph expects METIS built with 32-bit idx_t");
 static_assert(sizeof(real_t) == sizeof(float), "tgraph expects METIS built with float real_t");
@@ -109,14 +110,21 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
   r.stats.edgecut = metis_kway(pg, library_weights(pg, phase, used), k, options, part);
   if (options.phases > 1 && options.loop_share > 0.0) {
     // Heavy loops as constraints of their own can be more than METIS balances (torso at K = 8:
-    // four constraints, imbalance 1.67): the constraints with one phase for the other tasks,
-    // and the level phases alone, are partitioned too, and the partition whose phases run
-    // shortest one after the other (phase_makespan over the finest phases) is kept: up to
-    // three METIS calls, only on steps with a heavy loop.
+    // four constraints, imbalance 1.67), and a loop spread over every part pays a hand-off per
+    // iteration between all of them: the constraints with one phase for the other tasks, and
+    // the level phases alone (the constraints without loops), are partitioned too, and the
+    // partition with the shortest simulated step (options.model) is kept: up to three METIS
+    // calls and simulations, only on steps with a heavy loop.
     std::uint32_t levels_used = 0;
     const std::vector<std::uint32_t> levels = task_phases(g, options.phases, levels_used);
     if (levels != phase) {
-      std::uint64_t best = phase_makespan(g, phase, used, part, k);
+      const auto predicted = [&](const std::vector<std::uint32_t>& p) {
+        Assignment a;
+        a.k = k;
+        a.proc.assign(p.begin(), p.end());
+        return simulate(g, a, options.model).makespan_ns;
+      };
+      std::uint64_t best = predicted(part);
       std::uint32_t rest_used = 0;
       const std::vector<std::uint32_t> rest_one =
           task_phases(g, options.phases, rest_used, options.loop_share, 1);
@@ -126,7 +134,7 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
         if (*alt == phase) continue;
         std::vector<std::uint32_t> p;
         const std::int64_t cut = metis_kway(pg, library_weights(pg, *alt, n), k, options, p);
-        const std::uint64_t m = phase_makespan(g, phase, used, p, k);
+        const std::uint64_t m = predicted(p);
         if (m < best) {
           best = m;
           part = std::move(p);

@@ -2,8 +2,6 @@
 #include "tgraph/partition/partition_graph.hpp"
 
 #include <algorithm>
-#include <stdexcept>
-#include <string>
 
 namespace tgraph::partition {
 
@@ -105,24 +103,6 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
     if (seen[p]) dense[p] = used++;
   for (std::uint32_t& p : phase) p = dense[p];
   return phase;
-}
-
-std::uint64_t phase_makespan(const StepGraph& g, const std::vector<std::uint32_t>& phase,
-                             std::uint32_t nphases, const std::vector<std::uint32_t>& part,
-                             std::uint32_t k) {
-  if (phase.size() != g.tasks.size() || part.size() != g.tasks.size() || k == 0)
-    throw std::invalid_argument("phase_makespan: one phase and one part per task, k >= 1");
-  std::vector<std::uint64_t> load(static_cast<std::size_t>(nphases) * k, 0);
-  for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    if (phase[t] >= nphases || part[t] >= k)
-      throw std::invalid_argument("phase_makespan: task " + std::to_string(t) + " out of range");
-    load[static_cast<std::size_t>(phase[t]) * k + part[t]] += task_work(g, t);
-  }
-  std::uint64_t sum = 0;
-  for (std::uint32_t c = 0; c < nphases; ++c)
-    sum += *std::max_element(load.begin() + static_cast<std::ptrdiff_t>(c) * k,
-                             load.begin() + static_cast<std::ptrdiff_t>(c + 1) * k);
-  return sum;
 }
 
 std::int64_t edgecut(const UndirectedGraph& u, const std::vector<std::uint32_t>& part) {

@@ -229,8 +229,8 @@ TEST(Metis, BalancesEachPhaseInMultiConstraintMode) {
 }
 
 TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
-  // Outside loops: a chain of 8 tasks (24,000 ns). A loop run 10 times: 16 tasks of 100 ns
-  // on their own data, all reading one shared vector (16,000 ns), then its break. Balanced by
+  // Outside loops: a chain of 8 tasks (480 us). A loop run 10 times: 16 tasks of 2 us on
+  // their own data, all reading one shared vector (320 us), then its break. Balanced by
   // levels only, the loop shares its level phase with the chain's head, and a part holding
   // that head gets the smaller share of the loop: the loop's processors meet at every
   // iteration, so the other waits for the larger share.
@@ -239,16 +239,16 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   for (int i = 0; i < 8; ++i) c.push_back(b.datum(testing::name("c", i), 4096));
   for (int i = 0; i < 8; ++i) {
     if (i == 0)
-      b.task({{c[0], M::W}}, 3000);
+      b.task({{c[0], M::W}}, 60000);
     else
-      b.task({{c[static_cast<std::size_t>(i - 1)], M::R}, {c[static_cast<std::size_t>(i)], M::W}}, 3000);
+      b.task({{c[static_cast<std::size_t>(i - 1)], M::R}, {c[static_cast<std::size_t>(i)], M::W}}, 60000);
   }
   const DatumId shared = b.datum("shared", 1 << 16);
   const DatumId cond = b.datum("cond", 8);
   b.task({{shared, M::W}}, 100);
   const auto first = static_cast<TaskId>(b.g.tasks.size());
   for (int i = 0; i < 16; ++i)
-    b.task({{shared, M::R}, {b.datum(testing::name("y", i), 64), M::RW}}, 100);
+    b.task({{shared, M::R}, {b.datum(testing::name("y", i), 64), M::RW}}, 2000);
   b.task({{cond, M::RW}}, 1);
   b.loop(cond, first, static_cast<TaskId>(b.g.tasks.size()), 10);
   const StepGraph g = b.done();
@@ -260,7 +260,7 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   for (TaskId t = 0; t < first; ++t) EXPECT_LT(phase[t], 2u) << t;
   std::uint32_t none = 0, levels = 0;
   EXPECT_EQ(task_phases(g, 2, none, 0.0), task_phases(g, 2, levels));  // 0: no loop phase
-  EXPECT_EQ(task_phases(g, 2, none, 0.9), task_phases(g, 2, levels));  // 16/40.1 < 0.9
+  EXPECT_EQ(task_phases(g, 2, none, 0.9), task_phases(g, 2, levels));  // 320/800 < 0.9
 
   Options o;
   o.phases = 2;
@@ -271,15 +271,13 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   EXPECT_GE(on0, 7u);
   EXPECT_LE(on0, 9u);
 
-  // Phases one after the other, each as long as its most loaded processor: everything on
-  // processor 0 takes the whole work (8 x 3000 + 100 + 10 x (16 x 100 + 1)); the loop
-  // alone moved to processor 1 overlaps nothing, since it is a phase of its own.
-  std::vector<std::uint32_t> part(g.tasks.size(), 0);
-  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 16010u);
-  for (TaskId t = first; t < g.tasks.size(); ++t) part[t] = 1;
-  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 16010u);
-  for (TaskId t = first; t < g.tasks.size(); t += 2) part[t] = 0;  // 8 + the break on 1
-  EXPECT_EQ(phase_makespan(g, phase, used, part, 2), 24000u + 100u + 8010u);
+  // Kept only when no other constraint set simulates shorter: not worse than the level
+  // phases alone.
+  Options no_loops = o;
+  no_loops.loop_share = 0.0;
+  const Result plain = make_strategy("metis")->partition(g, 2, {}, no_loops);
+  EXPECT_LE(simulate(g, r.assignment, o.model).makespan_ns,
+            simulate(g, plain.assignment, o.model).makespan_ns);
 }
 
 // Strategy `name` on a random graph of `seed` gives, on 4 threads partitioning 10 times each,

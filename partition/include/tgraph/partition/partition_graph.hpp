@@ -46,11 +46,6 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g);
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
                                        std::uint32_t& used, double loop_share = 0.0,
                                        std::uint32_t rest_phases = 0);
-/// The makespan of a step whose phases run one after the other, each as long as its most
-/// loaded processor: the sum over phases of the largest load (cost x runs) of `part`.
-std::uint64_t phase_makespan(const StepGraph& g, const std::vector<std::uint32_t>& phase,
-                             std::uint32_t nphases, const std::vector<std::uint32_t>& part,
-                             std::uint32_t k);
 
 /// Scotch graph partitioning of `pg` (weights `w`, vertex constraints summed) into `k` parts
 /// with `options`' flavour, imbalance and seed: what the `scotch` strategy calls, serialised.
