@@ -29,6 +29,10 @@ namespace {
 using namespace tgraph::measure;
 
 // Threads of this process (/proc/self/status).
+// Threads of this process now. Tests compare it with the count before the executor was made
+// with EXPECT_LE: a thread of an earlier test (a library's helper) may still be ending when
+// the first count is taken (seen once under TSan: 5 before, 4 after), while a worker that
+// was not joined keeps the count above it.
 int process_threads() {
   std::ifstream f("/proc/self/status");
   std::string line;
@@ -157,7 +161,7 @@ TEST(ThrowingTask, AFailedFirstTouchEndsThePartitionStepAndJoinsItsThreads) {
       }
       EXPECT_EQ(w.ran.load(), 0u);  // no task ran on unallocated data
     }
-    EXPECT_EQ(process_threads(), before) << "k=" << k;  // every worker joined
+    EXPECT_LE(process_threads(), before) << "k=" << k;  // every worker joined
   }
 }
 
@@ -216,7 +220,9 @@ TEST(ThrowingTask, EndsALiveRunWithItsMessageForEveryPolicy) {
     }
     // The partition executor's threads are the run's own (TBB, OpenMP and StarPU keep
     // their pools): they are all joined when the run ends.
-    if (c.policy == Policy::kPartition) EXPECT_EQ(process_threads(), before) << name_of(c);
+    if (c.policy == Policy::kPartition) {
+      EXPECT_LE(process_threads(), before) << name_of(c);
+    }
   }
 }
 
@@ -267,7 +273,7 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
         EXPECT_NE(msg.find("(datum '"), std::string::npos) << msg;
       }
     }
-    EXPECT_EQ(process_threads(), before) << "k=" << k;  // workers and watchdog joined
+    EXPECT_LE(process_threads(), before) << "k=" << k;  // workers and watchdog joined
     // Without the lost signal the same step runs to its end under the same watchdog.
     auto ex = make_executor(Policy::kPartition, o);
     FaultyWorkload ok;
