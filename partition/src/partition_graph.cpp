@@ -79,16 +79,17 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases
   // constraints, imbalance 4.1; docs/partitioning.md).
   const std::uint32_t nlevels = *std::max_element(level.begin(), level.end()) + 1;
   std::vector<std::uint64_t> work(nlevels, 0);  // group 0's, by level
-  std::vector<std::uint64_t> group_work(groups, 0);
-  for (TaskId t = 0; t < n; ++t) {
-    if (group[t] == 0) work[level[t]] += weight[t];
-    group_work[group[t]] += weight[t];
-  }
+  std::uint64_t rest = 0;                        // group 0's in all
+  for (TaskId t = 0; t < n; ++t)
+    if (group[t] == 0) {
+      work[level[t]] += weight[t];
+      rest += weight[t];
+    }
   std::vector<std::uint32_t> phase_of_level(nlevels, 0);
   std::uint64_t before = 0;
-  for (std::uint32_t l = 0; l < nlevels && group_work[0] > 0; ++l) {
+  for (std::uint32_t l = 0; l < nlevels && rest > 0; ++l) {
     const long double mid = static_cast<long double>(before) + static_cast<long double>(work[l]) / 2;
-    const auto p = static_cast<std::uint32_t>(mid * nphases / static_cast<long double>(group_work[0]));
+    const auto p = static_cast<std::uint32_t>(mid * nphases / static_cast<long double>(rest));
     phase_of_level[l] = std::min(p, nphases - 1);
     before += work[l];
   }
