@@ -48,6 +48,50 @@ struct VersionOnProcHash {
   }
 };
 
+/// The set of VersionOnProc keys a simulation has seen: open addressing with linear probing
+/// in one array (no allocation per key; std::unordered_set spent most of a sticky partition
+/// of falling64 in node allocation and rehashing).
+class VersionSet {
+ public:
+  /// Inserts `k`; true when it was not there yet.
+  bool insert(const VersionOnProc& k) {
+    if ((size_ + 1) * 4 > slots_.size() * 3) grow();
+    const std::size_t mask = slots_.size() - 1;
+    for (std::size_t i = mix(k) & mask;; i = (i + 1) & mask) {
+      VersionOnProc& s = slots_[i];
+      if (s.instance == kNoInstance) {
+        s = k;
+        ++size_;
+        return true;
+      }
+      if (s == k) return false;
+    }
+  }
+  void clear() {
+    slots_.assign(slots_.size(), kEmpty);
+    size_ = 0;
+  }
+  std::size_t size() const { return size_; }
+
+ private:
+  static constexpr VersionOnProc kEmpty{kNoInstance, 0, 0};
+  static std::size_t mix(const VersionOnProc& k) {
+    std::uint64_t h = VersionOnProcHash{}(k);
+    h ^= h >> 29;  // the low bits index the table
+    h *= 0xBF58476D1CE4E5B9ull;
+    return static_cast<std::size_t>(h ^ (h >> 32));
+  }
+  void grow() {
+    std::vector<VersionOnProc> old(slots_.empty() ? 64 : slots_.size() * 2, kEmpty);
+    old.swap(slots_);
+    size_ = 0;
+    for (const VersionOnProc& k : old)
+      if (k.instance != kNoInstance) insert(k);
+  }
+  std::vector<VersionOnProc> slots_;
+  std::size_t size_ = 0;
+};
+
 /// Per task, the first of its instances (iteration i of task t is `first[t] + i`), plus the
 /// total number of instances at the end.
 std::vector<std::uint64_t> first_instances(const StepGraph& g);

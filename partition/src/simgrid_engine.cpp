@@ -262,7 +262,7 @@ class Driver {
       if (from == p || hosts_[from] != hosts_[p]) continue;
       const std::uint64_t src = dependency_source(*g_, first_, d, t, i);
       if (src == kNoInstance) continue;
-      if (received_.insert({src, d.datum, p}).second && d.raw) bytes += g_->data[d.datum].bytes;
+      if (received_.insert({src, d.datum, p}) && d.raw) bytes += g_->data[d.datum].bytes;
     }
     current_.bytes += bytes;
     return static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * read_ns_per_byte_[p]));
@@ -417,7 +417,7 @@ class Driver {
   std::vector<std::vector<Out>> outs_;
   std::vector<std::uint8_t> done_;
   std::unordered_set<std::uint64_t> arrived_;
-  std::unordered_set<VersionOnProc, VersionOnProcHash> received_;  // the reader paid
+  VersionSet received_;  // the reader paid
   std::unordered_map<std::uint64_t, std::vector<ProcId>> waiters_;
   std::vector<State> state_;
   std::vector<std::uint64_t> pending_;  // received messages' time, before p's next instance

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_set>
 
 #include "tgraph/graph/error.hpp"
 #include "schedule_program.hpp"
@@ -17,8 +16,6 @@ using detail::Dep;
 using detail::Item;
 constexpr std::uint64_t kUnknown = detail::kNoInstance;
 
-using SyncKey = detail::VersionOnProc;
-using SyncKeyHash = detail::VersionOnProcHash;
 
 void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
@@ -77,10 +74,10 @@ class Simulator {
   // Records that processor p receives (instance, datum) from processor `from`; returns
   // true the first time (a wait, and a signal if nobody received it before).
   bool receive(std::uint64_t instance, DatumId datum, ProcId from, ProcId p) {
-    if (!waits_.insert({instance, datum, p}).second) return false;
+    if (!waits_.insert({instance, datum, p})) return false;
     ++s_.waits;
     ++s_.waits_between[static_cast<std::size_t>(from) * k_ + p];
-    if (signals_.insert({instance, datum, 0}).second) ++s_.signals;
+    if (signals_.insert({instance, datum, 0})) ++s_.signals;
     return true;
   }
 
@@ -167,7 +164,7 @@ class Simulator {
   std::vector<std::vector<Dep>> deps_;
   std::vector<std::vector<Item>> items_;
   std::vector<State> state_;
-  std::unordered_set<SyncKey, SyncKeyHash> waits_, signals_;
+  detail::VersionSet waits_, signals_;
 };
 
 }  // namespace
