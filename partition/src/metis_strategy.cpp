@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "strategies.hpp"
+#include "tgraph/graph/metrics.hpp"
 #include "tgraph/partition/simulator.hpp"
 
 static_assert(sizeof(idx_t) == 4, "tgraph expects METIS built with 32-bit idx_t");
@@ -97,6 +98,10 @@ std::int64_t metis_kway(const UndirectedGraph& pg, const LibraryWeights& w, std:
 
 namespace {
 
+// How far above the step's lower bound the first heavy-loop candidate may be predicted and
+// still be kept without partitioning the other two (metis_partition).
+constexpr double kCandidateSlack = 0.05;
+
 // METIS k-way on the task graph; optional multi-constraint mode balancing each phase.
 Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& options) {
   if (auto trivial = library_trivial_case(g, k)) return *trivial;
@@ -114,7 +119,11 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
     // iteration between all of them: the constraints with one phase for the other tasks, and
     // the level phases alone (the constraints without loops), are partitioned too, and the
     // partition with the shortest simulated step (options.model) is kept: up to three METIS
-    // calls and simulations, only on steps with a heavy loop.
+    // calls and simulations, only on steps with a heavy loop, and the other two only when
+    // the first is predicted more than kCandidateSlack above the step's lower bound (no
+    // partition beats max(work / K, span) after the host work): a live run partitions on its
+    // critical path, and falling64's pile spent 15-44 ms per fallback step on candidates
+    // that could not gain more than that.
     std::uint32_t levels_used = 0;
     const std::vector<std::uint32_t> levels = task_phases(g, options.phases, levels_used);
     if (levels != phase) {
@@ -125,6 +134,13 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
         return simulate(g, a, options.model).makespan_ns;
       };
       std::uint64_t best = predicted(part);
+      const Metrics m = compute_metrics(g);
+      const double bound = static_cast<double>(g.host_ns) +
+                           std::max(static_cast<double>(m.work_ns) / k, static_cast<double>(m.span_ns));
+      if (static_cast<double>(best) <= bound * (1.0 + kCandidateSlack)) {
+        r.assignment.proc.assign(part.begin(), part.end());
+        return r;
+      }
       std::uint32_t rest_used = 0;
       const std::vector<std::uint32_t> rest_one =
           task_phases(g, options.phases, rest_used, options.loop_share, 1);
