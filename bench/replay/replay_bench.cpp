@@ -165,9 +165,13 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   const ExecStepStats first = ex->run_step(g, &a, w);
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : first.threads) instances += c.tasks;
-  std::uint64_t signals = 0, blocked = 0, parks = 0;
+  std::uint64_t signals = 0, blocked = 0, parks = 0, waits = 0;
+  std::int64_t wait_ns = 0, prepare = 0;
   for (auto _ : state) {
     const ExecStepStats s = ex->run_step(g, &a, w);
+    for (const ThreadCounters& c : s.threads) waits += c.waits;
+    wait_ns += s.wait_ns();
+    prepare += s.prepare_ns;
     signals += s.signals();
     blocked += s.blocked_waits();
     parks += s.parks();
@@ -176,6 +180,9 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   state.counters["signals_per_step"] = static_cast<double>(signals) / steps;
   state.counters["blocked_per_step"] = static_cast<double>(blocked) / steps;
   state.counters["parks_per_step"] = static_cast<double>(parks) / steps;
+  state.counters["waits_per_step"] = static_cast<double>(waits) / steps;
+  state.counters["wait_us_per_step"] = static_cast<double>(wait_ns) / steps / 1e3;
+  state.counters["prepare_us_per_step"] = static_cast<double>(prepare) / steps / 1e3;
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * instances));
   state.counters["ns_per_task"] =
       benchmark::Counter(static_cast<double>(state.iterations() * instances),
