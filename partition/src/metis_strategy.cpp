@@ -108,9 +108,12 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
   Result r;
   r.assignment.k = k;
   const UndirectedGraph pg = library_graph(g);
-  std::vector<std::uint32_t> phase;
+  std::vector<std::uint32_t> phase, level;
   std::uint32_t used = 1;
-  if (options.phases > 1) phase = task_phases(g, options.phases, used, options.loop_share);
+  if (options.phases > 1) {
+    level = task_levels(g);
+    phase = task_phases(g, level, options.phases, used, options.loop_share);
+  }
   std::vector<std::uint32_t> part;
   r.stats.edgecut = metis_kway(pg, library_weights(pg, phase, used), k, options, part);
   if (options.phases > 1 && options.loop_share > 0.0) {
@@ -125,8 +128,9 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
     // critical path, and falling64's pile spent 15-44 ms per fallback step on candidates
     // that could not gain more than that.
     std::uint32_t levels_used = 0;
-    const std::vector<std::uint32_t> levels = task_phases(g, options.phases, levels_used);
-    if (levels != phase) {
+    const std::vector<std::uint32_t> level_phases =
+        task_phases(g, level, options.phases, levels_used);
+    if (level_phases != phase) {
       const auto predicted = [&](const std::vector<std::uint32_t>& p) {
         Assignment a;
         a.k = k;
@@ -134,18 +138,19 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
         return simulate(g, a, options.model).makespan_ns;
       };
       std::uint64_t best = predicted(part);
-      const Metrics m = compute_metrics(g);
-      const double bound = static_cast<double>(g.host_ns) +
-                           std::max(static_cast<double>(m.work_ns) / k, static_cast<double>(m.span_ns));
+      const Metrics metrics = compute_metrics(g);
+      const double bound =
+          static_cast<double>(g.host_ns) + std::max(static_cast<double>(metrics.work_ns) / k,
+                                                    static_cast<double>(metrics.span_ns));
       if (static_cast<double>(best) <= bound * (1.0 + kCandidateSlack)) {
         r.assignment.proc.assign(part.begin(), part.end());
         return r;
       }
       std::uint32_t rest_used = 0;
       const std::vector<std::uint32_t> rest_one =
-          task_phases(g, options.phases, rest_used, options.loop_share, 1);
+          task_phases(g, level, options.phases, rest_used, options.loop_share, 1);
       const std::pair<const std::vector<std::uint32_t>*, std::uint32_t> alternatives[] = {
-          {&rest_one, rest_used}, {&levels, levels_used}};
+          {&rest_one, rest_used}, {&level_phases, levels_used}};
       for (const auto& [alt, n] : alternatives) {
         if (*alt == phase) continue;
         std::vector<std::uint32_t> p;

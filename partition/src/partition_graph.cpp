@@ -49,7 +49,12 @@ std::uint64_t task_work(const StepGraph& g, TaskId t) {
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
                                        std::uint32_t& used, double loop_share,
                                        std::uint32_t rest_phases) {
-  const std::vector<std::uint32_t> level = task_levels(g);
+  return task_phases(g, task_levels(g), nphases, used, loop_share, rest_phases);
+}
+
+std::vector<std::uint32_t> task_phases(const StepGraph& g, const std::vector<std::uint32_t>& level,
+                                       std::uint32_t nphases, std::uint32_t& used,
+                                       double loop_share, std::uint32_t rest_phases) {
   used = 0;
   if (level.empty()) return {};
   nphases = std::max<std::uint32_t>(nphases, 1);

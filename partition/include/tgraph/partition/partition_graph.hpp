@@ -46,6 +46,11 @@ std::vector<std::uint32_t> task_levels(const StepGraph& g);
 std::vector<std::uint32_t> task_phases(const StepGraph& g, std::uint32_t nphases,
                                        std::uint32_t& used, double loop_share = 0.0,
                                        std::uint32_t rest_phases = 0);
+/// The same from the step's task_levels(g), computed once by a caller that needs several
+/// phase sets of one step.
+std::vector<std::uint32_t> task_phases(const StepGraph& g, const std::vector<std::uint32_t>& level,
+                                       std::uint32_t nphases, std::uint32_t& used,
+                                       double loop_share = 0.0, std::uint32_t rest_phases = 0);
 
 /// Scotch graph partitioning of `pg` (weights `w`, vertex constraints summed) into `k` parts
 /// with `options`' flavour, imbalance and seed: what the `scotch` strategy calls, serialised.
