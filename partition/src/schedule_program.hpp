@@ -53,7 +53,8 @@ struct VersionOnProcHash {
 /// of falling64 in node allocation and rehashing).
 class VersionSet {
  public:
-  /// Inserts `k`; true when it was not there yet.
+  /// Inserts `k` (its instance is never kNoInstance, the empty slot's mark); true when it
+  /// was not there yet.
   bool insert(const VersionOnProc& k) {
     if ((size_ + 1) * 4 > slots_.size() * 3) grow();
     const std::size_t mask = slots_.size() - 1;
