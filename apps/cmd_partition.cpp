@@ -13,9 +13,11 @@
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
-namespace {
 
 namespace tp = tgraph::partition;
+
+namespace {
+
 using Named = std::shared_ptr<tp::NamedOptions>;
 
 void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
@@ -24,6 +26,8 @@ void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--calibration", n.calibration,
                   "Calibration file (default: " + tp::default_calibration_path() + " if present)");
 }
+
+}  // namespace
 
 void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   tp::Options& o = n.values;
@@ -57,6 +61,8 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
       ->check(CLI::IsMember({"program", "list"}));
   add_model_flags(cmd, n);
 }
+
+namespace {
 
 // A verb with its own Args and --json.
 CLI::App* verb(CLI::App& app, const char* name, const char* what, std::shared_ptr<Args>& a) {

@@ -88,12 +88,12 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
 }
 
 // The live loop tests/measure/live_test.cpp exercises: measure::run_live on the samples engine.
-void run(const Args& a, meas::LiveOptions& o) {
+void run(const Args& a, meas::LiveOptions& o, const tp::NamedOptions& strategy) {
   if (a.steps && *a.steps < 1) throw UsageError("--steps must be at least 1");
   if (o.repeat == 0) throw UsageError("--repeat must be at least 1");
   const meas::MethodChoice m = method_flags(a.method, a.policy);
   std::optional<tp::StepPartitioner> part;
-  if (m.policy == tr::Policy::kPartition) part = tp::step_partitioner(m.method);
+  if (m.policy == tr::Policy::kPartition) part = tp::step_partitioner(m.method, strategy.options());
   samples::SceneOptions scene_options;
   scene_options.split = a.split;
   const int scene_steps = samples::make_scene(a.input, scene_options)->default_steps();  // InputError if unknown
@@ -146,6 +146,7 @@ void add_replay_verbs(CLI::App& app) {
 
   a = std::make_shared<Args>();
   auto live = std::make_shared<meas::LiveOptions>();
+  auto strategy = std::make_shared<tp::NamedOptions>();
   a->method = "owner";
   cmd = app.add_subcommand("run", "Run a scene live through the executor (engine bodies)");
   cmd->add_option("--scene", a->input, "Built-in scene or scene file")->required();
@@ -175,7 +176,8 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_flag("--check", live->check,
                 "Compare the final state with a sequential run of the same reduction order, bit "
                 "for bit");
-  cmd->callback([a, live] { run(*a, *live); });
+  add_strategy_flags(cmd, *strategy);
+  cmd->callback([a, live, strategy] { run(*a, *live, *strategy); });
 }
 
 }  // namespace tgraph::app

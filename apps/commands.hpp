@@ -20,6 +20,10 @@
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/samples/capture_run.hpp"
 
+namespace tgraph::partition {
+struct NamedOptions;
+}  // namespace tgraph::partition
+
 namespace tgraph::app {
 
 /// The work itself failed (exit 1), as opposed to bad input (tgraph::Error, exit 2).
@@ -62,6 +66,8 @@ void add_generate(CLI::App& app);
 void add_demo(CLI::App& app);
 void add_experiment(CLI::App& app);
 void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
+/// The partitioning flags of `partition`, `compare` and `run` (strategy, phases, cost model).
+void add_strategy_flags(CLI::App* cmd, partition::NamedOptions& n);
 void add_replay_verbs(CLI::App& app);     // replay, run
 void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)
 void add_viz_verbs(CLI::App& app);        // viz, then add_timeline and add_report

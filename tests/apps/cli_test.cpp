@@ -350,6 +350,22 @@ TEST_F(Cli, BarrierRuleFlagChoosesThePhasesAndRejectsUnknownRules) {
   EXPECT_NE(bad.err.find("--barrier-rule"), std::string::npos) << bad.err;
 }
 
+// `run` takes `partition`'s strategy flags: they reach the live partitioner (a calibration
+// file that does not exist fails when the strategy loads its cost model), are range-checked,
+// and a run with other phases still matches the sequential state bit for bit.
+TEST_F(Cli, RunTakesThePartitioningFlags) {
+  const std::string live = "run --scene fig2 --threads 2 --method sticky --steps 2 --no-pin --json ";
+  const Result missing = run(live + "--calibration nope.json");
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_TRUE(one_line(missing.err)) << missing.err;
+  EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
+  const Result share = run(live + "--loop-share 1.5");
+  EXPECT_EQ(share.code, 2);
+  EXPECT_NE(share.err.find("--loop-share"), std::string::npos) << share.err;
+  const auto j = run_json(live + "--phases 3 --loop-share 0.5 --objective vol --check");
+  EXPECT_EQ(j["check"], "identical");
+}
+
 TEST_F(Cli, CapturePassesKeepTheGraphAndRejectZero) {
   Result r = run("capture --scene fig2 --steps 3 --cost-passes 3 -o f3.tgt --json");
   ASSERT_EQ(r.code, 0) << r.err;
