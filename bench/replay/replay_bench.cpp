@@ -169,7 +169,7 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   std::int64_t wait_ns = 0, prepare = 0;
   for (auto _ : state) {
     const ExecStepStats s = ex->run_step(g, &a, w);
-    for (const ThreadCounters& c : s.threads) waits += c.waits;
+    waits += s.waits();
     wait_ns += s.wait_ns();
     prepare += s.prepare_ns;
     signals += s.signals();

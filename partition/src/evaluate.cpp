@@ -115,7 +115,7 @@ StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostMode
   const Metrics m = compute_metrics(g);
   r.span_ns = m.span_ns;
   r.host_ns = g.host_ns;
-  r.lower_bound_ns = g.host_ns + std::max<std::uint64_t>((r.work_ns + a.k - 1) / a.k, m.span_ns);
+  r.lower_bound_ns = step_lower_bound_ns(g.host_ns, r.work_ns, m.span_ns, a.k);
   r.speedup = r.makespan_ns == 0 ? 1.0
                                  : static_cast<double>(r.work_ns + r.host_ns) /
                                        static_cast<double>(r.makespan_ns);

@@ -13,6 +13,7 @@
 
 #include "strategies.hpp"
 #include "tgraph/graph/metrics.hpp"
+#include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/simulator.hpp"
 
 static_assert(sizeof(idx_t) == 4, "tgraph expects METIS built with 32-bit idx_t");
@@ -134,32 +135,29 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
       const auto predicted = [&](const std::vector<std::uint32_t>& p) {
         Assignment a;
         a.k = k;
-        a.proc.assign(p.begin(), p.end());
+        a.proc = p;
         return simulate(g, a, options.model).makespan_ns;
       };
       std::uint64_t best = predicted(part);
       const Metrics metrics = compute_metrics(g);
-      const double bound =
-          static_cast<double>(g.host_ns) + std::max(static_cast<double>(metrics.work_ns) / k,
-                                                    static_cast<double>(metrics.span_ns));
-      if (static_cast<double>(best) <= bound * (1.0 + kCandidateSlack)) {
-        r.assignment.proc.assign(part.begin(), part.end());
-        return r;
-      }
-      std::uint32_t rest_used = 0;
-      const std::vector<std::uint32_t> rest_one =
-          task_phases(g, level, options.phases, rest_used, options.loop_share, 1);
-      const std::pair<const std::vector<std::uint32_t>*, std::uint32_t> alternatives[] = {
-          {&rest_one, rest_used}, {&level_phases, levels_used}};
-      for (const auto& [alt, n] : alternatives) {
-        if (*alt == phase) continue;
-        std::vector<std::uint32_t> p;
-        const std::int64_t cut = metis_kway(pg, library_weights(pg, *alt, n), k, options, p);
-        const std::uint64_t m = predicted(p);
-        if (m < best) {
-          best = m;
-          part = std::move(p);
-          r.stats.edgecut = cut;
+      const double bound = static_cast<double>(
+          step_lower_bound_ns(g.host_ns, metrics.work_ns, metrics.span_ns, k));
+      if (static_cast<double>(best) > bound * (1.0 + kCandidateSlack)) {
+        std::uint32_t rest_used = 0;
+        const std::vector<std::uint32_t> rest_one =
+            task_phases(g, level, options.phases, rest_used, options.loop_share, 1);
+        const std::pair<const std::vector<std::uint32_t>*, std::uint32_t> alternatives[] = {
+            {&rest_one, rest_used}, {&level_phases, levels_used}};
+        for (const auto& [alt, n] : alternatives) {
+          if (*alt == phase) continue;
+          std::vector<std::uint32_t> p;
+          const std::int64_t cut = metis_kway(pg, library_weights(pg, *alt, n), k, options, p);
+          const std::uint64_t m = predicted(p);
+          if (m < best) {
+            best = m;
+            part = std::move(p);
+            r.stats.edgecut = cut;
+          }
         }
       }
     }

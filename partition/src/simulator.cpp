@@ -16,7 +16,6 @@ using detail::Dep;
 using detail::Item;
 constexpr std::uint64_t kUnknown = detail::kNoInstance;
 
-
 void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
 }

@@ -2,6 +2,7 @@
 // Offline evaluation of the assignments of a trace.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -65,6 +66,13 @@ std::string report_text(const Report& report);
 /// processors counted by simulate(): which versions cross does not depend on the cost model
 /// or on timing. Throws tgraph::Error when `a` does not fit `g`.
 QuotientGraph step_quotient(const StepGraph& g, const Assignment& a);
+
+/// What no partition of a step over `k` processors beats (StepReport::lower_bound_ns): its
+/// host work, then max(ceil(work / k), span).
+constexpr std::uint64_t step_lower_bound_ns(std::uint64_t host_ns, std::uint64_t work_ns,
+                                            std::uint64_t span_ns, std::uint32_t k) {
+  return host_ns + std::max<std::uint64_t>((work_ns + k - 1) / k, span_ns);
+}
 
 /// Checks that `a` fits `trace`; throws InputError naming `a_name` otherwise.
 void check_fits(const Trace& trace, const TraceAssignment& a, const std::string& a_name);
