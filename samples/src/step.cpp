@@ -208,16 +208,24 @@ class Stepper {
 
   // Backward Euler: (M (1 + h alpha) - h B - h^2 K) dv = h (f - alpha M v + h K v), solved
   // by conjugate gradient as a dynamic loop (paper section 3.3); v += dv; x += h v.
-  void implicit_euler(Group& g) {
+  // Recorded in four parts, each for every group before the next part (advance()), so that
+  // a processor waiting for the end of one group's force assembly has the other groups'
+  // assembly before it in program order rather than after that group's loop.
+  // Part 1: forces and their derivative on v.
+  void implicit_assemble(Group& g) {
     prepare(g, true);
-    GroupSolver* s = g.solver;
-    declare_solver(*s);
+    declare_solver(*g.solver);
     const double h = h_;
-    const double tol2 = scene_.solver().tolerance * scene_.solver().tolerance;
     reset_forces(g);
     for (const detail::FieldRef& r : g.refs) add_force(r, true);
     for (const detail::FieldRef& r : g.refs)
       if (r.ff->has_stiffness()) add_dforce(r, VecId::kF, VecId::kV, h, 0.0);
+  }
+
+  // Part 2: the right-hand side and the first residual.
+  void implicit_rhs(Group& g) {
+    GroupSolver* s = g.solver;
+    const double h = h_;
     rec_.task(b_.cg_init, s->object,
               {{s->d_rho, W}, {s->d_den, W}, {s->d_rho_new, W}, {s->d_beta, W}}, [s] {
                 s->rho = s->den = s->rho_new = s->beta = 0.0;
@@ -246,7 +254,13 @@ class Stepper {
       s->b2 = s->rho;
       s->converged = false;
     });
+  }
 
+  // Part 3: the conjugate gradient iterations.
+  void implicit_solve(Group& g) {
+    GroupSolver* s = g.solver;
+    const double h = h_;
+    const double tol2 = scene_.solver().tolerance * scene_.solver().tolerance;
     const LoopId loop = rec_.begin_loop(s->d_cond, scene_.solver().max_iterations);
     do {
       for (int i : g.bodies) {
@@ -302,7 +316,10 @@ class Stepper {
                 });
     } while (!rec_.conditional_break(loop, [s] { return s->converged; }));
     rec_.end_loop(loop);
+  }
 
+  // Part 4: v += dv; x += h v.
+  void implicit_update(Group& g) {
     for (int i : g.bodies) {
       Body* bd = body(i);
       rec_.task(b_.update_velocity, object_of(i), {{vec(i, VecId::kDv), R}, {vec(i, VecId::kV), RW}},
@@ -427,11 +444,16 @@ bool Scene::advance(Recorder& rec, bool allow_reuse) {
     group_of[obj] = static_cast<std::uint32_t>(m.body_group[static_cast<std::size_t>(body)]);
   rec.set_contacts(std::move(contact_set), std::move(group_of));
 
-  for (Group& g : m.groups) {
-    switch (solver_.integrator) {
-      case Integrator::kExplicitEuler: stepper.explicit_euler(g); break;
-      case Integrator::kImplicitEuler: stepper.implicit_euler(g); break;
-    }
+  switch (solver_.integrator) {
+    case Integrator::kExplicitEuler:
+      for (Group& g : m.groups) stepper.explicit_euler(g);
+      break;
+    case Integrator::kImplicitEuler:
+      for (Group& g : m.groups) stepper.implicit_assemble(g);
+      for (Group& g : m.groups) stepper.implicit_rhs(g);
+      for (Group& g : m.groups) stepper.implicit_solve(g);
+      for (Group& g : m.groups) stepper.implicit_update(g);
+      break;
   }
   if (detect_in_graph) detail::record_detection(*this, m, rec, [&stepper](int i) { return stepper.vec(i, VecId::kX); });
   if (rec.mode() != capture::Mode::kDeferred) detail::check_divergence(*this, m);
