@@ -63,6 +63,7 @@ class Simulator {
     std::uint32_t iter = 0;
     std::size_t pos = 0;
     std::uint64_t time = 0;
+    std::size_t ready = 0;  // dependencies of the instance tried last known to be done
   };
 
   // Instance that dependency `d` of iteration `i` of a task refers to; kUnknown for none.
@@ -81,13 +82,17 @@ class Simulator {
   }
 
   bool try_run(ProcId p, TaskId t, std::uint32_t i) {
-    for (const Dep& d : deps_[t]) {
-      const std::uint64_t src = source(d, t, i);
+    State& st = state_[p];
+    // The dependencies before st.ready finished when this instance was last tried: a
+    // processor polled while it waits rescans only the rest.
+    const std::vector<Dep>& deps = deps_[t];
+    for (; st.ready < deps.size(); ++st.ready) {
+      const std::uint64_t src = source(deps[st.ready], t, i);
       if (src != kUnknown && s_.end_ns[src] == kUnknown) return false;
     }
-    State& st = state_[p];
+    st.ready = 0;
     std::uint64_t ready = st.time, bytes = 0;
-    for (const Dep& d : deps_[t]) {
+    for (const Dep& d : deps) {
       const std::uint64_t src = source(d, t, i);
       if (src == kUnknown) continue;
       std::uint64_t arrival = s_.end_ns[src];

@@ -40,6 +40,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   std::unordered_map<std::uint64_t, ProcId> redirect;     // (task, datum) -> processor temp
   std::unordered_map<std::uint64_t, bool> serialize_acc;  // (task, datum) -> CW becomes RW
   std::vector<std::vector<PendingReducer>> after(n);      // reducers emitted after task t
+  std::vector<std::vector<PendingReducer>> before(n);     // reducers emitted before task t
   const bool lower_groups =
       mode == CwMode::kReduce &&
       (per_writer || (scope == ReduceScope::kPerProcessor && a != nullptr && a->k > 1));
@@ -60,7 +61,11 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
     auto slot = [&](const Segment& s, std::size_t i) -> ProcId {
       return per_writer ? static_cast<ProcId>(i) : proc(s.members[i]);
     };
-    auto lower_segment = [&](Segment& s, DatumId d) {
+    // `reader`: the task of the same loop region whose access ends the segment; the reducer
+    // goes right before it (its home processor first runs what precedes that task in its
+    // program rather than block on the other processors' writers), else right after the
+    // last writer.
+    auto lower_segment = [&](Segment& s, DatumId d, TaskId reader = kNoTask) {
       if (s.members.empty()) return;
       std::vector<ProcId> slots;
       for (std::size_t i = 0; i < s.members.size(); ++i) slots.push_back(slot(s, i));
@@ -85,7 +90,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
           if (p != home_slot) r.slots.push_back(p);
         for (std::size_t i = 0; i < s.members.size(); ++i)
           if (slot(s, i) != home_slot) redirect[pair_key(s.members[i], d)] = slot(s, i);
-        after[last].push_back(std::move(r));
+        (reader != kNoTask ? before[reader] : after[last]).push_back(std::move(r));
       }
       s.members.clear();
     };
@@ -130,7 +135,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
           if (s.members.empty()) open_list.push_back(d);
           if (s.members.empty() || s.members.back() != t) s.members.push_back(t);
         } else {
-          lower_segment(s, d);
+          lower_segment(s, d, t);
         }
       }
     }
@@ -168,8 +173,36 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   x.exec_of.resize(n);
   std::vector<ProcId> exec_proc;
   std::vector<Access> acc_buf;
+  // A reducer in the loop region of task `at`, with `key` for its stable key.
+  auto emit_reducer = [&](PendingReducer& r, const Task& at) {
+    if (!have_reduce_kind) {
+      reduce_kind = out.intern_kind("reduce");
+      have_reduce_kind = true;
+    }
+    Reduction red;
+    red.target = r.target;
+    acc_buf.clear();
+    for (ProcId p : r.slots) {
+      const DatumId tmp = temp(r.target, p);
+      red.temps.push_back(tmp);
+      acc_buf.push_back({tmp, AccessMode::RW});
+    }
+    // Per processor, the reducer and the home writers share a processor: CW leaves the
+    // reducer free to go before them in an explicit order. Per writer, the first writer
+    // may run on any thread: RW orders the reducer after it (consecutive CW accesses of
+    // one datum have no edge between them).
+    acc_buf.push_back({r.target, per_writer ? AccessMode::RW : AccessMode::CW});
+    const TaskId rid = out.add_task(reduce_kind, g.data[r.target].object, acc_buf, 0,
+                                    at.key * 1099511628211ull + r.target + 1);
+    out.tasks[rid].loop = at.loop;
+    x.origin.push_back(kNoTask);
+    x.reduction.push_back(static_cast<std::uint32_t>(x.reductions.size()));
+    x.reductions.push_back(std::move(red));
+    exec_proc.push_back(r.home);
+  };
   for (TaskId t = 0; t < n; ++t) {
     const Task& task = g.tasks[t];
+    for (PendingReducer& r : before[t]) emit_reducer(r, task);
     acc_buf.clear();
     for (Access acc : g.accesses_of(t)) {
       if (acc.mode == AccessMode::CW) {
@@ -188,32 +221,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
     x.origin.push_back(t);
     x.reduction.push_back(kNoReduction);
     exec_proc.push_back(proc(t));
-    for (PendingReducer& r : after[t]) {
-      if (!have_reduce_kind) {
-        reduce_kind = out.intern_kind("reduce");
-        have_reduce_kind = true;
-      }
-      Reduction red;
-      red.target = r.target;
-      acc_buf.clear();
-      for (ProcId p : r.slots) {
-        const DatumId tmp = temp(r.target, p);
-        red.temps.push_back(tmp);
-        acc_buf.push_back({tmp, AccessMode::RW});
-      }
-      // Per processor, the reducer and the home writers share a processor: CW leaves the
-      // reducer free to go before them in an explicit order. Per writer, the first writer
-      // may run on any thread: RW orders the reducer after it (consecutive CW accesses of
-      // one datum have no edge between them).
-      acc_buf.push_back({r.target, per_writer ? AccessMode::RW : AccessMode::CW});
-      const TaskId rid = out.add_task(reduce_kind, g.data[r.target].object, acc_buf, 0,
-                                      task.key * 1099511628211ull + r.target + 1);
-      out.tasks[rid].loop = task.loop;
-      x.origin.push_back(kNoTask);
-      x.reduction.push_back(static_cast<std::uint32_t>(x.reductions.size()));
-      x.reductions.push_back(std::move(red));
-      exec_proc.push_back(r.home);
-    }
+    for (PendingReducer& r : after[t]) emit_reducer(r, task);
   }
   out.loops = g.loops;
   for (Loop& l : out.loops) {

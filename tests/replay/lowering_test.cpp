@@ -87,7 +87,8 @@ TEST_P(CrossingReducers, AreOrderedAfterTheirAncestorsThroughOtherProcessorsOrde
   const Assignment a = crossing_assignment(g);
   const ExecGraph x = lower(g, &a, CwMode::kReduce);
   ASSERT_EQ(x.reductions.size(), 2u);
-  const TaskId ra = x.exec_of[4] + 1, rb = x.exec_of[5] + 1;  // reducers of a, b
+  // The reducers of a and b, each emitted right before its datum's reader.
+  const TaskId ra = x.exec_of[6] - 1, rb = x.exec_of[7] - 1;
   ASSERT_EQ(x.reduction[ra], 0u);
   ASSERT_EQ(x.reduction[rb], 1u);
   EXPECT_EQ(x.assignment.proc[ra], 1u);
@@ -140,6 +141,54 @@ INSTANTIATE_TEST_SUITE_P(StraightAndLoop, CrossingReducers, ::testing::Bool(),
 /// The reducer of y (loop B, home p0) waits for b1, which p1 runs after leaving loop A, that
 /// is after p0's a2 decided A's exit. By edges alone it had no ancestor on p0 and went to
 /// the front of p0's order, pulling p0's whole B block ahead of A: a deadlock.
+// Two processors accumulate f; p0, the home, has an independent task (on g) between its
+// write and f's reader in program order. The reducer is emitted right before the reader,
+// so p0 runs the independent task first instead of blocking on p1's writer; in a loop the
+// reducer stays in the loop.
+TEST(CwReduction, TheReducerGoesRightBeforeItsReaderAfterTheHomesIndependentWork) {
+  for (bool in_loop : {false, true}) {
+    StepGraph g;
+    g.intern_kind("add");
+    g.intern_kind("other");
+    g.intern_kind("read");
+    g.intern_kind("loop.break");
+    g.objects.push_back({"o"});
+    g.data = {{"f", 0, 64}, {"g", 0, 64}, {"cond", kNoObject, 8}};
+    auto add = [&](KindId kind, std::vector<Access> acc) {
+      g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(g.tasks.size() + 1));
+    };
+    add(0, {{0, AccessMode::CW}});
+    add(0, {{0, AccessMode::CW}});
+    add(1, {{1, AccessMode::RW}});
+    add(2, {{0, AccessMode::R}, {2, AccessMode::W}});
+    if (in_loop) {
+      add(3, {{2, AccessMode::R}});
+      for (Task& t : g.tasks) t.loop = 0;
+      g.loops.push_back({2, 0, 5, 3, 0});
+    }
+    g.derive_edges();
+    ASSERT_EQ(g.validate(), "");
+    Assignment a;
+    a.k = 2;
+    a.proc = {0, 1, 0, 0};
+    if (in_loop) a.proc.push_back(0);
+    const ExecGraph x = lower(g, &a, CwMode::kReduce);
+    ASSERT_EQ(x.reductions.size(), 1u);
+    const TaskId r = x.exec_of[3] - 1;
+    ASSERT_EQ(x.reduction[r], 0u) << in_loop;
+    EXPECT_LT(x.exec_of[2], r);
+    EXPECT_EQ(x.assignment.proc[r], 0u);
+    EXPECT_EQ(x.graph.tasks[r].loop, in_loop ? 0u : kNoLoop);
+    if (in_loop) EXPECT_EQ(x.graph.loops[0].last, x.exec_of[4] + 1);
+    for (bool serial : {true, false}) {
+      auto ex = make_executor(Policy::kPartition, test::partition_options(2, serial, 20'000));
+      SyntheticWorkload w({.cost_scale = 0.0});
+      w.set_step(g);
+      ASSERT_NO_THROW(ex->run_step(g, &a, w)) << (serial ? "serial" : "threads");
+    }
+  }
+}
+
 TEST(CwReduction, ReducerStaysInItsLoopBlockBehindTheExitOfEarlierLoops) {
   StepGraph g;
   g.intern_kind("k");
