@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <tuple>
+#include <vector>
 
 #include "tgraph/graph/error.hpp"
 #include "schedule_program.hpp"
@@ -31,6 +34,7 @@ class Simulator {
     s_.start_ns.assign(total, 0);
     s_.end_ns.assign(total, kUnknown);
     deps_ = detail::dependencies(g);
+    find_fan_ins();
     items_ = detail::programs(g, a);
     state_.resize(k_);
     // The step's serial host work (StepGraph::host_ns) runs before any of its tasks.
@@ -81,18 +85,71 @@ class Simulator {
     return true;
   }
 
+  // A task's largest group of at least kFanIn dependencies on one datum (the CW writers of
+  // a CG scalar that every object's task reads) goes first in its list; readers with the
+  // same group (same datum, loop and sources) share one id, so that after the first of
+  // them on a processor the others reuse its arrival time: their receives are all repeats
+  // (no wait, no signal, no bytes), and the scan is quadratic in the group otherwise.
+  static constexpr std::size_t kFanIn = 8;
+  static constexpr std::uint32_t kNoFanIn = UINT32_MAX;
+  struct FanIn {
+    std::uint32_t id = kNoFanIn;
+    std::uint32_t size = 0;  // deps_[t][0, size) are the group
+  };
+  struct Memo {
+    std::uint32_t iter = UINT32_MAX;  // the instance (iteration) whose arrival is kept
+    std::uint64_t arrival = 0;
+  };
+
+  void find_fan_ins() {
+    fan_in_.assign(deps_.size(), FanIn{});
+    std::map<std::vector<std::uint64_t>, std::uint32_t> ids;
+    std::vector<std::uint64_t> key;
+    for (TaskId t = 0; t < deps_.size(); ++t) {
+      std::vector<Dep>& deps = deps_[t];
+      if (deps.size() < kFanIn) continue;
+      std::sort(deps.begin(), deps.end(), [](const Dep& x, const Dep& y) {
+        return std::tie(x.datum, x.from, x.carried, x.raw) < std::tie(y.datum, y.from, y.carried, y.raw);
+      });
+      std::size_t best = 0, best_len = 0;
+      for (std::size_t b = 0, e = 0; b < deps.size(); b = e) {
+        for (e = b; e < deps.size() && deps[e].datum == deps[b].datum; ++e) {}
+        if (e - b > best_len) {
+          best = b;
+          best_len = e - b;
+        }
+      }
+      if (best_len < kFanIn) continue;
+      std::rotate(deps.begin(), deps.begin() + static_cast<std::ptrdiff_t>(best),
+                  deps.begin() + static_cast<std::ptrdiff_t>(best + best_len));
+      key.assign({deps[0].datum, g_.tasks[t].loop});
+      for (std::size_t j = 0; j < best_len; ++j)
+        key.push_back((static_cast<std::uint64_t>(deps[j].from) << 2) |
+                      (deps[j].raw ? 2u : 0u) | (deps[j].carried ? 1u : 0u));
+      const auto [it, fresh] = ids.emplace(key, static_cast<std::uint32_t>(ids.size()));
+      fan_in_[t] = {it->second, static_cast<std::uint32_t>(best_len)};
+    }
+    memo_.assign(static_cast<std::size_t>(k_) * ids.size(), Memo{});
+    fan_ins_ = ids.size();
+  }
+
   bool try_run(ProcId p, TaskId t, std::uint32_t i) {
     State& st = state_[p];
+    const std::vector<Dep>& deps = deps_[t];
+    const FanIn fi = fan_in_[t];
+    Memo* memo = fi.id == kNoFanIn ? nullptr : &memo_[p * fan_ins_ + fi.id];
+    const bool known = memo != nullptr && memo->iter == i;
     // The dependencies before st.ready finished when this instance was last tried: a
     // processor polled while it waits rescans only the rest.
-    const std::vector<Dep>& deps = deps_[t];
+    if (known) st.ready = std::max<std::size_t>(st.ready, fi.size);
     for (; st.ready < deps.size(); ++st.ready) {
       const std::uint64_t src = source(deps[st.ready], t, i);
       if (src != kUnknown && s_.end_ns[src] == kUnknown) return false;
     }
     st.ready = 0;
-    std::uint64_t ready = st.time, bytes = 0;
-    for (const Dep& d : deps) {
+    std::uint64_t ready = st.time, bytes = 0, group = 0;
+    for (std::size_t j = known ? fi.size : 0; j < deps.size(); ++j) {
+      const Dep& d = deps[j];
       const std::uint64_t src = source(d, t, i);
       if (src == kUnknown) continue;
       std::uint64_t arrival = s_.end_ns[src];
@@ -101,6 +158,12 @@ class Simulator {
         if (receive(src, d.datum, a_.proc[d.from], p) && d.raw) bytes += g_.data[d.datum].bytes;
       }
       ready = std::max(ready, arrival);
+      if (j < fi.size) group = std::max(group, arrival);
+    }
+    if (known) {
+      ready = std::max(ready, memo->arrival);
+    } else if (memo != nullptr) {
+      *memo = Memo{i, group};
     }
     const std::uint64_t duration =
         g_.tasks[t].cost_ns + overhead_ +
@@ -166,6 +229,9 @@ class Simulator {
   const std::uint64_t overhead_;  // CostModel::task_overhead_ns, per instance
   Schedule s_;
   std::vector<std::vector<Dep>> deps_;
+  std::vector<FanIn> fan_in_;
+  std::vector<Memo> memo_;  // by processor, then fan-in id
+  std::size_t fan_ins_ = 0;
   std::vector<std::vector<Item>> items_;
   std::vector<State> state_;
   detail::VersionSet waits_, signals_;

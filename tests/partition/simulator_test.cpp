@@ -84,6 +84,34 @@ TEST(Simulator, ChargesTransferBytesOncePerVersionAndProcessor) {
   EXPECT_EQ(s.signals, 1u);
 }
 
+TEST(Simulator, ReadersOfOneFanInShareItsArrivalButNotItsCharges) {
+  // 16 CW writers of d (cost 100, alternating p0 / p1) and four readers (cost 10, two on
+  // each processor): every processor's writers end at 800, the other's arrive at 800 + 10.
+  // The first reader on a processor waits for the 8 remote writers (8 waits, 8 x 64 bytes
+  // at 0.5 ns); the second one only for the first.
+  Builder b;
+  const DatumId d = b.datum("d", 64);
+  std::vector<ProcId> proc;
+  for (int j = 0; j < 16; ++j) {
+    b.task({{d, M::CW}}, 100);
+    proc.push_back(static_cast<ProcId>(j % 2));
+  }
+  for (int j = 0; j < 4; ++j) {
+    b.task({{d, M::R}}, 10);
+    proc.push_back(static_cast<ProcId>(j % 2));
+  }
+  const Schedule s = simulate(b.done(), assign(2, proc), model(10, 0.5));
+  // 810 + 8 x 64 x 0.5 = 256 -> [810, 1076]; then [1076, 1086].
+  EXPECT_EQ(s.start_ns[16], 810u);
+  EXPECT_EQ(s.start_ns[18], 1076u);
+  EXPECT_EQ(s.start_ns[17], 810u);
+  EXPECT_EQ(s.start_ns[19], 1076u);
+  EXPECT_EQ(s.makespan_ns, 1086u);
+  EXPECT_EQ(s.waits, 16u);
+  EXPECT_EQ(s.signals, 16u);
+  EXPECT_EQ(s.transfer_bytes, 16u * 64u);
+}
+
 TEST(Simulator, RunsForkJoinInParallel) {
   Builder b;
   const DatumId s0 = b.datum("s", 8), u = b.datum("u", 8), v = b.datum("v", 8);
