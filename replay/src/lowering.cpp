@@ -173,7 +173,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   x.exec_of.resize(n);
   std::vector<ProcId> exec_proc;
   std::vector<Access> acc_buf;
-  // A reducer in the loop region of task `at`, with `key` for its stable key.
+  // A reducer in the loop region of task `at`, its stable key derived from `at`'s.
   auto emit_reducer = [&](PendingReducer& r, const Task& at) {
     if (!have_reduce_kind) {
       reduce_kind = out.intern_kind("reduce");
