@@ -109,7 +109,8 @@ class Simulator {
       std::vector<Dep>& deps = deps_[t];
       if (deps.size() < kFanIn) continue;
       std::sort(deps.begin(), deps.end(), [](const Dep& x, const Dep& y) {
-        return std::tie(x.datum, x.from, x.carried, x.raw) < std::tie(y.datum, y.from, y.carried, y.raw);
+        return std::tie(x.datum, x.from, x.carried, x.raw) <
+               std::tie(y.datum, y.from, y.carried, y.raw);
       });
       std::size_t best = 0, best_len = 0;
       for (std::size_t b = 0, e = 0; b < deps.size(); b = e) {

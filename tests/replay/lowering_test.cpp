@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "random_graph.hpp"
@@ -28,6 +29,13 @@ namespace {
 /// the reducer of b (home p0) only on t1 and t5 (p1). Placed by edges alone, both went to
 /// the front of their processor's order and waited for each other's processor: a deadlock.
 /// With `in_loop`, the same tasks form a loop body, with a residual and a break on p0.
+// Appends a task of object 0 (cost 1000, key = its id + 1), in loop 0 when `in_loop`.
+void add_task(StepGraph& g, KindId kind, std::vector<Access> acc, bool in_loop) {
+  const auto t = static_cast<TaskId>(g.tasks.size());
+  g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(t + 1));
+  if (in_loop) g.tasks[t].loop = 0;
+}
+
 StepGraph crossing_reducers(bool in_loop) {
   StepGraph g;
   g.intern_kind("reset");
@@ -37,9 +45,7 @@ StepGraph crossing_reducers(bool in_loop) {
   g.objects.push_back({"o"});
   g.data = {{"a", 0, 64}, {"b", 0, 64}, {"cond", kNoObject, 8}};
   auto add = [&](KindId kind, std::vector<Access> acc) {
-    const auto t = static_cast<TaskId>(g.tasks.size());
-    g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(t + 1));
-    if (in_loop) g.tasks[t].loop = 0;
+    add_task(g, kind, std::move(acc), in_loop);
   };
   add(0, {{0, AccessMode::W}});
   add(0, {{1, AccessMode::W}});
@@ -155,15 +161,14 @@ TEST(CwReduction, TheReducerGoesRightBeforeItsReaderAfterTheHomesIndependentWork
     g.objects.push_back({"o"});
     g.data = {{"f", 0, 64}, {"g", 0, 64}, {"cond", kNoObject, 8}};
     auto add = [&](KindId kind, std::vector<Access> acc) {
-      g.add_task(kind, 0, acc, 1000, static_cast<StableKey>(g.tasks.size() + 1));
-    };
+    add_task(g, kind, std::move(acc), in_loop);
+  };
     add(0, {{0, AccessMode::CW}});
     add(0, {{0, AccessMode::CW}});
     add(1, {{1, AccessMode::RW}});
     add(2, {{0, AccessMode::R}, {2, AccessMode::W}});
     if (in_loop) {
       add(3, {{2, AccessMode::R}});
-      for (Task& t : g.tasks) t.loop = 0;
       g.loops.push_back({2, 0, 5, 3, 0});
     }
     g.derive_edges();
@@ -179,7 +184,9 @@ TEST(CwReduction, TheReducerGoesRightBeforeItsReaderAfterTheHomesIndependentWork
     EXPECT_LT(x.exec_of[2], r);
     EXPECT_EQ(x.assignment.proc[r], 0u);
     EXPECT_EQ(x.graph.tasks[r].loop, in_loop ? 0u : kNoLoop);
-    if (in_loop) EXPECT_EQ(x.graph.loops[0].last, x.exec_of[4] + 1);
+    if (in_loop) {
+      EXPECT_EQ(x.graph.loops[0].last, x.exec_of[4] + 1);
+    }
     for (bool serial : {true, false}) {
       auto ex = make_executor(Policy::kPartition, test::partition_options(2, serial, 20'000));
       SyntheticWorkload w({.cost_scale = 0.0});

@@ -28,10 +28,10 @@ namespace {
 
 using namespace tgraph::measure;
 
-// Threads of this process now (/proc/self/status). Tests compare it with the count before the executor was made
-// with EXPECT_LE: a thread of an earlier test (a library's helper) may still be ending when
-// the first count is taken (seen once under TSan: 5 before, 4 after), while a worker that
-// was not joined keeps the count above it.
+// Threads of this process now (/proc/self/status). Tests compare it with the count before
+// the executor was made with EXPECT_LE: a thread of an earlier test (a library's helper) may
+// still be ending when the first count is taken (seen once under TSan: 5 before, 4 after),
+// while a worker that was not joined keeps the count above it.
 int process_threads() {
   std::ifstream f("/proc/self/status");
   std::string line;
