@@ -98,6 +98,7 @@ void run(const Args& a, meas::LiveOptions& o, const tp::NamedOptions& strategy) 
   scene_options.split = a.split;
   const int scene_steps = samples::make_scene(a.input, scene_options)->default_steps();  // InputError if unknown
   o.policy = m.policy;
+  o.loop_share = strategy.values.loop_share;
   o.steps = static_cast<std::uint32_t>(a.steps.value_or(scene_steps));
   const std::string scene = a.input, method = meas::method_name(m);
   const meas::LiveResult r =

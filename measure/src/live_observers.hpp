@@ -26,6 +26,7 @@ class CostObserver : public replay::Observer {
     exec_ = &exec;
     begin_.assign(static_cast<std::size_t>(threads) * 8, 0);
     sum_.assign(exec.graph.tasks.size(), 0);
+    max_.assign(exec.graph.tasks.size(), 0);
     runs_.assign(exec.graph.tasks.size(), 0);
   }
   void on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t) override {
@@ -34,7 +35,9 @@ class CostObserver : public replay::Observer {
   void on_end(std::uint32_t thread, TaskId task, std::uint32_t, std::int64_t t) override {
     // One writer per task at a time: instances of a task never overlap, and the executors
     // order consecutive instances (dependency or same thread).
-    sum_[task] += static_cast<std::uint64_t>(t - begin_[thread * 8]);
+    const auto d = static_cast<std::uint64_t>(t - begin_[thread * 8]);
+    sum_[task] += d;
+    max_[task] = std::max(max_[task], d);
     ++runs_[task];
   }
   /// Writes the measured means into `g` (the next step): by task index when `g` has the
@@ -51,7 +54,7 @@ class CostObserver : public replay::Observer {
       for (TaskId t = 0; t < sum_.size(); ++t) {
         const TaskId o = exec_->origin[t];
         if (o == kNoTask || o >= g.tasks.size() || runs_[t] == 0) continue;
-        const std::uint64_t sample = sum_[t] / runs_[t];
+        const std::uint64_t sample = mean(t);
         const std::uint64_t old = measured.tasks[o].cost_ns;
         g.tasks[o].cost_ns = std::max<std::uint64_t>(1, old > 1 ? (old + sample) / 2 : sample);
       }
@@ -60,7 +63,7 @@ class CostObserver : public replay::Observer {
     std::vector<std::uint64_t> cost(measured.tasks.size(), 0);
     for (TaskId t = 0; t < sum_.size(); ++t) {
       const TaskId o = exec_->origin[t];
-      if (o != kNoTask && o < cost.size() && runs_[t] > 0) cost[o] = sum_[t] / runs_[t];
+      if (o != kNoTask && o < cost.size() && runs_[t] > 0) cost[o] = mean(t);
     }
     std::unordered_map<StableKey, std::uint64_t> by_key;
     by_key.reserve(cost.size());
@@ -72,9 +75,16 @@ class CostObserver : public replay::Observer {
   }
 
  private:
+  // The mean of task t's samples in the step, its longest left out from three samples on: a
+  // loop task's instance preempted by the host (a 4 ms time slice in a 10 us body) would
+  // otherwise look like a task 60 times heavier and draw a rebalance.
+  std::uint64_t mean(TaskId t) const {
+    return runs_[t] >= 3 ? (sum_[t] - max_[t]) / (runs_[t] - 1) : sum_[t] / runs_[t];
+  }
+
   const ExecGraph* exec_ = nullptr;
   std::vector<std::int64_t> begin_;
-  std::vector<std::uint64_t> sum_, runs_;
+  std::vector<std::uint64_t> sum_, max_, runs_;
 };
 
 /// Time per task kind over the whole run.

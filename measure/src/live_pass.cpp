@@ -12,19 +12,6 @@
 namespace tgraph::measure::detail {
 namespace {
 
-/// Imbalance (max over mean of the processors' work) of `a` on `g` (cost x runs).
-double imbalance(const StepGraph& g, const Assignment& a) {
-  std::vector<double> load(a.k, 0.0);
-  double total = 0;
-  for (TaskId t = 0; t < g.tasks.size() && t < a.proc.size(); ++t) {
-    const double w = static_cast<double>(g.tasks[t].cost_ns) * static_cast<double>(g.runs(t));
-    load[a.proc[t]] += w;
-    total += w;
-  }
-  if (total <= 0 || a.k == 0) return 1.0;
-  return *std::max_element(load.begin(), load.end()) / (total / a.k);
-}
-
 /// Loop iteration counts for the partitioner: the last step's, by loop index when the
 /// structure is the same, else their mean (a deferred recording runs no iteration).
 void apply_iterations(const std::vector<std::uint32_t>& last, bool same, StepGraph& g) {
@@ -52,6 +39,7 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
   StepGraph prev_graph;   // the graph of the previous recorded program
   Assignment assignment;  // the assignment in use
   std::vector<std::uint32_t> last_iterations;
+  double made_imbalance = 1.0;  // the assignment's loop_imbalance when it was made
   bool have_prev = false;
   try {
     for (std::uint32_t s = 0; s < o.steps; ++s) {
@@ -83,9 +71,11 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
             throw UsageError("live check: no assignment for step " + std::to_string(s));
           assignment = (*fixed)[s];
         } else if (!have_prev || !reused || o.repartition_every_step ||
-                   imbalance(cur.graph, assignment) > 1.0 + o.rebalance_tolerance) {
+                   partition::loop_imbalance(cur.graph, assignment, o.loop_share) >
+                       (1.0 + o.rebalance_tolerance) * std::max(1.0, made_imbalance)) {
           assignment = (*partitioner)(cur.graph, ex.threads(), have_prev ? &measured : nullptr,
                                       have_prev ? &assignment : nullptr);
+          made_imbalance = partition::loop_imbalance(cur.graph, assignment, o.loop_share);
           m.partitioned = true;
         }
         have_prev = true;

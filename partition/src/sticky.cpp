@@ -19,16 +19,19 @@ struct Units {
     std::uint64_t work = 0;
     std::vector<TaskId> tasks;
   };
+  static constexpr std::size_t kNone = SIZE_MAX;
   std::vector<Unit> units;
-  std::vector<std::size_t> unit_of;
+  std::vector<std::size_t> unit_of;  ///< kNone for a task that may not move
   std::vector<std::vector<std::pair<TaskId, double>>> adj;
 
+  // `movable` (null: every task): the tasks that form units; the others stay where they are.
   Units(const StepGraph& g, const std::vector<std::uint64_t>& work, const CostModel& model,
-        const std::vector<ProcId>& proc) {
+        const std::vector<ProcId>& proc, const std::vector<char>* movable = nullptr) {
     const auto n = static_cast<TaskId>(g.tasks.size());
     std::unordered_map<std::uint64_t, std::size_t> unit_of_key;
-    unit_of.resize(n);
+    unit_of.assign(n, kNone);
     for (TaskId t = 0; t < n; ++t) {
+      if (movable != nullptr && (*movable)[t] == 0) continue;
       const ObjectId o = g.tasks[t].object;
       std::size_t u;
       if (o == kNoObject) {
@@ -73,14 +76,16 @@ struct Units {
 // single tasks, towards any less loaded processor. A move's gain is how much it lowers the
 // larger of the two loads; its price is the cut it adds minus the cut it removes (Units).
 // The best move with gain > price is applied until the imbalance is within `tolerance` or
-// no move pays.
+// no move pays. With `movable`, only those tasks move and only their work counts as load.
 void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
-                      double tolerance, const CostModel& model, std::vector<ProcId>& proc) {
+                      double tolerance, const CostModel& model, std::vector<ProcId>& proc,
+                      const std::vector<char>* movable = nullptr) {
   const auto n = static_cast<TaskId>(g.tasks.size());
-  Units us(g, work, model, proc);
+  Units us(g, work, model, proc, movable);
   auto& units = us.units;
   const auto& adj = us.adj;
-  std::vector<std::uint64_t> load = loads(work, proc, k);
+  std::vector<std::uint64_t> load(k, 0);
+  for (const auto& un : units) load[un.proc] += un.work;
   std::uint64_t total = 0;
   for (std::uint64_t l : load) total += l;
   const double limit = static_cast<double>(total) / k * tolerance;
@@ -117,7 +122,8 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
     for (std::size_t u = 0; u < units.size(); ++u)
       if (units[u].proc == p) consider(u, kNoTask, units[u].work, units[u].tasks);
     for (TaskId t = 0; t < n; ++t)
-      if (proc[t] == p && units[us.unit_of[t]].tasks.size() > 1) consider(us.unit_of[t], t, work[t], {t});
+      if (proc[t] == p && us.unit_of[t] != Units::kNone && units[us.unit_of[t]].tasks.size() > 1)
+        consider(us.unit_of[t], t, work[t], {t});
     if (best_unit == SIZE_MAX) break;
     if (best_task != kNoTask) {  // split the task off its unit
       auto& from = units[best_unit];
@@ -128,6 +134,23 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
       us.unit_of[best_task] = best_unit;
     }
     us.move(best_unit, best_q, proc, load);
+  }
+}
+
+// The greedy rebalance group by group (LoopGroups: the tasks outside heavy loops, then each
+// heavy loop): a loop's processors meet at every iteration, so each group is balanced on
+// its own, moving only its tasks; without heavy loops, the whole step at once.
+void phase_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
+                     double tolerance, const CostModel& model, const LoopGroups& lg,
+                     std::vector<ProcId>& proc) {
+  if (lg.count < 2) {
+    greedy_rebalance(g, work, k, tolerance, model, proc);
+    return;
+  }
+  std::vector<char> in(g.tasks.size());
+  for (std::uint32_t c = 0; c < lg.count; ++c) {
+    for (TaskId t = 0; t < g.tasks.size(); ++t) in[t] = lg.group[t] == c ? 1 : 0;
+    greedy_rebalance(g, work, k, tolerance, model, proc, &in);
   }
 }
 
@@ -220,17 +243,23 @@ class Sticky final : public Strategy {
   Result do_partition(const StepGraph& g, std::uint32_t k, const Previous& prev,
                       const Options& options) override {
     const std::vector<std::uint64_t> work = task_work(g);
+    // Imbalances are phased (loop_imbalance): a heavy loop's processors meet every iteration.
+    const LoopGroups lg = loop_groups(g, work, options.loop_share);
+    const auto phased = [&](const std::vector<ProcId>& proc) {
+      return phased_imbalance(lg, work, proc, k);
+    };
     if (prev.graph == nullptr || prev.assignment->k != k) {
       Result r = base_partition(g, k, options);
       r.assignment.order.clear();
-      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
+      polish(g, work, k, options, lg, r.assignment.proc);
+      remember(r.assignment.proc, phased(r.assignment.proc));
       return r;
     }
     // The imbalance the last full partition or rebalance reached: what the graph's
     // granularity allows. Rebalance only when the current one is `threshold` times worse.
     const double baseline = prev.assignment->proc == last_proc_
                                 ? baseline_
-                                : imbalance(loads(task_work(*prev.graph), prev.assignment->proc, k));
+                                : loop_imbalance(*prev.graph, *prev.assignment, options.loop_share);
     const double trigger = std::max(options.sticky_threshold, baseline * options.sticky_threshold);
     const double target = std::max(options.imbalance, baseline);
     Result r;
@@ -239,15 +268,15 @@ class Sticky final : public Strategy {
     if (g.same_structure(*prev.graph)) {
       // Same graph: reuse as is, unless measured costs drifted past the trigger.
       r.assignment = *prev.assignment;
-      if (k == 1 || n <= k || imbalance(loads(work, r.assignment.proc, k)) <= trigger) {
+      if (k == 1 || n <= k || phased(r.assignment.proc) <= trigger) {
         r.stats.reused = true;
         remember(r.assignment.proc, baseline);
         return r;
       }
       r.assignment.order.clear();
-      greedy_rebalance(g, work, k, target, options.model, r.assignment.proc);
+      phase_rebalance(g, work, k, target, options.model, lg, r.assignment.proc);
       r.stats.rebalanced = true;
-      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
+      remember(r.assignment.proc, phased(r.assignment.proc));
       return r;
     }
 
@@ -263,8 +292,9 @@ class Sticky final : public Strategy {
       r = base_partition(g, k, options);
       r.assignment.order.clear();
       relabel_to_previous(g, prev, r.assignment);
+      polish(g, work, k, options, lg, r.assignment.proc);
       r.stats.fallback = true;
-      remember(r.assignment.proc, imbalance(loads(work, r.assignment.proc, k)));
+      remember(r.assignment.proc, phased(r.assignment.proc));
       return r;
     }
     std::vector<ProcId>& proc = r.assignment.proc;
@@ -291,23 +321,23 @@ class Sticky final : public Strategy {
           refine(g, work, k, options.imbalance, target, options.model, proc);
       }
       r.stats.fallback = true;
-      remember(proc, imbalance(loads(work, proc, k)));
+      remember(proc, phased(proc));
       return r;
     }
-    if (imbalance(load) <= trigger || k == 1 || n <= k) {
+    if (k == 1 || n <= k || phased(proc) <= trigger) {
       remember(proc, baseline);
       return r;
     }
     switch (options.rebalance) {
       case Rebalance::kGreedy:
-        greedy_rebalance(g, work, k, target, options.model, proc);
+        phase_rebalance(g, work, k, target, options.model, lg, proc);
         break;
       case Rebalance::kScotch:
         scotch_rebalance(g, k, options, match, proc);
         break;
     }
     r.stats.rebalanced = true;
-    remember(proc, imbalance(loads(work, proc, k)));
+    remember(proc, phased(proc));
     return r;
   }
 
@@ -318,6 +348,14 @@ class Sticky final : public Strategy {
     Options o = options;
     if (o.phases == 0) o.phases = options.sticky_phases;
     return make_strategy(base)->partition(g, k, {}, o);
+  }
+
+  // A multi-constraint METIS partition often misses its tolerance on some heavy loop; the
+  // greedy rebalance, loop by loop, brings each group to it where moves pay.
+  static void polish(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
+                     const Options& options, const LoopGroups& lg, std::vector<ProcId>& proc) {
+    if (k > 1 && g.tasks.size() > k && lg.count > 1)
+      phase_rebalance(g, work, k, options.imbalance, options.model, lg, proc);
   }
 
   void remember(const std::vector<ProcId>& proc, double baseline) {

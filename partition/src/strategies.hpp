@@ -37,6 +37,19 @@ std::vector<std::uint64_t> loads(const std::vector<std::uint64_t>& work,
 /// max load / mean load (1 for zero work).
 double imbalance(const std::vector<std::uint64_t>& load);
 
+/// Tasks grouped as processors meet: group 0 the tasks outside heavy loops, then one group
+/// per dynamic loop holding at least `loop_share` of the step's work (0: no loop group).
+struct LoopGroups {
+  std::vector<std::uint32_t> group;  ///< per task
+  std::uint32_t count = 1;
+};
+LoopGroups loop_groups(const StepGraph& g, const std::vector<std::uint64_t>& work,
+                       double loop_share);
+/// Sum over the groups of the most loaded processor's work in that group, over the mean
+/// load of the whole step (loop_imbalance).
+double phased_imbalance(const LoopGroups& lg, const std::vector<std::uint64_t>& work,
+                        const std::vector<ProcId>& proc, std::uint32_t k);
+
 /// Places every task with `placed[t]` false, in program order, on the processor that holds
 /// most bytes of the data it touches (holders: the processors of placed tasks and of tasks
 /// placed before it); ties and no affinity go to the least loaded processor. `proc` holds

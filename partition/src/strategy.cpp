@@ -220,6 +220,11 @@ StepPartitioner step_partitioner(std::string_view method, const Options& options
   };
 }
 
+double loop_imbalance(const StepGraph& g, const Assignment& a, double loop_share) {
+  const std::vector<std::uint64_t> work = detail::task_work(g);
+  return detail::phased_imbalance(detail::loop_groups(g, work, loop_share), work, a.proc, a.k);
+}
+
 namespace detail {
 
 std::vector<std::uint64_t> task_work(const StepGraph& g) {
@@ -243,6 +248,43 @@ double imbalance(const std::vector<std::uint64_t>& load) {
   }
   if (total == 0 || load.empty()) return 1.0;
   return static_cast<double>(max) * static_cast<double>(load.size()) / static_cast<double>(total);
+}
+
+LoopGroups loop_groups(const StepGraph& g, const std::vector<std::uint64_t>& work,
+                       double loop_share) {
+  LoopGroups lg;
+  lg.group.assign(g.tasks.size(), 0);
+  if (loop_share <= 0.0 || g.loops.empty()) return lg;
+  std::uint64_t total = 0;
+  std::vector<std::uint64_t> loop_work(g.loops.size(), 0);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    total += work[t];
+    if (g.tasks[t].loop < g.loops.size()) loop_work[g.tasks[t].loop] += work[t];
+  }
+  std::vector<std::uint32_t> of_loop(g.loops.size(), 0);
+  for (LoopId l = 0; l < g.loops.size(); ++l)
+    if (static_cast<long double>(loop_work[l]) >= loop_share * static_cast<long double>(total))
+      of_loop[l] = lg.count++;
+  for (TaskId t = 0; t < g.tasks.size(); ++t)
+    if (g.tasks[t].loop < g.loops.size()) lg.group[t] = of_loop[g.tasks[t].loop];
+  return lg;
+}
+
+double phased_imbalance(const LoopGroups& lg, const std::vector<std::uint64_t>& work,
+                        const std::vector<ProcId>& proc, std::uint32_t k) {
+  if (k == 0) return 1.0;
+  std::vector<std::uint64_t> load(static_cast<std::size_t>(lg.count) * k, 0);
+  std::uint64_t total = 0;
+  for (std::size_t t = 0; t < proc.size() && t < work.size(); ++t) {
+    load[static_cast<std::size_t>(lg.group[t]) * k + proc[t]] += work[t];
+    total += work[t];
+  }
+  if (total == 0) return 1.0;
+  long double sum_max = 0;
+  for (std::uint32_t c = 0; c < lg.count; ++c)
+    sum_max += *std::max_element(load.begin() + static_cast<std::ptrdiff_t>(c) * k,
+                                 load.begin() + static_cast<std::ptrdiff_t>(c + 1) * k);
+  return static_cast<double>(sum_max * k / static_cast<long double>(total));
 }
 
 void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& work,

@@ -360,6 +360,79 @@ TEST(Sticky, KeepsExistingTasksAndPlacesNewOnesByAffinity) {
   EXPECT_TRUE(p == p2 || p == p5);
 }
 
+// Outside loops: 8 independent tasks of 20 us. Two loops run 10 times, each 8 tasks of 2 us
+// on their own data, all reading one shared vector, then its break: each loop holds a third
+// of the step's work (heavy for loop_share 0.1). Loop tasks are first_a.. and first_b..
+struct TwoLoops {
+  StepGraph g;
+  TaskId first_a = 0, first_b = 0;
+};
+TwoLoops two_loops() {
+  Builder b;
+  TwoLoops r;
+  for (int i = 0; i < 8; ++i) b.task({{b.datum(testing::name("r", i), 64), M::W}}, 20000);
+  for (int l = 0; l < 2; ++l) {
+    const DatumId shared = b.datum(testing::name("shared", l), 4096);
+    const DatumId cond = b.datum(testing::name("cond", l), 8);
+    b.task({{shared, M::W}}, 100);
+    const auto first = static_cast<TaskId>(b.g.tasks.size());
+    (l == 0 ? r.first_a : r.first_b) = first;
+    for (int i = 0; i < 8; ++i)
+      b.task({{shared, M::R}, {b.datum(testing::name("y", 8 * l + i), 64), M::RW}}, 2000);
+    b.task({{cond, M::RW}}, 1);
+    b.loop(cond, first, static_cast<TaskId>(b.g.tasks.size()), 10);
+  }
+  r.g = b.done();
+  return r;
+}
+
+TEST(LoopImbalance, CountsEachHeavyLoopsMostLoadedProcessorApart) {
+  const TwoLoops tl = two_loops();
+  const StepGraph& g = tl.g;
+  // Rest 4 / 4; loop A 6 / 2, loop B 2 / 6 (breaks and writers on 0): the whole step is
+  // balanced, each loop is not.
+  Assignment a;
+  a.k = 2;
+  a.proc.assign(g.tasks.size(), 0);
+  for (TaskId t = 4; t < 8; ++t) a.proc[t] = 1;
+  for (int i = 6; i < 8; ++i) a.proc[tl.first_a + i] = 1;
+  for (int i = 2; i < 8; ++i) a.proc[tl.first_b + i] = 1;
+  const auto l = loads_of(g, a);
+  const double whole = static_cast<double>(std::max(l[0], l[1])) * 2 / static_cast<double>(l[0] + l[1]);
+  EXPECT_LT(whole, 1.001);
+  // Outside the loops processor 0 has 80 us and both shared vectors' writers (0.2 us); in
+  // loop A 120 us and both breaks (10 x 1 ns each); in loop B processor 1's 120 us. Over
+  // half the step's 480.22 us.
+  const double total = 160000 + 2 * (100 + 160000 + 10);
+  EXPECT_NEAR(loop_imbalance(g, a, 0.1), (80200 + 120010 + 120000) * 2 / total, 1e-9);
+  EXPECT_NEAR(loop_imbalance(g, a, 0.0), whole, 1e-12);  // no heavy loop: the whole step
+  EXPECT_NEAR(loop_imbalance(g, a, 0.5), whole, 1e-12);  // a third each: none heavy at 0.5
+}
+
+TEST(Sticky, RebalancesEachHeavyLoopWhenItsCostsDriftEvenIfTheWholeStepStaysBalanced) {
+  const TwoLoops tl = two_loops();
+  const StepGraph& g0 = tl.g;
+  Options o;  // threshold 1.2, loop_share 0.1
+  auto s = make_strategy("sticky");
+  const Result r0 = s->partition(g0, 2, {}, o);
+  ASSERT_LE(loop_imbalance(g0, r0.assignment, o.loop_share), 1.1);
+  // Loop A's tasks on processor 0 and loop B's on processor 1 become 3 times heavier: both
+  // processors gain about as much, but each loop now waits for one of them every iteration.
+  StepGraph g1 = g0;
+  for (int i = 0; i < 8; ++i) {
+    if (r0.assignment.proc[tl.first_a + i] == 0) g1.tasks[tl.first_a + i].cost_ns *= 3;
+    if (r0.assignment.proc[tl.first_b + i] == 1) g1.tasks[tl.first_b + i].cost_ns *= 3;
+  }
+  ASSERT_GT(loop_imbalance(g1, r0.assignment, o.loop_share), 1.25);
+  // As a whole step it is within the threshold: a whole-step check would reuse it.
+  ASSERT_LE(loop_imbalance(g1, r0.assignment, 0.0), 1.15);
+  const Result r1 = s->partition(g1, 2, {&g0, &r0.assignment}, o);
+  EXPECT_TRUE(r1.stats.rebalanced);
+  EXPECT_LE(loop_imbalance(g1, r1.assignment, o.loop_share), 1.15);
+  // Only loop tasks moved: the tasks outside the loops, balanced, stay.
+  for (TaskId t = 0; t < 8; ++t) EXPECT_EQ(r1.assignment.proc[t], r0.assignment.proc[t]) << t;
+}
+
 // Two steps of 16 objects, the second with new heavy tasks on object 0's data only (affinity
 // placement overloads its processor); costs in microseconds, so that moving a task pays off
 // against the cost model's sync + transfer.

@@ -41,10 +41,13 @@ struct LiveOptions {
   bool check = false;             ///< compare the final state with a sequential reference
   std::uint32_t cost_stride = 8;  ///< cost feedback samples loop iterations 0, 1, every n-th
   /// Partition policy: call the partitioner at every step. Default: only when the structure
-  /// changed or the last assignment's imbalance under the newly measured costs exceeds
-  /// 1 + rebalance_tolerance (otherwise the assignment, and so the plan, is kept).
+  /// changed or the last assignment's imbalance under the newly measured costs exceeds both
+  /// 1 + rebalance_tolerance and (1 + rebalance_tolerance) x its imbalance when it was made
+  /// (otherwise the assignment, and so the plan, is kept). Imbalances are
+  /// partition::loop_imbalance with `loop_share` (each heavy loop's share counted apart).
   bool repartition_every_step = false;
   double rebalance_tolerance = 0.05;
+  double loop_share = partition::Options{}.loop_share;
   /// Let the engine skip recording while the structure repeats (false: record every step).
   bool reuse_structure = true;
 };

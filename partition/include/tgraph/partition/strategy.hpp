@@ -190,6 +190,14 @@ using StepPartitioner = std::function<Assignment(
 /// Strategy `method` as a StepPartitioner (UsageError for an unknown name).
 StepPartitioner step_partitioner(std::string_view method, const Options& options = {});
 
+/// Imbalance of `a` on `g` as its processors meet: the most loaded processor's work outside
+/// the heavy loops (each dynamic loop holding at least `loop_share` of the step's work, cost
+/// x iterations) plus, for each heavy loop, its most loaded processor's work in that loop,
+/// over the mean load of the whole step. At least the whole step's max / mean: a loop's
+/// processors wait for each other at every iteration, so a loop unbalanced one way is not
+/// made up by another unbalanced the other way. loop_share 0: the whole step's max / mean.
+double loop_imbalance(const StepGraph& g, const Assignment& a, double loop_share);
+
 /// Renames the K part labels of `a` (a partition of `g`) so that as many tasks as possible,
 /// matched in `prev` by stable key and counted once each, keep their previous processor: an
 /// optimal assignment of labels (Hungarian algorithm on the K x K overlap), so no other
