@@ -46,7 +46,8 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
   cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");
   cmd->add_option("--threshold", o.sticky_threshold,
-                  "sticky: rebalance when imbalance exceeds this x the last partition's (1.20)");
+                  "sticky: rebalance when imbalance exceeds this x the last partition's (1.20; "
+                  "run: 1.05)");
   cmd->add_option("--rebalance", n.rebalance, "sticky: greedy (whole objects) or scotch")
       ->check(CLI::IsMember({"greedy", "scotch"}));
   cmd->add_option("--sticky-fallback", n.sticky_fallback,

@@ -40,6 +40,7 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
   Assignment assignment;  // the assignment in use
   std::vector<std::uint32_t> last_iterations;
   double made_imbalance = 1.0;  // the assignment's loop_imbalance when it was made
+  bool informed = false;        // the assignment was made from measured costs
   bool have_prev = false;
   try {
     for (std::uint32_t s = 0; s < o.steps; ++s) {
@@ -70,11 +71,17 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
           if (s >= fixed->size())
             throw UsageError("live check: no assignment for step " + std::to_string(s));
           assignment = (*fixed)[s];
-        } else if (!have_prev || !reused || o.repartition_every_step ||
+        } else if (!informed || !reused || o.repartition_every_step ||
                    partition::loop_imbalance(cur.graph, assignment, o.loop_share) >
                        (1.0 + o.rebalance_tolerance) * std::max(1.0, made_imbalance)) {
-          assignment = (*partitioner)(cur.graph, ex.threads(), have_prev ? &measured : nullptr,
-                                      have_prev ? &assignment : nullptr);
+          // The first assignment is made before any cost is measured (every task 1 ns): the
+          // next starts afresh, not from it (sticky would keep it while its imbalance under
+          // the measured costs, falling64's 1.13, is within its threshold).
+          const bool from_prev = have_prev && informed;
+
+          assignment = (*partitioner)(cur.graph, ex.threads(), from_prev ? &measured : nullptr,
+                                      from_prev ? &assignment : nullptr);
+          informed = have_prev || !feed_costs;
           made_imbalance = partition::loop_imbalance(cur.graph, assignment, o.loop_share);
           m.partitioned = true;
         }

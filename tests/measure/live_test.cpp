@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -160,6 +162,42 @@ TEST(LiveCompare, NamesTheFirstDifferingDatum) {
   EXPECT_EQ(diff->offset, 8u);
   EXPECT_EQ(diff->differing_bytes, 1u);
   EXPECT_EQ(to_string(*diff), "first differing datum v (byte 8, 1 bytes differ)");
+}
+
+// The first step is partitioned before any cost is measured (every task 1 ns): the second
+// partitions afresh from measured costs rather than from that assignment, and only the
+// later steps start from the previous one.
+TEST(Live, PartitionsAfreshOnceCostsAreMeasuredThenFromThePreviousStep) {
+  struct Call {
+    bool from_prev;
+    bool unit_costs;
+  };
+  std::vector<Call> calls;
+  std::shared_ptr<partition::Strategy> sticky = partition::make_strategy("sticky");
+  const partition::StepPartitioner p = [&](const StepGraph& g, std::uint32_t k,
+                                           const StepGraph* pg, const Assignment* pa) {
+    const bool unit = std::all_of(g.tasks.begin(), g.tasks.end(),
+                                  [](const Task& t) { return t.cost_ns == 1; });
+    calls.push_back({pg != nullptr, unit});
+    return sticky->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
+  };
+  LiveOptions o;
+  o.exec.threads = 2;
+  o.exec.spin_ns = 20'000;
+  o.steps = 5;
+  o.baseline = false;
+  o.observe = false;
+  o.repartition_every_step = true;  // a call at every step
+  run_live([] { return make_live_engine("bars64"); }, &p, o);
+  ASSERT_EQ(calls.size(), 5u);
+  EXPECT_TRUE(calls[0].unit_costs);
+  EXPECT_FALSE(calls[0].from_prev);
+  EXPECT_FALSE(calls[1].unit_costs);
+  EXPECT_FALSE(calls[1].from_prev);
+  for (std::size_t i = 2; i < calls.size(); ++i) {
+    EXPECT_FALSE(calls[i].unit_costs) << i;
+    EXPECT_TRUE(calls[i].from_prev) << i;
+  }
 }
 
 TEST(Live, RefusesThePartitionPolicyWithoutAPartitioner) {
