@@ -55,14 +55,17 @@ Trace capture_variant(const SceneVariant& v, std::uint32_t steps) {
   return trace;
 }
 
-// A strategy as a step partitioner that keeps each call's statistics (migrations).
+// A strategy as a step partitioner that keeps each call's statistics (migrations). Live,
+// sticky rebalances at the live trigger's tolerance, as `tgraph run` does.
 struct RecordingPartitioner {
   std::shared_ptr<tp::Strategy> strategy;
   std::shared_ptr<std::vector<tp::Stats>> calls = std::make_shared<std::vector<tp::Stats>>();
-  tp::StepPartitioner callback() const {
-    return [s = strategy, c = calls](const StepGraph& g, std::uint32_t k, const StepGraph* pg,
-                                     const Assignment* pa) {
-      tp::Result r = s->partition(g, k, tp::Previous{pg, pa}, tp::Options{});
+  tp::StepPartitioner callback(double rebalance_tolerance) const {
+    tp::Options options;
+    options.sticky_threshold = 1.0 + rebalance_tolerance;
+    return [s = strategy, c = calls, options](const StepGraph& g, std::uint32_t k,
+                                              const StepGraph* pg, const Assignment* pa) {
+      tp::Result r = s->partition(g, k, tp::Previous{pg, pa}, options);
       c->push_back(r.stats);
       return std::move(r.assignment);
     };
@@ -88,7 +91,7 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   tp::StepPartitioner callback;
   if (m.policy == tr::Policy::kPartition) {
     rp = RecordingPartitioner{tp::make_strategy(m.method)};
-    callback = rp->callback();
+    callback = rp->callback(o.rebalance_tolerance);
   }
   const std::string scene = v.scene;
   const samples::SceneOptions so = scene_options(v);

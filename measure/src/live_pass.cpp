@@ -78,7 +78,6 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
           // next starts afresh, not from it (sticky would keep it while its imbalance under
           // the measured costs, falling64's 1.13, is within its threshold).
           const bool from_prev = have_prev && informed;
-
           assignment = (*partitioner)(cur.graph, ex.threads(), from_prev ? &measured : nullptr,
                                       from_prev ? &assignment : nullptr);
           informed = have_prev || !feed_costs;
