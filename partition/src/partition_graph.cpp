@@ -3,6 +3,8 @@
 
 #include <algorithm>
 
+#include "strategies.hpp"
+
 namespace tgraph::partition {
 
 UndirectedGraph library_graph(const StepGraph& g) {
@@ -62,22 +64,10 @@ std::vector<std::uint32_t> task_phases(const StepGraph& g, const std::vector<std
   std::vector<std::uint64_t> weight(n);
   for (TaskId t = 0; t < n; ++t) weight[t] = task_work(g, t);
   // Groups: 0 the tasks outside heavy loops, then one per heavy loop in loop order.
-  std::uint64_t total = 0;
-  std::vector<std::uint64_t> loop_work(g.loops.size(), 0);
-  for (TaskId t = 0; t < n; ++t) {
-    total += weight[t];
-    if (g.tasks[t].loop < g.loops.size()) loop_work[g.tasks[t].loop] += weight[t];
-  }
-  std::vector<std::uint32_t> loop_group(g.loops.size(), 0);
-  std::uint32_t groups = 1;
-  if (loop_share > 0.0)
-    for (LoopId l = 0; l < g.loops.size(); ++l)
-      if (static_cast<long double>(loop_work[l]) >= loop_share * static_cast<long double>(total))
-        loop_group[l] = groups++;
+  const detail::LoopGroups lg = detail::loop_groups(g, weight, loop_share);
+  const std::vector<std::uint32_t>& group = lg.group;
+  const std::uint32_t groups = lg.count;
   if (groups > 1 && rest_phases > 0) nphases = rest_phases;
-  std::vector<std::uint32_t> group(n, 0);
-  for (TaskId t = 0; t < n; ++t)
-    if (g.tasks[t].loop < g.loops.size()) group[t] = loop_group[g.tasks[t].loop];
   // Group 0: level l goes to the phase holding the middle of its work in the cumulative
   // order. A heavy loop is one phase (nphases - 1 + its group): cutting it by levels too
   // gives METIS more constraints than it balances on a small step (torso at K = 8: 6
