@@ -129,35 +129,50 @@ ReduceScope Executor::scope() const {
 
 namespace {
 
-/// The plan cache's key of a step's structure: what same_structure() compares (which
-/// confirms every hit), hashed word by word. StepGraph::structural_hash() hashes byte by
-/// byte for the files that store it (one dependent multiply per byte: tens of microseconds
-/// per step for a bars64-sized step, paid on every run_step); this key is never stored.
+/// The plan cache's key of a step's structure: the numbers same_structure() compares (which
+/// confirms every hit, names included), hashed word by word in four independent chains.
+/// StepGraph::structural_hash() hashes byte by byte for the files that store it (one
+/// dependent multiply per byte: tens of microseconds per step for a bars64-sized step, paid
+/// on every run_step); this key is never stored. Names are left to the comparison (steps
+/// whose numbers agree but whose names differ are told apart by same_structure() all the
+/// same).
 std::uint64_t structure_key(const StepGraph& g) {
-  std::uint64_t h = 0x243f6a8885a308d3ull ^ g.tasks.size();
-  auto mix = [&h](std::uint64_t v) {
+  // Four independent chains (a dependent multiply per word is the cost), joined at the end.
+  std::uint64_t h0 = 0x243f6a8885a308d3ull ^ g.tasks.size(),
+                h1 = 0x13198a2e03707344ull ^ g.data.size(),
+                h2 = 0xa4093822299f31d0ull ^ g.accesses.size(),
+                h3 = 0x082efa98ec4e6c89ull ^ ((g.loops.size() << 32) | g.objects.size());
+  const auto mix = [](std::uint64_t& h, std::uint64_t v) {
     h = (h ^ v) * 0x9e3779b97f4a7c15ull;
     h ^= h >> 29;
   };
-  const std::hash<std::string_view> text;
-  for (const auto& k : g.kinds) mix(text(k));
-  for (const auto& o : g.objects) mix(text(o.name));
-  for (const auto& d : g.data) {
-    mix(text(d.name));
-    mix((static_cast<std::uint64_t>(d.object) << 32) ^ d.bytes);
-  }
+  h3 ^= g.kinds.size() << 48;
+  for (const auto& d : g.data) mix(h3, (static_cast<std::uint64_t>(d.object) << 32) ^ d.bytes);
   for (const Task& t : g.tasks) {
-    mix((static_cast<std::uint64_t>(t.kind) << 32) | t.object);
-    mix((static_cast<std::uint64_t>(t.access_count) << 32) | t.loop);
-    mix(t.key);
+    mix(h0, (static_cast<std::uint64_t>(t.kind) << 32) | t.object);
+    mix(h1, (static_cast<std::uint64_t>(t.access_count) << 32) | t.loop);
+    mix(h2, t.key);
   }
-  for (const Access& a : g.accesses)
-    mix((static_cast<std::uint64_t>(a.datum) << 8) | static_cast<std::uint64_t>(a.mode));
+  const auto word = [](const Access& a) {
+    return (static_cast<std::uint64_t>(a.datum) << 8) | static_cast<std::uint64_t>(a.mode);
+  };
+  const std::size_t na = g.accesses.size();
+  std::size_t i = 0;
+  for (; i + 4 <= na; i += 4) {
+    mix(h0, word(g.accesses[i]));
+    mix(h1, word(g.accesses[i + 1]));
+    mix(h2, word(g.accesses[i + 2]));
+    mix(h3, word(g.accesses[i + 3]));
+  }
+  for (; i < na; ++i) mix(h3, word(g.accesses[i]));
   for (const Loop& l : g.loops) {
-    mix((static_cast<std::uint64_t>(l.condition) << 32) | l.max_iterations);
-    mix((static_cast<std::uint64_t>(l.first) << 32) | l.last);
+    mix(h0, (static_cast<std::uint64_t>(l.condition) << 32) | l.max_iterations);
+    mix(h1, (static_cast<std::uint64_t>(l.first) << 32) | l.last);
   }
-  return h;
+  mix(h0, h1);
+  mix(h0, h2);
+  mix(h0, h3);
+  return h0;
 }
 
 std::uint64_t hash_assignment(const Assignment& a) {

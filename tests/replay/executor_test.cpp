@@ -243,6 +243,30 @@ TEST(Executor, ReusesThePlanWhileTheStructureRepeats) {
   EXPECT_EQ(ex->plans_built(), 2u);
 }
 
+// The plan cache's key hashes the numbers of a structure, not its names: a step that differs
+// only in a datum's or a kind's name shares the key and must still get its own plan (the
+// exec graph it runs names its data in reports), and each of the two stays cached.
+TEST(Executor, TellsApartStepsThatDifferOnlyInNames) {
+  const StepGraph g = test::random_graph(5);
+  const Assignment a = test::random_assignment(g, 2, 1);
+  StepGraph renamed = g;
+  renamed.data[0].name += "'";
+  StepGraph rekinded = g;
+  rekinded.kinds[0] += "'";
+  for (Policy policy : {Policy::kSequential, Policy::kPartition}) {
+    auto ex = make_executor(policy, opts(2));
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    EXPECT_TRUE(ex->run_step(g, &a, w).rebuilt);
+    EXPECT_TRUE(ex->run_step(renamed, &a, w).rebuilt);
+    EXPECT_TRUE(ex->run_step(rekinded, &a, w).rebuilt);
+    EXPECT_FALSE(ex->run_step(g, &a, w).rebuilt);
+    EXPECT_FALSE(ex->run_step(renamed, &a, w).rebuilt);
+    EXPECT_EQ(ex->plans_built(), 3u);
+    EXPECT_EQ(ex->last_exec()->graph.data[0].name, g.data[0].name + "'");
+  }
+}
+
 TEST(Executor, RejectsBadAssignments) {
   const StepGraph g = test::random_graph(9);
   auto ex = make_executor(Policy::kPartition, opts(2));
@@ -362,6 +386,34 @@ TEST(Synthetic, SpinsForTheRecordedCost) {
   EXPECT_GT(walls[2], 1'000'000);  // about 2 ms, not 2 µs (calibration under load may be off)
   EXPECT_LT(walls[0], 200'000'000);  // not a unit error either
   EXPECT_GT(SyntheticWorkload::calibration().spin_iterations_per_ns, 0.0);
+}
+
+// Blocked waits are timed with the time-stamp counter, converted to nanoseconds by a factor
+// measured once: a reader on thread 1 waiting for a 20 ms writer on thread 0 reports about
+// 20 ms of waiting, never more than the step's wall time.
+TEST(Executor, TimesBlockedWaitsInNanoseconds) {
+  StepGraph g;
+  g.intern_kind("write");
+  g.intern_kind("read");
+  g.data = {{"x", kNoObject, 8}};
+  const Access w_acc[] = {{0, AccessMode::W}};
+  const Access r_acc[] = {{0, AccessMode::R}};
+  g.add_task(0, kNoObject, w_acc, 20'000'000, 1);
+  g.add_task(1, kNoObject, r_acc, 0, 2);
+  g.derive_edges();
+  const Assignment a{2, {0, 1}, {}};
+  ExecOptions o = opts(2);
+  o.spin_ns = 1'000'000;  // spins 1 ms, then parks: both halves of a wait are timed
+  auto ex = make_executor(Policy::kPartition, o);
+  SyntheticWorkload w({.cost_scale = 1.0, .touch = false});
+  w.set_step(g);
+  ex->run_step(g, &a, w);  // the first step also waits for the buffers' first touch
+  const ExecStepStats s = ex->run_step(g, &a, w);
+  ASSERT_EQ(s.threads.size(), 2u);
+  EXPECT_EQ(s.threads[1].blocked_waits, 1u);
+  EXPECT_GE(s.threads[1].wait_ns, 10'000'000);
+  EXPECT_LE(s.threads[1].wait_ns, s.wall_ns);
+  EXPECT_EQ(s.threads[0].wait_ns, 0);
 }
 
 }  // namespace
