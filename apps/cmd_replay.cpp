@@ -177,10 +177,7 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_flag("--check", live->check,
                 "Compare the final state with a sequential run of the same reduction order, bit "
                 "for bit");
-  // A live run pays every point of imbalance in wall time, and its trigger already waits for
-  // rebalance_tolerance (5 %): sticky rebalances from there too unless --threshold says
-  // otherwise (at 1.20, torso's loops ran up to 20 % off for 60 steps).
-  strategy->values.sticky_threshold = 1.0 + live->rebalance_tolerance;
+  strategy->values.sticky_threshold = meas::live_sticky_threshold(*live);  // unless --threshold
   add_strategy_flags(cmd, *strategy);
   cmd->callback([a, live, strategy] { run(*a, *live, *strategy); });
 }

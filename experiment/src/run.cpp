@@ -60,9 +60,9 @@ Trace capture_variant(const SceneVariant& v, std::uint32_t steps) {
 struct RecordingPartitioner {
   std::shared_ptr<tp::Strategy> strategy;
   std::shared_ptr<std::vector<tp::Stats>> calls = std::make_shared<std::vector<tp::Stats>>();
-  tp::StepPartitioner callback(double rebalance_tolerance) const {
+  tp::StepPartitioner callback(const meas::LiveOptions& live) const {
     tp::Options options;
-    options.sticky_threshold = 1.0 + rebalance_tolerance;
+    options.sticky_threshold = meas::live_sticky_threshold(live);
     return [s = strategy, c = calls, options](const StepGraph& g, std::uint32_t k,
                                               const StepGraph* pg, const Assignment* pa) {
       tp::Result r = s->partition(g, k, tp::Previous{pg, pa}, options);
@@ -91,7 +91,7 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   tp::StepPartitioner callback;
   if (m.policy == tr::Policy::kPartition) {
     rp = RecordingPartitioner{tp::make_strategy(m.method)};
-    callback = rp->callback(o.rebalance_tolerance);
+    callback = rp->callback(o);
   }
   const std::string scene = v.scene;
   const samples::SceneOptions so = scene_options(v);
