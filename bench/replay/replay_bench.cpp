@@ -10,12 +10,17 @@
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
 //    worksteal, barrier, and starpu when the build has StarPU; per step, the signals
 //    published, the waits that blocked and those that parked.
+//  * TaskOverheadInTurn/threads:N: partition / sequential per empty task, the two executors
+//    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
+//    the iterations of the two blocks' median step times), so that a change of the host's
+//    speed between repetitions, which this project's VM shows in spells, falls on both.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
 //  * SignalWait/<spin|futex>: the floor under a hand-off: two threads bouncing a counter
 //    through one std::atomic, by spinning on it or by std::atomic::wait/notify_one;
 //    latency_ns is one signal -> wait (half a round trip).
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <string>
@@ -189,6 +194,54 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+/// Median of `v` (reordered).
+double median(std::vector<double>& v) {
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
+  const auto k = static_cast<std::uint32_t>(state.range(0));
+  const StepGraph g = bars_like(64, 25);
+  const Assignment a = owner_like(g, k, 64);
+  ExecOptions o;
+  o.threads = k;
+  std::unique_ptr<Executor> seq = make_executor(Policy::kSequential, o);
+  std::unique_ptr<Executor> par = make_executor(Policy::kPartition, o);
+  SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
+  w.set_step(g);
+  std::uint64_t instances = 0;
+  for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
+  par->run_step(g, &a, w);
+  std::vector<double> ratios, seq_ns, par_ns, walls(block);
+  for (auto _ : state) {
+    // Each executor's block follows the other's, the order alternating between iterations.
+    const auto time_block = [&](Executor& ex, const Assignment* as) {
+      for (std::uint32_t i = 0; i < block; ++i)
+        walls[i] = static_cast<double>(ex.run_step(g, as, w).wall_ns);
+      return median(walls);
+    };
+    double s = 0, p = 0;
+    if (ratios.size() % 2 == 0) {
+      s = time_block(*seq, nullptr);
+      p = time_block(*par, &a);
+    } else {
+      p = time_block(*par, &a);
+      s = time_block(*seq, nullptr);
+    }
+    ratios.push_back(p / s);
+    seq_ns.push_back(s);
+    par_ns.push_back(p);
+  }
+  const auto per_task = static_cast<double>(instances);
+  state.counters["ratio"] = median(ratios);
+  state.counters["sequential_ns_per_task"] = median(seq_ns) / per_task;
+  state.counters["partition_ns_per_task"] = median(par_ns) / per_task;
+  std::sort(ratios.begin(), ratios.end());
+  state.counters["ratio_p10"] = ratios[ratios.size() / 10];
+  state.counters["ratio_p90"] = ratios[ratios.size() * 9 / 10];
+}
+
 void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
   const auto k = static_cast<std::uint32_t>(state.range(0));
   const StepGraph g = bars_like(64, 25);
@@ -307,6 +360,15 @@ void register_all(bench::Size size) {
         bench::timed(b, size, 0.5);
       }
   add("BM_TaskOverhead", BM_TaskOverhead, Policy::kSequential, {1});
+  {
+    const auto block = bench::by_size<std::uint32_t>(size, 2, 100, 200);
+    auto* b = benchmark::RegisterBenchmark("BM_TaskOverheadInTurn", BM_TaskOverheadInTurn, block)
+                  ->ArgName("threads")
+                  ->Unit(benchmark::kMillisecond)
+                  ->UseRealTime()
+                  ->Iterations(bench::by_size<benchmark::IterationCount>(size, 2, 20, 40));
+    for (const std::int64_t t : {1, 2}) b->Arg(t);
+  }
   for (const Policy p : parallel)
     add("BM_TaskOverhead", BM_TaskOverhead, p,
         smoke ? std::vector<std::int64_t>{2} : std::vector<std::int64_t>{1, 2});
