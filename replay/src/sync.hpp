@@ -81,7 +81,9 @@ class Parking {
     if (ok(v)) return v;
     const std::int64_t t0 = wait_ticks();
     std::int64_t t = t0;
-    while (t - t0 < spin_ticks_) {
+    // (t < t0: the thread moved to a core whose counter is behind; it parks rather than
+    // spin for as long as the counters differ.)
+    while (t - t0 < spin_ticks_ && t >= t0) {
       for (int i = 0; i < 64; ++i) {
         if (oversubscribed_) {
           std::this_thread::yield();
