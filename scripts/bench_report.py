@@ -47,7 +47,8 @@ ABOUT = {
                     "one std::atomic, spinning or futex) and through the partition executor "
                     "(`BM_Handoff`, per hand-off, by spin budget before parking); each "
                     "policy on a synthetic bars64-like step (`BM_Policy`); executor cost "
-                    "per task instance with empty tasks (`BM_TaskOverhead`).",
+                    "per task instance with empty tasks (`BM_TaskOverhead`), and partition / "
+                    "sequential with the two run in turn (`BM_TaskOverheadInTurn`).",
     "incremental_bench": "What a contact change costs on falling, median over the steps "
                          "whose structure changed: graph update, plan rebuild, partitioning "
                          "(METIS, sticky with each fallback), the whole "
@@ -316,7 +317,7 @@ def ratios(all_runs):
     out.append("|---|---|---|---|")
     for t in (1, 2):
         base = med(r, f"BM_TaskOverhead/partition/threads:{t}", "ns_per_task")
-        for pol in ("sequential", "partition", "worksteal", "barrier", "starpu"):
+        for pol in ("sequential", "partition", "worksteal", "barrier", "omp-tasks", "starpu"):
             v = med(r, f"BM_TaskOverhead/{pol}/threads:{t}", "ns_per_task")
             if v is None:
                 continue
@@ -324,6 +325,17 @@ def ratios(all_runs):
     if not any(n.startswith("BM_TaskOverhead/starpu") for n in r):
         out.append("")
         out.append("(This build has no StarPU: `starpu` is not measured.)")
+    turns = [(t, med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio"),
+              med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio_p10"),
+              med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio_p90")) for t in (1, 2)]
+    if any(v is not None for _, v, _, _ in turns):
+        out.append("")
+        out.append("Partition / sequential with the two executors run in turn "
+                   "(`BM_TaskOverheadInTurn/threads:N`: blocks of 200 steps each, the median "
+                   "of 40 block pairs' ratios, robust to a change of the host's speed between "
+                   "repetitions): " + "; ".join(
+                       f"{t} thread{'s' if t > 1 else ''} {fmt(v)} (p10 {fmt(lo)}, p90 {fmt(hi)})"
+                       for t, v, lo, hi in turns if v is not None) + ".")
     out.append("")
 
     out.append("### Signal -> wait")
