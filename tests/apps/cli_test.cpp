@@ -195,7 +195,9 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
     EXPECT_TRUE(row["replay_failure"].is_null()) << row.dump();  // a failed row fails the demo
     EXPECT_GT(row["wall_ns"].get<double>(), 0.0) << row.dump();
     EXPECT_GT(row["sequential_wall_ns"].get<double>(), 0.0) << row.dump();
-    if (row["partitioned"].get<bool>()) EXPECT_GE(row["imbalance"].get<double>(), 1.0) << row.dump();
+    if (row["partitioned"].get<bool>()) {
+      EXPECT_GE(row["imbalance"].get<double>(), 1.0) << row.dump();
+    }
   }
   for (const char* m : {"owner", "metis", "scotch", "sticky", "list", "roundrobin", "random", "worksteal", "barrier"})
     EXPECT_NE(std::find(names.begin(), names.end(), m), names.end()) << m;

@@ -692,7 +692,9 @@ TEST(TaskOrder, ListOrdersEveryStrategysMappingWithoutDeadlockLoopsTogether) {
           for (TaskId t : r.assignment.order[p]) {
             const LoopId l = g.tasks[t].loop;
             if (l != open && open != kNoLoop) closed.insert(open);
-            if (l != kNoLoop) EXPECT_EQ(closed.count(l), 0u) << method << " seed " << seed;
+            if (l != kNoLoop) {
+              EXPECT_EQ(closed.count(l), 0u) << method << " seed " << seed;
+            }
             open = l;
           }
         }

@@ -288,8 +288,9 @@ TEST(CwReduction, OrdersRunWithoutDeadlockOnRandomProgramsOfEveryShape) {
         SyntheticWorkload w({.cost_scale = 0.0});
         w.set_step(g);
         ASSERT_NO_THROW(ex->run_step(g, &a, w)) << name << " seed " << seed << " k " << k;
-        if (!ex->last_exec()->added_edges)
+        if (!ex->last_exec()->added_edges) {
           EXPECT_EQ(ex->order_fallbacks(), 0u) << name << " seed " << seed << " k " << k;
+        }
         fallbacks += ex->order_fallbacks();
       }
     }

@@ -159,8 +159,9 @@ inline void expect_valid_order(const StepGraph& g, const std::vector<TimelineTas
   for (const Loop& l : g.loops)
     for (TaskId v = l.first; v < l.last; ++v)
       for (std::uint32_t i = 1; i < l.iterations; ++i) {
-        if (check.loop_gate)
+        if (check.loop_gate) {
           EXPECT_GE(start_of(v, i), end_of(l.last - 1, i - 1)) << "gate of loop, task " << v;
+        }
         EXPECT_GE(start_of(v, i), end_of(v, i - 1)) << "task " << v << " overtook itself";
       }
 }
