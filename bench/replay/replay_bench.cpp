@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "bench_main.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/synthetic.hpp"
@@ -192,12 +193,6 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   state.counters["ns_per_task"] =
       benchmark::Counter(static_cast<double>(state.iterations() * instances),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-}
-
-/// Median of `v` (reordered).
-double median(std::vector<double>& v) {
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
