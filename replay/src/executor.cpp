@@ -175,17 +175,6 @@ std::uint64_t structure_key(const StepGraph& g) {
   return h0;
 }
 
-std::uint64_t hash_assignment(const Assignment& a) {
-  std::uint64_t h = 1469598103934665603ull ^ a.k;
-  auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
-  for (ProcId p : a.proc) mix(p);
-  for (const auto& o : a.order) {
-    mix(0xabcdefull);
-    for (TaskId t : o) mix(t);
-  }
-  return h;
-}
-
 void validate_assignment(const StepGraph& g, const Assignment& a, std::uint32_t threads) {
   if (a.k != threads)
     throw UsageError("assignment has k = " + std::to_string(a.k) + " processors but " +
@@ -224,14 +213,16 @@ ExecStepStats Executor::run_step(const StepGraph& g, const Assignment* a, Worklo
   const std::vector<bool>* reducible = w.reducible();
   std::uint64_t key = structure_key(g) * 31 + static_cast<std::uint64_t>(mode) * 7 +
                       static_cast<std::uint64_t>(reduce);
-  if (use_assignment) key ^= hash_assignment(*a) * 0x9e3779b97f4a7c15ull;
+  // The assignment is not hashed (one dependent multiply per task on every step): the
+  // entries of one structure are few and their assignments are compared (a memcmp) before
+  // their structure.
   if (reducible != nullptr) key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;
 
   std::shared_ptr<CacheEntry> entry;
   for (auto& e : cache_) {
     if (e->key == key && (reducible ? e->reducible == *reducible : e->reducible.empty()) &&
-        e->shape.same_structure(g) &&
-        (!use_assignment || (e->has_assignment && e->assignment == *a))) {
+        (!use_assignment || (e->has_assignment && e->assignment == *a)) &&
+        e->shape.same_structure(g)) {
       entry = e;
       break;
     }
