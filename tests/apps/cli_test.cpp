@@ -13,6 +13,7 @@
 
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/version.hpp"
+#include "../scratch_dir.hpp"
 
 namespace {
 
@@ -34,10 +35,7 @@ std::string slurp(const fs::path& p) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("tgraph_cli_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = tgraph::test::scratch_dir("tgraph_cli_");
   }
   void TearDown() override { fs::remove_all(dir_); }
 

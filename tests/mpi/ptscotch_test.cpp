@@ -18,6 +18,7 @@
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/partition_graph.hpp"
 #include "tgraph/partition/strategy.hpp"
+#include "../scratch_dir.hpp"
 
 // The cases exist in builds whose tgraph::mpi has PT-Scotch.
 #if defined(TGRAPH_HAVE_PTSCOTCH)
@@ -41,10 +42,7 @@ std::string slurp(const fs::path& p) {
 class PtScotch : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("tgraph_ptscotch_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    dir_ = tgraph::test::scratch_dir("tgraph_ptscotch_");
   }
   void TearDown() override { fs::remove_all(dir_); }
 

@@ -16,6 +16,7 @@
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/mpi/replay.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "../scratch_dir.hpp"
 
 namespace tgraph::mpi {
 namespace {
@@ -27,13 +28,7 @@ struct Outcome {
   std::string out, err;
 };
 
-fs::path scratch() {
-  const fs::path d =
-      fs::temp_directory_path() / ("tgraph_mpi_test_" + std::to_string(::getpid()) + "_" +
-                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(d);
-  return d;
-}
+fs::path scratch() { return tgraph::test::scratch_dir("tgraph_mpi_test_"); }
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);

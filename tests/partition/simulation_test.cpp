@@ -16,6 +16,7 @@
 #include "tgraph/partition/simulation.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
+#include "../scratch_dir.hpp"
 
 namespace tgraph::partition {
 namespace {
@@ -348,10 +349,7 @@ TEST(SimgridEngine, ReportsADeadlockedOrder) {
 class PlatformFiles : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("tgraph_platform_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
+    dir_ = tgraph::test::scratch_dir("tgraph_platform_");
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string write(const std::string& name, const std::string& text) {

@@ -26,6 +26,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "../scratch_dir.hpp"
 
 namespace tgraph {
 namespace {
@@ -94,11 +95,7 @@ bool running(const Child& c, int& code) {
 class Files : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("tgraph_robust_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+    dir_ = tgraph::test::scratch_dir("tgraph_robust_");
   }
   void TearDown() override { fs::remove_all(dir_); }
 
