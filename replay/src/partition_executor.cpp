@@ -319,16 +319,23 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   }
 
   // Runs ops[pc] and the plain task ops after it; returns the first op past them. With
-  // `Watch`, the slot tells the watchdog what runs and that the thread progresses.
+  // `Watch`, the slot tells the watchdog what runs and that the thread progresses. Out of
+  // line, so that what the loop keeps across the body's call stays in registers (inlined
+  // into run_proc, it reloaded the workload, the graph and the bounds from the stack at
+  // every task); the TaskRun is built once, each task setting its two ids.
   template <bool Watch>
-  static std::size_t run_plain(const Op* ops, std::size_t pc, std::size_t n_ops,
-                               const ExecGraph& x, Workload& w, std::uint32_t iter,
-                               std::uint32_t p, Slot& slot) {
+  [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc,
+                                                 std::size_t n_ops, const ExecGraph& x,
+                                                 Workload& w, std::uint32_t iter,
+                                                 std::uint32_t p, Slot& slot) {
     const std::size_t first = pc;
+    TaskRun run{&x, 0, kNoTask, iter, p};
     do {
       const Op& op = ops[pc];
       if constexpr (Watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // a report
-      w.run(TaskRun{&x, op.task, op.origin, iter, p});
+      run.task = op.task;
+      run.origin = op.origin;
+      w.run(run);
       ++pc;
     } while (pc < n_ops && plain(ops[pc]));
     if constexpr (Watch)  // relaxed: compared between two samples of the watchdog only
