@@ -312,34 +312,28 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     return out;
   }
 
-  // A task op that waits for nothing and publishes nothing.
-  static bool plain(const Op& op) {
-    return op.kind == OpKind::kTask && op.wait_begin == op.wait_end && !op.signal &&
-           !op.is_break;
-  }
-
-  // Runs ops[pc] and the plain task ops after it; returns the first op past them. With
-  // `Watch`, the slot tells the watchdog what runs and that the thread progresses. Out of
-  // line, so that what the loop keeps across the body's call stays in registers (inlined
-  // into run_proc, it reloaded the workload, the graph and the bounds from the stack at
-  // every task); the TaskRun is built once, each task setting its two ids.
+  // Runs the ops[pc].plain_run ops from ops[pc] on (tasks that neither wait nor publish); returns
+  // the first op past them. With `Watch`, the slot tells the watchdog what runs and that the
+  // thread progresses. Out of line, so that what the loop keeps across the body's call stays
+  // in registers (inlined into run_proc, it reloaded the workload, the graph and the bounds
+  // from the stack at every task); the TaskRun is built once, each task setting its two ids.
   template <bool Watch>
   [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc,
-                                                 std::size_t n_ops, const ExecGraph& x,
-                                                 Workload& w, std::uint32_t iter,
-                                                 std::uint32_t p, Slot& slot) {
-    const std::size_t first = pc;
+                                                 const ExecGraph& x, Workload& w,
+                                                 std::uint32_t iter, std::uint32_t p,
+                                                 Slot& slot) {
+    const std::uint32_t n = ops[pc].plain_run;
+    const std::size_t end = pc + n;
     TaskRun run{&x, 0, kNoTask, iter, p};
-    do {
+    for (; pc < end; ++pc) {
       const Op& op = ops[pc];
       if constexpr (Watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // a report
       run.task = op.task;
       run.origin = op.origin;
       w.run(run);
-      ++pc;
-    } while (pc < n_ops && plain(ops[pc]));
+    }
     if constexpr (Watch)  // relaxed: compared between two samples of the watchdog only
-      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + (pc - first),
+      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + n,
                           std::memory_order_relaxed);
     return pc;
   }
@@ -406,12 +400,11 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
             break;
           }
           case OpKind::kTask: {
-            if (!observe && plain(op)) {
+            if (!observe && op.plain_run != 0) {
               // A run of tasks that neither wait nor publish: the sequential loop.
-              const std::size_t first = pc;
-              pc = watch ? run_plain<true>(ops, pc, n_ops, x, w, iter, p, slot)
-                         : run_plain<false>(ops, pc, n_ops, x, w, iter, p, slot);
-              tasks += pc - first;
+              tasks += op.plain_run;
+              pc = watch ? run_plain<true>(ops, pc, x, w, iter, p, slot)
+                         : run_plain<false>(ops, pc, x, w, iter, p, slot);
               break;
             }
             for (auto i = op.wait_begin; i < op.wait_end; ++i) {

@@ -214,6 +214,15 @@ void finish_plan(const ExecGraph& x, PartitionPlan& plan) {
   for (ProcPlan& pp : plan.procs)
     for (Op& op : pp.ops)
       if (op.kind == OpKind::kTask) op.signal = signal[op.task];
+  for (ProcPlan& pp : plan.procs) {
+    std::uint32_t run = 0;
+    for (auto op = pp.ops.rbegin(); op != pp.ops.rend(); ++op) {
+      const bool plain = op->kind == OpKind::kTask && op->wait_begin == op->wait_end &&
+                         !op->signal && !op->is_break;
+      run = plain ? run + 1 : 0;
+      op->plain_run = run;
+    }
+  }
   const auto owner = first_accessor_owner(x);
   const std::size_t k = plan.procs.size();
   for (ProcPlan& pp : plan.procs) pp.owned.clear();

@@ -46,6 +46,9 @@ struct alignas(32) Op {
   std::uint32_t wait_begin = 0, wait_end = 0;
   std::uint32_t jump = 0;       // kLoopEnd: first op of the body
   TaskId origin = kNoTask;      // kTask: the original task (ExecGraph::origin)
+  // kTask: how many ops from this one on are tasks that wait for nothing and publish
+  // nothing (the executor runs them in one loop, as the sequential program); 0: not this one.
+  std::uint32_t plain_run = 0;
   friend bool operator==(const Op&, const Op&) = default;
 };
 static_assert(sizeof(Op) == 32);

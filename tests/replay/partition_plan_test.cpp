@@ -105,6 +105,47 @@ TEST(PartitionPlan, ElisionKeepsOnlyTheLastWaitOnEachProcessor) {
   EXPECT_FALSE(detail::same_programs(elided, every));
 }
 
+// The plain runs the executor runs as one loop: per task op, how many ops from it on wait for
+// nothing and publish nothing (tasks only: a loop's begin and end ops cut a run).
+std::vector<std::uint32_t> plain_runs(const PartitionPlan& plan, ProcId p) {
+  std::vector<std::uint32_t> out;
+  for (const detail::Op& op : plan.procs[p].ops) out.push_back(op.plain_run);
+  return out;
+}
+
+TEST(PartitionPlan, PlainRunsStopAtAWaitASignalAndALoop) {
+  // Processor 0: t0 (signals: t2 reads d0), t1, t3, t4; processor 1: t2 (waits for t0,
+  // signals: t3 reads d1), t5. t3 waits for t2.
+  const StepGraph g = chain_graph({{{0, AccessMode::W}},
+                                   {{2, AccessMode::W}},
+                                   {{0, AccessMode::R}, {1, AccessMode::W}},
+                                   {{1, AccessMode::R}},
+                                   {{2, AccessMode::R}},
+                                   {{3, AccessMode::W}}},
+                                  4);
+  const Assignment a = on({0, 0, 1, 0, 0, 1}, 2);
+  const PartitionPlan plan = detail::build_plan(lower(g, &a, CwMode::kReduce), 2, true, true);
+  ASSERT_EQ(tasks_of(plan, 0), (std::vector<TaskId>{0, 1, 3, 4}));
+  EXPECT_EQ(plain_runs(plan, 0), (std::vector<std::uint32_t>{0, 1, 0, 1}));
+  EXPECT_EQ(plain_runs(plan, 1), (std::vector<std::uint32_t>{0, 1}));
+  // One processor: nothing waits or signals; a loop's begin and end ops and its break task
+  // (which publishes the loop's decision) cut the runs.
+  StepGraph looped = chain_graph({{{0, AccessMode::W}},
+                                  {{0, AccessMode::R}, {1, AccessMode::W}},
+                                  {{1, AccessMode::R}, {2, AccessMode::W}},
+                                  {{2, AccessMode::R}},
+                                  {{0, AccessMode::R}}},
+                                 3);
+  for (TaskId t : {1u, 2u, 3u}) looped.tasks[t].loop = 0;
+  looped.loops.push_back({2, 1, 4, 3, 0});
+  looped.derive_edges();
+  const Assignment one = on({0, 0, 0, 0, 0}, 1);
+  const PartitionPlan single =
+      detail::build_plan(lower(looped, &one, CwMode::kReduce), 1, true, true);
+  // t0, loop begin, t1, t2, t3 (break), loop end, t4.
+  EXPECT_EQ(plain_runs(single, 0), (std::vector<std::uint32_t>{1, 0, 2, 1, 0, 0, 1}));
+}
+
 TEST(PartitionPlan, ReadinessRuleCountsExecutionsByWaitKind) {
   const WaitPoint once{0, kNoLoop, WaitKind::kOnce};
   const WaitPoint same{0, 0, WaitKind::kSameIter};
