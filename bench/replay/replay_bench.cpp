@@ -14,6 +14,8 @@
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
 //    speed between repetitions, which this project's VM shows in spells, falls on both.
+//    `handoff_ns`: after each pair of blocks, the host's raw hand-off latency (two threads
+//    bouncing a counter): the state of the machine the ratios were measured in.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -32,6 +34,7 @@
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/synthetic.hpp"
+#include "tgraph/replay/thread_binding.hpp"
 
 namespace tgraph::replay {
 namespace {
@@ -195,6 +198,41 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
+/// The host's cross-thread hand-off latency at this moment: two threads bouncing a counter
+/// (spinning), half the median round trip over blocks of 100. On this project's VM it moves
+/// in spells of seconds between about 30 ns (the host runs the two vCPUs on one core's two
+/// hardware threads: they share that core, two threads are hardly faster than one), 60 ns
+/// (two cores near each other: the quiet machine) and 250 ns (two cores far apart: every
+/// wait of a 2-thread step on another thread's task pays it).
+double handoff_latency_ns() {
+  if (hardware_pus() < 2) return 0;
+  constexpr int kBlocks = 20, kRounds = 100;
+  // acquire/release: as an executor's completion counter (each side reads the other's write).
+  std::atomic<std::uint64_t> counter{0};
+  // The main thread is on thread slot 0's core (the partition executor pinned it); the
+  // partner takes slot 1's, the executor's second thread's.
+  std::thread partner([&counter] {
+    BindingScope binding;
+    binding.pin(1);
+    for (std::uint64_t v = 1; v < 2ull * kBlocks * kRounds; v += 2) {
+      while (counter.load(std::memory_order_acquire) != v) cpu_relax();
+      counter.store(v + 1, std::memory_order_release);
+    }
+  });
+  std::vector<double> half_round_trips;
+  std::uint64_t next = 1;
+  for (int b = 0; b < kBlocks; ++b) {
+    const std::int64_t t0 = now_ns();
+    for (int r = 0; r < kRounds; ++r, next += 2) {
+      counter.store(next, std::memory_order_release);
+      while (counter.load(std::memory_order_acquire) != next + 1) cpu_relax();
+    }
+    half_round_trips.push_back(static_cast<double>(now_ns() - t0) / (2.0 * kRounds));
+  }
+  partner.join();
+  return median(half_round_trips);
+}
+
 void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   const auto k = static_cast<std::uint32_t>(state.range(0));
   const StepGraph g = bars_like(64, 25);
@@ -208,7 +246,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
-  std::vector<double> ratios, seq_ns, par_ns, walls(block);
+  std::vector<double> ratios, seq_ns, par_ns, handoff, walls(block);
   for (auto _ : state) {
     // Each executor's block follows the other's, the order alternating between iterations.
     const auto time_block = [&](Executor& ex, const Assignment* as) {
@@ -227,6 +265,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     ratios.push_back(p / s);
     seq_ns.push_back(s);
     par_ns.push_back(p);
+    handoff.push_back(handoff_latency_ns());
   }
   const auto per_task = static_cast<double>(instances);
   state.counters["ratio"] = median(ratios);
@@ -235,6 +274,11 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::sort(ratios.begin(), ratios.end());
   state.counters["ratio_p10"] = ratios[ratios.size() / 10];
   state.counters["ratio_p90"] = ratios[ratios.size() * 9 / 10];
+  // The host's hand-off latency over the same iterations (handoff_latency_ns()).
+  state.counters["handoff_ns"] = median(handoff);
+  std::sort(handoff.begin(), handoff.end());
+  state.counters["handoff_ns_p10"] = handoff[handoff.size() / 10];
+  state.counters["handoff_ns_p90"] = handoff[handoff.size() * 9 / 10];
 }
 
 void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
