@@ -14,8 +14,9 @@
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
 //    speed between repetitions, which this project's VM shows in spells, falls on both.
-//    `handoff_ns`: after each pair of blocks, the host's raw hand-off latency (two threads
-//    bouncing a counter): the state of the machine the ratios were measured in.
+//    After each pair of blocks, the host is probed (probe_host()): `handoff_ns`, two threads
+//    bouncing a counter, and `core_speed` (p10, p90), the second thread's core's speed over
+//    the first's when both run the same empty steps at once: 1 on a quiet machine.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -198,26 +199,46 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-/// The host's cross-thread hand-off latency at this moment: two threads bouncing a counter
-/// (spinning), half the median round trip over blocks of 100. On this project's VM it moves
-/// in spells of seconds between about 30 ns (the host runs the two vCPUs on one core's two
-/// hardware threads: they share that core, two threads are hardly faster than one), 60 ns
-/// (two cores near each other: the quiet machine) and 250 ns (two cores far apart: every
-/// wait of a 2-thread step on another thread's task pays it).
-double handoff_latency_ns() {
-  if (hardware_pus() < 2) return 0;
-  constexpr int kBlocks = 20, kRounds = 100;
-  // acquire/release: as an executor's completion counter (each side reads the other's write).
+/// The state of the host at this moment, for reading a ratio measured next to it.
+struct HostProbe {
+  double handoff_ns = 0;  ///< one way, two threads bouncing a counter
+  double core_speed = 0;  ///< thread 1's core's speed over thread 0's, both busy at once
+};
+
+/// Two threads on thread slots 0 and 1's cores (the partition executor pinned the calling
+/// thread to slot 0's; the partner takes slot 1's, the executor's second thread's):
+/// first they bounce a counter (half the median round trip over blocks of 100), then each
+/// runs the same block of sequential empty steps of `g` at the same time (its own executor
+/// and workload; median step time t0, t1; core_speed = t0 / t1). On this project's VM the
+/// hand-off stays near 33 ns while the two vCPUs' speeds move apart in spells of
+/// milliseconds to seconds: a block of bars64-like empty steps takes 120 us on a vCPU in its
+/// fast state and about 200 us in its slow one, often one vCPU in each.
+HostProbe probe_host(const StepGraph& g) {
+  HostProbe h;
+  if (hardware_pus() < 2) return h;
+  constexpr int kBlocks = 20, kRounds = 100, kSteps = 50;
+  const auto step_time = [&g] {
+    std::unique_ptr<Executor> ex = make_executor(Policy::kSequential, ExecOptions{});
+    SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
+    w.set_step(g);
+    ex->run_step(g, nullptr, w);
+    std::vector<double> walls(kSteps);
+    for (double& t : walls) t = static_cast<double>(ex->run_step(g, nullptr, w).wall_ns);
+    return median(walls);
+  };
+  // acquire/release: as an executor's completion counter (each side reads the other's
+  // write); the counter also starts the two blocks of steps together.
   std::atomic<std::uint64_t> counter{0};
-  // The main thread is on thread slot 0's core (the partition executor pinned it); the
-  // partner takes slot 1's, the executor's second thread's.
-  std::thread partner([&counter] {
+  double t1 = 0;
+  std::thread partner([&] {
     BindingScope binding;
     binding.pin(1);
     for (std::uint64_t v = 1; v < 2ull * kBlocks * kRounds; v += 2) {
       while (counter.load(std::memory_order_acquire) != v) cpu_relax();
       counter.store(v + 1, std::memory_order_release);
     }
+    while (counter.load(std::memory_order_acquire) != 2ull * kBlocks * kRounds + 1) cpu_relax();
+    t1 = step_time();
   });
   std::vector<double> half_round_trips;
   std::uint64_t next = 1;
@@ -229,8 +250,12 @@ double handoff_latency_ns() {
     }
     half_round_trips.push_back(static_cast<double>(now_ns() - t0) / (2.0 * kRounds));
   }
+  counter.store(next, std::memory_order_release);
+  const double t0 = step_time();
   partner.join();
-  return median(half_round_trips);
+  h.handoff_ns = median(half_round_trips);
+  h.core_speed = t0 / t1;
+  return h;
 }
 
 void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
@@ -246,7 +271,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
-  std::vector<double> ratios, seq_ns, par_ns, handoff, walls(block);
+  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, walls(block);
   for (auto _ : state) {
     // Each executor's block follows the other's, the order alternating between iterations.
     const auto time_block = [&](Executor& ex, const Assignment* as) {
@@ -265,7 +290,9 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     ratios.push_back(p / s);
     seq_ns.push_back(s);
     par_ns.push_back(p);
-    handoff.push_back(handoff_latency_ns());
+    const HostProbe h = probe_host(g);
+    handoff.push_back(h.handoff_ns);
+    core_speed.push_back(h.core_speed);
   }
   const auto per_task = static_cast<double>(instances);
   state.counters["ratio"] = median(ratios);
@@ -274,11 +301,12 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::sort(ratios.begin(), ratios.end());
   state.counters["ratio_p10"] = ratios[ratios.size() / 10];
   state.counters["ratio_p90"] = ratios[ratios.size() * 9 / 10];
-  // The host's hand-off latency over the same iterations (handoff_latency_ns()).
+  // The host over the same iterations (probe_host()).
   state.counters["handoff_ns"] = median(handoff);
-  std::sort(handoff.begin(), handoff.end());
-  state.counters["handoff_ns_p10"] = handoff[handoff.size() / 10];
-  state.counters["handoff_ns_p90"] = handoff[handoff.size() * 9 / 10];
+  state.counters["core_speed"] = median(core_speed);
+  std::sort(core_speed.begin(), core_speed.end());
+  state.counters["core_speed_p10"] = core_speed[core_speed.size() / 10];
+  state.counters["core_speed_p90"] = core_speed[core_speed.size() * 9 / 10];
 }
 
 void BM_OmpTasks(benchmark::State& state, bool mutex, bool iteration_wait) {
