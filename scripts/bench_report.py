@@ -336,6 +336,14 @@ def ratios(all_runs):
                    "repetitions): " + "; ".join(
                        f"{t} thread{'s' if t > 1 else ''} {fmt(v)} (p10 {fmt(lo)}, p90 {fmt(hi)})"
                        for t, v, lo, hi in turns if v is not None) + ".")
+        speed = med(r, "BM_TaskOverheadInTurn/threads:2", "core_speed")
+        if speed is not None:
+            out.append("The host during the 2-thread run (probed after each block pair): "
+                       f"second core's speed over the first's {fmt(speed)} (p10 "
+                       f"{fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'core_speed_p10'))}, "
+                       f"p90 {fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'core_speed_p90'))}; "
+                       "1 on a quiet machine), hand-off "
+                       f"{fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'probe_handoff_ns'))} ns.")
     out.append("")
 
     out.append("### Signal -> wait")

@@ -14,9 +14,9 @@
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
 //    speed between repetitions, which this project's VM shows in spells, falls on both.
-//    After each pair of blocks, the host is probed (probe_host()): `handoff_ns`, two threads
-//    bouncing a counter, and `core_speed` (p10, p90), the second thread's core's speed over
-//    the first's when both run the same empty steps at once: 1 on a quiet machine.
+//    After each pair of blocks, the host is probed (probe_host()): `probe_handoff_ns`, two
+//    threads bouncing a counter, and `core_speed` (p10, p90), the second thread's core's
+//    speed over the first's when both run the same empty steps at once: 1 on a quiet machine.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -302,7 +302,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   state.counters["ratio_p10"] = ratios[ratios.size() / 10];
   state.counters["ratio_p90"] = ratios[ratios.size() * 9 / 10];
   // The host over the same iterations (probe_host()).
-  state.counters["handoff_ns"] = median(handoff);
+  state.counters["probe_handoff_ns"] = median(handoff);
   state.counters["core_speed"] = median(core_speed);
   std::sort(core_speed.begin(), core_speed.end());
   state.counters["core_speed_p10"] = core_speed[core_speed.size() / 10];
