@@ -9,14 +9,16 @@
 //  * TaskOverhead/<policy>/threads:N: the same step with empty bodies (no spin, no data):
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
 //    worksteal, barrier, and starpu when the build has StarPU; per step, the signals
-//    published, the waits that blocked and those that parked.
+//    published, the waits that blocked and those that parked; `core_speed` and
+//    `probe_step_us` as below, probed once after the repetition's steps.
 //  * TaskOverheadInTurn/threads:N: partition / sequential per empty task, the two executors
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
 //    speed between repetitions, which this project's VM shows in spells, falls on both.
 //    After each pair of blocks, the host is probed (probe_host()): `probe_handoff_ns`, two
 //    threads bouncing a counter, and `core_speed` (p10, p90), the second thread's core's
-//    speed over the first's when both run the same empty steps at once: 1 on a quiet machine.
+//    speed over the first's when both run the same empty steps at once: 1 on a quiet machine;
+//    `probe_step_us`, the first thread's median step meanwhile (its core's own speed).
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -163,6 +165,69 @@ void BM_Policy(benchmark::State& state, Policy policy) {
   for (auto _ : state) ex->run_step(g, &a, w);
 }
 
+/// The state of the host at this moment, for reading a ratio measured next to it.
+struct HostProbe {
+  double handoff_ns = 0;  ///< one way, two threads bouncing a counter
+  double core_speed = 0;  ///< thread 1's core's speed over thread 0's, both busy at once
+  double step_us = 0;     ///< thread 0's median empty step meanwhile (its core's own speed)
+};
+
+/// Two threads on thread slots 0 and 1's cores (the calling thread for the probe's length,
+/// as the executors pin their threads 0 and 1):
+/// first they bounce a counter (half the median round trip over blocks of 100), then each
+/// runs the same block of sequential empty steps of `g` at the same time (its own executor
+/// and workload; median step time t0, t1; core_speed = t0 / t1). On this project's VM the
+/// hand-off stays near 33 ns while the two vCPUs' speeds move apart in spells of
+/// milliseconds to seconds: a block of bars64-like empty steps takes 120 us on a vCPU in its
+/// fast state and about 200 us in its slow one, often one vCPU in each.
+HostProbe probe_host(const StepGraph& g) {
+  HostProbe h;
+  if (hardware_pus() < 2) return h;
+  BindingScope binding;  // the calling thread's binding, restored on return
+  binding.pin(0);
+  constexpr int kBlocks = 20, kRounds = 100, kSteps = 50;
+  const auto step_time = [&g] {
+    std::unique_ptr<Executor> ex = make_executor(Policy::kSequential, ExecOptions{});
+    SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
+    w.set_step(g);
+    ex->run_step(g, nullptr, w);
+    std::vector<double> walls(kSteps);
+    for (double& t : walls) t = static_cast<double>(ex->run_step(g, nullptr, w).wall_ns);
+    return median(walls);
+  };
+  // acquire/release: as an executor's completion counter (each side reads the other's
+  // write); the counter also starts the two blocks of steps together.
+  std::atomic<std::uint64_t> counter{0};
+  double t1 = 0;
+  std::thread partner([&] {
+    BindingScope partner_binding;
+    partner_binding.pin(1);
+    for (std::uint64_t v = 1; v < 2ull * kBlocks * kRounds; v += 2) {
+      while (counter.load(std::memory_order_acquire) != v) cpu_relax();
+      counter.store(v + 1, std::memory_order_release);
+    }
+    while (counter.load(std::memory_order_acquire) != 2ull * kBlocks * kRounds + 1) cpu_relax();
+    t1 = step_time();
+  });
+  std::vector<double> half_round_trips;
+  std::uint64_t next = 1;
+  for (int b = 0; b < kBlocks; ++b) {
+    const std::int64_t t0 = now_ns();
+    for (int r = 0; r < kRounds; ++r, next += 2) {
+      counter.store(next, std::memory_order_release);
+      while (counter.load(std::memory_order_acquire) != next + 1) cpu_relax();
+    }
+    half_round_trips.push_back(static_cast<double>(now_ns() - t0) / (2.0 * kRounds));
+  }
+  counter.store(next, std::memory_order_release);
+  const double t0 = step_time();
+  partner.join();
+  h.handoff_ns = median(half_round_trips);
+  h.core_speed = t0 / t1;
+  h.step_us = t0 / 1e3;
+  return h;
+}
+
 void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   const auto k = static_cast<std::uint32_t>(state.range(0));
   const StepGraph g = bars_like(64, 25);
@@ -187,6 +252,11 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
     parks += s.parks();
   }
   const auto steps = static_cast<double>(state.iterations());
+  // The host right after the timed steps (probe_host()): core_speed 1 on a quiet machine;
+  // probe_step_us, thread 0's core's own speed, compares repetitions run at different times.
+  const HostProbe host = probe_host(g);
+  state.counters["core_speed"] = host.core_speed;
+  state.counters["probe_step_us"] = host.step_us;
   state.counters["signals_per_step"] = static_cast<double>(signals) / steps;
   state.counters["blocked_per_step"] = static_cast<double>(blocked) / steps;
   state.counters["parks_per_step"] = static_cast<double>(parks) / steps;
@@ -197,65 +267,6 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   state.counters["ns_per_task"] =
       benchmark::Counter(static_cast<double>(state.iterations() * instances),
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
-}
-
-/// The state of the host at this moment, for reading a ratio measured next to it.
-struct HostProbe {
-  double handoff_ns = 0;  ///< one way, two threads bouncing a counter
-  double core_speed = 0;  ///< thread 1's core's speed over thread 0's, both busy at once
-};
-
-/// Two threads on thread slots 0 and 1's cores (the partition executor pinned the calling
-/// thread to slot 0's; the partner takes slot 1's, the executor's second thread's):
-/// first they bounce a counter (half the median round trip over blocks of 100), then each
-/// runs the same block of sequential empty steps of `g` at the same time (its own executor
-/// and workload; median step time t0, t1; core_speed = t0 / t1). On this project's VM the
-/// hand-off stays near 33 ns while the two vCPUs' speeds move apart in spells of
-/// milliseconds to seconds: a block of bars64-like empty steps takes 120 us on a vCPU in its
-/// fast state and about 200 us in its slow one, often one vCPU in each.
-HostProbe probe_host(const StepGraph& g) {
-  HostProbe h;
-  if (hardware_pus() < 2) return h;
-  constexpr int kBlocks = 20, kRounds = 100, kSteps = 50;
-  const auto step_time = [&g] {
-    std::unique_ptr<Executor> ex = make_executor(Policy::kSequential, ExecOptions{});
-    SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
-    w.set_step(g);
-    ex->run_step(g, nullptr, w);
-    std::vector<double> walls(kSteps);
-    for (double& t : walls) t = static_cast<double>(ex->run_step(g, nullptr, w).wall_ns);
-    return median(walls);
-  };
-  // acquire/release: as an executor's completion counter (each side reads the other's
-  // write); the counter also starts the two blocks of steps together.
-  std::atomic<std::uint64_t> counter{0};
-  double t1 = 0;
-  std::thread partner([&] {
-    BindingScope binding;
-    binding.pin(1);
-    for (std::uint64_t v = 1; v < 2ull * kBlocks * kRounds; v += 2) {
-      while (counter.load(std::memory_order_acquire) != v) cpu_relax();
-      counter.store(v + 1, std::memory_order_release);
-    }
-    while (counter.load(std::memory_order_acquire) != 2ull * kBlocks * kRounds + 1) cpu_relax();
-    t1 = step_time();
-  });
-  std::vector<double> half_round_trips;
-  std::uint64_t next = 1;
-  for (int b = 0; b < kBlocks; ++b) {
-    const std::int64_t t0 = now_ns();
-    for (int r = 0; r < kRounds; ++r, next += 2) {
-      counter.store(next, std::memory_order_release);
-      while (counter.load(std::memory_order_acquire) != next + 1) cpu_relax();
-    }
-    half_round_trips.push_back(static_cast<double>(now_ns() - t0) / (2.0 * kRounds));
-  }
-  counter.store(next, std::memory_order_release);
-  const double t0 = step_time();
-  partner.join();
-  h.handoff_ns = median(half_round_trips);
-  h.core_speed = t0 / t1;
-  return h;
 }
 
 void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
@@ -271,7 +282,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
-  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, walls(block);
+  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, probe_step, walls(block);
   for (auto _ : state) {
     // Each executor's block follows the other's, the order alternating between iterations.
     const auto time_block = [&](Executor& ex, const Assignment* as) {
@@ -293,6 +304,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     const HostProbe h = probe_host(g);
     handoff.push_back(h.handoff_ns);
     core_speed.push_back(h.core_speed);
+    probe_step.push_back(h.step_us);
   }
   const auto per_task = static_cast<double>(instances);
   state.counters["ratio"] = median(ratios);
@@ -304,6 +316,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   // The host over the same iterations (probe_host()).
   state.counters["probe_handoff_ns"] = median(handoff);
   state.counters["core_speed"] = median(core_speed);
+  state.counters["probe_step_us"] = median(probe_step);
   std::sort(core_speed.begin(), core_speed.end());
   state.counters["core_speed_p10"] = core_speed[core_speed.size() / 10];
   state.counters["core_speed_p90"] = core_speed[core_speed.size() * 9 / 10];
