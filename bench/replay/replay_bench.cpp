@@ -9,8 +9,8 @@
 //  * TaskOverhead/<policy>/threads:N: the same step with empty bodies (no spin, no data):
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
 //    worksteal, barrier, and starpu when the build has StarPU; per step, the signals
-//    published, the waits that blocked and those that parked; `core_speed` and
-//    `probe_step_us` as below, probed once after the repetition's steps.
+//    published, the waits that blocked and those that parked; `core_speed`,
+//    `probe_step_us` and `probe_handoff_ns` as below, probed after the repetition's steps.
 //  * TaskOverheadInTurn/threads:N: partition / sequential per empty task, the two executors
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
@@ -257,6 +257,7 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   const HostProbe host = probe_host(g);
   state.counters["core_speed"] = host.core_speed;
   state.counters["probe_step_us"] = host.step_us;
+  state.counters["probe_handoff_ns"] = host.handoff_ns;
   state.counters["signals_per_step"] = static_cast<double>(signals) / steps;
   state.counters["blocked_per_step"] = static_cast<double>(blocked) / steps;
   state.counters["parks_per_step"] = static_cast<double>(parks) / steps;
