@@ -310,8 +310,14 @@ def ratios(all_runs):
 
     out.append("### Executor overhead per task")
     out.append("")
+    seq_row = r.get("BM_TaskOverhead/sequential/threads:1", {}).get("median")
+    seq_ns = med(r, "BM_TaskOverhead/sequential/threads:1", "ns_per_task")
+    instances = ""
+    if seq_row is not None and seq_ns:
+        scale = {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[seq_row.get("time_unit", "ns")]
+        instances = f"{seq_row['real_time'] * scale / seq_ns:,.0f} task instances at one thread, "
     out.append("`replay_bench`, `BM_TaskOverhead/<policy>/threads:N` (a bars64-like step, "
-               "20,000 task instances with empty bodies):")
+               f"{instances}empty bodies):")
     out.append("")
     out.append("| policy | threads | ns per task | / partition at the same threads |")
     out.append("|---|---|---|---|")
