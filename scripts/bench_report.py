@@ -342,14 +342,13 @@ def ratios(all_runs):
                    "repetitions): " + "; ".join(
                        f"{t} thread{'s' if t > 1 else ''} {fmt(v)} (p10 {fmt(lo)}, p90 {fmt(hi)})"
                        for t, v, lo, hi in turns if v is not None) + ".")
-        speed = med(r, "BM_TaskOverheadInTurn/threads:2", "core_speed")
-        if speed is not None:
+        def probe(key):
+            return med(r, "BM_TaskOverheadInTurn/threads:2", key)
+        if probe("core_speed") is not None:
             out.append("The host during the 2-thread run (probed after each block pair): "
-                       f"second core's speed over the first's {fmt(speed)} (p10 "
-                       f"{fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'core_speed_p10'))}, "
-                       f"p90 {fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'core_speed_p90'))}; "
-                       "1 on a quiet machine), hand-off "
-                       f"{fmt(med(r, 'BM_TaskOverheadInTurn/threads:2', 'probe_handoff_ns'))} ns.")
+                       f"second core's speed over the first's {fmt(probe('core_speed'))} (p10 "
+                       f"{fmt(probe('core_speed_p10'))}, p90 {fmt(probe('core_speed_p90'))}; "
+                       f"1 on a quiet machine), hand-off {fmt(probe('probe_handoff_ns'))} ns.")
     out.append("")
 
     out.append("### Signal -> wait")

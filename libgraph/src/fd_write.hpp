@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Internal: the write/sync/rename sequence of all-or-nothing outputs (file_util.cpp), shared
-// by write_file_atomic and the streaming TraceWriter (trace_io.cpp).
+// by write_file_atomic and the streaming TraceWriter (trace_write.cpp), and the unnamed file
+// the TraceWriter writes its header to before naming it.
 #pragma once
 
 #include <string>
@@ -18,5 +19,13 @@ void write_all(int fd, std::string_view bytes, const std::string& name);
 /// place: ..."), leaving `from` in place.
 void sync_close_rename(int fd, const std::string& from, const std::string& to,
                        const std::string& name, const std::string& from_label);
+
+/// An unnamed file (O_TMPFILE) in the folder of `path`, open for writing; -1 where the file
+/// system or the kernel has none.
+int open_unnamed_beside(const std::string& path);
+
+/// Gives the unnamed file `fd` the name `path`, replacing a file of that name; false if
+/// neither /proc nor linkat(AT_EMPTY_PATH) can name it.
+bool name_unnamed(int fd, const std::string& path);
 
 }  // namespace tgraph::detail

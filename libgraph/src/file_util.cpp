@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <string>
 
 #include "fd_write.hpp"
 #include "tgraph/graph/error.hpp"
@@ -96,6 +97,29 @@ void sync_close_rename(int fd, const std::string& from, const std::string& to,
   if (::close(fd) != 0) throw Error(name + ": cannot close: " + errno_text(errno));
   if (::rename(from.c_str(), to.c_str()) != 0)
     throw Error(to + ": cannot rename " + from_label + " into place: " + errno_text(errno));
+}
+
+int open_unnamed_beside(const std::string& path) {
+#ifdef O_TMPFILE
+  const std::filesystem::path target(path);  // its folder as write_file_atomic finds it
+  const std::filesystem::path folder =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  return ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+#else
+  (void)path;
+  return -1;
+#endif
+}
+
+bool name_unnamed(int fd, const std::string& path) {
+  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  if (::unlink(path.c_str()) != 0 && errno != ENOENT) return false;
+  if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
+    return true;
+#ifdef AT_EMPTY_PATH
+  if (::linkat(fd, "", AT_FDCWD, path.c_str(), AT_EMPTY_PATH) == 0) return true;
+#endif
+  return false;
 }
 
 }  // namespace detail

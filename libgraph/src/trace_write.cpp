@@ -205,37 +205,6 @@ struct TraceWriter::Impl {
   }
 };
 
-namespace {
-
-// An unnamed file in the folder of `path` (O_TMPFILE), -1 where the file system or the
-// kernel has none.
-int open_unnamed_beside(const std::string& path) {
-#ifdef O_TMPFILE
-  const std::string::size_type slash = path.rfind('/');
-  const std::string folder =
-      slash == std::string::npos ? std::string(".") : slash == 0 ? "/" : path.substr(0, slash);
-  return ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
-#else
-  (void)path;
-  return -1;
-#endif
-}
-
-// Gives the unnamed file `fd` the name `path`, replacing a file of that name; false if
-// neither /proc nor linkat(AT_EMPTY_PATH) can name it.
-bool name_unnamed(int fd, const std::string& path) {
-  const std::string self = "/proc/self/fd/" + std::to_string(fd);
-  if (::unlink(path.c_str()) != 0 && errno != ENOENT) return false;
-  if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
-    return true;
-#ifdef AT_EMPTY_PATH
-  if (::linkat(fd, "", AT_FDCWD, path.c_str(), AT_EMPTY_PATH) == 0) return true;
-#endif
-  return false;
-}
-
-}  // namespace
-
 // The header frame is written before the partial file gets its name where the file system
 // allows it (an unnamed O_TMPFILE file, then linked): a process killed at any moment leaves
 // either no partial file or one that starts with a whole header (an empty one otherwise,
@@ -245,10 +214,10 @@ TraceWriter::TraceWriter(const std::string& path, const TraceHeader& header)
   impl_->path = path;
   impl_->partial = path + ".partial";
   encode_file_header(impl_->buffer, header);
-  impl_->fd = open_unnamed_beside(impl_->partial);
+  impl_->fd = detail::open_unnamed_beside(impl_->partial);
   if (impl_->fd >= 0) {
     impl_->flush_buffer();
-    if (name_unnamed(impl_->fd, impl_->partial)) return;
+    if (detail::name_unnamed(impl_->fd, impl_->partial)) return;
     ::close(impl_->fd);
     impl_->written = 0;
     encode_file_header(impl_->buffer, header);  // flush_buffer() emptied it
