@@ -159,25 +159,51 @@ std::uint64_t StepGraph::structural_hash() const {
   return h.h;
 }
 
+namespace {
+
+// Equal names, the lists' lengths already equal.
+template <class T, class Name>
+bool same_names(const std::vector<T>& a, const std::vector<T>& b, Name name) {
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (name(a[i]) != name(b[i])) return false;
+  return true;
+}
+
+}  // namespace
+
+// Called on every step by the executors' plan cache, where it mostly says "equal": the
+// numbers are compared first, each list in one pass without early exit (the differences
+// OR-ed together, which the compiler can vectorise), the names (a string comparison each)
+// last.
 bool StepGraph::same_structure(const StepGraph& o) const {
-  if (kinds != o.kinds || objects != o.objects || data != o.data || accesses != o.accesses ||
-      tasks.size() != o.tasks.size() || loops.size() != o.loops.size())
+  if (tasks.size() != o.tasks.size() || accesses.size() != o.accesses.size() ||
+      data.size() != o.data.size() || objects.size() != o.objects.size() ||
+      kinds.size() != o.kinds.size() || loops.size() != o.loops.size())
     return false;
+  std::uint64_t diff = 0;
+  for (std::size_t i = 0; i < accesses.size(); ++i)
+    diff |= (accesses[i].datum ^ o.accesses[i].datum) |
+            static_cast<std::uint32_t>(static_cast<std::uint8_t>(accesses[i].mode) ^
+                                       static_cast<std::uint8_t>(o.accesses[i].mode));
   for (std::size_t i = 0; i < tasks.size(); ++i) {
     const Task& a = tasks[i];
     const Task& b = o.tasks[i];
-    if (a.kind != b.kind || a.object != b.object || a.access_begin != b.access_begin ||
-        a.access_count != b.access_count || a.loop != b.loop || a.key != b.key)
-      return false;
+    diff |= (a.kind ^ b.kind) | (a.object ^ b.object) | (a.access_begin ^ b.access_begin) |
+            (a.access_count ^ b.access_count) | (a.loop ^ b.loop) | (a.key ^ b.key);
   }
+  for (std::size_t i = 0; i < data.size(); ++i)
+    diff |= (data[i].object ^ o.data[i].object) | (data[i].bytes ^ o.data[i].bytes) |
+            (data[i].name.size() ^ o.data[i].name.size());
   for (std::size_t i = 0; i < loops.size(); ++i) {
     const Loop& a = loops[i];
     const Loop& b = o.loops[i];
-    if (a.condition != b.condition || a.first != b.first || a.last != b.last ||
-        a.max_iterations != b.max_iterations)
-      return false;
+    diff |= (a.condition ^ b.condition) | (a.first ^ b.first) | (a.last ^ b.last) |
+            (a.max_iterations ^ b.max_iterations);
   }
-  return true;
+  if (diff != 0) return false;
+  const auto name = [](const auto& x) -> const std::string& { return x.name; };
+  return kinds == o.kinds && same_names(objects, o.objects, name) &&
+         same_names(data, o.data, name);
 }
 
 }  // namespace tgraph

@@ -211,21 +211,31 @@ ExecStepStats Executor::run_step(const StepGraph& g, const Assignment* a, Worklo
   const CwMode mode = cw();
   const ReduceScope reduce = scope();
   const std::vector<bool>* reducible = w.reducible();
-  std::uint64_t key = structure_key(g) * 31 + static_cast<std::uint64_t>(mode) * 7 +
-                      static_cast<std::uint64_t>(reduce);
-  // The assignment is not hashed (one dependent multiply per task on every step): the
-  // entries of one structure are few and their assignments are compared (a memcmp) before
-  // their structure.
-  if (reducible != nullptr) key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;
-
+  // An entry serves this step when its structure, assignment and reducible data are this
+  // step's (mode and scope are the executor's own, fixed at construction).
+  const auto serves = [&](const CacheEntry& e) {
+    return (reducible ? e.reducible == *reducible : e.reducible.empty()) &&
+           (!use_assignment || (e.has_assignment && e.assignment == *a)) &&
+           e.shape.same_structure(g);
+  };
+  // The previous step's entry first, confirmed without the key: a structure that repeats
+  // (a step without contact changes) skips hashing it.
   std::shared_ptr<CacheEntry> entry;
-  for (auto& e : cache_) {
-    if (e->key == key && (reducible ? e->reducible == *reducible : e->reducible.empty()) &&
-        (!use_assignment || (e->has_assignment && e->assignment == *a)) &&
-        e->shape.same_structure(g)) {
-      entry = e;
-      break;
-    }
+  if (last_entry_ && serves(*last_entry_)) entry = last_entry_;
+  std::uint64_t key = 0;
+  if (!entry) {
+    key = structure_key(g) * 31 + static_cast<std::uint64_t>(mode) * 7 +
+          static_cast<std::uint64_t>(reduce);
+    // The assignment is not hashed (one dependent multiply per task on every step): the
+    // entries of one structure are few and their assignments are compared (a memcmp) before
+    // their structure.
+    if (reducible != nullptr)
+      key ^= std::hash<std::vector<bool>>{}(*reducible) * 0xff51afd7ed558ccdull;
+    for (auto& e : cache_)
+      if (e->key == key && serves(*e)) {
+        entry = e;
+        break;
+      }
   }
   if (!entry) {
     if (use_assignment) validate_assignment(g, *a, options_.threads);

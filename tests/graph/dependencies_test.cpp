@@ -189,5 +189,55 @@ TEST(StructuralHash, IgnoresCostsAndIterationsButNotAccesses) {
   EXPECT_FALSE(a.g.same_structure(c.g));
 }
 
+// same_structure() reads each field of the structure (the executors' plan cache trusts it on
+// every step) and nothing else: one change at a time from a two-task loop over two objects.
+TEST(StructuralHash, SameStructureSeesEachFieldAndOnlyThose) {
+  const auto base = [] {
+    StepGraph g;
+    g.kinds = {"op", "loop.break"};
+    g.objects = {{"a"}, {"b"}};
+    g.data = {{"x", 0, 8}, {"cond", kNoObject, 8}};
+    const Access t0[] = {{0, M::R}, {1, M::W}};
+    const Access t1[] = {{1, M::R}};
+    g.add_task(0, 0, t0, 10, 7);
+    g.add_task(1, kNoObject, t1, 10, 8);
+    for (Task& t : g.tasks) t.loop = 0;
+    g.loops.push_back({1, 0, 2, 3, 10});
+    return g;
+  };
+  const StepGraph g = base();
+  ASSERT_EQ(g.validate(), "");
+  const auto differs = [&](auto&& change) {
+    StepGraph h = base();
+    change(h);
+    return !g.same_structure(h) && !h.same_structure(g);
+  };
+  EXPECT_FALSE(differs([](StepGraph& h) {
+    h.tasks[0].cost_ns = 99;
+    h.loops[0].iterations = 9;
+  }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.accesses[0].mode = M::RW; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.accesses[2].datum = 0; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.tasks[0].kind = 1; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.tasks[0].object = 1; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.tasks[1].key = 9; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.tasks[1].loop = kNoLoop; }));
+  EXPECT_TRUE(differs([](StepGraph& h) {
+    h.tasks[0].access_count = 1;
+    h.tasks[1].access_begin = 1;
+    h.tasks[1].access_count = 2;
+  }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.data[0].bytes = 16; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.data[0].object = 1; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.data[0].name = "y"; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.data[1].name = "cond2"; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.objects[1].name = "c"; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.kinds[0] = "op2"; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.loops[0].max_iterations = 11; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.loops[0].first = 1; }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.data.push_back({"z", kNoObject, 8}); }));
+  EXPECT_TRUE(differs([](StepGraph& h) { h.objects.push_back({"c"}); }));
+}
+
 }  // namespace
 }  // namespace tgraph
