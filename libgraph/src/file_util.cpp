@@ -1,12 +1,16 @@
 // SPDX-License-Identifier: MIT
-// Whole-file reads and all-or-nothing writes (temporary file + rename in the same folder).
+// Whole-file reads and all-or-nothing writes (an unnamed or temporary file, then a rename in
+// the same folder).
 #include "tgraph/graph/file_util.hpp"
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cerrno>
+#include <cstdio>
+#include <ctime>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -124,7 +128,56 @@ bool name_unnamed(int fd, const std::string& path) {
 
 }  // namespace detail
 
+namespace {
+
+// The unnamed-file way of write_file_atomic: the bytes written and synced before the file
+// has a name, then linked as ".NAME.tmp.<n>" and renamed over `path`, so that a process
+// killed while it writes leaves nothing behind (only the two calls between link and rename
+// can leave the temporary name). False, with nothing written, where the file system has no
+// unnamed files or /proc cannot link them (the caller then takes the named way).
+bool write_unnamed_then_rename(const std::string& path, std::string_view content) {
+  const int fd = detail::open_unnamed_beside(path);
+  if (fd < 0) return false;
+  FdGuard guard(fd);
+  ::fchmod(fd, 0644);  // as the named way: ordinary readable files, whatever the umask
+  detail::write_all(fd, content, path);
+  if (::fsync(fd) != 0 && errno != EINVAL) throw Error(path + ": cannot sync: " + errno_text(errno));
+  const std::filesystem::path target(path);
+  const std::filesystem::path folder =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  static std::atomic<std::uint64_t> serial{0};
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    const std::uint64_t n = (static_cast<std::uint64_t>(::getpid()) << 40) ^
+                            (static_cast<std::uint64_t>(::time(nullptr)) << 20) ^
+                            serial.fetch_add(1, std::memory_order_relaxed);
+    char suffix[24];
+    std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(n));
+    const std::string tmp =
+        (folder / ("." + target.filename().string() + ".tmp." + suffix)).string();
+    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, tmp.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+      if (errno == EEXIST) continue;
+      return false;  // no /proc, or links refused: the named way
+    }
+    if (::close(guard.release()) != 0) {
+      const int err = errno;
+      ::unlink(tmp.c_str());
+      throw Error(path + ": cannot close: " + errno_text(err));
+    }
+    if (::rename(tmp.c_str(), path.c_str()) != 0) {
+      const int err = errno;
+      ::unlink(tmp.c_str());
+      throw Error(path + ": cannot rename the temporary file into place: " + errno_text(err));
+    }
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 void write_file_atomic(const std::string& path, std::string_view content) {
+  if (write_unnamed_then_rename(path, content)) return;
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
