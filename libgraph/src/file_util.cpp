@@ -23,6 +23,23 @@ namespace {
 
 std::string errno_text(int err) { return std::strerror(err); }
 
+// The folder an output's temporary or unnamed file goes to: the output's own.
+std::filesystem::path folder_of(const std::filesystem::path& target) {
+  return target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+}
+
+// Gives the unnamed file `fd` the new name `path` (fails with EEXIST if it exists): through
+// /proc/self/fd, else linkat(AT_EMPTY_PATH) where the process may use it.
+bool link_unnamed(int fd, const std::string& path) {
+  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
+    return true;
+#ifdef AT_EMPTY_PATH
+  if (errno != EEXIST && ::linkat(fd, "", AT_FDCWD, path.c_str(), AT_EMPTY_PATH) == 0) return true;
+#endif
+  return false;
+}
+
 // Closes a descriptor on scope exit unless released.
 class FdGuard {
  public:
@@ -105,10 +122,7 @@ void sync_close_rename(int fd, const std::string& from, const std::string& to,
 
 int open_unnamed_beside(const std::string& path) {
 #ifdef O_TMPFILE
-  const std::filesystem::path target(path);  // its folder as write_file_atomic finds it
-  const std::filesystem::path folder =
-      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  return ::open(folder.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+  return ::open(folder_of(path).c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
 #else
   (void)path;
   return -1;
@@ -116,14 +130,8 @@ int open_unnamed_beside(const std::string& path) {
 }
 
 bool name_unnamed(int fd, const std::string& path) {
-  const std::string self = "/proc/self/fd/" + std::to_string(fd);
   if (::unlink(path.c_str()) != 0 && errno != ENOENT) return false;
-  if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, path.c_str(), AT_SYMLINK_FOLLOW) == 0)
-    return true;
-#ifdef AT_EMPTY_PATH
-  if (::linkat(fd, "", AT_FDCWD, path.c_str(), AT_EMPTY_PATH) == 0) return true;
-#endif
-  return false;
+  return link_unnamed(fd, path);
 }
 
 }  // namespace detail
@@ -143,9 +151,7 @@ bool write_unnamed_then_rename(const std::string& path, std::string_view content
   detail::write_all(fd, content, path);
   if (::fsync(fd) != 0 && errno != EINVAL) throw Error(path + ": cannot sync: " + errno_text(errno));
   const std::filesystem::path target(path);
-  const std::filesystem::path folder =
-      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
-  const std::string self = "/proc/self/fd/" + std::to_string(fd);
+  const std::filesystem::path folder = folder_of(target);
   static std::atomic<std::uint64_t> serial{0};
   for (int attempt = 0; attempt < 64; ++attempt) {
     const std::uint64_t n = (static_cast<std::uint64_t>(::getpid()) << 40) ^
@@ -155,7 +161,7 @@ bool write_unnamed_then_rename(const std::string& path, std::string_view content
     std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(n));
     const std::string tmp =
         (folder / ("." + target.filename().string() + ".tmp." + suffix)).string();
-    if (::linkat(AT_FDCWD, self.c_str(), AT_FDCWD, tmp.c_str(), AT_SYMLINK_FOLLOW) != 0) {
+    if (!link_unnamed(fd, tmp)) {
       if (errno == EEXIST) continue;
       return false;  // no /proc, or links refused: the named way
     }
@@ -180,8 +186,7 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   if (write_unnamed_then_rename(path, content)) return;
   namespace fs = std::filesystem;
   const fs::path target(path);
-  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string tmp = (folder / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  std::string tmp = (folder_of(target) / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
   const int fd = ::mkstemp(tmp.data());
   if (fd < 0)
     throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));
