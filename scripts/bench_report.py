@@ -342,6 +342,15 @@ def ratios(all_runs):
                    "repetitions): " + "; ".join(
                        f"{t} thread{'s' if t > 1 else ''} {fmt(v)} (p10 {fmt(lo)}, p90 {fmt(hi)})"
                        for t, v, lo, hi in turns if v is not None) + ".")
+        quiet = [(t, med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio_quiet"),
+                  med(r, f"BM_TaskOverheadInTurn/threads:{t}", "quiet_pairs")) for t in (1, 2)]
+        if any(n is not None for _, _, n in quiet):
+            out.append("Over the block pairs whose host probes, before and after the pair, found "
+                       "both cores at the same speed and the first near its fastest (a quiet "
+                       "machine): " + "; ".join(
+                           f"{t} thread{'s' if t > 1 else ''} "
+                           + (f"{fmt(v)} ({n:.0f} pairs)" if n else "no quiet pair")
+                           for t, v, n in quiet if n is not None) + ".")
         def probe(key):
             return med(r, "BM_TaskOverheadInTurn/threads:2", key)
         if probe("core_speed") is not None:

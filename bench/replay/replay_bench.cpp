@@ -19,6 +19,8 @@
 //    threads bouncing a counter, and `core_speed` (p10, p90), the second thread's core's
 //    speed over the first's when both run the same empty steps at once: 1 on a quiet machine;
 //    `probe_step_us`, the first thread's median step meanwhile (its core's own speed).
+//    `ratio_quiet`: the median ratio over the `quiet_pairs`, those whose probes before and
+//    after found equal core speeds and the first core near its fastest.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -284,6 +286,8 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
   std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, probe_step, walls(block);
+  // The host probed before and after each pair (the after of one is the before of the next).
+  std::vector<HostProbe> probes{probe_host(g)};
   for (auto _ : state) {
     // Each executor's block follows the other's, the order alternating between iterations.
     const auto time_block = [&](Executor& ex, const Assignment* as) {
@@ -303,12 +307,29 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     seq_ns.push_back(s);
     par_ns.push_back(p);
     const HostProbe h = probe_host(g);
+    probes.push_back(h);
     handoff.push_back(h.handoff_ns);
     core_speed.push_back(h.core_speed);
     probe_step.push_back(h.step_us);
   }
+  // Quiet pairs: both probes around the pair found the two cores at the same speed (within
+  // 5 %) and the first core, with the second busy beside it, within 10 % of its fastest step
+  // of the run: neither a slow vCPU nor two vCPUs slowing each other. ratio_quiet is the
+  // median over those pairs (0 when there are none): the figure of a quiet machine, chosen by
+  // the probes, not by the ratios.
+  double fastest = 0;
+  for (const HostProbe& h : probes)
+    if (h.step_us > 0 && (fastest == 0 || h.step_us < fastest)) fastest = h.step_us;
+  const auto quiet = [fastest](const HostProbe& h) {
+    return h.core_speed >= 0.95 && h.core_speed <= 1.05 && h.step_us <= 1.10 * fastest;
+  };
+  std::vector<double> quiet_ratios;
+  for (std::size_t i = 0; i < ratios.size(); ++i)
+    if (quiet(probes[i]) && quiet(probes[i + 1])) quiet_ratios.push_back(ratios[i]);
   const auto per_task = static_cast<double>(instances);
   state.counters["ratio"] = median(ratios);
+  state.counters["ratio_quiet"] = quiet_ratios.empty() ? 0.0 : median(quiet_ratios);
+  state.counters["quiet_pairs"] = static_cast<double>(quiet_ratios.size());
   state.counters["sequential_ns_per_task"] = median(seq_ns) / per_task;
   state.counters["partition_ns_per_task"] = median(par_ns) / per_task;
   std::sort(ratios.begin(), ratios.end());

@@ -312,20 +312,43 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     return out;
   }
 
+  // The counter the op after a plain run checks first (its first wait's producer, or its
+  // loop's decision), or null when it checks none here.
+  const void* next_check(const Op* ops, std::size_t next, std::size_t n_ops,
+                         const WaitPoint* waits) const {
+    if (next >= n_ops) return nullptr;
+    const Op& op = ops[next];
+    if (op.kind == OpKind::kLoopEnd) return &loop_[op.loop].v;
+    if (op.kind != OpKind::kTask || op.wait_begin == op.wait_end) return nullptr;
+    const WaitPoint& wp = waits[op.wait_begin];
+    return wp.kind == WaitKind::kAfterLoop ? &loop_[wp.loop].v : &done_[wp.producer].v;
+  }
+
+  // Tasks before the end of a plain run at which run_plain prefetches the next op's counter.
+  static constexpr std::size_t kPrefetchAhead = 8;
+
   // Runs the ops[pc].plain_run ops from ops[pc] on (tasks that neither wait nor publish); returns
   // the first op past them. With `Watch`, the slot tells the watchdog what runs and that the
   // thread progresses. Out of line, so that what the loop keeps across the body's call stays
   // in registers (inlined into run_proc, it reloaded the workload, the graph and the bounds
   // from the stack at every task); the TaskRun is built once, each task setting its two ids.
+  // `next`: the counter the op after the run checks first; it is prefetched kPrefetchAhead
+  // tasks before the end (half way in a shorter run), so that a value its producer published
+  // while this thread ran is already in this core's cache when the check reads it: a miss
+  // less on the critical path of a hand-off (a loop decision read at the end of the body, a
+  // producer that ran ahead).
   template <bool Watch>
   [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc,
                                                  const ExecGraph& x, Workload& w,
                                                  std::uint32_t iter, std::uint32_t p,
-                                                 Slot& slot) {
+                                                 Slot& slot, const void* next) {
     const std::uint32_t n = ops[pc].plain_run;
     const std::size_t end = pc + n;
     TaskRun run{&x, 0, kNoTask, iter, p};
+    const std::size_t fetch_at =
+        next == nullptr ? end : (n > 2 * kPrefetchAhead ? end - kPrefetchAhead : pc + n / 2);
     for (; pc < end; ++pc) {
+      if (pc == fetch_at) __builtin_prefetch(next, 0, 3);
       const Op& op = ops[pc];
       if constexpr (Watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // a report
       run.task = op.task;
@@ -403,8 +426,9 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
             if (!observe && op.plain_run != 0) {
               // A run of tasks that neither wait nor publish: the sequential loop.
               tasks += op.plain_run;
-              pc = watch ? run_plain<true>(ops, pc, x, w, iter, p, slot)
-                         : run_plain<false>(ops, pc, x, w, iter, p, slot);
+              const void* next = next_check(ops, pc + op.plain_run, n_ops, waits);
+              pc = watch ? run_plain<true>(ops, pc, x, w, iter, p, slot, next)
+                         : run_plain<false>(ops, pc, x, w, iter, p, slot, next);
               break;
             }
             for (auto i = op.wait_begin; i < op.wait_end; ++i) {

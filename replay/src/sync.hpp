@@ -35,23 +35,50 @@ struct alignas(64) PaddedCounter {
   std::atomic<std::uint64_t> v{0};
 };
 
+/// Whether this process can use membarrier(MEMBARRIER_CMD_PRIVATE_EXPEDITED) (registered on
+/// the first call); false where the kernel or a seccomp filter refuses it.
+bool asymmetric_fence_available();
+/// A full memory barrier on every running thread of this process (membarrier); only where
+/// asymmetric_fence_available().
+void asymmetric_heavy_fence();
+
 /// Spin-then-park waiting shared by the threads of one executor.
 ///
 /// Protocol (Dekker): a waiter that is about to sleep increments `parked` (seq_cst) and then
-/// re-reads the counter (seq_cst); a signaller stores the counter (seq_cst) and then reads
-/// `parked` (seq_cst). In the single total order of seq_cst operations, either the
-/// signaller sees the waiter registered (and notifies) or the waiter sees the new value
-/// (and does not sleep); std::atomic::wait itself never misses a notify that follows its
-/// value check.
+/// re-reads the counter (seq_cst); a signaller stores the counter and then reads `parked`.
+/// Each side needs its store ordered before its load. Where the process may use
+/// membarrier and the threads have a core each, the fence is asymmetric: the signaller,
+/// on every hand-off, only stores (release) and keeps the compiler from moving its load above
+/// the store, and the waiter, once per sleep, runs asymmetric_heavy_fence() between its
+/// increment and its re-read, a full barrier on every running thread. Then either the
+/// signaller's store was before that barrier on its core (the waiter's re-read sees the
+/// value and does not sleep) or its load of `parked` was after it (it sees the waiter and
+/// notifies). Elsewhere the signaller's store and load are seq_cst (an xchg on x86: about
+/// 10 ns more per hand-off on this project's VM, replay_bench BM_Handoff); in the single
+/// total order of seq_cst operations the same either/or holds. std::atomic::wait itself
+/// never misses a notify that follows its value check.
 class Parking {
  public:
+  /// Oversubscribed threads (more than cores) park often: each sleep's heavy fence would
+  /// interrupt every core, so they keep the symmetric fence.
   explicit Parking(std::int64_t spin_ns, bool oversubscribed)
       : tick_ns_(wait_tick_ns()),
         spin_ticks_(static_cast<std::int64_t>(static_cast<double>(spin_ns) / tick_ns_)),
-        oversubscribed_(oversubscribed) {}
+        oversubscribed_(oversubscribed),
+        asymmetric_(!oversubscribed && asymmetric_fence_available()) {}
 
   /// Publishes `value` into `c` and wakes sleepers if any.
   void signal(std::atomic<std::uint64_t>& c, std::uint64_t value) {
+    if (asymmetric_) {
+      // release: the writer's data is visible to whoever acquires `value`. The store ->
+      // load order of the Dekker pair is the sleeper's heavy fence's (class comment); the
+      // signal fence keeps the compiler from hoisting the load above the store.
+      c.store(value, std::memory_order_release);
+      std::atomic_signal_fence(std::memory_order_seq_cst);
+      // relaxed: ordered by the fences above and the sleeper's heavy fence.
+      if (parked_.load(std::memory_order_relaxed) != 0) c.notify_all();
+      return;
+    }
     // seq_cst: orders this store before the load of parked_ below (see class comment);
     // it is also a release, so the writer's data is visible to whoever acquires `value`.
     c.store(value, std::memory_order_seq_cst);
@@ -102,6 +129,7 @@ class Parking {
     parked = true;
     // seq_cst: Dekker with signal() (class comment).
     parked_.fetch_add(1, std::memory_order_seq_cst);
+    if (asymmetric_) asymmetric_heavy_fence();  // the signallers' half of their fence
     for (;;) {
       v = c.load(std::memory_order_seq_cst);                      // seq_cst: Dekker with signal()
       if (ok(v) || abort.load(std::memory_order_seq_cst)) break;  // seq_cst: Dekker with abort
@@ -127,6 +155,7 @@ class Parking {
   double tick_ns_;
   std::int64_t spin_ticks_;
   bool oversubscribed_;
+  bool asymmetric_;
   alignas(64) std::atomic<std::uint32_t> parked_{0};
 };
 

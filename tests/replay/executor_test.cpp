@@ -391,6 +391,34 @@ TEST(Synthetic, SpinsForTheRecordedCost) {
 // Blocked waits are timed with the time-stamp counter, converted to nanoseconds by a factor
 // measured once: a reader on thread 1 waiting for a 20 ms writer on thread 0 reports about
 // 20 ms of waiting, never more than the step's wall time.
+// Every blocked wait parks at once (spin 0): each hand-off goes through the sleep/wake
+// protocol (sync.hpp: with two threads on two cores, the asymmetric fence, the signaller only
+// storing), many times per step. A lost wake-up would stall a step: the watchdog turns it
+// into an error here instead of a hang. The states still match the sequential run's.
+TEST(Executor, WaitsThatAllParkAreAllWoken) {
+  for (std::uint32_t seed = 1; seed <= 3; ++seed) {
+    const StepGraph g = test::random_graph(seed * 104729);
+    const Assignment a = test::random_assignment(g, 2, seed);
+    ExecOptions o = opts(2, false, 0);
+    o.partition.timeout_ms = 20'000;
+    auto ex = make_executor(Policy::kPartition, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    std::uint64_t parks = 0;
+    for (int step = 0; step < 300; ++step) {
+      ExecStepStats s;
+      ASSERT_NO_THROW(s = ex->run_step(g, &a, w)) << "seed " << seed << " step " << step;
+      parks += s.parks();
+      for (LoopId l = 0; l < g.loops.size(); ++l)
+        ASSERT_EQ(s.loop_iterations[l], g.loops[l].iterations);
+    }
+    EXPECT_GT(parks, 0u) << "seed " << seed;
+    const auto got = final_state(w, g), want = sequential_state(g, 300);
+    for (DatumId d = 0; d < g.data.size(); ++d)
+      EXPECT_TRUE(got[d] == want[d]) << "seed " << seed << ": datum " << g.data[d].name;
+  }
+}
+
 TEST(Executor, TimesBlockedWaitsInNanoseconds) {
   StepGraph g;
   g.intern_kind("write");
