@@ -346,8 +346,8 @@ def ratios(all_runs):
                   med(r, f"BM_TaskOverheadInTurn/threads:{t}", "quiet_pairs")) for t in (1, 2)]
         if any(n is not None for _, _, n in quiet):
             out.append("Over the block pairs whose host probes, before and after the pair, found "
-                       "both cores at the same speed and the first near its fastest (a quiet "
-                       "machine): " + "; ".join(
+                       "both cores at the same speed, the first as fast beside the second as "
+                       "alone, and near its fastest (a quiet machine): " + "; ".join(
                            f"{t} thread{'s' if t > 1 else ''} "
                            + (f"{fmt(v)} ({n:.0f} pairs)" if n else "no quiet pair")
                            for t, v, n in quiet if n is not None) + ".")

@@ -10,7 +10,8 @@
 //    what each executor costs per task instance (ns_per_task): sequential, partition,
 //    worksteal, barrier, and starpu when the build has StarPU; per step, the signals
 //    published, the waits that blocked and those that parked; `core_speed`,
-//    `probe_step_us` and `probe_handoff_ns` as below, probed after the repetition's steps.
+//    `probe_step_us`, `probe_alone_us` and `probe_handoff_ns` as below, probed after the
+//    repetition's steps.
 //  * TaskOverheadInTurn/threads:N: partition / sequential per empty task, the two executors
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
@@ -19,8 +20,10 @@
 //    threads bouncing a counter, and `core_speed` (p10, p90), the second thread's core's
 //    speed over the first's when both run the same empty steps at once: 1 on a quiet machine;
 //    `probe_step_us`, the first thread's median step meanwhile (its core's own speed).
+//    `probe_alone_us`: the same step on the first thread with the second gone.
 //    `ratio_quiet`: the median ratio over the `quiet_pairs`, those whose probes before and
-//    after found equal core speeds and the first core near its fastest.
+//    after found equal core speeds, the first core as fast beside the second as alone, and
+//    near its fastest.
 //  * OmpTasks/<cw>/<wait>/threads:N: the Policy step under omp-tasks, CW lowered per writer
 //    (inout + reducer task) or left whole as mutexinoutset, with or without a taskwait per
 //    CG iteration: which way of writing it a competent OpenMP user should pick here.
@@ -172,6 +175,7 @@ struct HostProbe {
   double handoff_ns = 0;  ///< one way, two threads bouncing a counter
   double core_speed = 0;  ///< thread 1's core's speed over thread 0's, both busy at once
   double step_us = 0;     ///< thread 0's median empty step meanwhile (its core's own speed)
+  double alone_us = 0;    ///< the same on thread 0 with thread 1 gone (no neighbour's load)
 };
 
 /// Two threads on thread slots 0 and 1's cores (the calling thread for the probe's length,
@@ -227,6 +231,7 @@ HostProbe probe_host(const StepGraph& g) {
   h.handoff_ns = median(half_round_trips);
   h.core_speed = t0 / t1;
   h.step_us = t0 / 1e3;
+  h.alone_us = step_time() / 1e3;
   return h;
 }
 
@@ -259,6 +264,7 @@ void BM_TaskOverhead(benchmark::State& state, Policy policy) {
   const HostProbe host = probe_host(g);
   state.counters["core_speed"] = host.core_speed;
   state.counters["probe_step_us"] = host.step_us;
+  state.counters["probe_alone_us"] = host.alone_us;
   state.counters["probe_handoff_ns"] = host.handoff_ns;
   state.counters["signals_per_step"] = static_cast<double>(signals) / steps;
   state.counters["blocked_per_step"] = static_cast<double>(blocked) / steps;
@@ -285,7 +291,8 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
-  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, probe_step, walls(block);
+  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, probe_step, probe_alone,
+      walls(block);
   // The host probed before and after each pair (the after of one is the before of the next).
   std::vector<HostProbe> probes{probe_host(g)};
   for (auto _ : state) {
@@ -311,17 +318,19 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     handoff.push_back(h.handoff_ns);
     core_speed.push_back(h.core_speed);
     probe_step.push_back(h.step_us);
+    probe_alone.push_back(h.alone_us);
   }
   // Quiet pairs: both probes around the pair found the two cores at the same speed (within
-  // 5 %) and the first core, with the second busy beside it, within 10 % of its fastest step
-  // of the run: neither a slow vCPU nor two vCPUs slowing each other. ratio_quiet is the
-  // median over those pairs (0 when there are none): the figure of a quiet machine, chosen by
-  // the probes, not by the ratios.
+  // 5 %), the first core as fast with the second busy beside it as alone (within 10 %), and
+  // alone within 10 % of its fastest of the run: neither a slow vCPU nor two vCPUs slowing
+  // each other. ratio_quiet is the median over those pairs (0 when there are none): the
+  // figure of a quiet machine, the pairs chosen by the probes, not by their ratios.
   double fastest = 0;
   for (const HostProbe& h : probes)
-    if (h.step_us > 0 && (fastest == 0 || h.step_us < fastest)) fastest = h.step_us;
+    if (h.alone_us > 0 && (fastest == 0 || h.alone_us < fastest)) fastest = h.alone_us;
   const auto quiet = [fastest](const HostProbe& h) {
-    return h.core_speed >= 0.95 && h.core_speed <= 1.05 && h.step_us <= 1.10 * fastest;
+    return h.core_speed >= 0.95 && h.core_speed <= 1.05 && h.step_us <= 1.10 * h.alone_us &&
+           h.alone_us <= 1.10 * fastest;
   };
   std::vector<double> quiet_ratios;
   for (std::size_t i = 0; i < ratios.size(); ++i)
@@ -339,6 +348,7 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   state.counters["probe_handoff_ns"] = median(handoff);
   state.counters["core_speed"] = median(core_speed);
   state.counters["probe_step_us"] = median(probe_step);
+  state.counters["probe_alone_us"] = median(probe_alone);
   std::sort(core_speed.begin(), core_speed.end());
   state.counters["core_speed_p10"] = core_speed[core_speed.size() / 10];
   state.counters["core_speed_p90"] = core_speed[core_speed.size() * 9 / 10];
