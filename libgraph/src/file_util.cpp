@@ -28,6 +28,16 @@ std::filesystem::path folder_of(const std::filesystem::path& target) {
   return target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
 }
 
+// The temporary name of an output in its folder: ".NAME.tmp.TAIL" (appended: GCC 12 inlines
+// `"." + name` into a false -Wrestrict warning).
+std::string temporary_name(const std::filesystem::path& target, const char* tail) {
+  std::string name(".");
+  name += target.filename().string();
+  name += ".tmp.";
+  name += tail;
+  return (folder_of(target) / name).string();
+}
+
 // Gives the unnamed file `fd` the new name `path` (fails with EEXIST if it exists): through
 // /proc/self/fd, else linkat(AT_EMPTY_PATH) where the process may use it.
 bool link_unnamed(int fd, const std::string& path) {
@@ -151,7 +161,6 @@ bool write_unnamed_then_rename(const std::string& path, std::string_view content
   detail::write_all(fd, content, path);
   if (::fsync(fd) != 0 && errno != EINVAL) throw Error(path + ": cannot sync: " + errno_text(errno));
   const std::filesystem::path target(path);
-  const std::filesystem::path folder = folder_of(target);
   static std::atomic<std::uint64_t> serial{0};
   for (int attempt = 0; attempt < 64; ++attempt) {
     const std::uint64_t n = (static_cast<std::uint64_t>(::getpid()) << 40) ^
@@ -159,8 +168,7 @@ bool write_unnamed_then_rename(const std::string& path, std::string_view content
                             serial.fetch_add(1, std::memory_order_relaxed);
     char suffix[24];
     std::snprintf(suffix, sizeof suffix, "%016llx", static_cast<unsigned long long>(n));
-    const std::string tmp =
-        (folder / ("." + target.filename().string() + ".tmp." + suffix)).string();
+    const std::string tmp = temporary_name(target, suffix);
     if (!link_unnamed(fd, tmp)) {
       if (errno == EEXIST) continue;
       return false;  // no /proc, or links refused: the named way
@@ -186,7 +194,7 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   if (write_unnamed_then_rename(path, content)) return;
   namespace fs = std::filesystem;
   const fs::path target(path);
-  std::string tmp = (folder_of(target) / ("." + target.filename().string() + ".tmp.XXXXXX")).string();
+  std::string tmp = temporary_name(target, "XXXXXX");
   const int fd = ::mkstemp(tmp.data());
   if (fd < 0)
     throw Error(path + ": cannot create a temporary file in its folder: " + errno_text(errno));

@@ -22,7 +22,8 @@ namespace tgraph::replay::test {
 
 /// prefix + i ("d3"). Appended, not `"d" + std::to_string(i)`: GCC 12 inlines that
 /// operator+ into a false -Wrestrict warning.
-inline std::string numbered(const char* prefix, std::uint64_t i) {
+template <class Int>
+std::string numbered(const char* prefix, Int i) {
   std::string s(prefix);
   s += std::to_string(i);
   return s;
