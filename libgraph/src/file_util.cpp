@@ -151,8 +151,9 @@ namespace {
 // The unnamed-file way of write_file_atomic: the bytes written and synced before the file
 // has a name, then linked as ".NAME.tmp.<n>" and renamed over `path`, so that a process
 // killed while it writes leaves nothing behind (only the two calls between link and rename
-// can leave the temporary name). False, with nothing written, where the file system has no
-// unnamed files or /proc cannot link them (the caller then takes the named way).
+// can leave the temporary name). False where the file system has no unnamed files or /proc
+// cannot link them, leaving nothing behind (an unnamed file already written is dropped with
+// its descriptor; the caller then writes the bytes again the named way).
 bool write_unnamed_then_rename(const std::string& path, std::string_view content) {
   const int fd = detail::open_unnamed_beside(path);
   if (fd < 0) return false;
