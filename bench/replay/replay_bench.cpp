@@ -16,6 +16,8 @@
 //    run in turn in blocks of steps within one benchmark iteration (`ratio`: the median over
 //    the iterations of the two blocks' median step times), so that a change of the host's
 //    speed between repetitions, which this project's VM shows in spells, falls on both.
+//    A third block runs partition with PartitionOptions::combine off (`ratio_uncombined`,
+//    `ratio_quiet_uncombined`): what the combined reductions save, in the same pairs.
 //    After each pair of blocks, the host is probed (probe_host()): `probe_handoff_ns`, two
 //    threads bouncing a counter, and `core_speed` (p10, p90), the second thread's core's
 //    speed over the first's when both run the same empty steps at once: 1 on a quiet machine;
@@ -286,31 +288,38 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
   o.threads = k;
   std::unique_ptr<Executor> seq = make_executor(Policy::kSequential, o);
   std::unique_ptr<Executor> par = make_executor(Policy::kPartition, o);
+  ExecOptions uncombined = o;  // the same executor with every task on its own processor
+  uncombined.partition.combine = false;
+  std::unique_ptr<Executor> apart = make_executor(Policy::kPartition, uncombined);
   SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
   w.set_step(g);
   std::uint64_t instances = 0;
   for (const ThreadCounters& c : seq->run_step(g, nullptr, w).threads) instances += c.tasks;
   par->run_step(g, &a, w);
-  std::vector<double> ratios, seq_ns, par_ns, handoff, core_speed, probe_step, probe_alone,
-      walls(block);
+  apart->run_step(g, &a, w);
+  std::vector<double> ratios, apart_ratios, seq_ns, par_ns, handoff, core_speed, probe_step,
+      probe_alone, walls(block);
   // The host probed before and after each pair (the after of one is the before of the next).
   std::vector<HostProbe> probes{probe_host(g)};
   for (auto _ : state) {
-    // Each executor's block follows the other's, the order alternating between iterations.
+    // Each executor's block follows the others', the order reversed every other iteration.
     const auto time_block = [&](Executor& ex, const Assignment* as) {
       for (std::uint32_t i = 0; i < block; ++i)
         walls[i] = static_cast<double>(ex.run_step(g, as, w).wall_ns);
       return median(walls);
     };
-    double s = 0, p = 0;
+    double s = 0, p = 0, n = 0;
     if (ratios.size() % 2 == 0) {
       s = time_block(*seq, nullptr);
       p = time_block(*par, &a);
+      n = time_block(*apart, &a);
     } else {
+      n = time_block(*apart, &a);
       p = time_block(*par, &a);
       s = time_block(*seq, nullptr);
     }
     ratios.push_back(p / s);
+    apart_ratios.push_back(n / s);
     seq_ns.push_back(s);
     par_ns.push_back(p);
     const HostProbe h = probe_host(g);
@@ -332,12 +341,18 @@ void BM_TaskOverheadInTurn(benchmark::State& state, std::uint32_t block) {
     return h.core_speed >= 0.95 && h.core_speed <= 1.05 && h.step_us <= 1.10 * h.alone_us &&
            h.alone_us <= 1.10 * fastest;
   };
-  std::vector<double> quiet_ratios;
+  std::vector<double> quiet_ratios, quiet_apart;
   for (std::size_t i = 0; i < ratios.size(); ++i)
-    if (quiet(probes[i]) && quiet(probes[i + 1])) quiet_ratios.push_back(ratios[i]);
+    if (quiet(probes[i]) && quiet(probes[i + 1])) {
+      quiet_ratios.push_back(ratios[i]);
+      quiet_apart.push_back(apart_ratios[i]);
+    }
   const auto per_task = static_cast<double>(instances);
   state.counters["ratio"] = median(ratios);
   state.counters["ratio_quiet"] = quiet_ratios.empty() ? 0.0 : median(quiet_ratios);
+  // The same without combines (PartitionOptions::combine off), timed in the same pairs.
+  state.counters["ratio_uncombined"] = median(apart_ratios);
+  state.counters["ratio_quiet_uncombined"] = quiet_apart.empty() ? 0.0 : median(quiet_apart);
   state.counters["quiet_pairs"] = static_cast<double>(quiet_ratios.size());
   state.counters["sequential_ns_per_task"] = median(seq_ns) / per_task;
   state.counters["partition_ns_per_task"] = median(par_ns) / per_task;

@@ -12,7 +12,11 @@
 // readers of the previous version the same way. Loops: every processor holding body tasks
 // runs the loop control itself; the processor of the break task publishes, per iteration,
 // loop[l] = (epoch << 32) | (iterations << 1) | stop, and the others read it before starting
-// the next iteration. Calling thread = processor 0.
+// the next iteration. Combines (partition_plan.hpp, PartitionOptions::combine): each party
+// adds one to arrivals[c] (acq_rel; reset to the epoch at the start of a step), and the one
+// whose arrival completes an execution's count runs the reducer and the tasks after it, then
+// publishes their done counters; the reducer's own processor, when not last, waits for
+// combined[c] = epoch | executions instead. Calling thread = processor 0.
 #include <atomic>
 #include <exception>
 #include <memory>
@@ -35,13 +39,14 @@
 namespace tgraph::replay {
 namespace {
 
+using detail::CombineRole;
+using detail::Op;
 using detail::OpKind;
 using detail::PaddedCounter;
 using detail::PartitionPlan;
 using detail::ProcPlan;
 using detail::WaitKind;
 using detail::WaitPoint;
-using detail::Op;
 
 class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
  public:
@@ -90,22 +95,25 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   std::uint32_t rebuilt(const PartitionPlan& plan) const override { return plan.rebuilt_procs; }
 
   // Program order on every processor never deadlocks (every wait names an earlier task in
-  // program order); only an explicit order needs the check.
-  // PartitionTestHooks::lose_signal is applied here, to full and incremental builds alike.
+  // program order); only an explicit order needs the check. Then the combines are marked
+  // (they add no wait a deadlock could come from: a combine runs once its parties arrive,
+  // which the plan's own waits already required). PartitionTestHooks::lose_signal is
+  // applied last, to full and incremental builds alike.
   std::unique_ptr<PartitionPlan> checked(const ExecGraph& x, PartitionPlan built) {
     auto plan = std::make_unique<PartitionPlan>(std::move(built));
-    lose_signal(*plan, x);
-    if (plan->program_order) return plan;
-    try {
-      detail::check_deadlock_free(*plan, x);
-    } catch (const UsageError&) {
-      if (!x.added_edges) throw;  // the order itself is invalid
-      // The explicit order cannot be kept with the lowered graph's extra edges (serialised
-      // CW writers): fall back to program order on each processor, which never deadlocks.
-      *plan = detail::build_plan(x, threads(), false, options().partition.elide_waits);
-      lose_signal(*plan, x);
-      ++order_fallbacks_;
+    if (!plan->program_order) {
+      try {
+        detail::check_deadlock_free(*plan, x);
+      } catch (const UsageError&) {
+        if (!x.added_edges) throw;  // the order itself is invalid
+        // The explicit order cannot be kept with the lowered graph's extra edges (serialised
+        // CW writers): fall back to program order on each processor, which never deadlocks.
+        *plan = detail::build_plan(x, threads(), false, options().partition.elide_waits);
+        ++order_fallbacks_;
+      }
     }
+    if (options().partition.combine && !options().partition.serial) detail::add_combines(x, *plan);
+    lose_signal(*plan, x);
     return plan;
   }
 
@@ -129,6 +137,11 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       loop_ = std::make_unique<PaddedCounter[]>(plan.loops);
       loop_cap_ = plan.loops;
     }
+    if (plan.combines.size() > combine_cap_) {
+      arrivals_ = std::make_unique<PaddedCounter[]>(plan.combines.size());
+      combined_ = std::make_unique<PaddedCounter[]>(plan.combines.size());
+      combine_cap_ = plan.combines.size();
+    }
     plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
@@ -139,6 +152,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     abort_.store(false, std::memory_order_relaxed);
     const std::uint64_t seq = ++steps_;
     epoch_ = seq << 32;
+    for (std::size_t c = 0; c < plan.combines.size(); ++c)
+      arrivals_[c].v.store(epoch_, std::memory_order_relaxed);  // relaxed: as abort_ below
     start_watchdog();
     if (watchdog_) watchdog_->begin_step(seq);  // a release: step context visible
     parking_.signal(step_seq_, seq);            // seq_cst store (a release): step context visible
@@ -206,12 +221,22 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     // a woken waiter sees abort_ and leaves.
     for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.poke(done_[t].v);
     for (std::size_t l = 0; l < plan_->loops; ++l) parking_.poke(loop_[l].v);
+    for (std::size_t c = 0; c < plan_->combines.size(); ++c) parking_.poke(combined_[c].v);
+  }
+
+  // Arrival at combine c in the step of epoch E: whether the caller is the last of its
+  // parties in this execution (then it runs the combine).
+  bool arrive(std::uint32_t c, std::uint64_t E, std::uint32_t parties) {
+    // acq_rel: releases what the caller ran (and acquired) to the last to arrive, which
+    // acquires every party's through the chain of these read-modify-writes.
+    const std::uint64_t before = arrivals_[c].v.fetch_add(1, std::memory_order_acq_rel);
+    return (before - E + 1) % parties == 0;
   }
 
   // Waits until ok(c); false when the step is aborting. The check that holds at once is
   // inlined into the hot loop; blocking is out of line (block()).
   // `kind`/`id`: what is waited for, for the watchdog's report (1: task id's completion,
-  // 2: loop id's decision, 3: the first-touch barrier).
+  // 2: loop id's decision, 3: the first-touch barrier, 4: combine id).
   template <class Ok>
   bool wait(std::atomic<std::uint64_t>& c, Ok ok, std::uint32_t thread, TaskId task,
             ThreadCounters& tc, std::uint64_t& value, std::uint32_t kind, std::uint32_t id) {
@@ -227,9 +252,9 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   // The blocking part of wait(): spin, then park; returns the value that satisfied ok (or
   // the last one read when aborting).
   template <class Ok>
-  [[gnu::noinline]] std::uint64_t block(std::atomic<std::uint64_t>& c, Ok ok,
-                                        std::uint32_t thread, TaskId task, ThreadCounters& tc,
-                                        std::uint32_t kind, std::uint32_t id) {
+  [[gnu::noinline]] std::uint64_t block(std::atomic<std::uint64_t>& c, Ok ok, std::uint32_t thread,
+                                        TaskId task, ThreadCounters& tc, std::uint32_t kind,
+                                        std::uint32_t id) {
     Slot& slot = counters_[thread];
     // relaxed: read by the watchdog for its report only.
     slot.at_task.store(task, std::memory_order_relaxed);
@@ -257,7 +282,10 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     const TaskId t = x.exec_of[*hooks_.lose_signal];
     for (ProcPlan& pp : plan.procs)
       for (Op& op : pp.ops)
-        if (op.kind == OpKind::kTask && op.task == t) op.signal = false;
+        if (op.kind == OpKind::kTask && op.task == t) {
+          op.signal = false;
+          if (op.combine == CombineRole::kOffer) op.combine = CombineRole::kNone;  // no arrival
+        }
   }
 
   void start_watchdog() {
@@ -303,6 +331,11 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
         out += " waits for the decision of loop " + std::to_string(id);
       } else if (kind == 3) {
         out += " waits at the first-touch barrier";
+      } else if (kind == 4 && id < plan_->combines.size()) {
+        const detail::Combine& c = plan_->combines[id];
+        out += " waits for " + label(plan_->procs[c.home].ops[c.head].task) +
+               " and the tasks after it, run by the last of their " + std::to_string(c.parties) +
+               " threads to arrive";
       } else if (task < x.graph.tasks.size()) {
         out += " runs or last ran " + label(task);
       } else {
@@ -338,9 +371,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   // less on the critical path of a hand-off (a loop decision read at the end of the body, a
   // producer that ran ahead).
   template <bool Watch>
-  [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc,
-                                                 const ExecGraph& x, Workload& w,
-                                                 std::uint32_t iter, std::uint32_t p,
+  [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc, const ExecGraph& x,
+                                                 Workload& w, std::uint32_t iter, std::uint32_t p,
                                                  Slot& slot, const void* next) {
     const std::uint32_t n = ops[pc].plain_run;
     const std::size_t end = pc + n;
@@ -396,6 +428,23 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       }
       std::uint32_t iter = 0;
       std::uint64_t v = 0;
+      // Runs a task op (of this program, or of a combine's home) and publishes its completion.
+      const auto execute = [&](const Op& op) {
+        if (observe && detail::sampled(iter, stride))
+          detail::notify_begin(observers(), p, op.task, iter);
+        if (watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // relaxed: report
+        w.run(TaskRun{&x, op.task, op.origin, iter, p});
+        if (observe && detail::sampled(iter, stride))
+          detail::notify_end(observers(), p, op.task, iter);
+        if (watch)  // relaxed: compared between two samples of the watchdog only
+          slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
+                              std::memory_order_relaxed);
+        ++tasks;
+        if (op.signal) {
+          parking_.signal(done_[op.task].v, E + iter + 1);
+          ++signals;
+        }
+      };
       const Op* const ops = pp.ops.data();
       const WaitPoint* const waits = pp.waits.data();
       const std::size_t n_ops = pp.ops.size();
@@ -431,7 +480,22 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
                          : run_plain<false>(ops, pc, x, w, iter, p, slot, next);
               break;
             }
-            for (auto i = op.wait_begin; i < op.wait_end; ++i) {
+            if (op.combine == CombineRole::kHead) [[unlikely]] {
+              // Arrival instead of the waits (each producer arrives after running). Not
+              // last: another party runs the combine; wait until it has.
+              const detail::Combine& c = plan.combines[op.jump];
+              if (!arrive(op.jump, E, c.parties)) {
+                const std::uint64_t target = E + iter + 1;
+                if (!wait(
+                        combined_[op.jump].v, [target](std::uint64_t s) { return s >= target; }, p,
+                        op.task, tc, v, 4, op.jump))
+                  goto out;
+                pc = c.end;
+                break;
+              }
+            }
+            for (auto i = op.combine == CombineRole::kHead ? op.wait_end : op.wait_begin;
+                 i < op.wait_end; ++i) {
               const WaitPoint& wp = waits[i];
               std::uint32_t loop_ran = 0;
               if (wp.kind == WaitKind::kAfterLoop) {  // the loop's decision to stop first
@@ -451,25 +515,21 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
                       op.task, tc, v, 1, wp.producer))
                 goto out;
             }
-            if (observe && detail::sampled(iter, stride))
-              detail::notify_begin(observers(), p, op.task, iter);
-            if (watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // relaxed: report
-            w.run(TaskRun{&x, op.task, op.origin, iter, p});
-            if (observe && detail::sampled(iter, stride))
-              detail::notify_end(observers(), p, op.task, iter);
-            if (watch)  // relaxed: compared between two samples of the watchdog only
-              slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
-                                  std::memory_order_relaxed);
-            ++tasks;
-            if (op.signal) {
-              parking_.signal(done_[op.task].v, E + iter + 1);
-              ++signals;
-            }
+            execute(op);
             if (op.is_break) {
               const bool stop = detail::leave_loop(x, op.loop, iter, w);
               parking_.signal(loop_[op.loop].v,
                               E | (static_cast<std::uint64_t>(iter + 1) << 1) | (stop ? 1u : 0u));
               ++signals;
+            }
+            if (op.combine == CombineRole::kOffer) [[unlikely]] {
+              const detail::Combine& c = plan.combines[op.jump];
+              if (arrive(op.jump, E, c.parties)) {  // last: the combine runs here
+                const Op* const home = plan.procs[c.home].ops.data();
+                for (std::uint32_t i = c.head; i < c.end; ++i) execute(home[i]);
+                parking_.signal(combined_[op.jump].v, E + iter + 1);
+                ++signals;
+              }
             }
             ++pc;
             break;
@@ -495,6 +555,9 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   std::size_t done_cap_ = 0;
   std::unique_ptr<PaddedCounter[]> loop_;
   std::size_t loop_cap_ = 0;
+  std::unique_ptr<PaddedCounter[]> arrivals_;  // by combine: epoch + arrivals this step
+  std::unique_ptr<PaddedCounter[]> combined_;  // by combine: epoch | executions run
+  std::size_t combine_cap_ = 0;
   // Step context: written by the main thread before the step_seq_ store, read by workers
   // after acquiring it.
   const PartitionPlan* plan_ = nullptr;

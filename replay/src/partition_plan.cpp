@@ -46,7 +46,8 @@ std::vector<TaskId> local_topological(const ExecGraph& x, const std::vector<Task
 }  // namespace
 
 /// Step 1: each loop's body tasks are gathered in one block of a processor's ops.
-void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide, PartitionPlan& plan) {
+void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide,
+               PartitionPlan& plan) {
   const StepGraph& g = x.graph;
   const auto n = static_cast<TaskId>(g.tasks.size());
   const Assignment& a = x.assignment;
@@ -84,18 +85,21 @@ void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide, 
       const LoopId l = g.tasks[t].loop;
       if (l == kNoLoop) {
         plan.pos[t] = static_cast<std::int64_t>(ops.size());
-        ops.push_back({OpKind::kTask, false, false, t, kNoLoop, 0, 0, 0, x.origin[t]});
+        ops.push_back(
+            {OpKind::kTask, false, false, CombineRole::kNone, t, kNoLoop, 0, 0, 0, x.origin[t]});
         continue;
       }
       if (opened[l]) continue;
       opened[l] = true;
-      ops.push_back({OpKind::kLoopBegin, false, false, 0, l, 0, 0, 0, kNoTask});
+      ops.push_back({OpKind::kLoopBegin, false, false, CombineRole::kNone, 0, l, 0, 0, 0, kNoTask});
       const auto body = static_cast<std::uint32_t>(ops.size());
       for (TaskId u : in_loop[l]) {
         plan.pos[u] = static_cast<std::int64_t>(ops.size());
-        ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, u, l, 0, 0, 0, x.origin[u]});
+        ops.push_back({OpKind::kTask, false, u + 1 == g.loops[l].last, CombineRole::kNone, u, l, 0,
+                       0, 0, x.origin[u]});
       }
-      ops.push_back({OpKind::kLoopEnd, false, false, 0, l, 0, 0, body, kNoTask});
+      ops.push_back(
+          {OpKind::kLoopEnd, false, false, CombineRole::kNone, 0, l, 0, 0, body, kNoTask});
     }
   }
 }
@@ -240,6 +244,92 @@ PartitionPlan build_plan(const ExecGraph& x, std::uint32_t k, bool use_order, bo
   plan.rebuilt_procs = k;
   finish_plan(x, plan);
   return plan;
+}
+
+namespace {
+
+/// Whether processor q, between its offer at ops[at] in two iterations of loop l, waits for
+/// something that home runs at or after ops[head] (a task there, or the loop's decision when
+/// the break task is there): then every arrival of one iteration precedes those of the next.
+bool orders_iterations(const ExecGraph& x, const PartitionPlan& plan, ProcId q, std::uint32_t at,
+                       ProcId home, std::uint32_t head, LoopId l) {
+  const auto after_head = [&](TaskId t) {
+    return plan.proc[t] == home && plan.pos[t] >= head && x.graph.tasks[t].loop == l;
+  };
+  if (after_head(plan.breaks[l])) return true;  // q reads the decision at its loop's end
+  const ProcPlan& pp = plan.procs[q];
+  std::uint32_t begin = at;
+  while (begin > 0 && !(pp.ops[begin].kind == OpKind::kLoopBegin && pp.ops[begin].loop == l))
+    --begin;
+  for (std::uint32_t i = begin + 1; i < pp.ops.size(); ++i) {
+    const Op& op = pp.ops[i];
+    if (op.kind == OpKind::kLoopEnd && op.loop == l) break;
+    if (op.kind != OpKind::kTask) continue;
+    for (auto w = op.wait_begin; w < op.wait_end; ++w) {
+      const WaitPoint& wp = pp.waits[w];
+      if (!after_head(wp.producer)) continue;
+      if ((wp.kind == WaitKind::kSameIter && i > at) || (wp.kind == WaitKind::kPrevIter && i <= at))
+        return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+void add_combines(const ExecGraph& x, PartitionPlan& plan) {
+  plan.combines.clear();
+  const std::size_t k = plan.procs.size();
+  if (!plan.elide || k < 2) return;
+  const StepGraph& g = x.graph;
+  std::vector<bool> taken(plan.tasks, false);  // a head, an offer, or in a combine's tasks
+  const auto op_of = [&plan](TaskId t) -> Op& {
+    return plan.procs[plan.proc[t]].ops[static_cast<std::size_t>(plan.pos[t])];
+  };
+  std::vector<ProcId> parties;
+  for (ProcId p = 0; p < k; ++p) {
+    std::vector<Op>& ops = plan.procs[p].ops;
+    const std::vector<WaitPoint>& waits = plan.procs[p].waits;
+    for (std::uint32_t h = 0; h < ops.size(); ++h) {
+      const Op& head = ops[h];
+      if (head.kind != OpKind::kTask || x.reduction[head.task] == kNoReduction ||
+          head.wait_begin == head.wait_end || head.is_break || taken[head.task])
+        continue;
+      const LoopId l = head.loop;
+      const WaitKind same = l == kNoLoop ? WaitKind::kOnce : WaitKind::kSameIter;
+      parties.clear();
+      bool ok = true;
+      for (auto i = head.wait_begin; ok && i < head.wait_end; ++i) {
+        const WaitPoint& wp = waits[i];
+        const ProcId q = plan.proc[wp.producer];
+        ok = wp.kind == same && g.tasks[wp.producer].loop == l && q != p &&
+             std::find(parties.begin(), parties.end(), q) == parties.end() && !taken[wp.producer] &&
+             !op_of(wp.producer).is_break &&
+             (l == kNoLoop ||
+              orders_iterations(x, plan, q, static_cast<std::uint32_t>(plan.pos[wp.producer]), p, h,
+                                l));
+        parties.push_back(q);
+      }
+      if (!ok) continue;
+      // The tasks after the head that wait for nothing and that another processor waits for.
+      std::uint32_t end = h + 1;
+      while (end < ops.size() && ops[end].kind == OpKind::kTask &&
+             ops[end].wait_begin == ops[end].wait_end && ops[end].signal && !ops[end].is_break &&
+             !taken[ops[end].task])
+        ++end;
+      const auto s = static_cast<std::uint32_t>(plan.combines.size());
+      plan.combines.push_back({p, h, end, static_cast<std::uint32_t>(parties.size() + 1)});
+      for (std::uint32_t i = h; i < end; ++i) taken[ops[i].task] = true;
+      ops[h].combine = CombineRole::kHead;
+      ops[h].jump = s;
+      for (auto i = head.wait_begin; i < head.wait_end; ++i) {
+        Op& offer = op_of(waits[i].producer);
+        offer.combine = CombineRole::kOffer;
+        offer.jump = s;
+        taken[offer.task] = true;
+      }
+    }
+  }
 }
 
 }  // namespace tgraph::replay::detail

@@ -34,6 +34,13 @@ struct WaitPoint {
 /// What an op of a processor's program does.
 enum class OpKind : std::uint8_t { kTask, kLoopBegin, kLoopEnd };
 
+/// A task op's part in a combine (PartitionPlan::combines; Op::jump holds the combine).
+enum class CombineRole : std::uint8_t {
+  kNone,
+  kOffer,  ///< after running (and signalling), arrive; the last to arrive runs the combine
+  kHead,   ///< arrive instead of waiting; run the combine if last, else wait until it ran
+};
+
 /// One op of a processor's program: 32 bytes, aligned, so that a record never straddles two
 /// cache lines and the hot loop indexes ops with a shift. Everything the loop needs for a
 /// task is here (its original id too), not in the exec graph's arrays.
@@ -41,11 +48,12 @@ struct alignas(32) Op {
   OpKind kind = OpKind::kTask;
   bool signal = false;    // publish done[task] after running
   bool is_break = false;  // evaluate and publish the loop decision after running
+  CombineRole combine = CombineRole::kNone;
   TaskId task = 0;
   LoopId loop = kNoLoop;
   std::uint32_t wait_begin = 0, wait_end = 0;
-  std::uint32_t jump = 0;       // kLoopEnd: first op of the body
-  TaskId origin = kNoTask;      // kTask: the original task (ExecGraph::origin)
+  std::uint32_t jump = 0;   // kLoopEnd: first op of the body; kTask: its combine
+  TaskId origin = kNoTask;  // kTask: the original task (ExecGraph::origin)
   // kTask: how many ops from this one on are tasks that wait for nothing and publish
   // nothing (the executor runs them in one loop, as the sequential program); 0: not this one.
   std::uint32_t plain_run = 0;
@@ -61,11 +69,25 @@ struct ProcPlan {
   friend bool operator==(const ProcPlan&, const ProcPlan&) = default;
 };
 
+/// A combine: a task that waits for one producer on each of several other processors (a
+/// reduction of per-processor partial sums), with the tasks after it on its processor that
+/// wait for nothing and that another processor waits for (the scalar of a dot product). Run
+/// by whichever processor arrives last (its own, or a producer's right after the producer
+/// ran) instead of by its own processor after the producers' signals: one hand-off on the
+/// critical path instead of two (the producers' to it, its result's back).
+struct Combine {
+  ProcId home = 0;                  ///< the processor whose program holds the tasks
+  std::uint32_t head = 0, end = 0;  ///< its ops [head, end) in that program
+  std::uint32_t parties = 0;        ///< arrivals per execution: the producers' processors and home
+  friend bool operator==(const Combine&, const Combine&) = default;
+};
+
 /// The partition executor's plan: one program per processor, and what the next incremental
 /// update compares with.
 struct PartitionPlan {
   std::vector<ProcPlan> procs;
-  bool program_order = true;  // false: the assignment's explicit order is followed
+  std::vector<Combine> combines;  // add_combines()
+  bool program_order = true;      // false: the assignment's explicit order is followed
   std::size_t tasks = 0;
   std::size_t loops = 0;
   // What the next incremental build compares with (by exec task of this plan).
@@ -75,10 +97,9 @@ struct PartitionPlan {
   std::vector<ProcId> proc;
   std::vector<std::int64_t> pos;    // position in its processor's ops
   std::vector<TaskId> breaks;       // by loop: its break task
-  Csr intra, carried;              // predecessors along intra-step and loop-carried edges
+  Csr intra, carried;               // predecessors along intra-step and loop-carried edges
   std::uint32_t rebuilt_procs = 0;  // processors whose wait points this build computed
 };
-
 
 /// The one wait-readiness rule: how many executions of `w.producer` (this step) a task in
 /// iteration `iter` of its loop (0 outside loops) needs before it runs; 0: none.
@@ -121,5 +142,14 @@ void build_ops(const ExecGraph& x, std::uint32_t k, bool use_order, bool elide,
 void build_waits(const ExecGraph& x, ProcId p, PartitionPlan& plan);
 /// Step 3: signal flags and first-touch owners.
 void finish_plan(const ExecGraph& x, PartitionPlan& plan);
+
+/// Marks the combines of a finished plan (Combine; the threaded executor's option
+/// PartitionOptions::combine): every task op whose waits name one producer on each of
+/// other processors, all in its own loop iteration (or all outside loops), becomes a head,
+/// each producer an offer, when every producer's processor, between two of its offers,
+/// waits for something its home runs at or after the head (so that the arrivals of one
+/// iteration all come before those of the next). Needs elided waits (plan.elide); the
+/// serial twin ignores the roles.
+void add_combines(const ExecGraph& x, PartitionPlan& plan);
 
 }  // namespace tgraph::replay::detail

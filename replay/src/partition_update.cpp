@@ -76,8 +76,10 @@ PartitionPlan update_plan(const ExecGraph& x, const PartitionPlan& prev, std::ui
     for (std::size_t i = 0; same && i < ops.size(); ++i) {
       const Op& o = ops[i];
       const Op& q = old[i];
-      same = o.kind == q.kind && o.is_break == q.is_break && o.jump == q.jump &&
-             same_loop(o.loop, q.loop) && (o.kind != OpKind::kTask || old_of[o.task] == q.task);
+      // (a task op's jump is its combine, which add_combines() sets after this build)
+      same = o.kind == q.kind && o.is_break == q.is_break &&
+             (o.kind != OpKind::kLoopEnd || o.jump == q.jump) && same_loop(o.loop, q.loop) &&
+             (o.kind != OpKind::kTask || old_of[o.task] == q.task);
     }
     same_ops[p] = same;
     std::int64_t last = -1;
@@ -97,8 +99,7 @@ PartitionPlan update_plan(const ExecGraph& x, const PartitionPlan& prev, std::ui
   std::uint32_t stamp = 0;
   // Predecessor lists of v and of its previous task ov are the same, each predecessor where
   // it was, in the same loop, on a processor that kept its order.
-  auto same_preds = [&](const Csr& now, const Csr& before, TaskId v, TaskId ov,
-                        ProcId p) {
+  auto same_preds = [&](const Csr& now, const Csr& before, TaskId v, TaskId ov, ProcId p) {
     if (now.size(v) != before.size(ov)) return false;
     ++stamp;
     for (auto i = now.begin[v]; i < now.begin[v + 1]; ++i) {

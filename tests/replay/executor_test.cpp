@@ -7,8 +7,10 @@
 #include <cstring>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <numeric>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "random_graph.hpp"
 #include "tgraph/graph/error.hpp"
@@ -192,6 +194,60 @@ TEST(CwReduction, IsDeterministicAcrossRunsAndEqualsTheSerialTwin) {
   double plain = 0;
   for (TaskId t = 0; t < 12; ++t) plain += 0.1 * (t + 1) / 3.0;
   EXPECT_NEAR(expected, plain, 1e-12);
+}
+
+// The dot product's reducer and scalar run on whichever processor finishes its partial sums
+// last: here the one whose partial tasks take 2 ms each (the others' take nothing). Waiting
+// threads park at once, so that three threads on fewer cores still let the fast ones arrive.
+TEST(CombinedReductions, RunOnTheLastProcessorToArriveAndLeaveTheSequentialState) {
+  constexpr std::uint32_t kIterations = 5;
+  constexpr int kSteps = 3;
+  for (std::uint32_t k : {2u, 3u}) {
+    for (ProcId slow : {0u, 1u}) {
+      const test::DotLoop d = test::dot_loop(6, k, kIterations, slow, 2'000'000);
+      // Tasks per thread when every task runs on its own processor (the serial twin).
+      std::vector<std::uint64_t> own(k, 0);
+      {
+        auto twin = make_executor(Policy::kPartition, opts(k, true));
+        SyntheticWorkload w({.cost_scale = 0.0});
+        w.set_step(d.g);
+        const ExecStepStats s = twin->run_step(d.g, &d.a, w);
+        for (ProcId p = 0; p < k; ++p) own[p] = s.threads[p].tasks;
+      }
+      for (bool combine : {true, false}) {
+        ExecOptions o = opts(k, false, 0);
+        o.partition.combine = combine;
+        auto ex = make_executor(Policy::kPartition, o);
+        SyntheticWorkload w({.cost_scale = 1.0});
+        w.set_step(d.g);
+        std::int64_t on_slow = 0;  // combined tasks the slow thread ran
+        for (int step = 0; step < kSteps; ++step) {
+          const ExecStepStats s = ex->run_step(d.g, &d.a, w);
+          std::uint64_t total = 0;
+          for (ProcId p = 0; p < k; ++p) total += s.threads[p].tasks;
+          EXPECT_EQ(total, std::accumulate(own.begin(), own.end(), std::uint64_t{0}));
+          if (!combine) {
+            for (ProcId p = 0; p < k; ++p)
+              EXPECT_EQ(s.threads[p].tasks, own[p]) << "k=" << k << " thread " << p;
+            continue;
+          }
+          const auto extra = static_cast<std::int64_t>(s.threads[slow].tasks) -
+                             static_cast<std::int64_t>(own[slow]);
+          on_slow += slow == 0 ? 2 * kIterations + extra : extra;  // home: own holds them
+        }
+        // The reducer and the scalar, each iteration of each step, on the slow thread (80 %:
+        // a fast thread preempted on a loaded machine may arrive last once in a while).
+        // With more threads than cores, a fast thread sharing the slow one's core may well
+        // arrive last: then only the results are compared.
+        if (combine && k <= std::thread::hardware_concurrency())
+          EXPECT_GE(on_slow, 2 * kIterations * kSteps * 8 / 10) << "k=" << k << " slow " << slow;
+        const auto got = final_state(w, d.g), want = sequential_state(d.g, kSteps);
+        for (DatumId x = 0; x < d.g.data.size(); ++x)
+          EXPECT_TRUE(got[x] == want[x]) << "k=" << k << " slow " << slow << " combine "
+                                         << combine << ": datum " << d.g.data[x].name;
+      }
+    }
+  }
 }
 
 using test::Throwing;

@@ -9,12 +9,14 @@
 
 #include "partition_plan.hpp"
 #include "partition_serial.hpp"
+#include "random_graph.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
 namespace {
 
+using detail::CombineRole;
 using detail::OpKind;
 using detail::PartitionPlan;
 using detail::WaitKind;
@@ -209,6 +211,109 @@ TEST(PartitionPlan, SerialTwinRunsEveryTaskAndCountsItsWaits) {
   EXPECT_EQ(stats.threads[1].tasks, 1u);
   EXPECT_EQ(stats.waits(), 2u);
   EXPECT_EQ(stats.signals(), 2u);
+}
+
+// The ops of combine s that offer (one per producing processor).
+std::vector<const detail::Op*> offers_of(const PartitionPlan& plan, std::uint32_t s) {
+  std::vector<const detail::Op*> out;
+  for (const auto& pp : plan.procs)
+    for (const detail::Op& op : pp.ops)
+      if (op.combine == CombineRole::kOffer && op.jump == s) out.push_back(&op);
+  return out;
+}
+
+TEST(PartitionPlan, ADotProductsReducerAndScalarAreCombinedWithEachProcessorsLastPartial) {
+  for (std::uint32_t k : {2u, 3u}) {
+    const test::DotLoop d = test::dot_loop(6, k, 4, 0, 0);
+    const ExecGraph x = lower(d.g, &d.a, CwMode::kReduce);
+    PartitionPlan plan = detail::build_plan(x, k, true, true);
+    detail::add_combines(x, plan);
+    ASSERT_EQ(plan.combines.size(), 1u) << "k=" << k;
+    const detail::Combine& c = plan.combines[0];
+    EXPECT_EQ(c.home, 0u);
+    EXPECT_EQ(c.parties, k);
+    const std::vector<detail::Op>& ops = plan.procs[0].ops;
+    ASSERT_EQ(c.end - c.head, 2u);  // the reducer, then the scalar (read on every processor)
+    EXPECT_EQ(ops[c.head].combine, CombineRole::kHead);
+    EXPECT_NE(x.reduction[ops[c.head].task], kNoReduction);
+    EXPECT_EQ(x.graph.kind_name(ops[c.head + 1].task), "scalar");
+    // Each other processor offers after its last partial sum.
+    const auto offers = offers_of(plan, 0);
+    ASSERT_EQ(offers.size(), k - 1);
+    for (ProcId q = 1; q < k; ++q) {
+      TaskId last = kNoTask;
+      for (const detail::Op& op : plan.procs[q].ops)
+        if (op.kind == OpKind::kTask && x.graph.kind_name(op.task) == "partial") last = op.task;
+      EXPECT_EQ(offers[q - 1]->task, last) << "k=" << k << " processor " << q;
+    }
+    // Without elision a reducer waits for every writer: no combine.
+    PartitionPlan every = detail::build_plan(x, k, true, false);
+    detail::add_combines(x, every);
+    EXPECT_TRUE(every.combines.empty());
+  }
+}
+
+TEST(PartitionPlan, AReductionOutsideLoopsIsCombinedToo) {
+  // t0, t1, t2 add into d0 on processors 0, 1, 2; t3 reads it (processor 0) and writes d1,
+  // which t4 reads on processor 1: the reducer and t3 are the combine.
+  const StepGraph g = chain_graph({{{0, AccessMode::CW}},
+                                   {{0, AccessMode::CW}},
+                                   {{0, AccessMode::CW}},
+                                   {{0, AccessMode::R}, {1, AccessMode::W}},
+                                   {{1, AccessMode::R}}},
+                                  2);
+  const Assignment a = on({0, 1, 2, 0, 1}, 3);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  PartitionPlan plan = detail::build_plan(x, 3, true, true);
+  detail::add_combines(x, plan);
+  ASSERT_EQ(plan.combines.size(), 1u);
+  EXPECT_EQ(plan.combines[0].parties, 3u);
+  EXPECT_EQ(plan.combines[0].end - plan.combines[0].head, 2u);
+  const auto offers = offers_of(plan, 0);
+  ASSERT_EQ(offers.size(), 2u);
+  EXPECT_EQ(offers[0]->task, x.exec_of[1]);
+  EXPECT_EQ(offers[1]->task, x.exec_of[2]);
+}
+
+TEST(PartitionPlan, CombinesOfRandomGraphsHaveAReducerHeadAndOneOfferPerOtherProcessor) {
+  std::size_t combines = 0;
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    const StepGraph g = test::random_graph(seed * 7919);
+    for (std::uint32_t k : {2u, 3u, 5u}) {
+      const Assignment a = test::random_assignment(g, k, seed);
+      const ExecGraph x = lower(g, &a, CwMode::kReduce);
+      PartitionPlan plan = detail::build_plan(x, k, true, true);
+      detail::add_combines(x, plan);
+      combines += plan.combines.size();
+      for (std::uint32_t s = 0; s < plan.combines.size(); ++s) {
+        const detail::Combine& c = plan.combines[s];
+        const detail::ProcPlan& home = plan.procs[c.home];
+        const detail::Op& head = home.ops[c.head];
+        EXPECT_EQ(head.combine, CombineRole::kHead);
+        EXPECT_EQ(head.jump, s);
+        EXPECT_NE(x.reduction[head.task], kNoReduction);
+        EXPECT_EQ(head.wait_end - head.wait_begin, c.parties - 1);
+        for (std::uint32_t i = c.head + 1; i < c.end; ++i) {
+          EXPECT_EQ(home.ops[i].wait_begin, home.ops[i].wait_end);
+          EXPECT_TRUE(home.ops[i].signal);
+          EXPECT_FALSE(home.ops[i].is_break);
+        }
+        std::vector<ProcId> procs;
+        for (const detail::Op* op : offers_of(plan, s)) {
+          const ProcId q = x.assignment.proc[op->task];
+          EXPECT_NE(q, c.home);
+          EXPECT_EQ(std::count(procs.begin(), procs.end(), q), 0);
+          procs.push_back(q);
+          bool waited = false;
+          for (auto i = head.wait_begin; i < head.wait_end; ++i)
+            waited |= home.waits[i].producer == op->task;
+          EXPECT_TRUE(waited) << "seed " << seed << " k " << k;
+        }
+        EXPECT_EQ(procs.size() + 1, c.parties);
+      }
+    }
+  }
+  EXPECT_GT(combines, 20u);  // the random graphs do exercise them
 }
 
 }  // namespace

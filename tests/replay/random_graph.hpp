@@ -96,6 +96,48 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
 }
 
 /// A random assignment on k processors (program order).
+/// A dot product in a loop, as in a conjugate gradient: per object o (on processor o % k),
+/// "partial" (R v_o, CW dot: each processor's partial sums end in one reducer on processor
+/// 0 after lowering); "scalar" (R dot, W s) on processor 0; per object "update" (R s, RW
+/// v_o); "residual" (R s, W cond) and the break on processor 0. Costs: `slow_ns` for the
+/// partial tasks of processor `slow`'s objects, 0 for every other task.
+struct DotLoop {
+  StepGraph g;
+  Assignment a;
+};
+inline DotLoop dot_loop(std::uint32_t objects, std::uint32_t k, std::uint32_t iterations,
+                        ProcId slow, std::uint64_t slow_ns) {
+  DotLoop d;
+  StepGraph& g = d.g;
+  const KindId partial = g.intern_kind("partial"), scalar = g.intern_kind("scalar"),
+               update = g.intern_kind("update"), residual = g.intern_kind("residual"),
+               brk = g.intern_kind("loop.break");
+  for (std::uint32_t o = 0; o < objects; ++o) {
+    g.objects.push_back({numbered("o", o)});
+    g.data.push_back({numbered("v", o), o, 64});
+  }
+  const auto dot = static_cast<DatumId>(objects), s = dot + 1, cond = dot + 2;
+  g.data.push_back({"dot", kNoObject, 8});
+  g.data.push_back({"s", kNoObject, 8});
+  g.data.push_back({"cond", kNoObject, 8});
+  const auto add = [&](KindId kind, ObjectId o, std::vector<Access> acc, std::uint64_t cost) {
+    const TaskId t = g.add_task(kind, o, acc, cost, static_cast<StableKey>(g.tasks.size() + 1));
+    g.tasks[t].loop = 0;
+    d.a.proc.push_back(o == kNoObject ? 0 : o % k);
+  };
+  for (std::uint32_t o = 0; o < objects; ++o)
+    add(partial, o, {{o, AccessMode::R}, {dot, AccessMode::CW}}, o % k == slow ? slow_ns : 0);
+  add(scalar, kNoObject, {{dot, AccessMode::R}, {s, AccessMode::W}}, 0);
+  for (std::uint32_t o = 0; o < objects; ++o)
+    add(update, o, {{s, AccessMode::R}, {o, AccessMode::RW}}, 0);
+  add(residual, kNoObject, {{s, AccessMode::R}, {cond, AccessMode::W}}, 0);
+  add(brk, kNoObject, {{cond, AccessMode::R}}, 0);
+  g.loops.push_back({cond, 0, static_cast<TaskId>(g.tasks.size()), iterations, 0});
+  d.a.k = k;
+  g.derive_edges();
+  return d;
+}
+
 inline Assignment random_assignment(const StepGraph& g, std::uint32_t k, std::uint32_t seed) {
   std::mt19937 rng(seed);
   Assignment a;

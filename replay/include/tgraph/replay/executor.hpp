@@ -38,6 +38,16 @@ struct PartitionOptions {
   /// Run the per-processor programs interleaved on the calling thread (deterministic, same
   /// plans and waits; the serial twin of the threaded executor).
   bool serial = false;
+  /// Reductions run by whichever of their processors arrives last: a reducer waiting for
+  /// one partial sum from each of other processors, and the tasks after it on its processor
+  /// that another processor waits for (a dot product's scalar), run on the thread that
+  /// finishes its part last (the reducer's own, or a writer's right after its partial sum)
+  /// instead of on the reducer's thread after the writers' signals: one cross-thread
+  /// hand-off on the critical path of a dot product instead of two. The tasks and their
+  /// order are the same, and so are the results; only which thread runs these few tasks
+  /// changes (observers see the thread that ran them). Needs elide_waits; off: every task
+  /// on its assigned processor.
+  bool combine = true;
   /// The watchdog. A step during which no thread finishes a task or passes a wait for this
   /// long ends with std::runtime_error naming what each thread waits for or runs (0: no
   /// watchdog). Every thread is joined before run_step throws.
