@@ -55,6 +55,10 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
                   "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
   cmd->add_flag_callback(
       "--no-pin", [&exec] { exec.pin = false; }, "Do not bind threads to cores");
+  cmd->add_flag_callback(
+      "--no-combine", [&exec] { exec.partition.combine = false; },
+      "Partition policy: run every reducer on its own processor (default: a dot product's "
+      "reducer and scalar run on the last of its processors to arrive)");
   cmd->add_flag("--json", a.json, "Print one JSON object");
 }
 

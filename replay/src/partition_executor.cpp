@@ -345,16 +345,25 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     return out;
   }
 
+  // A counter to prefetch, and whether for writing (an arrival's read-modify-write).
+  struct Prefetch {
+    const void* at = nullptr;
+    bool write = false;
+  };
+
   // The counter the op after a plain run checks first (its first wait's producer, or its
-  // loop's decision), or null when it checks none here.
-  const void* next_check(const Op* ops, std::size_t next, std::size_t n_ops,
-                         const WaitPoint* waits) const {
-    if (next >= n_ops) return nullptr;
+  // loop's decision), or, for a combine's head or offer, the arrival counter it adds to;
+  // none when it checks none here.
+  Prefetch next_check(const Op* ops, std::size_t next, std::size_t n_ops,
+                      const WaitPoint* waits) const {
+    if (next >= n_ops) return {};
     const Op& op = ops[next];
-    if (op.kind == OpKind::kLoopEnd) return &loop_[op.loop].v;
-    if (op.kind != OpKind::kTask || op.wait_begin == op.wait_end) return nullptr;
+    if (op.kind == OpKind::kLoopEnd) return {&loop_[op.loop].v};
+    if (op.kind != OpKind::kTask) return {};
+    if (op.combine != CombineRole::kNone) return {&arrivals_[op.jump].v, true};
+    if (op.wait_begin == op.wait_end) return {};
     const WaitPoint& wp = waits[op.wait_begin];
-    return wp.kind == WaitKind::kAfterLoop ? &loop_[wp.loop].v : &done_[wp.producer].v;
+    return {wp.kind == WaitKind::kAfterLoop ? &loop_[wp.loop].v : &done_[wp.producer].v};
   }
 
   // Tasks before the end of a plain run at which run_plain prefetches the next op's counter.
@@ -369,18 +378,24 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   // tasks before the end (half way in a shorter run), so that a value its producer published
   // while this thread ran is already in this core's cache when the check reads it: a miss
   // less on the critical path of a hand-off (a loop decision read at the end of the body, a
-  // producer that ran ahead).
+  // producer that ran ahead). An arrival counter is prefetched for writing: the party
+  // arriving last then finds it in this core's cache, the others having added to it.
   template <bool Watch>
   [[gnu::noinline]] static std::size_t run_plain(const Op* ops, std::size_t pc, const ExecGraph& x,
                                                  Workload& w, std::uint32_t iter, std::uint32_t p,
-                                                 Slot& slot, const void* next) {
+                                                 Slot& slot, Prefetch next) {
     const std::uint32_t n = ops[pc].plain_run;
     const std::size_t end = pc + n;
     TaskRun run{&x, 0, kNoTask, iter, p};
     const std::size_t fetch_at =
-        next == nullptr ? end : (n > 2 * kPrefetchAhead ? end - kPrefetchAhead : pc + n / 2);
+        next.at == nullptr ? end : (n > 2 * kPrefetchAhead ? end - kPrefetchAhead : pc + n / 2);
     for (; pc < end; ++pc) {
-      if (pc == fetch_at) __builtin_prefetch(next, 0, 3);
+      if (pc == fetch_at) {
+        if (next.write)
+          __builtin_prefetch(next.at, 1, 3);
+        else
+          __builtin_prefetch(next.at, 0, 3);
+      }
       const Op& op = ops[pc];
       if constexpr (Watch) slot.at_task.store(op.task, std::memory_order_relaxed);  // a report
       run.task = op.task;
@@ -475,7 +490,7 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
             if (!observe && op.plain_run != 0) {
               // A run of tasks that neither wait nor publish: the sequential loop.
               tasks += op.plain_run;
-              const void* next = next_check(ops, pc + op.plain_run, n_ops, waits);
+              const Prefetch next = next_check(ops, pc + op.plain_run, n_ops, waits);
               pc = watch ? run_plain<true>(ops, pc, x, w, iter, p, slot, next)
                          : run_plain<false>(ops, pc, x, w, iter, p, slot, next);
               break;
