@@ -351,6 +351,15 @@ def ratios(all_runs):
                            f"{t} thread{'s' if t > 1 else ''} "
                            + (f"{fmt(v)} ({n:.0f} pairs)" if n else "no quiet pair")
                            for t, v, n in quiet if n is not None) + ".")
+        apart = [(t, med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio_uncombined"),
+                  med(r, f"BM_TaskOverheadInTurn/threads:{t}", "ratio_quiet_uncombined"))
+                 for t in (1, 2)]
+        if any(v is not None for _, v, _ in apart):
+            out.append("Partition without combined reductions (`PartitionOptions::combine` off, "
+                       "timed in the same iterations, a third block): " + "; ".join(
+                           f"{t} thread{'s' if t > 1 else ''} {fmt(v)}"
+                           + (f" (quiet pairs: {fmt(q)})" if q else "")
+                           for t, v, q in apart if v is not None) + ".")
         def probe(key):
             return med(r, "BM_TaskOverheadInTurn/threads:2", key)
         if probe("core_speed") is not None:

@@ -14,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "partition_plan.hpp"     // replay/src: the combines of a plan
 #include "partition_testing.hpp"  // replay/src: the lost-signal fault
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
@@ -278,6 +279,45 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
     FaultyWorkload ok;
     EXPECT_NO_THROW(ex->run_step(g, &a, ok));
     EXPECT_NO_THROW(ex->run_step(g, &a, ok));
+  }
+}
+
+// A producer of a combined reduction that never arrives: its reducer's processor waits for
+// the combine, and the report says so.
+TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
+  const StepGraph& g = falling_step();
+  const Assignment a = by_object(g, 2);
+  // The first combine's offer in the plan the executor builds (the same lowering and plan).
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  detail::PartitionPlan plan = detail::build_plan(x, 2, true, true);
+  detail::add_combines(x, plan);
+  ASSERT_FALSE(plan.combines.empty());
+  TaskId lost = kNoTask, reducer = kNoTask;
+  for (const detail::ProcPlan& pp : plan.procs)
+    for (const detail::Op& op : pp.ops)
+      if (lost == kNoTask && op.combine == detail::CombineRole::kOffer && op.jump == 0)
+        lost = x.origin[op.task];
+  const detail::Combine& c = plan.combines[0];
+  reducer = plan.procs[c.home].ops[c.head].task;
+  ASSERT_NE(lost, kNoTask);
+  ExecOptions o;
+  o.threads = 2;
+  o.pin = false;
+  o.spin_ns = 1000;
+  o.partition.timeout_ms = 200;
+  auto ex = detail::make_partition_executor_for_tests(o, {.lose_signal = lost});
+  FaultyWorkload w;
+  try {
+    ex->run_step(g, &a, w);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::runtime_error& e) {
+    const std::string msg = e.what();
+    std::printf("%s\n", msg.c_str());  // the report, for the record
+    EXPECT_NE(msg.find("thread " + std::to_string(c.home) + " waits for task " +
+                       std::to_string(reducer) + " (" + x.graph.kind_name(reducer) +
+                       ") and the tasks after it, run by the last of their 2 threads to arrive"),
+              std::string::npos)
+        << msg;
   }
 }
 
