@@ -31,7 +31,8 @@ constexpr std::array<std::array<double, 3>, 8> kCorner = {{{-1, -1, -1},
 Mat38 shape_derivatives(double xi, double eta, double zeta) {
   Mat38 d;
   for (int i = 0; i < 8; ++i) {
-    const double a = kCorner[i][0], b = kCorner[i][1], c = kCorner[i][2];
+    const auto& corner = kCorner[static_cast<std::size_t>(i)];
+    const double a = corner[0], b = corner[1], c = corner[2];
     d(0, i) = 0.125 * a * (1 + eta * b) * (1 + zeta * c);
     d(1, i) = 0.125 * b * (1 + xi * a) * (1 + zeta * c);
     d(2, i) = 0.125 * c * (1 + xi * a) * (1 + eta * b);
@@ -108,7 +109,8 @@ HexFemForceField::Mat24 HexFemForceField::element_stiffness(const Mat38& rest, c
   const double det0 = j0.determinant();
   const Mat3 j0_inv_t = j0.inverse().transpose();
   for (int gi = 0; gi < 8; ++gi) {
-    const double xi = kCorner[gi][0] * gp, eta = kCorner[gi][1] * gp, zeta = kCorner[gi][2] * gp;
+    const auto& corner = kCorner[static_cast<std::size_t>(gi)];
+    const double xi = corner[0] * gp, eta = corner[1] * gp, zeta = corner[2] * gp;
     const Mat38 dref = shape_derivatives(xi, eta, zeta);
     const Mat3 j = rest * dref.transpose();  // J_ab = sum_i X_i[a] dN_i/dxi_b
     const double det = j.determinant();

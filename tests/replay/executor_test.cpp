@@ -239,8 +239,9 @@ TEST(CombinedReductions, RunOnTheLastProcessorToArriveAndLeaveTheSequentialState
         // a fast thread preempted on a loaded machine may arrive last once in a while).
         // With more threads than cores, a fast thread sharing the slow one's core may well
         // arrive last: then only the results are compared.
-        if (combine && k <= std::thread::hardware_concurrency())
+        if (combine && k <= std::thread::hardware_concurrency()) {
           EXPECT_GE(on_slow, 2 * kIterations * kSteps * 8 / 10) << "k=" << k << " slow " << slow;
+        }
         const auto got = final_state(w, d.g), want = sequential_state(d.g, kSteps);
         for (DatumId x = 0; x < d.g.data.size(); ++x)
           EXPECT_TRUE(got[x] == want[x]) << "k=" << k << " slow " << slow << " combine "

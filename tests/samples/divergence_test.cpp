@@ -100,7 +100,9 @@ TEST(Divergence, ExplicitBlowUpStopsOnKineticEnergyNamingStepAndObject) {
 }
 
 TEST(Divergence, HugeTimeStepStopsAtStepZeroOnANonFiniteState) {
-  auto scene = make_scene("falling", SceneOptions{1e308});
+  SceneOptions options;
+  options.dt = 1e308;
+  auto scene = make_scene("falling", options);
   const DivergenceError e = run_until_divergence(*scene, 3, capture::Mode::kOff);
   EXPECT_EQ(e.step(), 0u);
   EXPECT_TRUE(e.quantity() == "position" || e.quantity() == "velocity") << e.quantity();

@@ -71,8 +71,10 @@ TEST(HexFem, ForcesRotateWithTheDeformedBody) {
   auto* b1 = dynamic_cast<ParticleBody*>(s1->bodies()[0].get());
   auto* b2 = dynamic_cast<ParticleBody*>(s2->bodies()[0].get());
   StateVec deformed = b1->rest();
-  for (Index i = 0; i < deformed.cols(); ++i)
-    deformed.col(i) += 0.01 * Vec3(std::sin(3.0 * i), std::cos(5.0 * i), std::sin(7.0 * i + 1.0));
+  for (Index i = 0; i < deformed.cols(); ++i) {
+    const auto x = static_cast<double>(i);
+    deformed.col(i) += 0.01 * Vec3(std::sin(3.0 * x), std::cos(5.0 * x), std::sin(7.0 * x + 1.0));
+  }
   const Mat3 rot = Eigen::AngleAxisd(2.0, Vec3(1.0, -0.5, 0.2).normalized()).toRotationMatrix();
   b1->vec(VecId::kX) = deformed;
   b2->vec(VecId::kX) = rot * deformed;

@@ -24,8 +24,10 @@ std::unique_ptr<Scene> spring_block(const std::string& integrator, double dt) {
                                         "springgrid name=b nodes=5,5,5 size=0.4,0.4,0.4 stiffness=500 density=100\n"),
                        "springs");
   StateVec& v = s->bodies()[0]->vec(VecId::kV);
-  for (Index i = 0; i < v.cols(); ++i)
-    v.col(i) = 0.5 * Vec3(std::sin(1.7 * i), std::cos(2.3 * i + 0.5), std::sin(0.9 * i + 2.0));
+  for (Index i = 0; i < v.cols(); ++i) {
+    const auto x = static_cast<double>(i);
+    v.col(i) = 0.5 * Vec3(std::sin(1.7 * x), std::cos(2.3 * x + 0.5), std::sin(0.9 * x + 2.0));
+  }
   v.colwise() -= Vec3(v.rowwise().mean());
   return s;
 }

@@ -30,8 +30,8 @@ class Body {
   Index columns() const { return columns_; }
   /// State vector `id` (for a cumulative write, the temporary a live executor redirected it
   /// to: see tgraph/graph/cumulative.hpp).
-  StateVec& vec(VecId id) { return accumulate(vecs_[static_cast<int>(id)]); }
-  const StateVec& vec(VecId id) const { return vecs_[static_cast<int>(id)]; }
+  StateVec& vec(VecId id) { return accumulate(vecs_[static_cast<std::size_t>(id)]); }
+  const StateVec& vec(VecId id) const { return vecs_[static_cast<std::size_t>(id)]; }
 
   /// out += factor * M * in.
   virtual void add_mdx(StateVec& out, const StateVec& in, double factor) const = 0;
