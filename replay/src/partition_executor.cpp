@@ -28,6 +28,7 @@
 
 #include "common.hpp"
 #include "partition_plan.hpp"
+#include "partition_report.hpp"
 #include "partition_serial.hpp"
 #include "partition_testing.hpp"
 #include "planned_executor.hpp"
@@ -304,45 +305,15 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
 
   // Where each thread stands (the watchdog's report; the step context is valid).
   std::string stall_report() const {
-    const ExecGraph& x = *exec_;
-    std::string out;
-    for (std::uint32_t p = 0; p < options().threads; ++p) {
+    std::vector<detail::ThreadStand> threads(options().threads);
+    for (std::uint32_t p = 0; p < threads.size(); ++p) {
       const Slot& s = counters_[p];
       // relaxed: diagnostics, a racy snapshot is fine.
-      const std::uint32_t kind = s.wait_kind.load(std::memory_order_relaxed);
-      const std::uint32_t id = s.wait_id.load(std::memory_order_relaxed);
-      const std::uint32_t task = s.at_task.load(std::memory_order_relaxed);
-      if (!out.empty()) out += "; ";
-      out += "thread " + std::to_string(p);
-      const auto label = [&x](TaskId t) {
-        return t < x.graph.tasks.size()
-                   ? "task " + std::to_string(t) + " (" + x.graph.kind_name(t) + ")"
-                   : std::string("no task");
-      };
-      if (kind == 1 && id < x.graph.tasks.size()) {
-        out += " waits for " + label(id) + " on thread " + std::to_string(x.assignment.proc[id]);
-        for (const Edge& e : x.graph.edges)
-          if (e.from == id && e.to == task && e.datum < x.graph.data.size()) {
-            out += " (datum '" + x.graph.data[e.datum].name + "')";
-            break;
-          }
-        if (task < x.graph.tasks.size()) out += " before running " + label(task);
-      } else if (kind == 2) {
-        out += " waits for the decision of loop " + std::to_string(id);
-      } else if (kind == 3) {
-        out += " waits at the first-touch barrier";
-      } else if (kind == 4 && id < plan_->combines.size()) {
-        const detail::Combine& c = plan_->combines[id];
-        out += " waits for " + label(plan_->procs[c.home].ops[c.head].task) +
-               " and the tasks after it, run by the last of their " + std::to_string(c.parties) +
-               " threads to arrive";
-      } else if (task < x.graph.tasks.size()) {
-        out += " runs or last ran " + label(task);
-      } else {
-        out += " has run no task yet";
-      }
+      threads[p] = {s.wait_kind.load(std::memory_order_relaxed),
+                    s.wait_id.load(std::memory_order_relaxed),
+                    s.at_task.load(std::memory_order_relaxed)};
     }
-    return out;
+    return detail::stall_report(*exec_, *plan_, threads);
   }
 
   // A counter to prefetch, and whether for writing (an arrival's read-modify-write).

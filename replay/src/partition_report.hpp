@@ -1,0 +1,28 @@
+// SPDX-License-Identifier: MIT
+// Internal: the partition executor's stall report (what its watchdog prints), apart from the
+// runtime that samples it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "partition_plan.hpp"
+
+namespace tgraph::replay::detail {
+
+/// Where one thread stands, as the watchdog samples it. `kind`: 0 nothing, 1 the completion
+/// of task `id`, 2 the decision of loop `id`, 3 the first-touch barrier, 4 combine `id`;
+/// `task`: the task it runs, last ran or waits to run.
+struct ThreadStand {
+  std::uint32_t kind = 0;
+  std::uint32_t id = 0;
+  TaskId task = kNoTask;
+};
+
+/// "thread 0 waits for task 13 (addForce) on thread 1 (datum 'f@1') before running task 73
+/// (reduce); thread 1 ...": one clause per thread, in thread order.
+std::string stall_report(const ExecGraph& x, const PartitionPlan& plan,
+                         const std::vector<ThreadStand>& threads);
+
+}  // namespace tgraph::replay::detail
