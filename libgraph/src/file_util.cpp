@@ -28,8 +28,7 @@ std::filesystem::path folder_of(const std::filesystem::path& target) {
   return target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
 }
 
-// The temporary name of an output in its folder: ".NAME.tmp.TAIL" (appended: GCC 12 inlines
-// `"." + name` into a false -Wrestrict warning).
+// The temporary name of an output in its folder: ".NAME.tmp.TAIL".
 std::string temporary_name(const std::filesystem::path& target, const char* tail) {
   std::string name(".");
   name += target.filename().string();

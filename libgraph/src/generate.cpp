@@ -9,7 +9,6 @@
 #include <limits>
 #include <string>
 
-#include "numbered.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph {
@@ -56,7 +55,7 @@ void cells(StepGraph& g, const GenerateOptions& o) {
   if (2 * width > kMaxIds) throw UsageError("--width: expected at most 2^31 - 1 columns");
   const KindId kind = g.intern_kind(std::string(to_string(o.pattern)));
   g.objects.reserve(width);
-  for (std::uint64_t i = 0; i < width; ++i) g.objects.push_back({detail::numbered("c", i)});
+  for (std::uint64_t i = 0; i < width; ++i) g.objects.push_back({"c" + std::to_string(i)});
   const bool data = o.pattern != Pattern::kTrivial;
   if (data) {
     g.data.reserve(2 * width);
@@ -127,7 +126,7 @@ void domain(StepGraph& g, const GenerateOptions& o) {
   g.data.reserve(5 * objects + 5);
   static constexpr std::array<const char*, 5> kVectors = {".x", ".f", ".p", ".q", ".r"};
   for (std::uint64_t b = 0; b < objects; ++b) {
-    g.objects.push_back({detail::numbered("b", b)});
+    g.objects.push_back({"b" + std::to_string(b)});
     for (const char* v : kVectors)
       g.data.push_back({g.objects.back().name + v, static_cast<ObjectId>(b), o.datum_bytes});
   }

@@ -6,7 +6,6 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "numbered.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
@@ -124,11 +123,11 @@ StgGraph parse_stg(std::string_view text, const std::string& name, std::uint64_t
   const KindId dummy = g.intern_kind("stg_dummy");
   // One datum per edge, written by the predecessor, read by the successor.
   std::vector<std::vector<Access>> acc(n);
-  for (std::uint64_t i = 0; i < n; ++i) g.objects.push_back({detail::numbered("stg", i)});
+  for (std::uint64_t i = 0; i < n; ++i) g.objects.push_back({"stg" + std::to_string(i)});
   for (std::uint64_t i = 0; i < n; ++i)
     for (TaskId p : preds[i]) {
       const auto d = static_cast<DatumId>(g.data.size());
-      g.data.push_back({detail::numbered("e", p) + "_" + std::to_string(i), p, edge_bytes});
+      g.data.push_back({"e" + std::to_string(p) + "_" + std::to_string(i), p, edge_bytes});
       acc[p].push_back({d, AccessMode::W});
       acc[i].push_back({d, AccessMode::R});
     }

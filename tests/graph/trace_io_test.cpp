@@ -30,13 +30,6 @@ using Bytes = std::vector<std::uint8_t>;
 
 // ---- building blocks -------------------------------------------------------------------
 
-// "prefix<i>" (appended, not `+`: GCC 12 -O3 misreports -Wrestrict on the latter).
-std::string numbered(const char* prefix, int i) {
-  std::string s(prefix);
-  s.append(std::to_string(i));
-  return s;
-}
-
 // A step with a dynamic loop, shared and owned data, contacts and groups. `variant`
 // changes the structure; `salt` changes only costs, iterations, contacts and groups.
 StepGraph make_step(int variant, int salt) {
@@ -45,10 +38,10 @@ StepGraph make_step(int variant, int salt) {
   const KindId dot = g.intern_kind("dot");
   const KindId brk = g.intern_kind("loop.break");
   const int n_objects = 3 + variant;
-  for (int o = 0; o < n_objects; ++o) g.objects.push_back({numbered("body", o)});
+  for (int o = 0; o < n_objects; ++o) g.objects.push_back({"body" + std::to_string(o)});
   for (int o = 0; o < n_objects; ++o)
     g.data.push_back(
-        {numbered("x", o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
+        {"x" + std::to_string(o), static_cast<ObjectId>(o), 24u * static_cast<unsigned>(o + 1)});
   const auto r = static_cast<DatumId>(g.data.size());
   g.data.push_back({"cg.r", kNoObject, 8});
   const auto done = static_cast<DatumId>(g.data.size());

@@ -21,7 +21,7 @@ StepGraph independent(const std::string& kind, std::uint32_t n) {
   g.intern_kind("unused");  // kind ids differ from the other graph's
   const KindId k = g.intern_kind(kind);
   for (std::uint32_t i = 0; i < n; ++i) {
-    g.data.push_back({test::numbered("d", i), kNoObject, 64});
+    g.data.push_back({"d" + std::to_string(i), kNoObject, 64});
     const Access acc[] = {{i, AccessMode::RW}};
     g.add_task(k, kNoObject, acc, 1000);
   }

@@ -20,15 +20,6 @@
 
 namespace tgraph::replay::test {
 
-/// prefix + i ("d3"). Appended, not `"d" + std::to_string(i)`: GCC 12 inlines that
-/// operator+ into a false -Wrestrict warning.
-template <class Int>
-std::string numbered(const char* prefix, Int i) {
-  std::string s(prefix);
-  s += std::to_string(i);
-  return s;
-}
-
 /// A random program: straight-line segments and do-while loops whose body ends with a task
 /// writing the condition and the break reading it. Accesses: R 40%, CW 30%, W 15%, RW 15%.
 inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segment = 10,
@@ -38,9 +29,9 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
   StepGraph g;
   for (const char* k : {"a", "b", "c", "f"}) g.intern_kind(k);
   const KindId brk = g.intern_kind("loop.break");
-  for (int o = 0; o < 4; ++o) g.objects.push_back({numbered("obj", o)});
+  for (int o = 0; o < 4; ++o) g.objects.push_back({"obj" + std::to_string(o)});
   for (int d = 0; d < data; ++d)
-    g.data.push_back({numbered("d", d), static_cast<ObjectId>(d % 4),
+    g.data.push_back({"d" + std::to_string(d), static_cast<ObjectId>(d % 4),
                       static_cast<std::uint64_t>(64 + 64 * pick(16))});
   auto add_random = [&](LoopId loop) {
     std::vector<Access> acc;
@@ -68,7 +59,7 @@ inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segm
   for (int s = 0; s < segments; ++s) {
     if (s % 2 == 1) {
       const auto cond = static_cast<DatumId>(g.data.size());
-      g.data.push_back({numbered("cond", s), kNoObject, 8});
+      g.data.push_back({"cond" + std::to_string(s), kNoObject, 8});
       const auto l = static_cast<LoopId>(g.loops.size());
       Loop loop;
       loop.condition = cond;
@@ -113,8 +104,8 @@ inline DotLoop dot_loop(std::uint32_t objects, std::uint32_t k, std::uint32_t it
                update = g.intern_kind("update"), residual = g.intern_kind("residual"),
                brk = g.intern_kind("loop.break");
   for (std::uint32_t o = 0; o < objects; ++o) {
-    g.objects.push_back({numbered("o", o)});
-    g.data.push_back({numbered("v", o), o, 64});
+    g.objects.push_back({"o" + std::to_string(o)});
+    g.data.push_back({"v" + std::to_string(o), o, 64});
   }
   const auto dot = static_cast<DatumId>(objects), s = dot + 1, cond = dot + 2;
   g.data.push_back({"dot", kNoObject, 8});
@@ -224,7 +215,7 @@ class Throwing : public Workload {
   explicit Throwing(TaskId bad) : bad_(bad) {}
   void run(const TaskRun& r) override {
     if (r.origin == bad_ && r.iteration == 0)
-      throw std::runtime_error(numbered("task ", bad_) + " failed");
+      throw std::runtime_error("task " + std::to_string(bad_) + " failed");
   }
   bool stop_after(LoopId, std::uint32_t it) override { return it >= 1; }
   std::optional<std::uint32_t> known_iterations(LoopId) const override { return known_; }
