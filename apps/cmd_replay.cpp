@@ -169,7 +169,15 @@ void add_replay_verbs(CLI::App& app) {
       "--no-reuse", [live] { live->reuse_structure = false; },
       "Record every step (default: rerun the last program while it repeats)");
   cmd->add_flag("--repartition-every-step", live->repartition_every_step,
-                "Call the partitioner at every step (default: on change or imbalance)");
+                "Call the partitioner at every step (default: on change, or when a drift's "
+                "gain over --horizon steps exceeds the cost of new plans)");
+  cmd->add_option("--horizon", live->repartition_horizon,
+                  "Steps over which a repartition must pay for itself (default 10)")
+      ->check(CLI::Range(1, 1000000));
+  cmd->add_flag_callback(
+      "--foreground-partition", [live] { live->background_partition = false; },
+      "The step waits for the partitioner (default: it runs on a helper thread and its "
+      "assignment applies at the next step boundary)");
   cmd->add_flag_callback(
       "--no-elide-waits", [live] { live->exec.partition.elide_waits = false; },
       "One wait per cross-processor producer (default: implied waits dropped)");

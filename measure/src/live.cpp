@@ -91,7 +91,8 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   const std::uint32_t baseline_cores =
       o.exec.pin ? std::min<std::uint32_t>({res.threads, tr::hardware_pus(), 4}) : 1;
   Baseline baseline{std::vector<PassTimes>(baseline_cores, PassTimes(o.steps)), PassTimes(o.steps)};
-  PassTimes wall(o.steps), record(o.steps), part(o.steps), prepare(o.steps), execute(o.steps);
+  PassTimes wall(o.steps), record(o.steps), part(o.steps), background(o.steps), prepare(o.steps),
+      execute(o.steps);
   for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
     if (o.baseline) time_baseline_pass(make_engine, o, baseline);
     if (!ex) ex = make();
@@ -107,10 +108,11 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
       wall.add(s, m.wall_ns);
       record.add(s, m.record_ns);
       part.add(s, m.partition_ns);
+      background.add(s, m.background_partition_ns);
       prepare.add(s, m.prepare_ns);
       execute.add(s, m.execute_ns);
     }
-    for (PassTimes* t : {&wall, &record, &part, &prepare, &execute}) t->end_pass();
+    for (PassTimes* t : {&wall, &record, &part, &background, &prepare, &execute}) t->end_pass();
   }
   const detail::PassResult& first = passes[0];
   res.signals = first.signals;
@@ -124,6 +126,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     m.wall_ns = wall.step_median(s);
     m.record_ns = record.step_median(s);
     m.partition_ns = part.step_median(s);
+    m.background_partition_ns = background.step_median(s);
     m.prepare_ns = prepare.step_median(s);
     m.execute_ns = execute.step_median(s);
     m.baseline_ns = baseline.fastest.step_median(s);

@@ -18,6 +18,13 @@ namespace tgraph::measure::detail {
 
 using replay::ExecGraph;
 
+/// A task's cost after a new measurement `sample`: an exponential average with the cost
+/// `old` already there (half weight to the new sample; `old` <= 1 means none yet), so that one
+/// preempted step does not look like an imbalance.
+inline std::uint64_t smoothed_cost(std::uint64_t old, std::uint64_t sample) {
+  return std::max<std::uint64_t>(1, old > 1 ? (old + sample) / 2 : sample);
+}
+
 /// Mean measured duration of each exec task in the last step (sampled iterations), for the
 /// next step's partitioning: deferred recording measures nothing itself.
 class CostObserver : public replay::Observer {
@@ -49,14 +56,11 @@ class CostObserver : public replay::Observer {
     }
     if (&measured == &g ||
         (g.tasks.size() == measured.tasks.size() && g.same_structure(measured))) {
-      // Same tasks: an exponential average with the costs already there (half weight to
-      // the new sample), so that one preempted step does not look like an imbalance.
+      // Same tasks: smoothed over steps.
       for (TaskId t = 0; t < sum_.size(); ++t) {
         const TaskId o = exec_->origin[t];
         if (o == kNoTask || o >= g.tasks.size() || runs_[t] == 0) continue;
-        const std::uint64_t sample = mean(t);
-        const std::uint64_t old = measured.tasks[o].cost_ns;
-        g.tasks[o].cost_ns = std::max<std::uint64_t>(1, old > 1 ? (old + sample) / 2 : sample);
+        g.tasks[o].cost_ns = smoothed_cost(measured.tasks[o].cost_ns, mean(t));
       }
       return;
     }

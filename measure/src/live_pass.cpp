@@ -5,8 +5,10 @@
 #include <memory>
 #include <string>
 
+#include "background_partitioner.hpp"
 #include "live_observers.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/measure/trigger.hpp"
 #include "tgraph/replay/program_workload.hpp"
 
 namespace tgraph::measure::detail {
@@ -35,13 +37,22 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
   CostObserver costs;
   if (feed_costs) ex.add_observer(costs);
   const bool partition = ex.policy() == replay::Policy::kPartition;
-  LiveStep cur;           // the program in use
-  StepGraph prev_graph;   // the graph of the previous recorded program
+  LiveStep cur;  // the program in use
+  // The graph of the previous recorded program: never changed once replaced, so background
+  // jobs share it.
+  std::shared_ptr<const StepGraph> prev_graph;
   Assignment assignment;  // the assignment in use
   std::vector<std::uint32_t> last_iterations;
-  double made_imbalance = 1.0;  // the assignment's loop_imbalance when it was made
-  bool informed = false;        // the assignment was made from measured costs
+  std::unique_ptr<BackgroundPartitioner> bg;
+  if (partition && fixed == nullptr)
+    bg = std::make_unique<BackgroundPartitioner>(*partitioner, o.background_partition);
+  RepartitionTrigger trigger({.tolerance = o.rebalance_tolerance,
+                              .loop_share = o.loop_share,
+                              .horizon = o.repartition_horizon});
+  std::int64_t last_build_ns = 0;  // the plan build of the last new assignment
+  bool informed = false;           // an assignment from measured costs was asked for
   bool have_prev = false;
+  auto copy_of = [](const StepGraph& g) { return std::make_shared<const StepGraph>(g); };
   try {
     for (std::uint32_t s = 0; s < o.steps; ++s) {
       LiveStepMeasure m;
@@ -51,38 +62,76 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
       if (!reused) {
         if (next.reuse_previous)
           throw UsageError("live run: the engine reused a program at step 0");
-        if (partition && s > 0) prev_graph = std::move(cur.graph);
+        if (partition && s > 0) prev_graph = std::make_shared<const StepGraph>(std::move(cur.graph));
         cur = std::move(next);
       }
       m.recorded = !reused;
       if (!reused) m.graph_update_ns = cur.graph_update_ns;
       const std::int64_t t1 = replay::now_ns();
       if (partition) {
-        const StepGraph& measured = reused ? cur.graph : prev_graph;
         if (feed_costs) {
           if (have_prev) {
-            costs.apply(measured, cur.graph);
+            costs.apply(reused ? cur.graph : *prev_graph, cur.graph);
           } else {
             for (Task& t : cur.graph.tasks) t.cost_ns = 1;
           }
         }
         apply_iterations(last_iterations, reused, cur.graph);
+        const std::uint32_t k = ex.threads();
+        // An assignment made for `g` (maybe of an earlier structure), for the current step.
+        auto adopt = [&](Assignment a, const StepGraph& g) {
+          if (!cur.graph.same_structure(g)) a = partition::carry_over(cur.graph, k, &g, &a);
+          if (a.proc != assignment.proc || a.order != assignment.order) m.reassigned = true;
+          assignment = std::move(a);
+          trigger.reset();
+        };
         if (fixed != nullptr) {
           if (s >= fixed->size())
             throw UsageError("live check: no assignment for step " + std::to_string(s));
           assignment = (*fixed)[s];
-        } else if (!informed || !reused || o.repartition_every_step ||
-                   partition::loop_imbalance(cur.graph, assignment, o.loop_share) >
-                       (1.0 + o.rebalance_tolerance) * std::max(1.0, made_imbalance)) {
-          // The first assignment is made before any cost is measured (every task 1 ns): the
-          // next starts afresh, not from it (sticky would keep it while its imbalance under
-          // the measured costs, falling64's 1.13, is within its threshold).
-          const bool from_prev = have_prev && informed;
-          assignment = (*partitioner)(cur.graph, ex.threads(), from_prev ? &measured : nullptr,
-                                      from_prev ? &assignment : nullptr);
-          informed = have_prev || !feed_costs;
-          made_imbalance = partition::loop_imbalance(cur.graph, assignment, o.loop_share);
-          m.partitioned = true;
+        } else {
+          // The assignment in use was made for the previous structure: carried over at once
+          // (the strategy's own, given the previous step, follows from the background).
+          const bool changed = have_prev && !reused;
+          std::shared_ptr<const Assignment> before;
+          if (changed) {
+            before = std::make_shared<const Assignment>(assignment);
+            adopt(partition::carry_over(cur.graph, k, prev_graph.get(), before.get()), cur.graph);
+          }
+          if (auto done = bg->take()) {
+            m.background_partition_ns += done->partition_ns;
+            adopt(std::move(done->assignment), *done->graph);
+          }
+          if (!have_prev && feed_costs) {
+            // Nothing measured yet (every cost 1): the owner rule at once; the strategy
+            // follows from the first measured costs.
+            adopt(partition::carry_over(cur.graph, k, nullptr, nullptr), cur.graph);
+            m.partitioned = true;
+          } else if (!informed || changed || o.repartition_every_step ||
+                     (!bg->busy() && !m.reassigned &&
+                      trigger.observe(cur.graph, assignment, last_build_ns))) {
+            // The first assignment from measured costs starts afresh; later ones are given
+            // the previous step and its assignment (what sticky needs).
+            BackgroundPartitioner::Job job{copy_of(cur.graph), nullptr, nullptr, k};
+            if (changed && informed) {
+              job.prev_graph = prev_graph;
+              job.prev = before;
+            } else if (informed) {
+              job.prev_graph = job.graph;
+              job.prev = std::make_shared<const Assignment>(assignment);
+            }
+            bg->submit(std::move(job));
+            informed = true;
+            m.partitioned = true;
+            if (!o.background_partition || assignment.proc.size() != cur.graph.tasks.size()) {
+              // In the foreground (or nothing to run yet): the step waits for it.
+              bg->drain();
+              if (auto done = bg->take()) {
+                m.background_partition_ns += done->partition_ns;
+                adopt(std::move(done->assignment), *done->graph);
+              }
+            }
+          }
         }
         have_prev = true;
       }
@@ -99,6 +148,7 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
       m.execute_ns = ss.wall_ns - ss.prepare_ns;
       m.wall_ns = t3 - t0;
       m.rebuilt = ss.rebuilt;
+      if (ss.rebuilt) last_build_ns = ss.build_ns;
       m.loop_iterations = ss.loop_iterations;
       last_iterations = ss.loop_iterations;
       if (po.stats != nullptr) m.threads = po.stats->threads();
@@ -109,6 +159,11 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
       r.wall_ns += m.wall_ns;
       r.steps.push_back(std::move(m));
       if (po.keep_assignments) r.assignments.push_back(assignment);
+    }
+    if (bg && !r.steps.empty()) {
+      // The partitioner's time of a job still running when the steps ended.
+      bg->drain();
+      if (auto done = bg->take()) r.steps.back().background_partition_ns += done->partition_ns;
     }
   } catch (...) {
     ex.clear_observers();

@@ -159,7 +159,7 @@ std::string to_text(const ReplayResult& r, const std::string& trace_name, std::u
 
 std::string to_json(const LiveResult& r) {
   json per_step = json::array();
-  std::int64_t record = 0, part = 0, prepare = 0, build = 0, execute = 0;
+  std::int64_t record = 0, part = 0, background = 0, prepare = 0, build = 0, execute = 0;
   std::vector<tr::StatsObserver::Thread> totals;
   for (const LiveStepMeasure& m : r.steps) {
     if (totals.size() < m.threads.size()) totals.resize(m.threads.size());
@@ -172,6 +172,7 @@ std::string to_json(const LiveResult& r) {
     }
     record += m.record_ns;
     part += m.partition_ns;
+    background += m.background_partition_ns;
     prepare += m.prepare_ns;
     build += m.build_ns;
     execute += m.execute_ns;
@@ -179,12 +180,14 @@ std::string to_json(const LiveResult& r) {
     s.update({{"engine_wall_ns", m.baseline_ns},
               {"record_ns", m.record_ns},
               {"partition_ns", m.partition_ns},
+              {"background_partition_ns", m.background_partition_ns},
               {"prepare_ns", m.prepare_ns},
               {"graph_update_ns", m.graph_update_ns},
               {"execute_ns", m.execute_ns},
               {"rebuilt", m.rebuilt},
               {"recorded", m.recorded},
               {"partitioned", m.partitioned},
+              {"reassigned", m.reassigned},
               {"loop_iterations", m.loop_iterations}});
     per_step.push_back(std::move(s));
   }
@@ -212,6 +215,7 @@ std::string to_json(const LiveResult& r) {
             {"breakdown",
              {{"record_ns", record},
               {"partition_ns", part},
+              {"background_partition_ns", background},
               {"prepare_ns", prepare},
               {"build_ns", build},
               {"execute_ns", execute}}},
@@ -260,8 +264,10 @@ std::string to_text(const LiveResult& r, const std::string& scene, const std::st
                       ms(r.baseline_wall_ns), r.speedup));
   const auto b = nlohmann::json::parse(to_json(r))["breakdown"];
   add(std::snprintf(line, sizeof line,
-                    "  record %.3f ms, partition %.3f ms, plans %.3f ms, execute %.3f ms\n",
+                    "  record %.3f ms, partition waited %.3f ms (%.3f ms in the background), "
+                    "plans %.3f ms, execute %.3f ms\n",
                     b["record_ns"].get<double>() / 1e6, b["partition_ns"].get<double>() / 1e6,
+                    b["background_partition_ns"].get<double>() / 1e6,
                     b["prepare_ns"].get<double>() / 1e6, b["execute_ns"].get<double>() / 1e6));
   if (r.check)
     add(std::snprintf(line, sizeof line, "  check against %s: %s (%zu data compared)\n",

@@ -9,10 +9,33 @@ namespace tgraph::partition::detail {
 
 namespace {
 
-// Work units and cut prices shared by the greedy rebalance and the refinement: a unit is
-// the tasks of one object on one processor (a task without object is a unit of its own);
-// the price of an edge is the synchronisation and transfer time (cost model) of cutting it,
-// per execution of the step (a loop body edge counts every iteration).
+// The price of cutting each edge, by task (both ends): the synchronisation and transfer time
+// (cost model) of the edge per execution of the step (a loop body edge counts every
+// iteration). Built once per rebalance and shared by its groups.
+using CutPrices = std::vector<std::vector<std::pair<TaskId, double>>>;
+
+CutPrices cut_prices(const StepGraph& g, const CostModel& model) {
+  CutPrices adj(g.tasks.size());
+  auto link = [&](const Edge& e) {
+    if (e.from == e.to) return;
+    const LoopId l = g.tasks[e.to].loop;
+    const double runs = l != kNoLoop && g.tasks[e.from].loop == l ? g.loops[l].iterations : 1.0;
+    const double c =
+        (model.sync_latency_ns + model.per_byte_ns * static_cast<double>(g.data[e.datum].bytes)) *
+        runs;
+    adj[e.from].push_back({e.to, c});
+    adj[e.to].push_back({e.from, c});
+  };
+  for (const Edge& e : g.edges) link(e);
+  for (const Edge& e : g.carried_edges) link(e);
+  return adj;
+}
+
+// Work units shared by the greedy rebalance and the refinement: a unit is the tasks of one
+// object on one processor (a task without object is a unit of its own), among the tasks
+// that may move; the others stay where they are. `unit_of` is scratch of one entry per task
+// of the step, kNone everywhere on entry and on exit (reset by the destructor), so that a
+// group costs its own size, not the step's.
 struct Units {
   struct Unit {
     ProcId proc;
@@ -21,17 +44,14 @@ struct Units {
   };
   static constexpr std::size_t kNone = SIZE_MAX;
   std::vector<Unit> units;
-  std::vector<std::size_t> unit_of;  ///< kNone for a task that may not move
-  std::vector<std::vector<std::pair<TaskId, double>>> adj;
+  std::vector<std::size_t>& unit_of;
+  const std::vector<TaskId>& movable;
 
-  // `movable` (null: every task): the tasks that form units; the others stay where they are.
-  Units(const StepGraph& g, const std::vector<std::uint64_t>& work, const CostModel& model,
-        const std::vector<ProcId>& proc, const std::vector<char>* movable = nullptr) {
-    const auto n = static_cast<TaskId>(g.tasks.size());
+  Units(const StepGraph& g, const std::vector<std::uint64_t>& work, const std::vector<ProcId>& proc,
+        const std::vector<TaskId>& tasks, std::vector<std::size_t>& scratch)
+      : unit_of(scratch), movable(tasks) {
     std::unordered_map<std::uint64_t, std::size_t> unit_of_key;
-    unit_of.assign(n, kNone);
-    for (TaskId t = 0; t < n; ++t) {
-      if (movable != nullptr && (*movable)[t] == 0) continue;
+    for (TaskId t : tasks) {
       const ObjectId o = g.tasks[t].object;
       std::size_t u;
       if (o == kNoObject) {
@@ -47,20 +67,12 @@ struct Units {
       units[u].tasks.push_back(t);
       unit_of[t] = u;
     }
-    adj.resize(n);
-    auto link = [&](const Edge& e) {
-      if (e.from == e.to) return;
-      const LoopId l = g.tasks[e.to].loop;
-      const double runs = l != kNoLoop && g.tasks[e.from].loop == l ? g.loops[l].iterations : 1.0;
-      const double c =
-          (model.sync_latency_ns + model.per_byte_ns * static_cast<double>(g.data[e.datum].bytes)) *
-          runs;
-      adj[e.from].push_back({e.to, c});
-      adj[e.to].push_back({e.from, c});
-    };
-    for (const Edge& e : g.edges) link(e);
-    for (const Edge& e : g.carried_edges) link(e);
   }
+  ~Units() {
+    for (TaskId t : movable) unit_of[t] = kNone;
+  }
+  Units(const Units&) = delete;
+  Units& operator=(const Units&) = delete;
 
   // Moves unit u (every task of it) to processor q.
   void move(std::size_t u, ProcId q, std::vector<ProcId>& proc, std::vector<std::uint64_t>& load) {
@@ -72,44 +84,53 @@ struct Units {
   }
 };
 
+// Scratch of one rebalance: per-task entries allocated once, whatever the number of groups.
+struct Scratch {
+  explicit Scratch(std::size_t n) : unit_of(n, Units::kNone), in_set(n, 0) {}
+  std::vector<std::size_t> unit_of;
+  std::vector<char> in_set;
+};
+
 // Moves work off the most loaded processor while that pays: candidates are whole units and
-// single tasks, towards any less loaded processor. A move's gain is how much it lowers the
-// larger of the two loads; its price is the cut it adds minus the cut it removes (Units).
-// The best move with gain > price is applied until the imbalance is within `tolerance` or
-// no move pays. With `movable`, only those tasks move and only their work counts as load.
+// single tasks of `tasks`, towards any less loaded processor; only their work counts as
+// load. A move's gain is how much it lowers the larger of the two loads; its price is the
+// cut it adds minus the cut it removes. The best move with gain > price is applied until
+// the imbalance is within `tolerance` or no move pays. Each candidate's edges are walked
+// once per round (its link to every processor at once), so a round costs the edges of the
+// most loaded processor's tasks plus K per candidate.
 void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
-                      double tolerance, const CostModel& model, std::vector<ProcId>& proc,
-                      const std::vector<char>* movable = nullptr) {
-  const auto n = static_cast<TaskId>(g.tasks.size());
-  Units us(g, work, model, proc, movable);
+                      double tolerance, const CutPrices& adj, const std::vector<TaskId>& tasks,
+                      Scratch& scratch, std::vector<ProcId>& proc) {
+  Units us(g, work, proc, tasks, scratch.unit_of);
   auto& units = us.units;
-  const auto& adj = us.adj;
   std::vector<std::uint64_t> load(k, 0);
   for (const auto& un : units) load[un.proc] += un.work;
   std::uint64_t total = 0;
   for (std::uint64_t l : load) total += l;
   const double limit = static_cast<double>(total) / k * tolerance;
-  std::vector<char> in_set(n, 0);
-  for (std::size_t step = 0; step < 4 * static_cast<std::size_t>(n); ++step) {
+  std::vector<char>& in_set = scratch.in_set;
+  std::vector<double> link(k);  // a candidate's cut price towards each processor
+  std::vector<TaskId> one(1);
+  for (std::size_t step = 0; step < 4 * tasks.size(); ++step) {
     const auto p = static_cast<ProcId>(std::max_element(load.begin(), load.end()) - load.begin());
     if (static_cast<double>(load[p]) <= limit) break;
     double best_score = 0.0;
     std::size_t best_unit = SIZE_MAX;
     TaskId best_task = kNoTask;
     ProcId best_q = p;
-    auto consider = [&](std::size_t u, TaskId single, std::uint64_t w, const std::vector<TaskId>& tasks) {
+    auto consider = [&](std::size_t u, TaskId single, std::uint64_t w, const std::vector<TaskId>& ts) {
       if (w == 0) return;
-      for (TaskId t : tasks) in_set[t] = 1;
+      // The price of moving it from p to q is its link to p minus its link to q.
+      for (TaskId t : ts) in_set[t] = 1;
+      std::fill(link.begin(), link.end(), 0.0);
+      for (TaskId t : ts)
+        for (const auto& [o, c] : adj[t])
+          if (!in_set[o]) link[proc[o]] += c;
+      for (TaskId t : ts) in_set[t] = 0;
       for (ProcId q = 0; q < k; ++q) {
         if (q == p || load[q] + w >= load[p]) continue;
         const double gain = static_cast<double>(load[p] - std::max(load[p] - w, load[q] + w));
-        double price = 0.0;
-        for (TaskId t : tasks)
-          for (const auto& [o, c] : adj[t]) {
-            if (in_set[o]) continue;
-            if (proc[o] == p) price += c;
-            if (proc[o] == q) price -= c;
-          }
+        const double price = link[p] - link[q];
         if (gain - price > best_score) {
           best_score = gain - price;
           best_unit = u;
@@ -117,13 +138,14 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
           best_q = q;
         }
       }
-      for (TaskId t : tasks) in_set[t] = 0;
     };
     for (std::size_t u = 0; u < units.size(); ++u)
       if (units[u].proc == p) consider(u, kNoTask, units[u].work, units[u].tasks);
-    for (TaskId t = 0; t < n; ++t)
-      if (proc[t] == p && us.unit_of[t] != Units::kNone && units[us.unit_of[t]].tasks.size() > 1)
-        consider(us.unit_of[t], t, work[t], {t});
+    for (TaskId t : tasks)
+      if (proc[t] == p && units[us.unit_of[t]].tasks.size() > 1) {
+        one[0] = t;
+        consider(us.unit_of[t], t, work[t], one);
+      }
     if (best_unit == SIZE_MAX) break;
     if (best_task != kNoTask) {  // split the task off its unit
       auto& from = units[best_unit];
@@ -137,21 +159,30 @@ void greedy_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work
   }
 }
 
+// Every task of the step, in order.
+std::vector<TaskId> all_tasks(const StepGraph& g) {
+  std::vector<TaskId> v(g.tasks.size());
+  for (TaskId t = 0; t < v.size(); ++t) v[t] = t;
+  return v;
+}
+
 // The greedy rebalance group by group (LoopGroups: the tasks outside heavy loops, then each
 // heavy loop): a loop's processors meet at every iteration, so each group is balanced on
-// its own, moving only its tasks; without heavy loops, the whole step at once.
+// its own, moving only its tasks; without heavy loops, the whole step at once. The cut
+// prices and the scratch are made once for all groups.
 void phase_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
                      double tolerance, const CostModel& model, const LoopGroups& lg,
                      std::vector<ProcId>& proc) {
+  const CutPrices adj = cut_prices(g, model);
+  Scratch scratch(g.tasks.size());
   if (lg.count < 2) {
-    greedy_rebalance(g, work, k, tolerance, model, proc);
+    greedy_rebalance(g, work, k, tolerance, adj, all_tasks(g), scratch, proc);
     return;
   }
-  std::vector<char> in(g.tasks.size());
-  for (std::uint32_t c = 0; c < lg.count; ++c) {
-    for (TaskId t = 0; t < g.tasks.size(); ++t) in[t] = lg.group[t] == c ? 1 : 0;
-    greedy_rebalance(g, work, k, tolerance, model, proc, &in);
-  }
+  std::vector<std::vector<TaskId>> groups(lg.count);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) groups[lg.group[t]].push_back(t);
+  for (const std::vector<TaskId>& tasks : groups)
+    greedy_rebalance(g, work, k, tolerance, adj, tasks, scratch, proc);
 }
 
 // Refinement from the incremental placement when collision groups merged or split: units
@@ -162,39 +193,44 @@ void phase_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work,
 // instead of a whole-step partition: what the paper's future work asks for.
 void refine(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
             double tolerance, double target, const CostModel& model, std::vector<ProcId>& proc) {
-  Units us(g, work, model, proc);
-  std::vector<std::uint64_t> load = loads(work, proc, k);
-  std::uint64_t total = 0;
-  for (std::uint64_t l : load) total += l;
-  const double limit = std::max(static_cast<double>(total) / k * tolerance,
-                                static_cast<double>(*std::max_element(load.begin(), load.end())));
-  std::vector<double> ext(k);
-  for (int pass = 0; pass < 8; ++pass) {
-    bool moved = false;
-    for (std::size_t u = 0; u < us.units.size(); ++u) {
-      const auto& un = us.units[u];
-      if (un.tasks.empty()) continue;
-      std::fill(ext.begin(), ext.end(), 0.0);
-      for (TaskId t : un.tasks)
-        for (const auto& [o, c] : us.adj[t])
-          if (us.unit_of[o] != u) ext[proc[o]] += c;
-      const ProcId p = un.proc;
-      ProcId best = p;
-      double best_gain = 0.0;
-      for (ProcId q = 0; q < k; ++q) {
-        if (q == p || static_cast<double>(load[q] + un.work) > limit) continue;
-        if (ext[q] - ext[p] > best_gain) {
-          best_gain = ext[q] - ext[p];
-          best = q;
+  const CutPrices adj = cut_prices(g, model);
+  const std::vector<TaskId> every = all_tasks(g);
+  Scratch scratch(g.tasks.size());
+  {
+    Units us(g, work, proc, every, scratch.unit_of);
+    std::vector<std::uint64_t> load = loads(work, proc, k);
+    std::uint64_t total = 0;
+    for (std::uint64_t l : load) total += l;
+    const double limit = std::max(static_cast<double>(total) / k * tolerance,
+                                  static_cast<double>(*std::max_element(load.begin(), load.end())));
+    std::vector<double> ext(k);
+    for (int pass = 0; pass < 8; ++pass) {
+      bool moved = false;
+      for (std::size_t u = 0; u < us.units.size(); ++u) {
+        const auto& un = us.units[u];
+        if (un.tasks.empty()) continue;
+        std::fill(ext.begin(), ext.end(), 0.0);
+        for (TaskId t : un.tasks)
+          for (const auto& [o, c] : adj[t])
+            if (us.unit_of[o] != u) ext[proc[o]] += c;
+        const ProcId p = un.proc;
+        ProcId best = p;
+        double best_gain = 0.0;
+        for (ProcId q = 0; q < k; ++q) {
+          if (q == p || static_cast<double>(load[q] + un.work) > limit) continue;
+          if (ext[q] - ext[p] > best_gain) {
+            best_gain = ext[q] - ext[p];
+            best = q;
+          }
         }
+        if (best == p) continue;
+        us.move(u, best, proc, load);
+        moved = true;
       }
-      if (best == p) continue;
-      us.move(u, best, proc, load);
-      moved = true;
+      if (!moved) break;
     }
-    if (!moved) break;
   }
-  greedy_rebalance(g, work, k, target, model, proc);
+  greedy_rebalance(g, work, k, target, adj, every, scratch, proc);
 }
 
 // SCOTCH_graphRepart from the current assignment. New tasks get their affinity placement

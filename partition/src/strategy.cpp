@@ -220,6 +220,31 @@ StepPartitioner step_partitioner(std::string_view method, const Options& options
   };
 }
 
+Assignment carry_over(const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
+                      const Assignment* prev) {
+  if (k == 0) throw UsageError("k must be at least 1");
+  if ((prev_graph == nullptr) != (prev == nullptr))
+    throw UsageError("previous step: graph and assignment must be given together");
+  if (prev == nullptr || prev->k != k)
+    return detail::make_owner()->partition(g, k, {}, {}).assignment;
+  const auto n = static_cast<TaskId>(g.tasks.size());
+  Assignment a;
+  a.k = k;
+  a.proc.assign(n, 0);
+  const std::vector<std::uint64_t> work = detail::task_work(g);
+  std::vector<std::uint64_t> load(k, 0);
+  std::vector<bool> placed(n, false);
+  const std::vector<TaskId> match = match_by_key(g, *prev_graph);
+  for (TaskId t = 0; t < n; ++t)
+    if (match[t] != kNoTask && match[t] < prev->proc.size()) {
+      a.proc[t] = prev->proc[match[t]];
+      load[a.proc[t]] += work[t];
+      placed[t] = true;
+    }
+  detail::place_by_affinity(g, work, k, placed, a.proc, load);
+  return a;
+}
+
 double loop_imbalance(const StepGraph& g, const Assignment& a, double loop_share) {
   const std::vector<std::uint64_t> work = detail::task_work(g);
   return detail::phased_imbalance(detail::loop_groups(g, work, loop_share), work, a.proc, a.k);

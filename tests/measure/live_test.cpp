@@ -7,10 +7,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
@@ -164,9 +167,10 @@ TEST(LiveCompare, NamesTheFirstDifferingDatum) {
   EXPECT_EQ(to_string(*diff), "first differing datum v (byte 8, 1 bytes differ)");
 }
 
-// The first step is partitioned before any cost is measured (every task 1 ns): the second
-// partitions afresh from measured costs rather than from that assignment, and only the
-// later steps start from the previous one.
+// The first step is placed by the owner rule before any cost is measured (every task 1 ns),
+// without calling the partitioner; the second partitions afresh from measured costs, and only
+// the later steps start from the previous one. In the foreground every call's assignment is
+// the one its step runs.
 TEST(Live, PartitionsAfreshOnceCostsAreMeasuredThenFromThePreviousStep) {
   struct Call {
     bool from_prev;
@@ -187,17 +191,76 @@ TEST(Live, PartitionsAfreshOnceCostsAreMeasuredThenFromThePreviousStep) {
   o.steps = 5;
   o.baseline = false;
   o.observe = false;
-  o.repartition_every_step = true;  // a call at every step
-  run_live([] { return make_live_engine("bars64"); }, &p, o);
-  ASSERT_EQ(calls.size(), 5u);
-  EXPECT_TRUE(calls[0].unit_costs);
+  o.repartition_every_step = true;  // a call at every step but the first
+  o.background_partition = false;
+  const LiveResult r = run_live([] { return make_live_engine("bars64"); }, &p, o);
+  ASSERT_EQ(calls.size(), 4u);
+  EXPECT_FALSE(calls[0].unit_costs);
   EXPECT_FALSE(calls[0].from_prev);
-  EXPECT_FALSE(calls[1].unit_costs);
-  EXPECT_FALSE(calls[1].from_prev);
-  for (std::size_t i = 2; i < calls.size(); ++i) {
+  for (std::size_t i = 1; i < calls.size(); ++i) {
     EXPECT_FALSE(calls[i].unit_costs) << i;
     EXPECT_TRUE(calls[i].from_prev) << i;
   }
+  for (const LiveStepMeasure& m : r.steps) EXPECT_TRUE(m.partitioned);
+  EXPECT_EQ(r.steps[0].background_partition_ns, 0);
+  EXPECT_GT(r.steps[1].background_partition_ns, 0);
+}
+
+// An engine that counts the steps it recorded.
+class CountingEngine : public LiveEngine {
+ public:
+  CountingEngine(std::unique_ptr<LiveEngine> e, std::atomic<std::uint32_t>& recorded)
+      : e_(std::move(e)), recorded_(recorded) {}
+  LiveStep record_step(bool allow_reuse) override {
+    LiveStep s = e_->record_step(allow_reuse);
+    recorded_.fetch_add(1);
+    return s;
+  }
+  void plain_step() override { e_->plain_step(); }
+  std::vector<StateRegion> state() const override { return e_->state(); }
+
+ private:
+  std::unique_ptr<LiveEngine> e_;
+  std::atomic<std::uint32_t>& recorded_;
+};
+
+// In the background (the default) the partitioner runs on another thread and no step waits
+// for it: a partitioner that returns only once every step was recorded lets the run finish,
+// the steps keep the owner rule's assignment meanwhile, and the state is the sequential
+// run's of the same assignments.
+TEST(Live, NoStepWaitsForABackgroundPartitioner) {
+  std::atomic<std::uint32_t> recorded{0};
+  std::vector<std::thread::id> callers;
+  bool timed_out = false;
+  std::shared_ptr<partition::Strategy> metis = partition::make_strategy("metis");
+  const partition::StepPartitioner p = [&](const StepGraph& g, std::uint32_t k,
+                                           const StepGraph* pg, const Assignment* pa) {
+    callers.push_back(std::this_thread::get_id());
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (recorded.load() < 6 && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    if (recorded.load() < 6) timed_out = true;
+    return metis->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
+  };
+  LiveOptions o;
+  o.exec.threads = 2;
+  o.exec.spin_ns = 20'000;
+  o.steps = 6;
+  o.baseline = false;
+  o.observe = false;
+  o.check = true;
+  const LiveResult r = run_live(
+      [&] { return std::make_unique<CountingEngine>(make_live_engine("bars64"), recorded); }, &p,
+      o);
+  EXPECT_FALSE(timed_out);
+  ASSERT_FALSE(callers.empty());
+  for (const std::thread::id& id : callers) EXPECT_NE(id, std::this_thread::get_id());
+  EXPECT_TRUE(r.steps[0].partitioned);
+  // Until the last step was recorded the partitioner cannot have returned.
+  for (std::size_t s = 2; s + 1 < r.steps.size(); ++s) EXPECT_FALSE(r.steps[s].reassigned) << s;
+  EXPECT_GT(r.steps.back().background_partition_ns, 0);
+  ASSERT_TRUE(r.check.has_value());
+  EXPECT_EQ(*r.check, Check::kIdentical);
 }
 
 TEST(Live, RefusesThePartitionPolicyWithoutAPartitioner) {

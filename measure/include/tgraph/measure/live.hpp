@@ -40,14 +40,21 @@ struct LiveOptions {
                                   ///< sequential one for the per-kind comparison
   bool check = false;             ///< compare the final state with a sequential reference
   std::uint32_t cost_stride = 8;  ///< cost feedback samples loop iterations 0, 1, every n-th
-  /// Partition policy: call the partitioner at every step. Default: only when the structure
-  /// changed or the last assignment's imbalance under the newly measured costs exceeds both
-  /// 1 + rebalance_tolerance and (1 + rebalance_tolerance) x its imbalance when it was made
-  /// (otherwise the assignment, and so the plan, is kept). Imbalances are
+  /// Partition policy: call the partitioner at every step. Default: at the first step, once
+  /// costs were first measured, when the structure changed, and when the trigger
+  /// (RepartitionTrigger: drift past `rebalance_tolerance` whose gain over
+  /// `repartition_horizon` steps exceeds the cost of rebuilding the plans and migrating)
+  /// fires; otherwise the assignment, and so the plan, is kept. Imbalances are
   /// partition::loop_imbalance with `loop_share` (each heavy loop's share counted apart).
   bool repartition_every_step = false;
   double rebalance_tolerance = 0.05;
+  std::uint32_t repartition_horizon = 10;
   double loop_share = partition::Options{}.loop_share;
+  /// Partition policy: the partitioner runs on a helper thread while steps go on, and its
+  /// assignment is applied at the first step boundary after it is ready; a step whose
+  /// structure changed gets partition::carry_over of the assignment in use at once. False:
+  /// the step waits for the partitioner (its time is then all in partition_ns).
+  bool background_partition = true;
   /// Let the engine skip recording while the structure repeats (false: record every step).
   bool reuse_structure = true;
 };
@@ -70,14 +77,19 @@ struct KindTime {
 /// StepRecord::wall_ns: record + partition + prepare + execute.
 struct LiveStepMeasure : StepRecord {
   std::int64_t record_ns = 0;        ///< coordination code in deferred mode, edges derived
-  std::int64_t partition_ns = 0;     ///< the partitioner callback
+  /// Time the step waited for partitioning: cost feedback, the quick carry-over of a changed
+  /// structure, and the partitioner itself when it runs in the foreground.
+  std::int64_t partition_ns = 0;
+  /// The partitioner's own time off the critical path (jobs finished by this step's start).
+  std::int64_t background_partition_ns = 0;
   std::int64_t prepare_ns = 0;       ///< plan lookup, lowering and plan build, binding
   std::int64_t graph_update_ns = 0;  ///< edge derivation within record_ns, first pass
   std::int64_t execute_ns = 0;       ///< the executor running the tasks
   std::int64_t baseline_ns = 0;      ///< the same step of the uninstrumented engine
   bool rebuilt = false;              ///< a plan was built for this step (first pass)
   bool recorded = true;              ///< the engine recorded the step (false: program reused)
-  bool partitioned = false;          ///< the partitioner was called (first pass)
+  bool partitioned = false;  ///< an assignment was made or asked for at this step (first pass)
+  bool reassigned = false;   ///< the assignment in use changed at this step (first pass)
   std::vector<std::uint32_t> loop_iterations;  ///< first pass
 };
 

@@ -190,6 +190,15 @@ using StepPartitioner = std::function<Assignment(
 /// Strategy `method` as a StepPartitioner (UsageError for an unknown name).
 StepPartitioner step_partitioner(std::string_view method, const Options& options = {});
 
+/// A quick assignment of `g` for a step that cannot wait for its strategy (O(tasks +
+/// accesses)): every task found in `prev_graph` by stable key keeps its processor in `prev`;
+/// the new ones go, in program order, to the processor holding most bytes of the data they
+/// touch, else the least loaded (sticky's incremental placement, without its rebalance).
+/// Without a previous step (both null): the owner-compute rule, `owner`. A live run applies
+/// it at once and lets the strategy's own assignment follow from a background thread.
+Assignment carry_over(const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
+                      const Assignment* prev);
+
 /// Imbalance of `a` on `g` as its processors meet: the most loaded processor's work outside
 /// the heavy loops (each dynamic loop holding at least `loop_share` of the step's work, cost
 /// x iterations) plus, for each heavy loop, its most loaded processor's work in that loop,
