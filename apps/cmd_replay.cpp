@@ -59,6 +59,10 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
       "--no-combine", [&exec] { exec.partition.combine = false; },
       "Partition policy: run every reducer on its own processor (default: a dot product's "
       "reducer and scalar run on the last of its processors to arrive)");
+  cmd->add_flag_callback(
+      "--no-steal", [&exec] { exec.partition.steal = false; },
+      "Partition policy: every task on its own processor (default: a thread that would wait "
+      "runs ready tasks of the programs, its own first, then the most loaded processor's)");
   cmd->add_flag("--json", a.json, "Print one JSON object");
 }
 

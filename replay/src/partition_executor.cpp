@@ -17,13 +17,29 @@
 // whose arrival completes an execution's count runs the reducer and the tasks after it, then
 // publishes their done counters; the reducer's own processor, when not last, waits for
 // combined[c] = epoch | executions instead. Calling thread = processor 0.
+//
+// Stealing (PartitionOptions::steal; partition_plan.hpp add_steal()): every task instance
+// is claimed before it runs, by a compare-and-swap of claim[t] = epoch + executions claimed
+// from its previous value, by its owner (at its place in the program) or by a thief (a
+// thread that would otherwise wait, in block(), or that finished its program and waits for
+// the others): exactly one of them runs it. Whoever ran it publishes fin[t] = epoch +
+// executions finished; a thief runs an instance only when every execution its full
+// dependency list names is finished (fin), the iteration exists (the loop's decision) and
+// the task's previous execution is finished. The owner, reaching a task a thief took,
+// passes its plan's waits as if it ran it, then waits for fin and publishes done[t] itself:
+// done counters still follow program order, which the elided waits rely on. A stolen task
+// writes the same temporaries (the lowering named them) and, through the CW chain in its
+// dependencies, adds into each in its processor's order: the bits do not change.
+#include <algorithm>
 #include <atomic>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "common.hpp"
@@ -81,6 +97,22 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     std::atomic<std::uint32_t> at_task{kNoTask};  // the task run or waited for last
     std::atomic<std::uint32_t> wait_kind{0};      // 0: none, 1: task, 2: loop, 3: first touch
     std::atomic<std::uint32_t> wait_id{0};        // the producer task or the loop
+    // Stealing: (step << 32) | the op the owner is at (relaxed: a hint where thieves look).
+    std::atomic<std::uint64_t> cursor{0};
+    // 1 while the thread sleeps in a wait (relaxed: a hint for the waiters of its counters,
+    // which spin on while it runs).
+    std::atomic<std::uint32_t> sleeping{0};
+  };
+
+  // Stealing: one task's claim and completion counters (epoch + executions), on one line.
+  struct alignas(64) TaskState {
+    std::atomic<std::uint64_t> claim{0};
+    std::atomic<std::uint64_t> fin{0};
+  };
+
+  // A thief's scratch: the processors to look at, most ops left first.
+  struct Thief {
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> order;  // (ops left, processor)
   };
 
   std::unique_ptr<PartitionPlan> build_plan(const ExecGraph& x) override {
@@ -114,6 +146,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       }
     }
     if (options().partition.combine && !options().partition.serial) detail::add_combines(x, *plan);
+    if (options().partition.steal && !options().partition.serial && threads() > 1)
+      detail::add_steal(x, *plan);
     lose_signal(*plan, x);
     return plan;
   }
@@ -143,6 +177,15 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       combined_ = std::make_unique<PaddedCounter[]>(plan.combines.size());
       combine_cap_ = plan.combines.size();
     }
+    steal_ = k > 1 && plan.stealable.size() == plan.tasks && plan.tasks > 0;
+    if (steal_) {
+      if (plan.tasks > state_cap_) {
+        state_ = std::make_unique<TaskState[]>(plan.tasks);
+        state_cap_ = plan.tasks;
+      }
+      if (!thieves_) thieves_ = std::make_unique<Thief[]>(k);
+      programs_target_ += k;
+    }
     plan_ = &plan;
     exec_ = &x;
     workload_ = &w;
@@ -166,7 +209,7 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       // acquire (inside wait): every worker's counters and writes are visible afterwards.
       parking_.wait(
           finished_, [target](std::uint64_t v) { return v >= target; }, never_abort_, parked,
-          waited);
+          waited, [] { return false; }, [] { return false; }, &counters_[0].sleeping);
     }
     if (watchdog_) watchdog_->end_step();
     stats.threads.resize(k);
@@ -200,7 +243,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       std::int64_t waited = 0;
       // acquire (inside wait): the step context written before the store is visible.
       seen = parking_.wait(
-          step_seq_, [seen](std::uint64_t v) { return v > seen; }, never_abort_, parked, waited);
+          step_seq_, [seen](std::uint64_t v) { return v > seen; }, never_abort_, parked, waited,
+          [] { return false; }, [] { return false; }, &counters_[p].sleeping);
       // relaxed: ordered by the acquire of step_seq_ above.
       if (shutdown_.load(std::memory_order_relaxed)) return;
       run_proc(p);
@@ -223,6 +267,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.poke(done_[t].v);
     for (std::size_t l = 0; l < plan_->loops; ++l) parking_.poke(loop_[l].v);
     for (std::size_t c = 0; c < plan_->combines.size(); ++c) parking_.poke(combined_[c].v);
+    if (steal_)
+      for (std::size_t t = 0; t < plan_->tasks; ++t) parking_.poke(state_[t].fin);
   }
 
   // Arrival at combine c in the step of epoch E: whether the caller is the last of its
@@ -264,7 +310,34 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     bool parked = false;
     std::int64_t waited = 0;
     const std::int64_t t0 = observers().empty() ? 0 : now_ns();
-    const std::uint64_t value = parking_.wait(c, ok, abort_, parked, waited);
+    // The thread whose signal ends the wait, where one does: the producer's processor (a
+    // task's completion), the break task's (a loop's decision). The wait spins on while it
+    // runs (Parking::wait). A stolen task's thief runs it now, and the end of the programs
+    // waits for threads that run: those spin on too; a combine's parties are not known.
+    constexpr std::uint32_t kNone = UINT32_MAX, kRunning = UINT32_MAX - 1;
+    std::uint32_t from = kind == 5 || kind == 6 ? kRunning : kNone;
+    if (kind == 1 && id < plan_->proc.size()) from = plan_->proc[id];
+    if (kind == 2 && id < plan_->breaks.size()) from = plan_->proc[plan_->breaks[id]];
+    const auto awake = [this, from] {
+      if (from >= kRunning) return from == kRunning;
+      // relaxed: a hint (spin or park); the counter decides.
+      return counters_[from].sleeping.load(std::memory_order_relaxed) == 0;
+    };
+    // While it waits, the thread runs ready tasks (not at the first-touch barrier: data
+    // may not exist yet).
+    const std::uint64_t value =
+        steal_ && kind != 3
+            ? parking_.wait(
+                  c, ok, abort_, parked, waited,
+                  [&] {
+                    if (!try_steal(thread, tc)) return false;
+                    // relaxed: as above.
+                    slot.at_task.store(task, std::memory_order_relaxed);
+                    return true;
+                  },
+                  awake, &slot.sleeping)
+            : parking_.wait(c, ok, abort_, parked, waited, [] { return false; }, awake,
+                            &slot.sleeping);
     // relaxed: as above; progress is only compared between two samples.
     slot.wait_kind.store(0, std::memory_order_relaxed);
     slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
@@ -275,6 +348,120 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     if (!observers().empty())
       for (Observer* o : observers()) o->on_wait(thread, task, t0, t0 + waited, parked);
     return value;
+  }
+
+  // Owner's claim of its task t's execution `iter` (its place in its program): false when
+  // a thief claimed it first.
+  bool claim_own(TaskId t, std::uint64_t E, std::uint32_t iter) {
+    std::atomic<std::uint64_t>& claim = state_[t].claim;
+    const std::uint64_t want = E + iter + 1;
+    // relaxed: the claim only decides who runs the instance; the data a task needs come
+    // through fin (acquire) and the plan's waits.
+    std::uint64_t c = claim.load(std::memory_order_relaxed);
+    if (c >= want) return false;
+    // relaxed: as above; a failed exchange means a thief claimed it (c >= want then).
+    return claim.compare_exchange_strong(c, want, std::memory_order_relaxed);
+  }
+
+  // Ops of a processor's program a thief looks at, from where its owner is.
+  static constexpr std::uint32_t kStealWindow = 32;
+
+  // Runs one ready task of some program (the thread's own ahead of its place first, then
+  // those of the processors with the most ops left) as thread `self`; false when none is
+  // ready. Only where steal_.
+  bool try_steal(std::uint32_t self, ThreadCounters& tc) {
+    // relaxed: a hint; a task a late reader runs was ready (the re-check below).
+    if (abort_.load(std::memory_order_relaxed)) return false;
+    const PartitionPlan& plan = *plan_;
+    const std::uint32_t k = threads();
+    const std::uint64_t E = epoch_;
+    auto& order = thieves_[self].order;
+    order.clear();
+    for (std::uint32_t q = 0; q < k; ++q) {
+      const std::uint32_t n_ops = static_cast<std::uint32_t>(plan.procs[q].ops.size());
+      const std::uint32_t pc = cursor_of(q, E);
+      if (pc >= n_ops) continue;
+      order.emplace_back(q == self ? UINT32_MAX : n_ops - pc, q);
+    }
+    std::sort(order.begin(), order.end(), std::greater<>());
+    for (const auto& [left, q] : order) {
+      const std::vector<Op>& ops = plan.procs[q].ops;
+      std::uint32_t seen = 0;
+      for (std::size_t i = cursor_of(q, E); i < ops.size() && seen < kStealWindow; ++i) {
+        const Op& op = ops[i];
+        if (op.kind == OpKind::kLoopEnd) break;  // the next iteration: not before the decision
+        if (op.kind != OpKind::kTask) continue;
+        ++seen;
+        if (plan.stealable[op.task] != 0 && steal_one(op, q, self, E, tc)) return true;
+      }
+    }
+    return false;
+  }
+
+  // Where the owner of program q is this step (0: not started).
+  std::uint32_t cursor_of(std::uint32_t q, std::uint64_t E) const {
+    // relaxed: a hint where to look; claims and fin decide.
+    const std::uint64_t c = counters_[q].cursor.load(std::memory_order_relaxed);
+    return (c >> 32) == (E >> 32) ? static_cast<std::uint32_t>(c) : 0;
+  }
+
+  // Runs the next unclaimed execution of `op` (of processor q's program) on thread `self`
+  // if it is ready; false if it is not, or claimed.
+  bool steal_one(const Op& op, std::uint32_t q, std::uint32_t self, std::uint64_t E,
+                 ThreadCounters& tc) {
+    const PartitionPlan& plan = *plan_;
+    const TaskId t = op.task;
+    TaskState& st = state_[t];
+    // relaxed: as in claim_own().
+    std::uint64_t c = st.claim.load(std::memory_order_relaxed);
+    const auto n = static_cast<std::uint32_t>(c >= E ? c - E : 0);  // executions claimed
+    if (op.loop == kNoLoop) {
+      if (n > 0) return false;
+    } else if (n > 0) {
+      // Iteration n exists: the loop's decision after iteration n - 1 is to go on.
+      // acquire: pairs with the break task's signal (nothing read depends on it but the
+      // decision; kept acquire as every other reader of loop counters).
+      const std::uint64_t d = loop_[op.loop].v.load(std::memory_order_acquire);
+      const auto decided = static_cast<std::uint32_t>((d & 0xffffffffu) >> 1);
+      if ((d >> 32) != (E >> 32) || decided < n || (decided == n && (d & 1u) != 0)) return false;
+      // The previous execution finished (executions of one task run in order).
+      // acquire: its writes are visible to this one.
+      if (st.fin.load(std::memory_order_acquire) < E + n) return false;
+    }
+    for (auto i = plan.steal_begin[t]; i < plan.steal_begin[t + 1]; ++i) {
+      const WaitPoint& wp = plan.steal_waits[i];
+      std::uint32_t loop_ran = 0;
+      if (wp.kind == WaitKind::kAfterLoop) {
+        // acquire: as above.
+        const std::uint64_t d = loop_[wp.loop].v.load(std::memory_order_acquire);
+        if ((d >> 32) != (E >> 32) || (d & 1u) == 0) return false;
+        loop_ran = static_cast<std::uint32_t>((d & 0xffffffffu) >> 1);
+      }
+      const std::uint32_t need = detail::needed_executions(wp, n, loop_ran);
+      // acquire: the producer's writes are visible to the task.
+      if (need != 0 && state_[wp.producer].fin.load(std::memory_order_acquire) < E + need)
+        return false;
+    }
+    // relaxed: a value poked by an abort was read with acquire above, after which the
+    // abort flag (set before the poke) is seen.
+    if (abort_.load(std::memory_order_relaxed)) return false;
+    // relaxed: as in claim_own().
+    if (!st.claim.compare_exchange_strong(c, E + n + 1, std::memory_order_relaxed)) return false;
+    const bool observe = !observers().empty() && detail::sampled(n, observe_stride());
+    if (observe) detail::notify_begin(observers(), self, t, n);
+    Slot& slot = counters_[self];
+    const bool watch = watchdog_ != nullptr;
+    if (watch) slot.at_task.store(t, std::memory_order_relaxed);  // relaxed: a report
+    workload_->run(TaskRun{exec_, t, op.origin, n, self});
+    if (observe) detail::notify_end(observers(), self, t, n);
+    if (watch)  // relaxed: compared between two samples of the watchdog only
+      slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
+                          std::memory_order_relaxed);
+    // A release (and a wake-up of the owner if it sleeps waiting for it).
+    parking_.signal(st.fin, E + n + 1);
+    ++tc.tasks;
+    if (q != self) ++tc.stolen;
+    return true;
   }
 
   // PartitionTestHooks::lose_signal: the task's completion is never published.
@@ -389,6 +576,7 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     const bool observe = !observers().empty();
     const std::uint32_t stride = observe_stride();
     const bool watch = watchdog_ != nullptr;
+    const bool steal = steal_;
     Slot& slot = counters_[p];
     // Kept in registers in the loop (tc escapes into wait()), added to tc at the end.
     std::uint64_t tasks = 0, signals = 0;
@@ -425,6 +613,10 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
         if (watch)  // relaxed: compared between two samples of the watchdog only
           slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,
                               std::memory_order_relaxed);
+        // release: a thief that reads it runs a successor (after the end observers saw;
+        // nobody sleeps on it: only the owner of a stolen task does, and the thief
+        // publishes that one).
+        if (steal) state_[op.task].fin.store(E + iter + 1, std::memory_order_release);
         ++tasks;
         if (op.signal) {
           parking_.signal(done_[op.task].v, E + iter + 1);
@@ -436,6 +628,8 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       const std::size_t n_ops = pp.ops.size();
       for (std::size_t pc = 0; pc < n_ops;) {
         const Op& op = ops[pc];
+        // relaxed: a hint for thieves (where to look).
+        if (steal) slot.cursor.store(E | pc, std::memory_order_relaxed);
         switch (op.kind) {
           case OpKind::kLoopBegin:
             iter = 0;
@@ -458,6 +652,20 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
             break;
           }
           case OpKind::kTask: {
+            if (steal && op.plain_run != 0 && op.combine == CombineRole::kNone) {
+              // The plain run task by task: each claimed, or waited for if a thief took it.
+              const std::size_t end = pc + op.plain_run;
+              for (; pc < end; ++pc) {
+                const Op& o = ops[pc];
+                slot.cursor.store(E | pc, std::memory_order_relaxed);  // relaxed: as above
+                if (!plan.stealable[o.task] || claim_own(o.task, E, iter)) {
+                  execute(o);
+                } else if (!await_stolen(o.task, E, iter, p, tc)) {
+                  goto out;
+                }
+              }
+              break;
+            }
             if (!observe && op.plain_run != 0) {
               // A run of tasks that neither wait nor publish: the sequential loop.
               tasks += op.plain_run;
@@ -501,6 +709,16 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
                       op.task, tc, v, 1, wp.producer))
                 goto out;
             }
+            if (steal && plan.stealable[op.task] && !claim_own(op.task, E, iter)) {
+              // A thief runs or ran it: its completion, then published here, in order.
+              if (!await_stolen(op.task, E, iter, p, tc)) goto out;
+              if (op.signal) {
+                parking_.signal(done_[op.task].v, E + iter + 1);
+                ++signals;
+              }
+              ++pc;
+              break;
+            }
             execute(op);
             if (op.is_break) {
               const bool stop = detail::leave_loop(x, op.loop, iter, w);
@@ -526,9 +744,35 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
       fail(std::current_exception());
     }
   out:
+    if (steal) finish_program(p, tc);
     tc.tasks += tasks;
     tc.signals += signals;
     counters_[p].c = tc;
+  }
+
+  // The owner's wait for its task t's execution `iter`, which a thief claimed; false when
+  // the step is aborting.
+  bool await_stolen(TaskId t, std::uint64_t E, std::uint32_t iter, std::uint32_t p,
+                    ThreadCounters& tc) {
+    const std::uint64_t target = E + iter + 1;
+    std::uint64_t v = 0;
+    return wait(state_[t].fin, [target](std::uint64_t s) { return s >= target; }, p, t, tc, v, 6,
+                t);
+  }
+
+  // Stealing: the end of thread p's own program. Until every program has ended, it runs
+  // ready tasks of the others (spinning, then parking when none comes).
+  void finish_program(std::uint32_t p, ThreadCounters& tc) {
+    // seq_cst RMW (a release): Dekker with the parked waiters as signal() (sync.hpp).
+    programs_.fetch_add(1, std::memory_order_seq_cst);
+    if (parking_.parked() != 0) parking_.wake(programs_);
+    const std::uint64_t all = programs_target_;
+    std::uint64_t v = 0;
+    try {
+      wait(programs_, [all](std::uint64_t s) { return s >= all; }, p, kNoTask, tc, v, 5, 0);
+    } catch (...) {
+      fail(std::current_exception());
+    }
   }
 
   detail::PartitionTestHooks hooks_;
@@ -544,17 +788,23 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
   std::unique_ptr<PaddedCounter[]> arrivals_;  // by combine: epoch + arrivals this step
   std::unique_ptr<PaddedCounter[]> combined_;  // by combine: epoch | executions run
   std::size_t combine_cap_ = 0;
+  std::unique_ptr<TaskState[]> state_;  // stealing: by task
+  std::size_t state_cap_ = 0;
+  std::unique_ptr<Thief[]> thieves_;  // by thread
   // Step context: written by the main thread before the step_seq_ store, read by workers
   // after acquiring it.
   const PartitionPlan* plan_ = nullptr;
   const ExecGraph* exec_ = nullptr;
   Workload* workload_ = nullptr;
   bool fresh_ = false;
+  bool steal_ = false;                 // this step steals
+  std::uint64_t programs_target_ = 0;  // programs_ once every program of this step ended
   std::uint64_t epoch_ = 0;
   std::uint64_t steps_ = 0;
   alignas(64) std::atomic<std::uint64_t> step_seq_{0};
   alignas(64) std::atomic<std::uint64_t> finished_{0};
   alignas(64) std::atomic<std::uint64_t> touched_{0};  // first-touch barrier arrivals
+  alignas(64) std::atomic<std::uint64_t> programs_{0};  // stealing: programs ended, all steps
   std::uint64_t touch_rounds_ = 0;
   std::uint64_t order_fallbacks_ = 0;
   alignas(64) std::atomic<bool> abort_{false};

@@ -332,4 +332,64 @@ void add_combines(const ExecGraph& x, PartitionPlan& plan) {
   }
 }
 
+void add_steal(const ExecGraph& x, PartitionPlan& plan) {
+  const StepGraph& g = x.graph;
+  const std::size_t n = plan.tasks;
+  plan.stealable.assign(n, 0);
+  plan.steal_begin.assign(n + 1, 0);
+  plan.steal_waits.clear();
+  if (plan.procs.size() < 2) return;
+  std::vector<bool> excluded(n, false);
+  for (const Combine& c : plan.combines)
+    for (std::uint32_t i = c.head; i < c.end; ++i)
+      excluded[plan.procs[c.home].ops[i].task] = true;
+  // The previous CW writer of each datum along each processor's program (one region: reset
+  // at every loop begin and end; lowering serialises CW groups that cross a loop boundary).
+  std::vector<std::vector<TaskId>> chains(n);  // by task: the previous CW writer of each datum
+  std::vector<TaskId> last(g.data.size(), kNoTask);
+  std::vector<DatumId> touched;
+  for (const ProcPlan& pp : plan.procs) {
+    for (const Op& op : pp.ops) {
+      if (op.kind != OpKind::kTask) {
+        for (DatumId d : touched) last[d] = kNoTask;
+        touched.clear();
+        continue;
+      }
+      if (op.combine != CombineRole::kNone || op.is_break) excluded[op.task] = true;
+      for (const Access& acc : g.accesses_of(op.task)) {
+        if (acc.mode != AccessMode::CW) continue;
+        const TaskId prev = last[acc.datum];
+        if (prev != kNoTask && prev != op.task &&
+            std::find(chains[op.task].begin(), chains[op.task].end(), prev) ==
+                chains[op.task].end())
+          chains[op.task].push_back(prev);
+        if (prev == kNoTask) touched.push_back(acc.datum);
+        last[acc.datum] = op.task;
+      }
+    }
+    for (DatumId d : touched) last[d] = kNoTask;
+    touched.clear();
+  }
+  for (TaskId v = 0; v < n; ++v) {
+    plan.steal_begin[v] = static_cast<std::uint32_t>(plan.steal_waits.size());
+    if (excluded[v]) continue;
+    plan.stealable[v] = 1;
+    const LoopId lv = g.tasks[v].loop;
+    const auto intra = [&](TaskId u) {
+      const LoopId lu = g.tasks[u].loop;
+      const WaitKind kind = lu == kNoLoop  ? WaitKind::kOnce
+                            : lu == lv     ? WaitKind::kSameIter
+                                           : WaitKind::kAfterLoop;
+      plan.steal_waits.push_back({u, lu, kind});
+    };
+    for (auto i = plan.intra.begin[v]; i < plan.intra.begin[v + 1]; ++i) intra(plan.intra.ids[i]);
+    for (TaskId u : chains[v]) intra(u);
+    for (auto i = plan.carried.begin[v]; i < plan.carried.begin[v + 1]; ++i) {
+      const TaskId u = plan.carried.ids[i];
+      plan.steal_waits.push_back({u, g.tasks[u].loop, WaitKind::kPrevIter});
+    }
+  }
+  plan.steal_begin[n] = static_cast<std::uint32_t>(plan.steal_waits.size());
+}
+
 }  // namespace tgraph::replay::detail

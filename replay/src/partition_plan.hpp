@@ -99,6 +99,12 @@ struct PartitionPlan {
   std::vector<TaskId> breaks;       // by loop: its break task
   Csr intra, carried;               // predecessors along intra-step and loop-carried edges
   std::uint32_t rebuilt_procs = 0;  // processors whose wait points this build computed
+  // Partition-guided stealing (add_steal(); PartitionOptions::steal), by exec task: whether
+  // a thread other than its processor's may run it (1), and every execution it needs
+  // before it runs, on any processor (steal_waits[steal_begin[t], steal_begin[t + 1])).
+  std::vector<std::uint8_t> stealable;
+  std::vector<std::uint32_t> steal_begin;
+  std::vector<WaitPoint> steal_waits;
 };
 
 /// The one wait-readiness rule: how many executions of `w.producer` (this step) a task in
@@ -151,5 +157,15 @@ void finish_plan(const ExecGraph& x, PartitionPlan& plan);
 /// iteration all come before those of the next). Needs elided waits (plan.elide); the
 /// serial twin ignores the roles.
 void add_combines(const ExecGraph& x, PartitionPlan& plan);
+
+/// Marks the tasks of a finished plan that another thread may run out of their processor's
+/// order (PartitionOptions::steal; after add_combines()): every task op but a loop's break
+/// task and the tasks of a combine (heads, offers and the tasks after a head). Lists each
+/// one's full dependencies as wait points, none elided: every intra-step and loop-carried
+/// predecessor, on its own processor too, and, for each datum it writes cumulatively, the
+/// previous cumulative writer of that datum in its processor's order within the same loop
+/// region (CW writers of one datum or temporary have no edge between them: program order
+/// alone fixes the order of their additions, which a thief must keep). Needs k >= 2.
+void add_steal(const ExecGraph& x, PartitionPlan& plan);
 
 }  // namespace tgraph::replay::detail

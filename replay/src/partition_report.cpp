@@ -33,6 +33,10 @@ std::string stall_report(const ExecGraph& x, const PartitionPlan& plan,
       out += " waits for " + label(plan.procs[c.home].ops[c.head].task) +
              " and the tasks after it, run by the last of their " + std::to_string(c.parties) +
              " threads to arrive";
+    } else if (kind == 5) {
+      out += " has finished its program and waits for the other threads to finish theirs";
+    } else if (kind == 6 && id < x.graph.tasks.size()) {
+      out += " waits for " + label(id) + ", taken from its program by another thread";
     } else if (task < x.graph.tasks.size()) {
       out += " runs or last ran " + label(task);
     } else {

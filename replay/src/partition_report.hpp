@@ -12,8 +12,9 @@
 namespace tgraph::replay::detail {
 
 /// Where one thread stands, as the watchdog samples it. `kind`: 0 nothing, 1 the completion
-/// of task `id`, 2 the decision of loop `id`, 3 the first-touch barrier, 4 combine `id`;
-/// `task`: the task it runs, last ran or waits to run.
+/// of task `id`, 2 the decision of loop `id`, 3 the first-touch barrier, 4 combine `id`,
+/// 5 the other threads' programs (stealing: the end of its own), 6 the completion of its
+/// own task `id` that another thread took; `task`: the task it runs, last ran or waits to run.
 struct ThreadStand {
   std::uint32_t kind = 0;
   std::uint32_t id = 0;

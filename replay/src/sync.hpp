@@ -30,6 +30,10 @@ inline std::int64_t wait_ticks() {
 /// (about 2 ms, the first time it is asked); 1 where the ticks are now_ns().
 double wait_tick_ns();
 
+/// How long a wait spins at most while the thread it waits for runs (Parking::wait with an
+/// `awake` test): beyond spin_ns, and only where every thread has a core of its own.
+inline constexpr std::int64_t kLongSpinNs = 1'000'000;
+
 /// A 64-bit counter alone on its cache line.
 struct alignas(64) PaddedCounter {
   std::atomic<std::uint64_t> v{0};
@@ -61,9 +65,14 @@ class Parking {
  public:
   /// Oversubscribed threads (more than cores) park often: each sleep's heavy fence would
   /// interrupt every core, so they keep the symmetric fence.
-  explicit Parking(std::int64_t spin_ns, bool oversubscribed)
+  /// `long_spin_ns`: how long a wait spins at most while awake() (kLongSpinNs).
+  explicit Parking(std::int64_t spin_ns, bool oversubscribed,
+                   std::int64_t long_spin_ns = kLongSpinNs)
       : tick_ns_(wait_tick_ns()),
         spin_ticks_(static_cast<std::int64_t>(static_cast<double>(spin_ns) / tick_ns_)),
+        long_ticks_(spin_ns <= 0 || oversubscribed
+                        ? 0
+                        : static_cast<std::int64_t>(static_cast<double>(long_spin_ns) / tick_ns_)),
         oversubscribed_(oversubscribed),
         asymmetric_(!oversubscribed && asymmetric_fence_available()) {}
 
@@ -97,20 +106,48 @@ class Parking {
   }
 
   /// Waits until ok(c) or `abort` is set; returns the last value read and whether it slept.
-  /// `spun_ns` receives the time spent (0 when ok at once).
+  /// `waited_ns` receives the time spent (0 when ok at once).
   template <class Ok>
   std::uint64_t wait(std::atomic<std::uint64_t>& c, Ok ok, const std::atomic<bool>& abort,
                      bool& parked, std::int64_t& waited_ns) {
+    return wait(c, ok, abort, parked, waited_ns, [] { return false; }, [] { return false; },
+                nullptr);
+  }
+
+  /// The same, calling idle() while it spins (before each round of checks): idle() returns
+  /// true when it did useful work (the partition executor runs a stolen task); the spin
+  /// budget then starts again, and the time idle() worked is not counted in `waited_ns`.
+  /// Past the spin budget it spins on, up to kLongSpinNs, while awake() (the thread it
+  /// waits for runs: a hand-off from a running thread costs no wake-up) where every thread
+  /// has a core (not oversubscribed, spin_ns > 0). `sleeping` (optional): the caller's flag,
+  /// 1 while it sleeps, which other threads' awake() read.
+  template <class Ok, class Idle, class Awake>
+  std::uint64_t wait(std::atomic<std::uint64_t>& c, Ok ok, const std::atomic<bool>& abort,
+                     bool& parked, std::int64_t& waited_ns, Idle idle, Awake awake,
+                     std::atomic<std::uint32_t>* sleeping) {
     parked = false;
     waited_ns = 0;
     // acquire: pairs with the signaller's store so its data writes are visible after.
     std::uint64_t v = c.load(std::memory_order_acquire);
     if (ok(v)) return v;
-    const std::int64_t t0 = wait_ticks();
+    const std::int64_t t_start = wait_ticks();
+    std::int64_t t0 = t_start, worked = 0;
     std::int64_t t = t0;
     // (t < t0: the thread moved to a core whose counter is behind; it parks rather than
     // spin for as long as the counters differ.)
-    while (t - t0 < spin_ticks_ && t >= t0) {
+    while (t >= t0 && (t - t0 < spin_ticks_ || (t - t0 < long_ticks_ && awake()))) {
+      if (idle()) {
+        const std::int64_t t1 = wait_ticks();
+        worked += t1 - t;
+        t0 = t = t1;
+        v = c.load(std::memory_order_acquire);  // acquire: as above
+        // relaxed: as in the loop below.
+        if (ok(v) || abort.load(std::memory_order_relaxed)) {
+          waited_ns = elapsed_ns(t_start, worked);
+          return v;
+        }
+        continue;
+      }
       for (int i = 0; i < 64; ++i) {
         if (oversubscribed_) {
           std::this_thread::yield();
@@ -120,13 +157,15 @@ class Parking {
         v = c.load(std::memory_order_acquire);  // acquire: as above
         // relaxed: abort is only a hint to stop; no data is read because of it.
         if (ok(v) || abort.load(std::memory_order_relaxed)) {
-          waited_ns = elapsed_ns(t0);
+          waited_ns = elapsed_ns(t_start, worked);
           return v;
         }
       }
       t = wait_ticks();
     }
     parked = true;
+    // relaxed: a hint for other waiters' awake() (spin or park), nothing is read through it.
+    if (sleeping != nullptr) sleeping->store(1, std::memory_order_relaxed);
     // seq_cst: Dekker with signal() (class comment).
     parked_.fetch_add(1, std::memory_order_seq_cst);
     if (asymmetric_) asymmetric_heavy_fence();  // the signallers' half of their fence
@@ -137,7 +176,8 @@ class Parking {
     }
     // relaxed: only signallers read it, and a stale non-zero value costs one notify.
     parked_.fetch_sub(1, std::memory_order_relaxed);
-    waited_ns = elapsed_ns(t0);
+    if (sleeping != nullptr) sleeping->store(0, std::memory_order_relaxed);  // relaxed: as above
+    waited_ns = elapsed_ns(t_start, worked);
     return v;
   }
 
@@ -147,13 +187,15 @@ class Parking {
  private:
   // Nanoseconds since wait_ticks() read t0 (0 if the ticks went back: a thread that is not
   // pinned may move to a core whose counter is behind).
-  std::int64_t elapsed_ns(std::int64_t t0) const {
-    const std::int64_t d = wait_ticks() - t0;
+  // `worked`: ticks of that spent in idle() work, not counted.
+  std::int64_t elapsed_ns(std::int64_t t0, std::int64_t worked = 0) const {
+    const std::int64_t d = wait_ticks() - t0 - worked;
     return d > 0 ? static_cast<std::int64_t>(static_cast<double>(d) * tick_ns_) : 0;
   }
 
   double tick_ns_;
   std::int64_t spin_ticks_;
+  std::int64_t long_ticks_;  // 0: no spinning past spin_ticks_
   bool oversubscribed_;
   bool asymmetric_;
   alignas(64) std::atomic<std::uint32_t> parked_{0};

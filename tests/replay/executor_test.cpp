@@ -489,6 +489,7 @@ TEST(Executor, TimesBlockedWaitsInNanoseconds) {
   const Assignment a{2, {0, 1}, {}};
   ExecOptions o = opts(2);
   o.spin_ns = 1'000'000;  // spins 1 ms, then parks: both halves of a wait are timed
+  o.partition.steal = false;  // thread 1 would otherwise take the write while it waits
   auto ex = make_executor(Policy::kPartition, o);
   SyntheticWorkload w({.cost_scale = 1.0, .touch = false});
   w.set_step(g);

@@ -48,6 +48,13 @@ struct PartitionOptions {
   /// changes (observers see the thread that ran them). Needs elide_waits; off: every task
   /// on its assigned processor.
   bool combine = true;
+  /// Partition-guided stealing: a thread that would wait (for a producer, or at the end of
+  /// its program for the others) runs ready tasks of the programs instead, its own first
+  /// (ahead of its program order), then those of the processors with the most left. A
+  /// processor's tasks keep their processor's temporaries and their order of cumulative
+  /// writes (the results are the same bits as without); a loop's break task and the tasks
+  /// of a combine are never taken. Off: every task on its assigned processor.
+  bool steal = true;
   /// The watchdog. A step during which no thread finishes a task or passes a wait for this
   /// long ends with std::runtime_error naming what each thread waits for or runs (0: no
   /// watchdog). Every thread is joined before run_step throws.
@@ -106,6 +113,7 @@ struct ThreadCounters {
   std::uint64_t blocked_waits = 0;  ///< waits whose condition did not hold at once
   std::uint64_t parks = 0;          ///< blocked waits that slept in the kernel
   std::int64_t wait_ns = 0;         ///< time in blocked waits
+  std::uint64_t stolen = 0;         ///< of `tasks`, those of another processor's program
 };
 
 /// What one step of an executor cost (the engine's own step figures are samples::StepStats).
