@@ -136,7 +136,8 @@ struct Engine {
       for (int cx = 0; cx < kSheetsX; ++cx) {
         const int me = cy * kSheetsX + cx;
         if (cx + 1 < kSheetsX) {
-          SpringSet seam{"seam[" + sheets[me].name + "|" + sheets[me + 1].name + "]", me, me + 1, {}};
+          SpringSet seam{
+              "seam[" + sheets[me].name + "|" + sheets[me + 1].name + "]", me, me + 1, {}};
           for (int j = 0; j < kSide; ++j) seam.springs.push_back({at(kSide - 1, j), at(0, j)});
           sets.push_back(std::move(seam));
         }
@@ -179,8 +180,8 @@ struct Instrumented {
   std::vector<ObjectId> set_obj;
   ObjectId solver = 0;
   DatumId residual = 0, converged = 0;
-  KindId reset = 0, spring_force = 0, integrate = 0, clear_delta = 0, project = 0,
-         apply_delta = 0, check = 0;
+  KindId reset = 0, spring_force = 0, integrate = 0, clear_delta = 0, project = 0, apply_delta = 0,
+         check = 0;
 
   void declare(Recorder& rec) {
     reset = rec.kind("resetForce");
@@ -216,8 +217,12 @@ struct Instrumented {
     for (std::size_t s = 0; s < e.sets.size(); ++s) {
       const Ids &a = ids[e.sets[s].sa], &b = ids[e.sets[s].sb];
       rec.task(spring_force, set_obj[s],
-               {{a.x, AccessMode::R}, {b.x, AccessMode::R}, {a.v, AccessMode::R},
-                {b.v, AccessMode::R}, {a.f, AccessMode::CW}, {b.f, AccessMode::CW}},
+               {{a.x, AccessMode::R},
+                {b.x, AccessMode::R},
+                {a.v, AccessMode::R},
+                {b.v, AccessMode::R},
+                {a.f, AccessMode::CW},
+                {b.f, AccessMode::CW}},
                [en, s] {
                  const SpringSet& set = en->sets[s];
                  Sheet &A = en->sheets[set.sa], &B = en->sheets[set.sb];
@@ -237,13 +242,16 @@ struct Instrumented {
       for (std::size_t s = 0; s < e.sets.size(); ++s) {
         const Ids &a = ids[e.sets[s].sa], &b = ids[e.sets[s].sb];
         rec.task(project, set_obj[s],
-                 {{a.x, AccessMode::R}, {b.x, AccessMode::R}, {a.delta, AccessMode::CW},
-                  {b.delta, AccessMode::CW}, {residual, AccessMode::CW}},
+                 {{a.x, AccessMode::R},
+                  {b.x, AccessMode::R},
+                  {a.delta, AccessMode::CW},
+                  {b.delta, AccessMode::CW},
+                  {residual, AccessMode::CW}},
                  [en, s] {
                    const SpringSet& set = en->sets[s];
                    Sheet &A = en->sheets[set.sa], &B = en->sheets[set.sb];
-                   tgraph::accumulate(en->residual) += set.project(
-                       A, B, tgraph::accumulate(A.delta), tgraph::accumulate(B.delta));
+                   tgraph::accumulate(en->residual) +=
+                       set.project(A, B, tgraph::accumulate(A.delta), tgraph::accumulate(B.delta));
                  });
       }
       for (std::size_t i = 0; i < ids.size(); ++i)
@@ -270,9 +278,8 @@ int capture(int steps, const std::string& out, bool quiet) {
   Instrumented inst;
   Recorder rec(tgraph::capture::Mode::kCapture);
   inst.declare(rec);
-  const std::string scene = "springs " + std::to_string(kSheetsX) + "x" +
-                            std::to_string(kSheetsY) + " sheets of " + std::to_string(kSide) +
-                            "x" + std::to_string(kSide);
+  const std::string scene = "springs " + std::to_string(kSheetsX) + "x" + std::to_string(kSheetsY) +
+                            " sheets of " + std::to_string(kSide) + "x" + std::to_string(kSide);
   tgraph::TraceHeader header{scene, "instrument-your-engine (explicit Euler)", "unknown",
                              TGRAPH_PACKAGE_VERSION};
   tgraph::TraceWriter writer(out, header);

@@ -57,8 +57,10 @@ struct TiledMatrix {
 // Tile (i, j) of matrix number `matrix`: off-diagonal entries uniform in [-1, 1] (drawn from
 // the tile's own seed), diagonal n = NT * B: strictly dominant by rows and columns.
 void fill_tile(TiledMatrix& a, int i, int j, std::uint64_t matrix) {
-  std::mt19937_64 gen(1000 + (matrix * static_cast<std::uint64_t>(a.nt) + static_cast<std::uint64_t>(i)) *
-                                 static_cast<std::uint64_t>(a.nt) + static_cast<std::uint64_t>(j));
+  std::mt19937_64 gen(1000 +
+                      (matrix * static_cast<std::uint64_t>(a.nt) + static_cast<std::uint64_t>(i)) *
+                          static_cast<std::uint64_t>(a.nt) +
+                      static_cast<std::uint64_t>(j));
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   double* t = a.tile(i, j);
   for (int c = 0; c < a.b; ++c)
@@ -76,12 +78,12 @@ bool getrf(double* akk, int b) {
   return true;
 }
 void trsm_lower(const double* akk, double* aik, int b) {  // A(i,k) <- A(i,k) U(k,k)^-1
-  cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, b, b, 1.0, akk,
-              b, aik, b);
+  cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, b, b, 1.0, akk, b,
+              aik, b);
 }
 void trsm_upper(const double* akk, double* akj, int b) {  // A(k,j) <- L(k,k)^-1 A(k,j)
-  cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasUnit, b, b, 1.0, akk, b,
-              akj, b);
+  cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasUnit, b, b, 1.0, akk, b, akj,
+              b);
 }
 void gemm(const double* aik, const double* akj, double* aij, int b) {  // A(i,j) -= A(i,k)A(k,j)
   cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, b, b, b, -1.0, aik, b, akj, b, 1.0, aij,
@@ -129,9 +131,9 @@ double relative_residual(const TiledMatrix& lu, std::uint64_t matrix) {
 // run (kDeferred) or runs the factorisation plainly (kOff).
 struct InstrumentedLu {
   TiledMatrix a;
-  std::vector<std::uint64_t> matrix;   // by tile: the number of the matrix it holds
-  std::vector<tgraph::DatumId> tile;   // datum of tile (i, j) at i * nt + j
-  std::vector<tgraph::DatumId> number; // datum of matrix[i * nt + j]
+  std::vector<std::uint64_t> matrix;    // by tile: the number of the matrix it holds
+  std::vector<tgraph::DatumId> tile;    // datum of tile (i, j) at i * nt + j
+  std::vector<tgraph::DatumId> number;  // datum of matrix[i * nt + j]
   tgraph::KindId fill_kind = 0, getrf_kind = 0, trsm_kind = 0, gemm_kind = 0;
 
   InstrumentedLu(int nt, int b) : a(nt, b), matrix(static_cast<std::size_t>(nt * nt), 0) {}
@@ -202,11 +204,11 @@ int capture(int nt, int b, int steps, const std::string& out, bool quiet) {
   Recorder rec(tgraph::capture::Mode::kCapture);
   lu.declare(rec);
   // Writing the trace: a header saying where it comes from, then one frame per step.
-  const tgraph::TraceHeader header{
-      "tiled LU " + std::to_string(nt) + "x" + std::to_string(nt) + " tiles of " +
-          std::to_string(b),
-      "tiled-lu (LAPACKE/CBLAS, no pivoting)", tgraph::machine_description(),
-      std::string(tgraph::kVersionString)};
+  const tgraph::TraceHeader header{"tiled LU " + std::to_string(nt) + "x" + std::to_string(nt) +
+                                       " tiles of " + std::to_string(b),
+                                   "tiled-lu (LAPACKE/CBLAS, no pivoting)",
+                                   tgraph::machine_description(),
+                                   std::string(tgraph::kVersionString)};
   tgraph::TraceWriter writer(out, header);
   double worst = 0;
   for (int s = 0; s < steps; ++s) {
@@ -303,7 +305,8 @@ int main(int argc, char** argv) {
       return usage("unknown or incomplete flag " + flag);
     }
   }
-  if (nt < 1 || nt > 64 || b < 1 || b > 1024 || steps < 1) return usage("NT, B or STEPS out of range");
+  if (nt < 1 || nt > 64 || b < 1 || b > 1024 || steps < 1)
+    return usage("NT, B or STEPS out of range");
 #ifndef TILED_LU_LIVE
   if (threads > 0) return usage("--live: built without tgraph::measure (find_package component)");
 #endif

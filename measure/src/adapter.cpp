@@ -16,7 +16,8 @@ namespace {
 class CallbackEngine final : public LiveEngine {
  public:
   explicit CallbackEngine(EngineCallbacks c) : c_(std::move(c)) {
-    if (!c_.declare || !c_.step) throw UsageError("engine callbacks: declare and step are required");
+    if (!c_.declare || !c_.step)
+      throw UsageError("engine callbacks: declare and step are required");
   }
 
   LiveStep record_step(bool allow_reuse) override {
@@ -54,7 +55,8 @@ class CallbackEngine final : public LiveEngine {
     if (!rec_) return r;
     const std::vector<Datum>& data = rec_->data();
     for (DatumId d = 0; d < data.size(); ++d)
-      if (rec_->datum_ptr(d) != nullptr) r.push_back({data[d].name, rec_->datum_ptr(d), data[d].bytes});
+      if (rec_->datum_ptr(d) != nullptr)
+        r.push_back({data[d].name, rec_->datum_ptr(d), data[d].bytes});
     return r;
   }
 

@@ -64,9 +64,8 @@ struct Tiny {
       rec.task(sum, obj[i], {{ids[i], AccessMode::R}, {total_id, AccessMode::CW}},
                [e, i] { accumulate(e->total) += e->cell[i] / (1.0 + static_cast<double>(i)); });
     if (plant)
-      rec.task(mark, obj[kCells - 1], {{planted_id, AccessMode::W}}, [e] {
-        e->planted = std::this_thread::get_id() == e->home ? 1.0 : 2.0;
-      });
+      rec.task(mark, obj[kCells - 1], {{planted_id, AccessMode::W}},
+               [e] { e->planted = std::this_thread::get_id() == e->home ? 1.0 : 2.0; });
   }
 };
 
@@ -144,13 +143,13 @@ TEST(Adapter, LiveStepsComputeWhatThePlainEngineComputes) {
 TEST(Adapter, ABodyThatDependsOnItsThreadIsReportedAsDiffersNamingItsRegion) {
   // Every task on processor 1: a worker thread in the live pass, the calling thread in the
   // serial twin the check compares with.
-  const partition::StepPartitioner on_processor_1 =
-      [](const StepGraph& g, std::uint32_t k, const StepGraph*, const Assignment*) {
-        Assignment a;
-        a.k = k;
-        a.proc.assign(g.tasks.size(), 1);
-        return a;
-      };
+  const partition::StepPartitioner on_processor_1 = [](const StepGraph& g, std::uint32_t k,
+                                                       const StepGraph*, const Assignment*) {
+    Assignment a;
+    a.k = k;
+    a.proc.assign(g.tasks.size(), 1);
+    return a;
+  };
   LiveOptions o = options(2, 2);
   o.policy = replay::Policy::kPartition;
   const LiveResult r = run_live(
@@ -164,13 +163,12 @@ TEST(Adapter, ABodyThatDependsOnItsThreadIsReportedAsDiffersNamingItsRegion) {
   EXPECT_EQ(*r.check, Check::kDiffers);
   ASSERT_TRUE(r.difference.has_value());
   EXPECT_EQ(r.difference->datum, "planted");  // cells and total agree: the first differing
-  EXPECT_EQ(r.difference->offset, 6u);  // 1.0 and 2.0 differ in their two top bytes
+  EXPECT_EQ(r.difference->offset, 6u);        // 1.0 and 2.0 differ in their two top bytes
   EXPECT_EQ(r.difference->differing_bytes, 2u);
 
   // The same engine without the planted task is identical under the same placement.
-  const LiveResult clean =
-      run_live([] { return make_live_engine(callbacks(std::make_shared<Tiny>())); },
-               &on_processor_1, o);
+  const LiveResult clean = run_live(
+      [] { return make_live_engine(callbacks(std::make_shared<Tiny>())); }, &on_processor_1, o);
   ASSERT_TRUE(clean.check.has_value());
   EXPECT_EQ(*clean.check, Check::kIdentical);
 }
