@@ -134,13 +134,13 @@ step "tgraph info --json springs.tgt (installed binary)"
 "$python" - "$tmp/info.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
-# 4 x 2 sub-sheets of 32 x 32 particles, 10 seams between neighbours (3 x 2 across, 4 down):
+# 4 x 2 sub-sheets of 48 x 48 particles, 10 seams between neighbours (3 x 2 across, 4 down):
 # per sheet resetForce, integrate, clearDelta, applyDelta; per spring set (a sheet's own
 # springs or a seam) addForce and projectLength; checkResidual and the loop's break.
 sheets, sets = 8, 8 + 10
 tasks = 4 * sheets + 2 * sets + 2
 checks = [
-    ("scene", j["scene"] == "springs 4x2 sheets of 32x32"),
+    ("scene", j["scene"] == "springs 4x2 sheets of 48x48"),
     ("steps", j["steps"] == 20),
     ("tasks per step", j["tasks_per_step"]["min"] == tasks == j["tasks_per_step"]["max"]),
     ("one loop per step", j["loops"] == 20 and all(s["loops"] == 1 for s in j["per_step"])),
