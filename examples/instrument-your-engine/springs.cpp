@@ -356,8 +356,8 @@ int run_live(int steps, int threads, const std::string& method, int repeat, bool
 
 int usage(const char* why) {
   std::fprintf(stderr,
-               "springs: %s\nusage: springs STEPS OUT.tgt [--live K [--method M] [--repeat R] "
-               "[--json]]\n",
+               "springs: %s (usage: springs STEPS OUT.tgt [--live K [--method M] [--repeat R] "
+               "[--json]])\n",
                why);
   return 2;
 }

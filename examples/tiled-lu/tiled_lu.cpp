@@ -271,8 +271,8 @@ int run_live(int nt, int b, int steps, int threads, const std::string& method, i
 
 int usage(const std::string& why) {
   std::fprintf(stderr,
-               "tiled_lu: %s\nusage: tiled_lu NT B OUT.tgt [STEPS] [--live K [--method M] "
-               "[--repeat R] [--json]]  (1 <= NT <= 64, 1 <= B <= 1024)\n",
+               "tiled_lu: %s (usage: tiled_lu NT B OUT.tgt [STEPS] [--live K [--method M] "
+               "[--repeat R] [--json]], 1 <= NT <= 64, 1 <= B <= 1024)\n",
                why.c_str());
   return 2;
 }
