@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 // `tgraph calibrate`: hand-off latencies (spinning and parked), cross-core transfer cost,
 // the bodies' slow-down against the busy cores and a reduction's cost of this machine.
+#include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -126,51 +129,55 @@ double measure_per_byte(int cpu_a, int cpu_b, std::size_t bytes, int repeats) {
   return median(per_byte);
 }
 
-// Round trips of a counter between two threads that each sleep in std::atomic::wait (a
-// futex, as the executors' parked waits) until the other's store and notify; returns the
-// median one-way time over blocks of 20 round trips: the waker's store and notify, the
-// kernel's wake-up and the sleeper's return, on the critical path of a parked hand-off.
+// One-way hand-offs to a parked thread: B sleeps in futex(FUTEX_WAIT) on a word (the
+// kernel call under the executors' parked waits, without std::atomic::wait's spinning
+// first); A waits 30 us (B is asleep by then), reads the clock, stores the word and calls
+// futex(FUTEX_WAKE); B reads the clock when the call returns. Median of B's time - A's.
 double measure_park_wake(int cpu_a, int cpu_b, int rounds) {
-  Flag ping;
-  constexpr int kBlock = 20;
-  const int blocks = std::max(1, rounds / kBlock);
-  const std::uint64_t total = static_cast<std::uint64_t>(blocks) * kBlock;
-  std::vector<double> per_block;
-  auto await = [&](std::uint64_t want) {
-    // acquire: as a real wait, the waker's writes before its store are visible after.
-    for (std::uint64_t v = ping.value.load(std::memory_order_acquire); v != want;
-         v = ping.value.load(std::memory_order_acquire))
-      ping.value.wait(v, std::memory_order_acquire);
+  alignas(64) std::atomic<std::uint32_t> word{0};
+  Flag ack;
+  std::vector<std::int64_t> sent(static_cast<std::size_t>(rounds)),
+      woke(static_cast<std::size_t>(rounds));
+  auto ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+        .count();
   };
   std::thread b([&] {
-    for (std::uint64_t i = 0; i < total; ++i) {
-      await(2 * i + 1);
-      // release: pairs with the other side's acquire (a signal's data).
-      ping.value.store(2 * i + 2, std::memory_order_release);
-      ping.value.notify_all();
+    for (int i = 0; i < rounds; ++i) {
+      const auto want = static_cast<std::uint32_t>(i + 1);
+      // acquire: A's clock reading before its store is visible after.
+      for (std::uint32_t v = word.load(std::memory_order_acquire); v != want;
+           v = word.load(std::memory_order_acquire))
+        syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, v,
+                nullptr, nullptr, 0);
+      woke[static_cast<std::size_t>(i)] = ns();
+      // release: B's reading is visible to A once it sees the acknowledgement.
+      ack.value.store(static_cast<std::uint64_t>(i + 1), std::memory_order_release);
     }
   });
   pin(b, cpu_b);
   std::thread a([&] {
-    std::uint64_t i = 0;
-    // One unmeasured round trip: both threads running on their CPUs first.
-    for (int blk = -1; blk < blocks; ++blk) {
-      const auto t0 = Clock::now();
-      for (int r = 0; r < (blk < 0 ? 1 : kBlock) && i < total; ++r, ++i) {
-        ping.value.store(2 * i + 1, std::memory_order_release);  // release: as above
-        ping.value.notify_all();
-        await(2 * i + 2);
+    for (int i = 0; i < rounds; ++i) {
+      // acquire: pairs with B's acknowledgement.
+      while (ack.value.load(std::memory_order_acquire) != static_cast<std::uint64_t>(i)) {
       }
-      const auto t1 = Clock::now();
-      if (blk >= 0)
-        per_block.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / kBlock /
-                            2);
+      const std::int64_t until = ns() + 30'000;
+      while (ns() < until) {
+      }
+      sent[static_cast<std::size_t>(i)] = ns();
+      word.store(static_cast<std::uint32_t>(i + 1), std::memory_order_release);  // release: above
+      syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, 1, nullptr,
+              nullptr, 0);
     }
   });
   pin(a, cpu_a);
   a.join();
   b.join();
-  return median(per_block);
+  std::vector<double> d;
+  for (int i = 0; i < rounds; ++i)
+    d.push_back(static_cast<double>(woke[static_cast<std::size_t>(i)] -
+                                    sent[static_cast<std::size_t>(i)]));
+  return median(d);
 }
 
 // A spin barrier for `n` threads that can be used round after round.
@@ -320,15 +327,18 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   c.per_byte_ns = measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1));
   c.park_rounds = std::max(options.park_rounds, 20);
   c.park_wake_ns = measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds);
-  // Inflation: each K's passes against one thread's, measured in the same call. A pass
-  // over 2 MiB takes 0.1-0.5 ms: 20 passes a round keep every K under half a second.
+  // Inflation: in each round one thread alone, then K at once (the same body, one round
+  // each), so that a machine whose speed drifts moves both alike; the median of the rounds'
+  // ratios. A pass over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
   c.inflation_bytes = options.inflation_bytes;
   const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
-  const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, rounds, passes);
   for (std::size_t k : thread_counts(cpus.size())) {
-    const double f =
-        k == 1 ? 1.0 : busy_pass_ns(cpus, k, c.inflation_bytes, rounds, passes) / alone;
-    c.inflation.push_back({static_cast<std::uint32_t>(k), f});
+    std::vector<double> ratio;
+    for (int r = 0; k > 1 && r < rounds; ++r) {
+      const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
+      ratio.push_back(busy_pass_ns(cpus, k, c.inflation_bytes, 1, passes) / alone);
+    }
+    c.inflation.push_back({static_cast<std::uint32_t>(k), k == 1 ? 1.0 : median(ratio)});
     if (k >= 2)
       c.reduction.push_back({static_cast<std::uint32_t>(k),
                              reduction_round_ns(cpus, k, std::max(options.reduction_rounds, 100))});

@@ -103,13 +103,14 @@ struct Calibration {
   int cpu_a = 0, cpu_b = 1;     ///< the two CPUs the threads were pinned to
   int rounds = 0;               ///< handoffs measured
   std::size_t buffer_bytes = 0; ///< buffer size of the transfer measurement
-  /// Median one-way hand-off to a thread parked in a futex wait (std::atomic::wait), from
-  /// the waker's store to the sleeper's return.
+  /// Median one-way hand-off to a thread parked in a futex wait, from the waker's clock
+  /// reading before its store and FUTEX_WAKE to the sleeper's return.
   double park_wake_ns = 0;
   int park_rounds = 0;  ///< parked hand-offs measured
   /// Slow-down of a memory-touching body run by K pinned threads at once against one
-  /// thread alone (median over rounds of the slowest thread's time per pass / alone), K = 1,
-  /// 2, 4, ... up to the CPUs this process may use (and that count itself).
+  /// thread alone (median over rounds, each one thread alone then K at once, of the K
+  /// threads' mean time per pass / alone's), K = 1, 2, 4, ... and the CPUs this process may
+  /// use.
   std::vector<ThreadsPoint> inflation;
   std::size_t inflation_bytes = 0;  ///< each body's working set
   /// Combine of one partial sum per thread (K threads, each arriving at a counter; the
@@ -124,7 +125,7 @@ struct CalibrateOptions {
   int rounds = 20000;                 ///< ping-pong round trips
   std::size_t buffer_bytes = 1 << 18; ///< transferred buffer (fits a private L2)
   int repeats = 15;                   ///< transfer measurements (median taken)
-  int park_rounds = 400;              ///< parked hand-offs (each side sleeps once per round)
+  int park_rounds = 400;              ///< parked hand-offs (each after 30 us asleep)
   /// Working set of each copy of the inflation body: 2 MiB (half read, half read-modify-
   /// written), an engine object's vectors several times over: beyond a core's private L2
   /// on current x86, so that the copies share the last-level cache and memory.
