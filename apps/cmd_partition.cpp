@@ -102,10 +102,14 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", a->assignment, "Assignment file (.tga)")->required();
   add_model_flags(cmd, *n);
-  cmd->callback([a, n] {
+  auto serial = std::make_shared<SerialFlags>();
+  add_serial_flags(cmd, *serial);
+  cmd->callback([a, n, serial] {
     const Trace trace = read_trace(a->input);
     const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
-    const tp::Report rep = tp::evaluate(trace, as, n->cost_model(), a->assignment);
+    const std::vector<std::uint64_t> per_step = serial->per_step(trace.steps.size());
+    const tp::Report rep = tp::evaluate(trace, as, n->cost_model(), a->assignment,
+                                        per_step.empty() ? nullptr : &per_step);
     std::cout << (a->json ? tp::report_json(rep) + "\n" : tp::report_text(rep));
   });
 

@@ -13,6 +13,28 @@ namespace tgraph::app {
 
 namespace tp = tgraph::partition;
 
+std::vector<std::uint64_t> SerialFlags::per_step(std::size_t steps) const {
+  if (serial_ns) return std::vector<std::uint64_t>(steps, *serial_ns);
+  if (live.empty()) return {};
+  std::vector<std::uint64_t> v = tp::load_serial_work(live);
+  if (v.size() < steps)
+    throw UsageError("--live " + live + ": the run has " + std::to_string(v.size()) +
+                     " steps, the trace " + std::to_string(steps));
+  v.resize(steps);
+  return v;
+}
+
+void add_serial_flags(CLI::App* cmd, SerialFlags& f) {
+  auto* live = cmd->add_option(
+      "--live", f.live,
+      "A `tgraph run --json` output of the same steps: each step's record + partition + "
+      "prepare time is serial work before its tasks (instead of the trace's host time)");
+  cmd->add_option("--serial-ns", f.serial_ns,
+                  "Serial work of the main thread before every step's tasks, ns (instead of the "
+                  "trace's host time)")
+      ->excludes(live);
+}
+
 void add_simulate(CLI::App& app) {
   struct Flags {
     std::string engine = "builtin", platform, cluster, model = "calibrated", calibration;
@@ -45,7 +67,9 @@ void add_simulate(CLI::App& app) {
                 "that spans processors reduced through a reducer task on its first writer's "
                 "processor (two hops), each processor in program order");
   cmd->add_flag("--json", a->json, "Print one JSON object");
-  cmd->callback([a, f] {
+  auto serial = std::make_shared<SerialFlags>();
+  add_serial_flags(cmd, *serial);
+  cmd->callback([a, f, serial] {
     tp::SimulatedPlatform p;
     p.model = tp::select_cost_model(f->model, f->calibration);
     if (!f->cluster.empty()) p.cluster = tp::parse_cluster(f->cluster, "--cluster");
@@ -58,6 +82,9 @@ void add_simulate(CLI::App& app) {
       throw UsageError("--platform: the builtin engine has no platform model (use --engine simgrid)");
     const Trace trace = read_trace(a->input);
     const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
+    p.serial_ns = serial->per_step(trace.steps.size());
+    if (!p.serial_ns.empty() && engine != tp::SimulationEngine::builtin)
+      throw UsageError("--live/--serial-ns: only the builtin engine charges the main thread's work");
     const tp::Prediction r = measure::simulate(trace, as, engine, p, f->lower);
     std::cout << (a->json ? tp::prediction_json(r) + "\n" : tp::prediction_text(r));
   });

@@ -23,6 +23,12 @@ void add_validate(CLI::App& app) {
   cmd->add_option("--steps", o->steps, "Steps (default 20)");
   cmd->add_option("--repeat", o->repeat,
                   "Rounds of live pass, capture, replay pass and simulation (medians; default 3)");
+  cmd->add_option("--calibration", o->calibration,
+                  "The simulator's calibration file (default: the default calibration file if "
+                  "present)");
+  cmd->add_flag("!--no-live-serial", o->live_serial,
+                "Charge the capture's host time in the prediction instead of the live run's "
+                "serial work per step (record, partition wait, prepare)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([o, a] {
     const measure::MethodChoice m = method_flags(o->method);

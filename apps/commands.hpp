@@ -48,6 +48,18 @@ struct Args {
   bool json = false, recover = false;
 };
 
+/// `--live RUN.json` | `--serial-ns N` of evaluate and simulate: the main thread's serial work
+/// per step that the simulation charges instead of the trace's host time.
+struct SerialFlags {
+  std::string live;                        ///< a `tgraph run --json` output
+  std::optional<std::uint64_t> serial_ns;  ///< the same for every step
+  /// The per-step values for a trace of `steps` steps (empty: neither flag); UsageError when
+  /// the run has fewer steps than the trace.
+  std::vector<std::uint64_t> per_step(std::size_t steps) const;
+};
+/// Adds `--live` and `--serial-ns` to `cmd`.
+void add_serial_flags(CLI::App* cmd, SerialFlags& f);
+
 /// Prints "tgraph: warning: TEXT" on stderr (what the user should know; not an error).
 inline void warn(const std::string& text) { std::cerr << "tgraph: warning: " << text << '\n'; }
 /// Prints a JSON object on stdout (one line, as `--json` promises).

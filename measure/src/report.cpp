@@ -287,7 +287,8 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
          {"engine_wall_ns", r.engine_ns},
          {"replay_wall_ns", r.replay_ns},
          {"predicted_ns", pred ? nlohmann::json(r.predicted_ns) : nlohmann::json(nullptr)},
-         {"host_ns", r.host_ns}});
+         {"host_ns", r.host_ns},
+         {"serial_ns", r.serial_ns}});
   nlohmann::json j = {
       {"scene", o.scene},
       {"policy", std::string(to_string(v.choice.policy))},
@@ -305,6 +306,8 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
   j["predicted_over_live"] = pred ? nlohmann::json(v.predicted_over_live) : nlohmann::json(nullptr);
   j["predicted_over_replay"] =
       pred ? nlohmann::json(v.predicted_over_replay) : nlohmann::json(nullptr);
+  j["model"] = v.model;
+  j["model_terms"] = v.model_terms;
   return j.dump() + "\n";
 }
 
@@ -332,6 +335,9 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
                   static_cast<double>(v.predicted_ns) / 1e6, v.predicted_over_live,
                   v.predicted_over_replay);
     out += line;
+    std::string terms;
+    for (const std::string& t : v.model_terms) terms += (terms.empty() ? "" : ", ") + t;
+    out += "  model " + v.model + ": " + terms + "\n";
   }
   return out;
 }

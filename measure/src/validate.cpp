@@ -25,7 +25,8 @@ Validation validate(const ValidateOptions& o) {
   v.threads = v.choice.policy == replay::Policy::kSequential ? 1 : o.threads;
   if (v.threads == 0 || o.steps == 0 || o.repeat == 0)
     throw UsageError("validate: threads, steps and rounds must be at least 1");
-  const auto model = partition::select_cost_model("calibrated", "");
+  partition::CostModel model = partition::select_cost_model("calibrated", o.calibration);
+  v.model = model.source;
 
   for (std::uint32_t round = 0; round < o.repeat; ++round) {
     ValidationRound r;
@@ -41,6 +42,14 @@ Validation validate(const ValidateOptions& o) {
         run_live([scene] { return make_live_engine(scene); }, part ? &*part : nullptr, lo);
     r.live_ns = live.wall_ns;
     r.engine_ns = live.baseline_wall_ns;
+    // The main thread's work between the steps' tasks, as this live run measured it.
+    std::vector<std::uint64_t> serial;
+    for (const LiveStepMeasure& m : live.steps) {
+      serial.push_back(static_cast<std::uint64_t>(m.record_ns + m.partition_ns + m.prepare_ns));
+      r.serial_ns += serial.back();
+    }
+    // The simulated threads wait as the live run's did: spinning this long, then parked.
+    model.spin_budget_ns = static_cast<double>(lo.exec.spin_ns);
 
     // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
     const Trace trace = capture_trace(o.scene, o.steps);
@@ -58,8 +67,14 @@ Validation validate(const ValidateOptions& o) {
 
     // 3. The simulator's makespan of the same partition (partition policy only).
     if (assignment)
-      for (std::uint64_t ns : partition::predicted_makespans(trace, *assignment, model))
+      for (std::uint64_t ns : partition::predicted_makespans(trace, *assignment, model,
+                                                             o.live_serial ? &serial : nullptr))
         r.predicted_ns += ns;
+    if (round == 0) {
+      bool host = false;
+      for (const StepGraph& g : trace.steps) host = host || g.host_ns > 0;
+      v.model_terms = partition::model_terms(model, o.live_serial, host);
+    }
     v.rounds.push_back(r);
   }
 

@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
-// `tgraph calibrate`: signal/wait latency and cross-core transfer cost of this machine.
+// `tgraph calibrate`: hand-off latencies (spinning and parked), cross-core transfer cost,
+// the bodies' slow-down against the busy cores and a reduction's cost of this machine.
+#include <linux/futex.h>
 #include <pthread.h>
 #include <sched.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -125,9 +129,191 @@ double measure_per_byte(int cpu_a, int cpu_b, std::size_t bytes, int repeats) {
   return median(per_byte);
 }
 
+// One-way hand-offs to a parked thread: B sleeps in futex(FUTEX_WAIT) on a word (the
+// kernel call under the executors' parked waits, without std::atomic::wait's spinning
+// first); A waits 30 us (B is asleep by then), reads the clock, stores the word and calls
+// futex(FUTEX_WAKE); B reads the clock when the call returns. Median of B's time - A's.
+double measure_park_wake(int cpu_a, int cpu_b, int rounds) {
+  alignas(64) std::atomic<std::uint32_t> word{0};
+  Flag ack;
+  std::vector<std::int64_t> sent(static_cast<std::size_t>(rounds)),
+      woke(static_cast<std::size_t>(rounds));
+  auto ns = [] {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch())
+        .count();
+  };
+  std::thread b([&] {
+    for (int i = 0; i < rounds; ++i) {
+      const auto want = static_cast<std::uint32_t>(i + 1);
+      // acquire: A's clock reading before its store is visible after.
+      for (std::uint32_t v = word.load(std::memory_order_acquire); v != want;
+           v = word.load(std::memory_order_acquire))
+        syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, v,
+                nullptr, nullptr, 0);
+      woke[static_cast<std::size_t>(i)] = ns();
+      // release: B's reading is visible to A once it sees the acknowledgement.
+      ack.value.store(static_cast<std::uint64_t>(i + 1), std::memory_order_release);
+    }
+  });
+  pin(b, cpu_b);
+  std::thread a([&] {
+    for (int i = 0; i < rounds; ++i) {
+      // acquire: pairs with B's acknowledgement.
+      while (ack.value.load(std::memory_order_acquire) != static_cast<std::uint64_t>(i)) {
+      }
+      const std::int64_t until = ns() + 30'000;
+      while (ns() < until) {
+      }
+      sent[static_cast<std::size_t>(i)] = ns();
+      word.store(static_cast<std::uint32_t>(i + 1), std::memory_order_release);  // release: above
+      syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAKE_PRIVATE, 1, nullptr,
+              nullptr, 0);
+    }
+  });
+  pin(a, cpu_a);
+  a.join();
+  b.join();
+  std::vector<double> d;
+  for (int i = 0; i < rounds; ++i)
+    d.push_back(static_cast<double>(woke[static_cast<std::size_t>(i)] -
+                                    sent[static_cast<std::size_t>(i)]));
+  return median(d);
+}
+
+// A spin barrier for `n` threads that can be used round after round.
+class SpinBarrier {
+ public:
+  explicit SpinBarrier(std::uint64_t n) : n_(n) {}
+  void arrive_and_wait() {
+    // relaxed: the generation is read before the arrival, which orders it (acq_rel).
+    const std::uint64_t gen = generation_.value.load(std::memory_order_relaxed);
+    // acq_rel: the last arrival sees every other thread's writes before the barrier.
+    if (arrived_.value.fetch_add(1, std::memory_order_acq_rel) + 1 == n_) {
+      arrived_.value.store(0, std::memory_order_relaxed);  // relaxed: published below
+      // release: the reset and the arrivals' writes are visible to whoever sees gen + 1.
+      generation_.value.store(gen + 1, std::memory_order_release);
+      return;
+    }
+    // acquire: pairs with the release above.
+    while (generation_.value.load(std::memory_order_acquire) == gen) {
+    }
+  }
+
+ private:
+  const std::uint64_t n_;
+  Flag arrived_, generation_;
+};
+
+// One pass of the inflation body: reads the first half of `w`, read-modify-writes the
+// second half with what it read, in 8 KiB chunks (an engine task's vectors: a force
+// field's read of positions and its += into forces).
+std::uint64_t body_pass(std::uint64_t* w, std::size_t words, std::uint64_t seed) {
+  const std::size_t half = words / 2, chunk = 1024;
+  std::uint64_t s = seed;
+  for (std::size_t c = 0; c + chunk <= half; c += chunk) {
+    std::uint64_t s0 = 0, s1 = 0;
+    for (std::size_t i = c; i < c + chunk; i += 2) {
+      s0 += w[i];
+      s1 += w[i + 1];
+    }
+    s += s0 ^ s1;
+    for (std::size_t i = half + c; i < half + c + chunk; ++i) w[i] = w[i] * 3 + s + i;
+  }
+  return s;
+}
+
+// Mean time per thread of `passes` passes of the body, each of `k` pinned threads on its
+// own working set of `bytes` (allocated and first touched by that thread), all started
+// together; median over `rounds`.
+double busy_pass_ns(const std::vector<int>& cpus, std::size_t k, std::size_t bytes, int rounds,
+                    int passes) {
+  const std::size_t words = std::max<std::size_t>(bytes / 8, 4096);
+  SpinBarrier barrier(k);
+  std::vector<std::vector<double>> times(k);
+  std::vector<std::uint64_t> sinks(k, 0);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < k; ++t) {
+    threads.emplace_back([&, t] {
+      std::vector<std::uint64_t> w(words, t + 1);
+      std::uint64_t s = 0;
+      for (int r = -1; r < rounds; ++r) {  // round -1 warms the caches, unmeasured
+        barrier.arrive_and_wait();
+        const auto t0 = Clock::now();
+        for (int p = 0; p < passes; ++p) s += body_pass(w.data(), words, s);
+        const auto t1 = Clock::now();
+        if (r >= 0) times[t].push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
+      }
+      sinks[t] = s;
+    });
+    pin(threads.back(), cpus[t]);
+  }
+  for (std::thread& t : threads) t.join();
+  volatile std::uint64_t keep = sinks[0];
+  (void)keep;
+  std::vector<double> mean_by_round;
+  for (int r = 0; r < rounds; ++r) {
+    double sum = 0;
+    for (std::size_t t = 0; t < k; ++t) sum += times[t][static_cast<std::size_t>(r)];
+    mean_by_round.push_back(sum / static_cast<double>(k) / passes);
+  }
+  return median(mean_by_round);
+}
+
+// Rounds of a combine over `k` pinned threads: each writes its partial on its own cache
+// line and arrives at a counter; the last to arrive sums the partials and publishes the
+// round; every thread waits (spinning) for that. Median ns per round over blocks of 100.
+double reduction_round_ns(const std::vector<int>& cpus, std::size_t k, int rounds) {
+  constexpr int kBlock = 100;
+  const int blocks = std::max(1, rounds / kBlock);
+  std::vector<Flag> partial(k);
+  Flag arrivals, published, result;
+  std::vector<double> per_block;
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < k; ++t) {
+    threads.emplace_back([&, t] {
+      std::uint64_t round = 0;
+      for (int blk = -1; blk < blocks; ++blk) {
+        const auto t0 = Clock::now();
+        for (int r = 0; r < kBlock; ++r, ++round) {
+          // relaxed: published by the acq_rel arrival below.
+          partial[t].value.store(round * k + t, std::memory_order_relaxed);
+          // acq_rel: the last arrival sees every partial written before the others arrived.
+          if (arrivals.value.fetch_add(1, std::memory_order_acq_rel) + 1 == (round + 1) * k) {
+            std::uint64_t sum = 0;
+            for (std::size_t q = 0; q < k; ++q)
+              sum += partial[q].value.load(std::memory_order_relaxed);  // ordered above
+            result.value.store(sum, std::memory_order_relaxed);  // relaxed: published below
+            // release: the sum is visible to every thread that sees round + 1.
+            published.value.store(round + 1, std::memory_order_release);
+          }
+          // acquire: pairs with the release above.
+          while (published.value.load(std::memory_order_acquire) < round + 1) {
+          }
+        }
+        const auto t1 = Clock::now();
+        if (t == 0 && blk >= 0)
+          per_block.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() /
+                              kBlock);
+      }
+    });
+    pin(threads.back(), cpus[t]);
+  }
+  for (std::thread& t : threads) t.join();
+  return median(per_block);
+}
+
+// 1, 2, 4, ... below n, and n.
+std::vector<std::size_t> thread_counts(std::size_t n) {
+  std::vector<std::size_t> out;
+  for (std::size_t k = 1; k < n; k *= 2) out.push_back(k);
+  out.push_back(n);
+  return out;
+}
+
 }  // namespace
 
 Calibration measure_calibration(const CalibrateOptions& options) {
+  const auto start = Clock::now();
   const std::vector<int> cpus = allowed_cpus();
   if (cpus.size() < 2)
     throw std::runtime_error("calibrate: needs two CPUs, this process may use " +
@@ -139,6 +325,25 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   c.buffer_bytes = options.buffer_bytes;
   c.sync_latency_ns = measure_latency(c.cpu_a, c.cpu_b, c.rounds);
   c.per_byte_ns = measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1));
+  c.park_rounds = std::max(options.park_rounds, 20);
+  c.park_wake_ns = measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds);
+  // Inflation: in each round one thread alone, then K at once (the same body, one round
+  // each), so that a machine whose speed drifts moves both alike; the median of the rounds'
+  // ratios. A pass over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
+  c.inflation_bytes = options.inflation_bytes;
+  const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
+  for (std::size_t k : thread_counts(cpus.size())) {
+    std::vector<double> ratio;
+    for (int r = 0; k > 1 && r < rounds; ++r) {
+      const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
+      ratio.push_back(busy_pass_ns(cpus, k, c.inflation_bytes, 1, passes) / alone);
+    }
+    c.inflation.push_back({static_cast<std::uint32_t>(k), k == 1 ? 1.0 : median(ratio)});
+    if (k >= 2)
+      c.reduction.push_back({static_cast<std::uint32_t>(k),
+                             reduction_round_ns(cpus, k, std::max(options.reduction_rounds, 100))});
+  }
+  c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return c;
 }
 

@@ -13,7 +13,30 @@
 
 namespace tgraph::partition {
 
-CostModel CostModel::ideal() { return CostModel{0.0, 0.0, "ideal", 0.0, 0.0, 0.0}; }
+CostModel CostModel::ideal() {
+  CostModel m;
+  m.sync_latency_ns = 0.0;
+  m.per_byte_ns = 0.0;
+  m.source = "ideal";
+  m.mpi_latency_ns = 0.0;
+  m.mpi_per_byte_ns = 0.0;
+  m.task_overhead_ns = 0.0;
+  m.mpi_message_overhead_ns = 0.0;
+  return m;
+}
+
+double CostModel::inflation_at(double busy) const {
+  if (inflation.empty() || busy <= 1.0) return 1.0;
+  // Below the first point: from (1, 1) to it; between points: linear; beyond: the last.
+  double x0 = 1.0, y0 = 1.0;
+  for (const ThreadsPoint& p : inflation) {
+    const double x1 = p.threads, y1 = p.value;
+    if (busy <= x1) return x1 <= x0 ? y1 : y0 + (y1 - y0) * (busy - x0) / (x1 - x0);
+    x0 = x1;
+    y0 = y1;
+  }
+  return y0;
+}
 
 // Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
 // servers (`tgraph calibrate` measures it) and 0.05 ns/byte (20 GB/s cross-core).
@@ -83,9 +106,40 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
                        std::string("expected \"") + key + "\" in [0, 1e9], found " + j[key].dump());
     return v;
   };
+  // A list of {"threads": K, <value>: v} sorted by K, each K in [1, 65536] once.
+  auto curve = [&](const char* key, const char* value_key, double min_value) {
+    std::vector<ThreadsPoint> out;
+    const nlohmann::json& list = j[key];
+    const std::string what = std::string("expected \"") + key +
+                             "\" as a list of {\"threads\": K, \"" + value_key +
+                             "\": v} with K rising from 1 and v in [" +
+                             (min_value > 0 ? "0.001" : "0") + ", 1e9]";
+    if (!list.is_array() || list.size() > 1024) throw InputError(name, std::nullopt, what);
+    for (const nlohmann::json& e : list) {
+      if (!e.is_object() || !e.contains("threads") || !e["threads"].is_number_integer() ||
+          !e.contains(value_key) || !e[value_key].is_number())
+        throw InputError(name, std::nullopt, what + ", found " + e.dump());
+      const auto k = e["threads"].get<std::int64_t>();
+      const double v = e[value_key].get<double>();
+      if (k < 1 || k > 65536 || !std::isfinite(v) || v < min_value || v > 1e9 ||
+          (!out.empty() && static_cast<std::uint32_t>(k) <= out.back().threads))
+        throw InputError(name, std::nullopt, what + ", found " + e.dump());
+      out.push_back({static_cast<std::uint32_t>(k), v});
+    }
+    return out;
+  };
   CostModel m;
-  m.sync_latency_ns = number("sync_latency_ns");
+  // Files written before "spin_handoff_ns" existed have only "sync_latency_ns" (the same
+  // measurement); either names the spinning hand-off.
+  m.sync_latency_ns = j.is_object() && !j.contains("sync_latency_ns") && j.contains("spin_handoff_ns")
+                          ? number("spin_handoff_ns")
+                          : number("sync_latency_ns");
   m.per_byte_ns = number("per_byte_ns");
+  // The terms of issue 39 are optional: an older file predicts as it did.
+  if (j.contains("park_wake_ns")) m.park_wake_ns = number("park_wake_ns");
+  if (j.contains("spin_budget_ns")) m.spin_budget_ns = number("spin_budget_ns");
+  if (j.contains("inflation")) m.inflation = curve("inflation", "factor", 0.001);
+  if (j.contains("reduction")) m.reduction = curve("reduction", "ns", 0.0);
   // Inter-node fields are optional: files written before they existed keep their meaning.
   if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
   if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
@@ -96,13 +150,56 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   return m;
 }
 
+std::vector<std::uint64_t> load_serial_work(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = read_file_bytes(path);
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(bytes.begin(), bytes.end());
+  } catch (const nlohmann::json::exception&) {
+    throw InputError(path, std::nullopt, "expected the JSON of `tgraph run --json` (malformed JSON)");
+  }
+  const char* what = "expected the JSON of `tgraph run --json`: per_step[] with record_ns, "
+                     "partition_ns and prepare_ns";
+  if (!j.is_object() || !j.contains("per_step") || !j["per_step"].is_array())
+    throw InputError(path, std::nullopt, what);
+  std::vector<std::uint64_t> out;
+  for (const nlohmann::json& s : j["per_step"]) {
+    std::int64_t sum = 0;
+    for (const char* key : {"record_ns", "partition_ns", "prepare_ns"}) {
+      if (!s.is_object() || !s.contains(key) || !s[key].is_number_integer() ||
+          s[key].get<std::int64_t>() < 0)
+        throw InputError(path, std::nullopt, what);
+      sum += s[key].get<std::int64_t>();
+    }
+    out.push_back(static_cast<std::uint64_t>(sum));
+  }
+  return out;
+}
+
+namespace {
+
+nlohmann::json curve_json(const std::vector<ThreadsPoint>& v, const char* value_key) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ThreadsPoint& p : v) out.push_back({{"threads", p.threads}, {value_key, p.value}});
+  return out;
+}
+
+}  // namespace
+
 std::string calibration_json(const Calibration& c) {
   nlohmann::json j;
   j["sync_latency_ns"] = c.sync_latency_ns;
+  j["spin_handoff_ns"] = c.sync_latency_ns;
+  j["park_wake_ns"] = c.park_wake_ns;
   j["per_byte_ns"] = c.per_byte_ns;
+  j["inflation"] = curve_json(c.inflation, "factor");
+  j["inflation_bytes"] = c.inflation_bytes;
+  j["reduction"] = curve_json(c.reduction, "ns");
   j["cpus"] = {c.cpu_a, c.cpu_b};
   j["rounds"] = c.rounds;
+  j["park_rounds"] = c.park_rounds;
   j["buffer_bytes"] = c.buffer_bytes;
+  j["seconds"] = c.seconds;
   j["tgraph_version"] = TGRAPH_VERSION;
   return j.dump(2) + "\n";
 }
@@ -118,17 +215,28 @@ std::string save_calibration(const Calibration& c, const std::string& path) {
 
 std::string calibration_report(const Calibration& c, const std::string& path, bool json) {
   if (json) {
-    const nlohmann::json j = {{"sync_latency_ns", c.sync_latency_ns},
-                              {"per_byte_ns", c.per_byte_ns},
-                              {"cpus", {c.cpu_a, c.cpu_b}},
-                              {"output", path}};
+    nlohmann::json j = nlohmann::json::parse(calibration_json(c));
+    j["output"] = path;
     return j.dump() + "\n";
   }
   char line[256];
   std::snprintf(line, sizeof line,
-                "signal/wait latency %.1f ns, transfer %.4f ns/byte (CPUs %d and %d)\n",
-                c.sync_latency_ns, c.per_byte_ns, c.cpu_a, c.cpu_b);
-  return line + ("wrote " + path + "\n");
+                "signal/wait latency %.1f ns spinning, %.1f ns to a parked thread; transfer %.4f "
+                "ns/byte (CPUs %d and %d)\n",
+                c.sync_latency_ns, c.park_wake_ns, c.per_byte_ns, c.cpu_a, c.cpu_b);
+  std::string out = line;
+  auto curve_text = [&](const char* title, const std::vector<ThreadsPoint>& v, const char* fmt) {
+    out += title;
+    for (const ThreadsPoint& p : v) {
+      std::snprintf(line, sizeof line, fmt, p.threads, p.value);
+      out += line;
+    }
+    out += "\n";
+  };
+  curve_text("inflation (threads: factor):", c.inflation, " %u: %.3f");
+  curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
+  std::snprintf(line, sizeof line, "measured in %.1f s\n", c.seconds);
+  return out + line + "wrote " + path + "\n";
 }
 
 }  // namespace tgraph::partition

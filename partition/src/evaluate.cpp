@@ -2,6 +2,7 @@
 #include "tgraph/partition/evaluate.hpp"
 
 #include <algorithm>
+#include <optional>
 #include <unordered_map>
 
 #include "tgraph/graph/error.hpp"
@@ -90,7 +91,8 @@ void migrations(const StepGraph& g, const Assignment& a, const StepGraph& prev,
   }
 }
 
-StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostModel& model) {
+StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostModel& model,
+                         std::optional<std::uint64_t> serial_ns) {
   StepReport r;
   r.tasks = g.tasks.size();
   const QuotientGraph q = quotient_graph(g, a);
@@ -107,7 +109,7 @@ StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostMode
   r.reducers = count_reducers(g, a);
   quotient(q, a.k, r);
 
-  const Schedule s = simulate(g, a, model);
+  const Schedule s = simulate(g, a, model, serial_ns);
   r.makespan_ns = s.makespan_ns;
   r.signals = s.signals;
   r.waits = s.waits;
@@ -135,7 +137,7 @@ void check_fits(const Trace& trace, const TraceAssignment& a, const std::string&
 }
 
 Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
-                const std::string& a_name) {
+                const std::string& a_name, const std::vector<std::uint64_t>* serial_ns) {
   check_fits(trace, a, a_name);
   Report rep;
   rep.method = a.method;
@@ -147,7 +149,9 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
   for (std::size_t s = 0; s < trace.steps.size(); ++s) {
     StepReport r;
     try {
-      r = evaluate_step(trace.steps[s], a.steps[s], model);
+      std::optional<std::uint64_t> serial;
+      if (serial_ns != nullptr && s < serial_ns->size()) serial = (*serial_ns)[s];
+      r = evaluate_step(trace.steps[s], a.steps[s], model, serial);
     } catch (const InputError&) {
       throw;
     } catch (const Error& e) {
@@ -179,6 +183,7 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
     sum_partition_ms += r.partition_ms;
     rep.steps.push_back(r);
   }
+  rep.model_terms = model_terms(model, serial_ns != nullptr && !serial_ns->empty(), tot.host_ns > 0);
   tot.imbalance = sum_mean_load > 0 ? static_cast<double>(tot.max_load_ns) / sum_mean_load : 1.0;
   const double sequential = static_cast<double>(tot.work_ns + tot.host_ns);
   tot.speedup = tot.makespan_ns == 0 ? 1.0 : sequential / static_cast<double>(tot.makespan_ns);

@@ -46,6 +46,7 @@ json report_object(const Report& rep, bool per_step) {
   j["imbalance_max"] = rep.imbalance_max;
   j["cyclic_steps"] = rep.cyclic_steps;
   j["predicted_speedup_with_partitioning"] = rep.speedup_with_partitioning;
+  j["model_terms"] = rep.model_terms;
   if (per_step) {
     json per = json::array();
     for (std::size_t s = 0; s < rep.steps.size(); ++s) {

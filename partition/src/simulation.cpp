@@ -47,7 +47,9 @@ Prediction builtin_predict(const Trace& trace, const TraceAssignment& a,
                                       std::to_string(platform.cluster->cores)
                                 : std::string("one machine");
   for (std::size_t s = 0; s < trace.steps.size() && s < a.steps.size(); ++s) {
-    const Schedule sch = simulate(trace.steps[s], a.steps[s], platform.model);
+    std::optional<std::uint64_t> serial;
+    if (s < platform.serial_ns.size()) serial = platform.serial_ns[s];
+    const Schedule sch = simulate(trace.steps[s], a.steps[s], platform.model, serial);
     r.steps.push_back({sch.makespan_ns, sch.waits, sch.transfer_bytes, 0, 0});
   }
   return r;
@@ -81,6 +83,17 @@ Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, Simulati
       break;
   }
   r.intra_node = platform.intra_node;
+  bool host = false;
+  for (const StepGraph& g : trace.steps) host = host || g.host_ns > 0;
+  if (engine == SimulationEngine::builtin) {
+    r.model_terms = model_terms(platform.model, !platform.serial_ns.empty(), host);
+  } else {
+    // SimGrid: the platform's links carry latency and bytes; no parking, no inflation.
+    r.model_terms = {"platform_links"};
+    if (platform.model.task_overhead_ns > 0) r.model_terms.push_back("task_overhead");
+    if (platform.model.mpi_message_overhead_ns > 0) r.model_terms.push_back("message_overhead");
+    if (host) r.model_terms.push_back("host_time");
+  }
   r.task_overhead_ns = platform.model.task_overhead_ns;
   if (engine == SimulationEngine::simgrid)
     r.message_overhead_ns = platform.model.mpi_message_overhead_ns;
@@ -113,6 +126,7 @@ std::string prediction_json(const Prediction& p) {
                             {"task_overhead_ns", p.task_overhead_ns},
                             {"message_overhead_ns", p.message_overhead_ns},
                             {"lowered", p.lowered},
+                            {"model_terms", p.model_terms},
                             {"per_step", steps}};
   return j.dump();
 }

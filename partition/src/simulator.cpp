@@ -23,12 +23,19 @@ void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
 }
 
+std::uint64_t to_ns(double ns) { return static_cast<std::uint64_t>(std::llround(std::max(0.0, ns))); }
+
 class Simulator {
  public:
-  Simulator(const StepGraph& g, const Assignment& a, const CostModel& m)
-      : g_(g), a_(a), k_(a.k), latency_(static_cast<std::uint64_t>(std::llround(m.sync_latency_ns))),
+  // `inflation`: per instance, the factor its cost is scaled by (nullptr: 1).
+  Simulator(const StepGraph& g, const Assignment& a, const CostModel& m, std::uint64_t serial_ns,
+            const std::vector<double>* inflation)
+      : g_(g), a_(a), k_(a.k), latency_(to_ns(m.sync_latency_ns)),
         per_byte_(m.per_byte_ns),
-        overhead_(static_cast<std::uint64_t>(std::llround(m.task_overhead_ns))) {
+        overhead_(to_ns(m.task_overhead_ns)),
+        wake_(to_ns(m.park_wake_ns)),
+        budget_(to_ns(m.spin_budget_ns)),
+        inflation_(inflation) {
     s_.first_instance = detail::first_instances(g);
     const std::uint64_t total = s_.first_instance.back();
     s_.start_ns.assign(total, 0);
@@ -37,8 +44,11 @@ class Simulator {
     find_fan_ins();
     items_ = detail::programs(g, a);
     state_.resize(k_);
-    // The step's serial host work (StepGraph::host_ns) runs before any of its tasks.
-    for (State& st : state_) st.time = g_.host_ns;
+    // The step's serial work (the main thread's, or StepGraph::host_ns) runs before any of
+    // its tasks on processor 0, the calling thread; the others wait for it, and when that
+    // is longer than they spin they have parked and start a wake-up later.
+    for (ProcId p = 0; p < k_; ++p)
+      state_[p].time = serial_ns + (p != 0 && wake_ > 0 && serial_ns > budget_ ? wake_ : 0);
     s_.busy_ns.assign(k_, 0);
     s_.finish_ns.assign(k_, 0);
     s_.waits_between.assign(static_cast<std::size_t>(k_) * k_, 0);
@@ -99,7 +109,17 @@ class Simulator {
   struct Memo {
     std::uint32_t iter = UINT32_MAX;  // the instance (iteration) whose arrival is kept
     std::uint64_t arrival = 0;
+    std::uint64_t remote_end = 0;  // the latest end of the group's remote sources
   };
+
+  // When a processor free at `free` can go on, given that its dependencies allow `ready`
+  // and the last of them sent from another processor ended at `remote_end`: a wait that
+  // outlasts the spin budget has parked, and the hand-off that ends it is a wake-up.
+  std::uint64_t woken(std::uint64_t free, std::uint64_t ready, std::uint64_t remote_end) const {
+    if (wake_ == 0 || ready <= free || ready - free <= budget_ || remote_end + latency_ < ready)
+      return ready;
+    return std::max(ready, remote_end + wake_);
+  }
 
   void find_fan_ins() {
     fan_in_.assign(deps_.size(), FanIn{});
@@ -149,12 +169,15 @@ class Simulator {
     }
     st.ready = 0;
     std::uint64_t ready = st.time, bytes = 0, group = 0;
+    std::uint64_t remote_end = 0, group_remote_end = 0;  // latest ends of remote sources
     for (std::size_t j = known ? fi.size : 0; j < deps.size(); ++j) {
       const Dep& d = deps[j];
       const std::uint64_t src = source(d, t, i);
       if (src == kUnknown) continue;
       std::uint64_t arrival = s_.end_ns[src];
       if (a_.proc[d.from] != p) {
+        remote_end = std::max(remote_end, arrival);
+        if (j < fi.size) group_remote_end = std::max(group_remote_end, arrival);
         arrival += latency_;
         if (receive(src, d.datum, a_.proc[d.from], p) && d.raw) bytes += g_.data[d.datum].bytes;
       }
@@ -163,13 +186,17 @@ class Simulator {
     }
     if (known) {
       ready = std::max(ready, memo->arrival);
+      remote_end = std::max(remote_end, memo->remote_end);
     } else if (memo != nullptr) {
-      *memo = Memo{i, group};
+      *memo = Memo{i, group, group_remote_end};
     }
-    const std::uint64_t duration =
-        g_.tasks[t].cost_ns + overhead_ +
-        static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
+    ready = woken(st.time, ready, remote_end);
     const std::uint64_t inst = s_.first_instance[t] + i;
+    const double cost = static_cast<double>(g_.tasks[t].cost_ns) *
+                        (inflation_ != nullptr ? (*inflation_)[inst] : 1.0);
+    const std::uint64_t duration =
+        to_ns(cost) + overhead_ +
+        static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
     s_.start_ns[inst] = ready;
     s_.end_ns[inst] = ready + duration;
     st.time = ready + duration;
@@ -208,7 +235,7 @@ class Simulator {
       if (s_.end_ns[inst] == kUnknown) return moved;
       std::uint64_t known = s_.end_ns[inst];
       if (a_.proc[brk] != p) {
-        known += latency_;
+        known = woken(st.time, known + latency_, known);
         receive(inst, loop.condition, a_.proc[brk], p);
       }
       st.time = std::max(st.time, known);
@@ -228,6 +255,9 @@ class Simulator {
   const std::uint64_t latency_;
   const double per_byte_;
   const std::uint64_t overhead_;  // CostModel::task_overhead_ns, per instance
+  const std::uint64_t wake_;      // CostModel::park_wake_ns (0: term off)
+  const std::uint64_t budget_;    // CostModel::spin_budget_ns
+  const std::vector<double>* inflation_;  // per instance, or nullptr
   Schedule s_;
   std::vector<std::vector<Dep>> deps_;
   std::vector<FanIn> fan_in_;
@@ -238,19 +268,85 @@ class Simulator {
   detail::VersionSet waits_, signals_;
 };
 
+
+// Per instance of `s`, the time-weighted mean number of instances running at once during
+// it (itself included), from the instances' intervals.
+std::vector<double> mean_busy(const Schedule& s) {
+  const std::size_t n = s.start_ns.size();
+  std::vector<std::pair<std::uint64_t, int>> events;
+  events.reserve(2 * n);
+  for (std::size_t i = 0; i < n; ++i)
+    if (s.end_ns[i] > s.start_ns[i]) {
+      events.push_back({s.start_ns[i], +1});
+      events.push_back({s.end_ns[i], -1});
+    }
+  std::sort(events.begin(), events.end());
+  // times[j]: the j-th distinct event time; area[j]: the integral of the count up to it;
+  // count[j]: the count just after it.
+  std::vector<std::uint64_t> times;
+  std::vector<double> area;
+  std::vector<int> count;
+  int c = 0;
+  double a = 0;
+  for (std::size_t e = 0; e < events.size();) {
+    const std::uint64_t t = events[e].first;
+    if (!times.empty()) a += static_cast<double>(count.back()) * static_cast<double>(t - times.back());
+    for (; e < events.size() && events[e].first == t; ++e) c += events[e].second;
+    times.push_back(t);
+    area.push_back(a);
+    count.push_back(c);
+  }
+  auto area_at = [&](std::uint64_t t) {  // t is an event time
+    const auto j = static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t) - times.begin());
+    return area[j];
+  };
+  std::vector<double> busy(n, 1.0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (s.end_ns[i] > s.start_ns[i])
+      busy[i] = (area_at(s.end_ns[i]) - area_at(s.start_ns[i])) /
+                static_cast<double>(s.end_ns[i] - s.start_ns[i]);
+  return busy;
+}
+
 }  // namespace
 
-Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model) {
+Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model,
+                  std::optional<std::uint64_t> serial_ns) {
   check_assignment(g, a);
-  return Simulator(g, a, model).run();
+  const std::uint64_t serial = serial_ns.value_or(g.host_ns);
+  Schedule s = Simulator(g, a, model, serial, nullptr).run();
+  if (model.inflation.empty() || a.k < 2) return s;
+  // The bodies' slow-down: each instance's cost scaled by the inflation at the number of
+  // instances that ran at once during it in the schedule without inflation.
+  std::vector<double> factor = mean_busy(s);
+  for (double& f : factor) f = model.inflation_at(f);
+  return Simulator(g, a, model, serial, &factor).run();
 }
 
 std::vector<std::uint64_t> predicted_makespans(const Trace& trace, const TraceAssignment& a,
-                                               const CostModel& model) {
+                                               const CostModel& model,
+                                               const std::vector<std::uint64_t>* serial_ns) {
   std::vector<std::uint64_t> out;
-  for (std::size_t s = 0; s < trace.steps.size() && s < a.steps.size(); ++s)
-    out.push_back(simulate(trace.steps[s], a.steps[s], model).makespan_ns);
+  for (std::size_t s = 0; s < trace.steps.size() && s < a.steps.size(); ++s) {
+    std::optional<std::uint64_t> serial;
+    if (serial_ns != nullptr && s < serial_ns->size()) serial = (*serial_ns)[s];
+    out.push_back(simulate(trace.steps[s], a.steps[s], model, serial).makespan_ns);
+  }
   return out;
+}
+
+std::vector<std::string> model_terms(const CostModel& model, bool serial_given, bool host_time) {
+  std::vector<std::string> terms = {"sync_latency", "per_byte"};
+  if (model.source == "ideal") terms.clear();
+  if (model.task_overhead_ns > 0) terms.push_back("task_overhead");
+  if (model.park_wake_ns > 0) terms.push_back("park_wake");
+  if (!model.inflation.empty()) terms.push_back("inflation");
+  if (serial_given) {
+    terms.push_back("serial_main_thread");
+  } else if (host_time) {
+    terms.push_back("host_time");
+  }
+  return terms;
 }
 
 }  // namespace tgraph::partition

@@ -18,6 +18,11 @@ struct ValidateOptions {
   std::uint32_t threads = 1;
   std::uint32_t steps = 20;
   std::uint32_t repeat = 3;  ///< rounds (live pass, capture, replay pass, simulation); medians
+  /// The simulator's calibration file ("": the default one if present, else the defaults).
+  std::string calibration;
+  /// Charge the live run's serial work per step (record + partition wait + prepare) in the
+  /// prediction instead of the capture's host time.
+  bool live_serial = true;
 };
 
 /// One round of a validation: the three measured back to back, so that a machine whose
@@ -28,6 +33,7 @@ struct ValidationRound {
   std::int64_t replay_ns = 0;      ///< synthetic replay of this round's capture, one pass
   std::uint64_t predicted_ns = 0;  ///< simulator on this round's capture (0: no partition)
   std::uint64_t host_ns = 0;       ///< the capture's host time (outside the graph)
+  std::uint64_t serial_ns = 0;     ///< the live run's serial work the prediction charged
 };
 
 /// The three figures of one validation: medians over the rounds, and the medians of each
@@ -39,6 +45,8 @@ struct Validation {
   std::int64_t live_ns = 0, engine_ns = 0, replay_ns = 0;
   std::uint64_t predicted_ns = 0;  ///< simulator, partition policy only (0: none)
   double replay_over_live = 0, predicted_over_live = 0, predicted_over_replay = 0;
+  std::string model;                     ///< the cost model's source
+  std::vector<std::string> model_terms;  ///< what the prediction charged
 };
 
 /// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a

@@ -2,10 +2,24 @@
 // Costs of synchronisation and data transfer that the schedule simulator charges.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace tgraph::partition {
+
+/// One point of a curve measured against the number of busy processors.
+struct ThreadsPoint {
+  std::uint32_t threads = 1;
+  double value = 0;  ///< inflation: a factor (1 = no slow-down); reduction: ns
+  friend bool operator==(const ThreadsPoint&, const ThreadsPoint&) = default;
+};
+
+/// The executor's default spin before a waiting thread parks (replay::kDefaultSpinNs, which
+/// partition cannot see: the modules are siblings; measure passes the executor's own).
+inline constexpr double kDefaultSpinBudgetNs = 50'000.0;
 
 /// What a cross-processor dependency costs in a simulated schedule.
 ///
@@ -40,6 +54,23 @@ struct CostModel {
   /// file has "mpi_message_overhead_ns" (`mpirun -np 2 tgraph-mpi calibrate` measures the
   /// MPI replay's).
   double mpi_message_overhead_ns = 0.0;
+  /// Hand-off to a thread that has parked (futex wake-up, `park_wake_ns` of `tgraph
+  /// calibrate`): a dependency whose waiting processor sat idle longer than spin_budget_ns
+  /// arrives park_wake_ns after its source ends instead of sync_latency_ns. 0: term off
+  /// (calibration files written before it was measured).
+  double park_wake_ns = 0.0;
+  /// How long a waiting thread spins before it parks (the executor's ExecOptions::spin_ns).
+  double spin_budget_ns = kDefaultSpinBudgetNs;
+  /// The bodies' slow-down against the number of busy processors (`inflation` of `tgraph
+  /// calibrate`: K copies of a memory-touching body at once against one), sorted by threads;
+  /// empty: term off. Between points linear, below the first 1, beyond the last the last.
+  std::vector<ThreadsPoint> inflation;
+  /// A cross-processor reduction's hand-off against the processors taking part (`reduction`
+  /// of `tgraph calibrate`, ns; measured, reported, not charged by the simulator).
+  std::vector<ThreadsPoint> reduction;
+
+  /// The inflation factor at `busy` processors busy at once (1 when the curve is empty).
+  double inflation_at(double busy) const;
 
   /// Zero synchronisation and transfer cost: pure precedence and load.
   static CostModel ideal();
@@ -60,6 +91,11 @@ CostModel parse_calibration(std::string_view text, const std::string& name);
 /// `calibration` if given, else the default calibration file if present, else defaults().
 CostModel select_cost_model(const std::string& model, const std::string& calibration);
 
+/// The main thread's serial work per step that a live run measured: per_step[].record_ns +
+/// partition_ns + prepare_ns of a `tgraph run --json` output (recording, the wait for
+/// partitioning, plan preparation). Throws InputError naming the file.
+std::vector<std::uint64_t> load_serial_work(const std::string& path);
+
 /// What `tgraph calibrate` measured.
 struct Calibration {
   double sync_latency_ns = 0;   ///< median one-way handoff by spinning on an atomic
@@ -67,6 +103,21 @@ struct Calibration {
   int cpu_a = 0, cpu_b = 1;     ///< the two CPUs the threads were pinned to
   int rounds = 0;               ///< handoffs measured
   std::size_t buffer_bytes = 0; ///< buffer size of the transfer measurement
+  /// Median one-way hand-off to a thread parked in a futex wait, from the waker's clock
+  /// reading before its store and FUTEX_WAKE to the sleeper's return.
+  double park_wake_ns = 0;
+  int park_rounds = 0;  ///< parked hand-offs measured
+  /// Slow-down of a memory-touching body run by K pinned threads at once against one
+  /// thread alone (median over rounds, each one thread alone then K at once, of the K
+  /// threads' mean time per pass / alone's), K = 1, 2, 4, ... and the CPUs this process may
+  /// use.
+  std::vector<ThreadsPoint> inflation;
+  std::size_t inflation_bytes = 0;  ///< each body's working set
+  /// Combine of one partial sum per thread (K threads, each arriving at a counter; the
+  /// last sums the partials and publishes; every thread reads the result): median ns per
+  /// round, for the same K as `inflation` (K >= 2).
+  std::vector<ThreadsPoint> reduction;
+  double seconds = 0;  ///< wall time of the whole measurement
 };
 
 /// Options of measure_calibration().
@@ -74,6 +125,13 @@ struct CalibrateOptions {
   int rounds = 20000;                 ///< ping-pong round trips
   std::size_t buffer_bytes = 1 << 18; ///< transferred buffer (fits a private L2)
   int repeats = 15;                   ///< transfer measurements (median taken)
+  int park_rounds = 400;              ///< parked hand-offs (each after 30 us asleep)
+  /// Working set of each copy of the inflation body: 2 MiB (half read, half read-modify-
+  /// written), an engine object's vectors several times over: beyond a core's private L2
+  /// on current x86, so that the copies share the last-level cache and memory.
+  std::size_t inflation_bytes = std::size_t{2} << 20;
+  int inflation_rounds = 7;           ///< rounds per thread count (median taken)
+  int reduction_rounds = 2000;        ///< reductions per thread count
 };
 
 /// Measures this machine with two threads pinned to two different CPUs; throws

@@ -47,12 +47,16 @@ struct Report {
   double imbalance_max = 1.0;         ///< worst step
   std::uint64_t cyclic_steps = 0;     ///< steps whose quotient graph has a cycle
   double speedup_with_partitioning = 1.0;  ///< (work + host) / (makespan + partition time)
+  std::vector<std::string> model_terms;    ///< what the prediction charged (model_terms())
 };
 
 /// Evaluates `a` on `trace`; throws InputError (naming `a_name`) when the assignment does
-/// not fit the trace (step count, task count, processor range, order).
+/// not fit the trace (step count, task count, processor range, order). `serial_ns` (when
+/// not null): the main thread's serial work per step that the simulation charges instead
+/// of the host time (simulate()).
 Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
-                const std::string& a_name = "<assignment>");
+                const std::string& a_name = "<assignment>",
+                const std::vector<std::uint64_t>* serial_ns = nullptr);
 
 /// `tgraph evaluate --json`: the totals' keys, method, k, model, steps, imbalance_max,
 /// cyclic_steps, predicted_speedup_with_partitioning and (when `per_step`) one object per step.

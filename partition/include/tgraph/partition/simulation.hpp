@@ -48,6 +48,9 @@ struct SimulatedPlatform {
   std::optional<ClusterShape> cluster; ///< `--cluster NxC`, or none
   CostModel model;                     ///< the built-in engine's costs; the links of `cluster`
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: who pays bytes in a node
+  /// Built-in engine: the main thread's serial work before each step's tasks (ns per step,
+  /// replacing the trace's host time; load_serial_work); empty: the host time.
+  std::vector<std::uint64_t> serial_ns;
 };
 
 /// One step's prediction.
@@ -74,6 +77,7 @@ struct Prediction {
   double task_overhead_ns = 0;    ///< CostModel::task_overhead_ns charged per task instance
   double message_overhead_ns = 0;  ///< CostModel::mpi_message_overhead_ns (SimGrid engine)
   bool lowered = false;           ///< the steps were lowered first (`simulate --lower`)
+  std::vector<std::string> model_terms;  ///< what the prediction charged (model_terms())
 };
 
 /// Simulates every step of `trace` under `a` with `engine`. Steps run one after the other

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
@@ -31,8 +33,16 @@ struct Schedule {
 
 /// Simulates step `g` (edges derived) under assignment `a`:
 ///
-/// * the step starts with its host time (StepGraph::host_ns: the engine's serial work
-///   outside the graph), which every processor waits for;
+/// * the step starts with its serial work on processor 0 (the calling thread), which every
+///   processor waits for: `serial_ns` when given (the main thread's work between steps as a
+///   live run measured it: recording, the wait for partitioning, plan preparation), else
+///   the host time (StepGraph::host_ns: the engine's serial work outside the graph);
+/// * a processor that waited longer than `model.spin_budget_ns` (for the serial work, a
+///   dependency from another processor or a loop decision) has parked: the hand-off that
+///   ends the wait costs `park_wake_ns` instead of `sync_latency_ns` (when park_wake_ns > 0);
+/// * with an inflation curve (and k >= 2), the step is simulated twice: each instance's cost
+///   is then scaled by `model.inflation_at(b)`, b the time-weighted mean number of
+///   instances running at once during it in the first schedule (itself included);
 /// * every processor runs its tasks one after the other, in `a.order[p]` or program order;
 /// * a task starts when its processor is free and every dependency (intra-step edges;
 ///   loop-carried edges from the previous iteration) has finished, plus
@@ -45,11 +55,20 @@ struct Schedule {
 ///   a processor's loop tasks form one block placed where its first loop task appears.
 ///
 /// Throws tgraph::Error when `a` does not fit `g` or its order deadlocks.
-Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model);
+Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& model,
+                  std::optional<std::uint64_t> serial_ns = std::nullopt);
 
 /// The simulated makespan of every step of `trace` under `a` (one per step), what `tgraph
-/// replay` reports as predicted.
-std::vector<std::uint64_t> predicted_makespans(const Trace& trace, const TraceAssignment& a,
-                                               const CostModel& model);
+/// replay` reports as predicted; `serial_ns` (when not null) the serial work per step.
+std::vector<std::uint64_t> predicted_makespans(
+    const Trace& trace, const TraceAssignment& a, const CostModel& model,
+    const std::vector<std::uint64_t>* serial_ns = nullptr);
+
+/// The terms a prediction with `model` charges (`model_terms` of `evaluate --json` and
+/// `simulate --json`): "sync_latency", "per_byte" (not with the ideal model),
+/// "task_overhead", "park_wake", "inflation" when the model has them, then
+/// "serial_main_thread" when the serial work per step was given, else "host_time" when
+/// the trace has host time.
+std::vector<std::string> model_terms(const CostModel& model, bool serial_given, bool host_time);
 
 }  // namespace tgraph::partition

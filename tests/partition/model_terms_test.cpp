@@ -1,0 +1,213 @@
+// SPDX-License-Identifier: MIT
+// The simulator's machine terms (issue 39) on tiny graphs, each term's effect on the makespan
+// computed by hand; the calibration file's new keys and older files without them.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "test_graphs.hpp"
+#include "tgraph/graph/error.hpp"
+#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/partition/simulator.hpp"
+
+namespace tgraph::partition {
+namespace {
+
+using testing::Builder;
+using testing::M;
+
+CostModel model(double latency) {
+  CostModel m;
+  m.sync_latency_ns = latency;
+  m.per_byte_ns = 0;
+  m.source = "test";
+  return m;
+}
+
+Assignment assign(std::uint32_t k, std::vector<ProcId> proc) {
+  Assignment a;
+  a.k = k;
+  a.proc = std::move(proc);
+  return a;
+}
+
+// t0 (cost 1000) writes x; t1 (cost 100) reads it.
+StepGraph producer_consumer() {
+  Builder b;
+  const DatumId x = b.datum("x", 8);
+  b.task({{x, M::W}}, 1000);
+  b.task({{x, M::R}}, 100);
+  return b.done();
+}
+
+// Two tasks of cost 1000 on disjoint data.
+StepGraph two_independent() {
+  Builder b;
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
+  b.task({{x, M::W}}, 1000);
+  b.task({{y, M::W}}, 1000);
+  return b.done();
+}
+
+TEST(ModelTerms, AWaitPastTheSpinBudgetAddsTheWakeUp) {
+  CostModel m = model(10);
+  m.spin_budget_ns = 200;
+  // Without the term: p1 waits 0 -> 1010 and starts at 1000 + 10.
+  const Schedule spin = simulate(producer_consumer(), assign(2, {0, 1}), m);
+  EXPECT_EQ(spin.start_ns[1], 1010u);
+  EXPECT_EQ(spin.makespan_ns, 1110u);
+  // With it: that wait (1010 ns) outlasts the 200 ns budget, so p1 has parked and the
+  // hand-off is the wake-up, 500 ns instead of 10: the makespan grows by exactly 490.
+  m.park_wake_ns = 500;
+  const Schedule parked = simulate(producer_consumer(), assign(2, {0, 1}), m);
+  EXPECT_EQ(parked.start_ns[1], 1500u);
+  EXPECT_EQ(parked.makespan_ns, spin.makespan_ns + 490u);
+  // A wait within the budget spins: the latency again.
+  m.spin_budget_ns = 2000;
+  EXPECT_EQ(simulate(producer_consumer(), assign(2, {0, 1}), m).start_ns[1], 1010u);
+  // On one processor nobody waits.
+  m.spin_budget_ns = 200;
+  EXPECT_EQ(simulate(producer_consumer(), assign(1, {0, 0}), m).makespan_ns, 1100u);
+}
+
+TEST(ModelTerms, InflationTwoAtTwoBusyProcessorsDoublesABody) {
+  CostModel m = model(10);
+  m.inflation = {{1, 1.0}, {2, 2.0}};
+  // Both bodies run at once on two processors: each takes 2 x 1000.
+  const Schedule both = simulate(two_independent(), assign(2, {0, 1}), m);
+  EXPECT_EQ(both.end_ns, (std::vector<std::uint64_t>{2000, 2000}));
+  EXPECT_EQ(both.makespan_ns, 2000u);
+  // The same two on one processor of two: one busy at a time, no slow-down.
+  const Schedule alone = simulate(two_independent(), assign(2, {0, 0}), m);
+  EXPECT_EQ(alone.end_ns, (std::vector<std::uint64_t>{1000, 2000}));
+  // Without the curve the parallel pair takes 1000.
+  m.inflation.clear();
+  EXPECT_EQ(simulate(two_independent(), assign(2, {0, 1}), m).makespan_ns, 1000u);
+}
+
+TEST(ModelTerms, InflationScalesABodyByTheMeanBusyCountDuringIt) {
+  // t0 (1000) on p0 beside t1 (500) on p1: t1 always has two busy, t0 half its time.
+  Builder b;
+  const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
+  b.task({{x, M::W}}, 1000);
+  b.task({{y, M::W}}, 500);
+  CostModel m = model(0);
+  m.inflation = {{1, 1.0}, {2, 2.0}};
+  const Schedule s = simulate(b.done(), assign(2, {0, 1}), m);
+  // Mean busy 1.5 -> factor 1.5 for t0; 2 -> factor 2 for t1.
+  EXPECT_EQ(s.end_ns, (std::vector<std::uint64_t>{1500, 1000}));
+}
+
+TEST(ModelTerms, InflationCurveInterpolatesAndHoldsItsLastPoint) {
+  CostModel m;
+  EXPECT_DOUBLE_EQ(m.inflation_at(8), 1.0);  // no curve: no slow-down
+  m.inflation = {{1, 1.0}, {2, 1.2}, {4, 1.6}};
+  EXPECT_DOUBLE_EQ(m.inflation_at(1), 1.0);
+  EXPECT_DOUBLE_EQ(m.inflation_at(1.5), 1.1);
+  EXPECT_DOUBLE_EQ(m.inflation_at(3), 1.4);
+  EXPECT_DOUBLE_EQ(m.inflation_at(16), 1.6);
+  m.inflation = {{2, 1.5}};  // from (1, 1) to the first point
+  EXPECT_DOUBLE_EQ(m.inflation_at(1.5), 1.25);
+}
+
+TEST(ModelTerms, GivenSerialWorkRunsBeforeTheTasksAndWakesTheOthers) {
+  CostModel m = model(10);
+  m.spin_budget_ns = 200;
+  m.park_wake_ns = 50;
+  // 300 ns of the main thread's work (past the budget): p0 starts at 300, p1 is woken 50
+  // later.
+  const Schedule s = simulate(two_independent(), assign(2, {0, 1}), m, 300);
+  EXPECT_EQ(s.start_ns, (std::vector<std::uint64_t>{300, 350}));
+  EXPECT_EQ(s.makespan_ns, 1350u);
+  // 100 ns (within the budget): both at 100.
+  EXPECT_EQ(simulate(two_independent(), assign(2, {0, 1}), m, 100).start_ns,
+            (std::vector<std::uint64_t>{100, 100}));
+  // Given serial work replaces the host time.
+  StepGraph g = two_independent();
+  g.host_ns = 5000;
+  EXPECT_EQ(simulate(g, assign(2, {0, 1}), m, 100).makespan_ns, 1100u);
+  EXPECT_EQ(simulate(g, assign(2, {0, 1}), model(10)).makespan_ns, 6000u);
+}
+
+TEST(ModelTerms, NamesTheTermsAPredictionCharges) {
+  CostModel m = model(10);
+  EXPECT_EQ(model_terms(m, false, false), (std::vector<std::string>{"sync_latency", "per_byte"}));
+  m.park_wake_ns = 5000;
+  m.inflation = {{1, 1.0}, {2, 1.1}};
+  m.task_overhead_ns = 3;
+  EXPECT_EQ(model_terms(m, true, true),
+            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead", "park_wake",
+                                      "inflation", "serial_main_thread"}));
+  EXPECT_EQ(model_terms(CostModel::ideal(), false, true), (std::vector<std::string>{"host_time"}));
+}
+
+TEST(CalibrationFile, OlderFileWithoutTheNewKeysPredictsAsBefore) {
+  const CostModel old =
+      parse_calibration(R"({"sync_latency_ns": 80, "per_byte_ns": 0.04, "cpus": [0, 1]})", "old");
+  EXPECT_DOUBLE_EQ(old.sync_latency_ns, 80);
+  EXPECT_DOUBLE_EQ(old.park_wake_ns, 0);
+  EXPECT_TRUE(old.inflation.empty());
+  EXPECT_TRUE(old.reduction.empty());
+  EXPECT_EQ(model_terms(old, false, false), (std::vector<std::string>{"sync_latency", "per_byte"}));
+  // The long wait of producer_consumer costs the spin latency only.
+  EXPECT_EQ(simulate(producer_consumer(), assign(2, {0, 1}), old).start_ns[1], 1080u);
+}
+
+TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
+  Calibration c;
+  c.sync_latency_ns = 70;
+  c.per_byte_ns = 0.03;
+  c.park_wake_ns = 6500;
+  c.inflation = {{1, 1.0}, {2, 1.08}};
+  c.reduction = {{2, 180}};
+  const std::string text = calibration_json(c);
+  const nlohmann::json j = nlohmann::json::parse(text);
+  EXPECT_DOUBLE_EQ(j.at("spin_handoff_ns").get<double>(), 70);
+  EXPECT_DOUBLE_EQ(j.at("park_wake_ns").get<double>(), 6500);
+  EXPECT_DOUBLE_EQ(j.at("inflation").at(1).at("factor").get<double>(), 1.08);
+  EXPECT_EQ(j.at("inflation").at(1).at("threads").get<int>(), 2);
+  const CostModel m = parse_calibration(text, "new");
+  EXPECT_DOUBLE_EQ(m.sync_latency_ns, 70);
+  EXPECT_DOUBLE_EQ(m.park_wake_ns, 6500);
+  EXPECT_EQ(m.inflation, c.inflation);
+  EXPECT_EQ(m.reduction, c.reduction);
+}
+
+TEST(CalibrationFile, RejectsAnInflationListThatIsNotOne) {
+  for (const char* bad : {R"("inflation": 3)", R"("inflation": [{"threads": 2}])",
+                          R"("inflation": [{"threads": 2, "factor": 1.1}, {"threads": 1, "factor": 1}])",
+                          R"("inflation": [{"threads": 0, "factor": 1}])",
+                          R"("inflation": [{"threads": 2, "factor": -1}])"}) {
+    const std::string text =
+        std::string(R"({"sync_latency_ns": 80, "per_byte_ns": 0.04, )") + bad + "}";
+    try {
+      parse_calibration(text, "cal.json");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("cal.json"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("\"inflation\""), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(SerialWork, ReadsRecordPartitionAndPrepareOfALiveRunPerStep) {
+  const std::string path = ::testing::TempDir() + "tgraph_live_run.json";
+  {
+    std::ofstream f(path);
+    f << R"({"per_step": [{"record_ns": 10, "partition_ns": 20, "prepare_ns": 3},
+                          {"record_ns": 1, "partition_ns": 0, "prepare_ns": 2}]})";
+  }
+  EXPECT_EQ(load_serial_work(path), (std::vector<std::uint64_t>{33, 3}));
+  {
+    std::ofstream f(path);
+    f << R"({"per_step": [{"record_ns": 10}]})";
+  }
+  EXPECT_THROW(load_serial_work(path), InputError);
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace tgraph::partition
