@@ -36,6 +36,7 @@
 #include "pinning.hpp"
 #include "planned_executor.hpp"
 #include "sync.hpp"
+#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 
@@ -69,7 +70,15 @@ enum class Check : std::uint8_t {
 class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
  public:
   explicit OmpTasksExecutor(const ExecOptions& o)
-      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {}
+      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {
+    // LLVM's libomp 14 (Debian 12) aborts in its dependence bookkeeping on `taskwait depend`
+    // from GCC-built code ("Assertion failure at kmp_taskdeps.h(26): n >= 0", falling64 at 2
+    // threads, docs/replay.md): refused rather than crash the process.
+    if (o.omp_tasks.wait_depend && openmp_runtime() == "llvm")
+      throw UsageError(
+          "--omp-wait depend: LLVM's OpenMP runtime aborts on taskwait depend from this build "
+          "(libomp 14, kmp_taskdeps.h assertion); use --omp-wait all or --openmp-runtime gnu");
+  }
 
  private:
   std::unique_ptr<OmpPlan> build_plan(const ExecGraph& x) override {
