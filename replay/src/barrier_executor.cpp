@@ -239,15 +239,10 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
     for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
 
     char token = 0;  // TSan: libgomp's fork, barriers and join, seen as release/acquire
-    TGRAPH_TSAN_RELEASE(&token);
-#pragma omp parallel num_threads(k)
-    {
-      detail::tsan_region_entry();
+    const auto region = TGRAPH_OMP_REGION {  // omp_region.hpp
+      TGRAPH_TSAN_ACQUIRE(&detail::region_token);
       TGRAPH_TSAN_ACQUIRE(&token);
       const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
-#if defined(TGRAPH_TSAN_PLANT_RACE)
-      ++planted_race_;  // tests/replay/tsan_planted_race.cpp: unsynchronised on purpose
-#endif
       detail::bind_current_thread(pin, thread);  // once: libgomp keeps its team's threads
       ThreadCounters& tc = counters_[thread];
       if (fresh) {
@@ -315,7 +310,11 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
         }
       }
       TGRAPH_TSAN_RELEASE(&token);
-    }
+    };
+    TGRAPH_TSAN_RELEASE(&token);
+    TGRAPH_TSAN_RELEASE(&detail::region_token);
+#pragma omp parallel num_threads(k)
+    region();
     TGRAPH_TSAN_ACQUIRE(&token);
     counters_.copy_to(stats);
     stats.loop_iterations = iterations;
@@ -324,9 +323,6 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
 
   detail::ThreadSlots counters_;
   detail::MainThreadBinding main_binding_;
-#if defined(TGRAPH_TSAN_PLANT_RACE)
-  int planted_race_ = 0;
-#endif
 };
 
 }  // namespace

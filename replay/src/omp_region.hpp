@@ -1,25 +1,19 @@
 // SPDX-License-Identifier: MIT
-// Internal: what every `omp parallel` region of the OpenMP executors does first.
+// Internal: how the OpenMP executors write their `omp parallel` regions for ThreadSanitizer.
 #pragma once
-
-#include <omp.h>
-
-#include "tsan.hpp"
 
 namespace tgraph::replay::detail {
 
-/// Call first in an `omp parallel` region, before it reads any shared variable. Under
-/// ThreadSanitizer: the runtime (not instrumented) fills the region's block of shared
-/// variables after anything the caller could annotate before the region, so the primary
-/// thread releases from inside the region and, after a barrier, every thread acquires: the
-/// block's writes then happen before its reads. Nothing in other builds.
-inline void tsan_region_entry() {
-#if defined(__SANITIZE_THREAD__)
-  static char token = 0;
-  if (omp_get_thread_num() == 0) TGRAPH_TSAN_RELEASE(&token);
-#pragma omp barrier
-  TGRAPH_TSAN_ACQUIRE(&token);
-#endif
-}
+/// TSan: the address standing for the start of an OpenMP region. libgomp (not instrumented)
+/// hands the region's block of shared variables to its threads, and GCC may read that block
+/// anywhere in the outlined region, even before a first statement. So each executor's
+/// region is a lambda of its own, not inlined (TGRAPH_OMP_REGION), that the region only
+/// calls: the caller releases this token after building the lambda, the lambda acquires it
+/// first (the address of a global needs no read), and GCC's outlined function (`*._omp_fn.N`)
+/// holds nothing but libgomp's hand-off (see docs/replay.md, "Tests and ThreadSanitizer").
+inline char region_token = 0;
 
 }  // namespace tgraph::replay::detail
+
+/// Opens an executor's OpenMP region body: `const auto region = TGRAPH_OMP_REGION { ... };`
+#define TGRAPH_OMP_REGION [&]() __attribute__((noinline))

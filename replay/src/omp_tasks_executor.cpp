@@ -254,14 +254,9 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     iterations_.assign(g.loops.size(), 0);
     counters_.reset();
     const bool pin = options().pin;
-    TGRAPH_TSAN_RELEASE(&submit_token_);
-#pragma omp parallel num_threads(static_cast<int>(options().threads))
-    {
-      detail::tsan_region_entry();
+    const auto region = TGRAPH_OMP_REGION {  // omp_region.hpp
+      TGRAPH_TSAN_ACQUIRE(&detail::region_token);
       TGRAPH_TSAN_ACQUIRE(&submit_token_);
-#if defined(TGRAPH_TSAN_PLANT_RACE)
-      ++planted_race_;  // tests/replay/tsan_planted_race.cpp: unsynchronised on purpose
-#endif
       // Once per thread and slot: the runtime keeps its team's threads from region to region.
       detail::bind_current_thread(pin, static_cast<std::uint32_t>(omp_get_thread_num()));
 #pragma omp single
@@ -273,7 +268,11 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
         }
       }  // the implicit barrier waits for every task
       TGRAPH_TSAN_RELEASE(&join_token_);
-    }
+    };
+    TGRAPH_TSAN_RELEASE(&submit_token_);
+    TGRAPH_TSAN_RELEASE(&detail::region_token);
+#pragma omp parallel num_threads(static_cast<int>(options().threads))
+    region();
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
     counters_.copy_to(stats);
@@ -293,9 +292,6 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
   std::mutex error_mutex_;
   std::exception_ptr error_;
   detail::MainThreadBinding main_binding_;
-#if defined(TGRAPH_TSAN_PLANT_RACE)
-  int planted_race_ = 0;
-#endif
   char submit_token_ = 0;  // TSan: address standing for libgomp's task creation hand-off
   char join_token_ = 0;    // TSan: address standing for taskwait and the region's end
 };
