@@ -1,10 +1,16 @@
 // SPDX-License-Identifier: MIT
 // `tgraph replay` (a trace's steps on real threads, synthetic bodies: measure::replay_trace)
 // and `tgraph run` (live: the engine's own bodies through the executor: measure::run_live).
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "flags.hpp"
@@ -31,6 +37,46 @@ std::int64_t timeout_ms(double seconds) {
                         : std::max<std::int64_t>(1, static_cast<std::int64_t>(seconds * 1000.0));
 }
 
+// `--openmp-runtime gnu|llvm`: the OpenMP runtime the barrier and omp-tasks policies run on.
+// tgraph is built against GCC's libgomp; for LLVM's libomp the process starts again with
+// libomp preloaded (its libgomp-compatible entry points then serve every OpenMP construct of
+// the process; one runtime per process, docs/replay.md). Returns only when `want` runs.
+void use_openmp_runtime(const std::string& want) {
+  if (want != "gnu" && want != "llvm")
+    throw UsageError("--openmp-runtime: expected gnu or llvm, got '" + want + "'");
+  if (want == tr::openmp_runtime()) return;
+  if (want == "gnu")
+    throw UsageError(
+        "--openmp-runtime gnu: this process was started with LLVM's OpenMP runtime preloaded "
+        "(LD_PRELOAD); start it without");
+  const std::string lib(tr::llvm_openmp_library());
+  if (lib.empty() || access(lib.c_str(), R_OK) != 0)
+    throw UsageError("--openmp-runtime llvm: LLVM's OpenMP runtime is not installed (Debian "
+                     "libomp-dev)" + (lib.empty() ? std::string() : ": no " + lib));
+  if (std::getenv("TGRAPH_OPENMP_RESTARTED") != nullptr)
+    throw Failure("--openmp-runtime llvm: preloading " + lib + " did not replace libgomp");
+  // The same command line again, from /proc (NUL-separated arguments).
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string line((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::string> args;
+  for (std::size_t b = 0; b < line.size();) {
+    const std::size_t e = line.find('\0', b);
+    args.push_back(line.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  const char* old = std::getenv("LD_PRELOAD");
+  const std::string preload = old != nullptr && *old != '\0' ? lib + ":" + old : lib;
+  setenv("LD_PRELOAD", preload.c_str(), 1);
+  setenv("TGRAPH_OPENMP_RESTARTED", "1", 1);
+  std::cout.flush();
+  execv("/proc/self/exe", argv.data());
+  throw Failure("--openmp-runtime llvm: could not restart tgraph with " + lib);
+}
+
 // The flags `replay` and `run` share, bound to `exec`.
 void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
   exec.threads = default_threads();
@@ -49,12 +95,34 @@ void add_exec_flags(CLI::App* cmd, Args& a, tr::ExecOptions& exec) {
   cmd->add_option_function<std::string>(
       "--barrier-rule",
       [&exec](const std::string& r) { exec.barrier.rule = barrier_rule_flag(r, "--barrier-rule"); },
-      "Barrier policy's phases: level (default; one per dependency level) or operation (one "
-      "per run of same-kind tasks in program order, the paper's rule)");
+      "Barrier policy's phases: omp-for (default; an omp for per operation, static schedule, "
+      "nowait where no other thread's result is read), level (one per dependency level) or "
+      "operation (one per run of same-kind tasks in program order, the paper's rule)");
+  cmd->add_option_function<std::string>(
+      "--openmp-runtime", [](const std::string& r) { use_openmp_runtime(r); },
+      "OpenMP runtime of the barrier and omp-tasks policies: gnu (default; GCC's libgomp) or "
+      "llvm (LLVM's libomp, preloaded into a restarted process)");
+  cmd->add_option_function<std::string>(
+      "--omp-wait",
+      [&exec](const std::string& v) {
+        if (v != "all" && v != "depend")
+          throw UsageError("--omp-wait: expected all or depend, got '" + v + "'");
+        exec.omp_tasks.wait_depend = v == "depend";
+      },
+      "omp-tasks: after each loop iteration, wait for every task (all: taskwait) or for the "
+      "break task only (depend: OpenMP 5.0 taskwait depend)");
   cmd->add_option("--starpu-sched", exec.starpu.sched,
                   "StarPU scheduler of --policy starpu (default lws; eager, ws, prio, dmda...)");
+  cmd->add_option_function<std::string>(
+      "--pin",
+      [&exec](const std::string& v) {
+        if (v != "on" && v != "off")
+          throw UsageError("--pin: expected on or off, got '" + v + "'");
+        exec.pin = v == "on";
+      },
+      "Bind thread p of every policy to the p-th core, once per run: on (default) or off");
   cmd->add_flag_callback(
-      "--no-pin", [&exec] { exec.pin = false; }, "Do not bind threads to cores");
+      "--no-pin", [&exec] { exec.pin = false; }, "Same as --pin off");
   cmd->add_flag_callback(
       "--no-combine", [&exec] { exec.partition.combine = false; },
       "Partition policy: run every reducer on its own processor (default: a dot product's "

@@ -19,11 +19,11 @@ inline replay::Policy policy_flag(std::string_view name, std::string_view flag) 
                    ": expected partition, worksteal, barrier, starpu, omp-tasks or sequential");
 }
 
-/// `--barrier-rule level|operation`; UsageError naming the flag otherwise.
+/// `--barrier-rule omp-for|level|operation`; UsageError naming the flag otherwise.
 inline replay::BarrierRule barrier_rule_flag(std::string_view name, std::string_view flag) {
   if (const auto r = replay::parse_barrier_rule(name)) return *r;
-  throw UsageError(std::string(flag) + ": expected level or operation, got '" + std::string(name) +
-                   "'");
+  throw UsageError(std::string(flag) + ": expected omp-for, level or operation, got '" +
+                   std::string(name) + "'");
 }
 
 /// `--method` (a strategy, or a baseline policy such as worksteal; "partition" stands for

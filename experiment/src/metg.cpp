@@ -323,6 +323,21 @@ MetgResult run_metg(const MetgOptions& options, Progress& progress) {
     std::vector<MetgPoint> points;
     int below = 0;  // consecutive points under 50 %: the run's sweep stops after two
   };
+  // A policy that cannot run some of the thread counts (StarPU beyond its build's CPU
+  // workers) runs the others; the skipped ones are named once, here and in the results.
+  for (const std::string& name : res.policies) {
+    const std::optional<std::uint32_t> top = tr::max_threads(*tr::parse_policy(name));
+    std::vector<std::uint32_t> over;
+    for (std::uint32_t k : res.threads)
+      if (top && k > *top) over.push_back(k);
+    if (over.empty()) continue;
+    std::string line = name + " skipped at";
+    for (std::uint32_t k : over) line += " " + std::to_string(k);
+    line += " threads: this " + name + " build has at most " + std::to_string(*top) +
+            " CPU workers";
+    progress.note(line);
+    res.skipped.push_back(std::move(line));
+  }
   progress.set_total(std::size(kShapes));
   for (MetgShape shape : kShapes) {
     const std::string shape_name(to_string(shape));
@@ -330,7 +345,9 @@ MetgResult run_metg(const MetgOptions& options, Progress& progress) {
     for (const std::string& name : res.policies) {
       const tr::Policy policy = *tr::parse_policy(name);
       if (policy == tr::Policy::kSequential) continue;  // the reference, timed at every point
-      for (std::uint32_t k : res.threads) runs.push_back({policy, name, k, {}, 0});
+      const std::optional<std::uint32_t> top = tr::max_threads(policy);
+      for (std::uint32_t k : res.threads)
+        if (!top || k <= *top) runs.push_back({policy, name, k, {}, 0});
     }
     progress.begin(shape_name);
     std::vector<MetgPoint> reference;
@@ -416,6 +433,7 @@ std::string metg_json(const MetgResult& res, int indent) {
   j["shapes"] = res.shapes;
   j["metg"] = nlohmann::json::array();
   j["unreached"] = nlohmann::json::array();
+  j["skipped"] = res.skipped;
   for (const MetgRecord& r : res.records) {
     nlohmann::json o = {{"policy", r.policy}, {"shape", r.shape}, {"threads", r.threads}};
     if (r.metg_ns) {
@@ -468,6 +486,7 @@ std::string metg_text(const MetgResult& res) {
       }
       s << "\n";
     }
+  for (const std::string& line : res.skipped) s << line << "\n";
   s << "files in " << res.options.out_dir << ":";
   for (const std::string& f : res.files) s << " " << f;
   s << "\n";

@@ -93,6 +93,14 @@ std::string to_json(const ReplayResult& r) {
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
   j["warnings"] = r.warnings;
+  // The OpenMP policies: which runtime ran them; barrier: barrier-separated phases per step
+  // (the barriers each thread passed, averaged over the replayed steps).
+  const bool openmp = r.policy == tr::Policy::kOmpTasks || r.policy == tr::Policy::kBarrier;
+  j["openmp_runtime"] = openmp ? json(std::string(tr::openmp_runtime())) : json(nullptr);
+  j["phases_per_step"] =
+      r.policy == tr::Policy::kBarrier && !r.steps.empty()
+          ? json(static_cast<double>(r.waits()) / static_cast<double>(r.threads * r.steps.size()))
+          : json(nullptr);
   const auto pred = r.predicted_makespan_ns();
   j["predicted_makespan_ns"] = pred ? json(*pred) : json(nullptr);
   // Ratio of measured to predicted, both without plan builds: the sum over steps of the

@@ -1,11 +1,18 @@
 // SPDX-License-Identifier: MIT
-// Barrier baseline (the paper's first attempt): parallel phases (OpenMP `omp for`) with a
-// barrier after each. BarrierRule::kLevel (default): one phase per dependency level of the
-// step's dataflow graph within each loop region, so the barrier is what orders dependent
-// tasks whatever the program order. BarrierRule::kOperation: one phase per run of
-// consecutive tasks of the same kind in program order, cut where a task depends on a task of
-// the same run. Either way CW writers write per-writer temporaries and a reducer phase adds
-// them after the writers.
+// Barrier baseline (the paper's first attempt): parallel phases (OpenMP `omp for`, static
+// schedule) with barriers between them. BarrierRule::kOmpFor (default): as an OpenMP user
+// writes a CG solver, one `omp for` per vector operation (a run of consecutive tasks of one
+// kind in program order, cut where a task depends on the run) with a static schedule, so
+// that the i-th object of every operation stays on one thread, and `nowait` wherever no task
+// before the next barrier depends on a task of another thread since the last one (an
+// operation that reads only its own objects' results of the previous one). The dot products'
+// writers are one `omp for` whose reducer (the `reduction(+:)` combine) follows a barrier.
+// BarrierRule::kLevel: one phase per dependency level of the step's dataflow graph within
+// each loop region, a barrier after each. BarrierRule::kOperation (the paper's): the
+// operations of kOmpFor with a barrier after each. Either way CW writers write the
+// lowering's temporaries and a reducer phase adds them after the writers. Each thread runs
+// the block of a phase that OpenMP's static schedule gives it (computed here, the same for
+// every OpenMP runtime), then passes the phase's barrier if it has one.
 #include <omp.h>
 
 #include <algorithm>
@@ -18,6 +25,8 @@
 #include <vector>
 
 #include "common.hpp"
+#include "omp_region.hpp"
+#include "pinning.hpp"
 #include "planned_executor.hpp"
 #include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
@@ -30,11 +39,26 @@ struct Phase {
   std::vector<TaskId> tasks;
   LoopId loop_end = kNoLoop;  // the phase ending a loop body: decide after it
   std::uint32_t jump = 0;     // first phase of that body
+  bool barrier = true;        // a barrier after it (false: `nowait`)
 };
 
 struct BarrierPlan {
   std::vector<Phase> phases;
 };
+
+/// First index of thread `p`'s block of an `omp for schedule(static)` of `n` iterations on
+/// `k` threads (the first n % k threads take one more); block p is [begin(p), begin(p + 1)).
+std::size_t static_begin(std::size_t n, std::size_t k, std::size_t p) {
+  const std::size_t q = n / k, r = n % k;
+  return p * q + std::min(p, r);
+}
+
+/// The thread whose static block holds iteration i of n.
+std::uint32_t static_thread(std::size_t i, std::size_t n, std::size_t k) {
+  const std::size_t q = n / k, r = n % k;
+  if (i < r * (q + 1)) return static_cast<std::uint32_t>(i / (q + 1));
+  return static_cast<std::uint32_t>(r + (i - r * (q + 1)) / q);
+}
 
 class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
  public:
@@ -44,12 +68,47 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
  private:
   std::unique_ptr<BarrierPlan> build_plan(const ExecGraph& x) override {
     switch (options().barrier.rule) {
+      case BarrierRule::kOmpFor:
+        return drop_barriers(x, build_by_operation(x));
       case BarrierRule::kLevel:
         return build_by_level(x);
       case BarrierRule::kOperation:
         return build_by_operation(x);
     }
-    return build_by_level(x);
+    return build_by_operation(x);
+  }
+
+  // `nowait`: keeps the barrier before a phase only where one of its tasks depends on a task
+  // that another thread ran since the last barrier (static blocks: the thread of each task
+  // is known). The phase ending a loop body keeps its barrier (every thread reads the
+  // decision after it; the next iteration's tasks then depend on nothing unsynchronised),
+  // and so does the last phase.
+  std::unique_ptr<BarrierPlan> drop_barriers(const ExecGraph& x, std::unique_ptr<BarrierPlan> plan) {
+    const StepGraph& g = x.graph;
+    const auto n = static_cast<TaskId>(g.tasks.size());
+    const std::size_t k = options().threads;
+    const detail::Csr pred = detail::build_csr(n, g.edges, true);
+    constexpr std::uint32_t kNever = UINT32_MAX;
+    std::vector<std::uint32_t> thread(n, 0), segment(n, kNever);
+    std::uint32_t seg = 0;
+    auto& phases = plan->phases;
+    for (std::size_t ph = 0; ph < phases.size(); ++ph) {
+      Phase& phase = phases[ph];
+      const std::size_t size = phase.tasks.size();
+      for (std::size_t i = 0; i < size; ++i) thread[phase.tasks[i]] = static_thread(i, size, k);
+      bool cross = false;
+      for (TaskId t : phase.tasks)
+        for (auto i = pred.begin[t]; i < pred.begin[t + 1] && !cross; ++i)
+          cross = segment[pred.ids[i]] == seg && thread[pred.ids[i]] != thread[t];
+      if (cross && ph > 0) {
+        phases[ph - 1].barrier = true;
+        ++seg;
+      }
+      for (TaskId t : phase.tasks) segment[t] = seg;
+      phase.barrier = phase.loop_end != kNoLoop || ph + 1 == phases.size();
+      if (phase.barrier) ++seg;
+    }
+    return plan;
   }
 
   // Phases by dependency level. The tasks split into loop regions (runs of tasks of one loop
@@ -180,12 +239,11 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
     for (const Loop& l : g.loops) is_break[l.last - 1] = 1;
 
     char token = 0;  // TSan: libgomp's fork, barriers and join, seen as release/acquire
-    TGRAPH_TSAN_RELEASE(&token);
-#pragma omp parallel num_threads(k)
-    {
+    const auto region = TGRAPH_OMP_REGION {  // omp_region.hpp
+      TGRAPH_TSAN_ACQUIRE(&detail::region_token);
       TGRAPH_TSAN_ACQUIRE(&token);
       const auto thread = static_cast<std::uint32_t>(omp_get_thread_num());
-      if (pin) detail::pin_current_thread(thread);
+      detail::bind_current_thread(pin, thread);  // once: libgomp keeps its team's threads
       ThreadCounters& tc = counters_[thread];
       if (fresh) {
 #pragma omp for schedule(static) nowait
@@ -199,10 +257,13 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
       std::uint32_t iter = 0;
       while (ph < plan.phases.size()) {
         const Phase& phase = plan.phases[ph];
-        const auto size = static_cast<std::int64_t>(phase.tasks.size());
-#pragma omp for schedule(static) nowait
-        for (std::int64_t i = 0; i < size; ++i) {
-          const TaskId t = phase.tasks[static_cast<std::size_t>(i)];
+        // This thread's block of the phase under a static schedule (`omp for
+        // schedule(static) nowait`, computed here so that every runtime splits it alike).
+        const std::size_t size = phase.tasks.size();
+        const std::size_t end = static_begin(size, static_cast<std::size_t>(k), thread + 1);
+        for (std::size_t i = static_begin(size, static_cast<std::size_t>(k), thread); i < end;
+             ++i) {
+          const TaskId t = phase.tasks[i];
           // relaxed: a hint to skip work once a task failed; the barriers order the rest.
           const bool aborted = abort.load(std::memory_order_relaxed);
           if (!aborted) {
@@ -233,11 +294,13 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
             if (stop) iterations[l] = iter + 1;
           }
         }
-        TGRAPH_TSAN_RELEASE(&token);
+        if (phase.barrier) {
+          TGRAPH_TSAN_RELEASE(&token);
 #pragma omp barrier
-        TGRAPH_TSAN_ACQUIRE(&token);
+          TGRAPH_TSAN_ACQUIRE(&token);
+          ++tc.waits;
+        }
         // After the barrier the phase's writes (and the loop decision) are visible to all.
-        ++tc.waits;
         if (phase.loop_end != kNoLoop && decision[phase.loop_end][iter % 2] == 0) {
           ++iter;
           ph = phase.jump;
@@ -247,7 +310,11 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
         }
       }
       TGRAPH_TSAN_RELEASE(&token);
-    }
+    };
+    TGRAPH_TSAN_RELEASE(&token);
+    TGRAPH_TSAN_RELEASE(&detail::region_token);
+#pragma omp parallel num_threads(k)
+    region();
     TGRAPH_TSAN_ACQUIRE(&token);
     counters_.copy_to(stats);
     stats.loop_iterations = iterations;

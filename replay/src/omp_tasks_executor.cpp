@@ -32,8 +32,11 @@
 #include <vector>
 
 #include "common.hpp"
+#include "omp_region.hpp"
+#include "pinning.hpp"
 #include "planned_executor.hpp"
 #include "sync.hpp"
+#include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 
@@ -52,6 +55,9 @@ struct OmpPlan {
   std::vector<TaskDeps> deps;
   std::vector<std::uint32_t> ids;
   std::unique_ptr<char[]> object;  // the dependence objects (their addresses)
+  /// Per loop, an object its break task writes (out or inout): `taskwait depend(in:)` on it
+  /// waits for the break and what it depends on.
+  std::vector<std::uint32_t> break_object;
 };
 
 /// What the break task of a loop iteration does after its body.
@@ -64,7 +70,15 @@ enum class Check : std::uint8_t {
 class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
  public:
   explicit OmpTasksExecutor(const ExecOptions& o)
-      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {}
+      : PlannedExecutor(Policy::kOmpTasks, o), counters_(o.threads) {
+    // LLVM's libomp 14 (Debian 12) aborts in its dependence bookkeeping on `taskwait depend`
+    // from GCC-built code ("Assertion failure at kmp_taskdeps.h(26): n >= 0", falling64 at 2
+    // threads, docs/replay.md): refused rather than crash the process.
+    if (o.omp_tasks.wait_depend && openmp_runtime() == "llvm")
+      throw UsageError(
+          "--omp-wait depend: LLVM's OpenMP runtime aborts on taskwait depend from this build "
+          "(libomp 14, kmp_taskdeps.h assertion); use --omp-wait all or --openmp-runtime gnu");
+  }
 
  private:
   std::unique_ptr<OmpPlan> build_plan(const ExecGraph& x) override {
@@ -116,6 +130,11 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
       d.inout = static_cast<std::uint16_t>(by_mode[2].size());
       d.mutex = static_cast<std::uint16_t>(by_mode[3].size());
       for (const auto& v : by_mode) plan->ids.insert(plan->ids.end(), v.begin(), v.end());
+    }
+    for (const Loop& l : g.loops) {
+      // A break task writes an object: its own W/RW data, or its private inout object.
+      const TaskDeps& d = plan->deps[l.last - 1];
+      plan->break_object.push_back(plan->ids[d.first + d.in]);
     }
     plan->object = std::make_unique<char[]>(std::max<std::uint32_t>(1, plan->objects));
     return plan;
@@ -179,6 +198,19 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     run_instance(t, it, check, count);
   }
 
+  /// After submitting an iteration of loop `l`: waits for its break task (OpenMP 5.0
+  /// `taskwait depend`) or for every task submitted so far (`taskwait`).
+  void wait_iteration(LoopId l) {
+    if (options().omp_tasks.wait_depend) {
+      char* obj = step_.plan->object.get() + step_.plan->break_object[l];
+#pragma omp taskwait depend(in : obj[0])
+      TGRAPH_TSAN_ACQUIRE(obj);  // the break task's release of its objects
+    } else {
+#pragma omp taskwait
+      TGRAPH_TSAN_ACQUIRE(&join_token_);
+    }
+  }
+
   /// Submits the whole step from the `single` thread; returns early on failure.
   void submit_step(const ExecGraph& x, Workload& w) {
     const StepGraph& g = x.graph;
@@ -193,8 +225,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
               for (TaskId u = loop.first; u < loop.last; ++u)
                 submit(u, it, u + 1 == loop.last ? Check::kUnrolled : Check::kNone, count);
               if (options().omp_tasks.iteration_wait) {
-#pragma omp taskwait
-                TGRAPH_TSAN_ACQUIRE(&join_token_);
+                wait_iteration(l);
                 if (failed_.load(std::memory_order_relaxed)) return;  // relaxed: see fail()
               }
             }
@@ -204,8 +235,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
               decision_ = -1;
               for (TaskId u = loop.first; u < loop.last; ++u)
                 submit(u, it, u + 1 == loop.last ? Check::kDecide : Check::kNone, 0);
-#pragma omp taskwait
-              TGRAPH_TSAN_ACQUIRE(&join_token_);
+              wait_iteration(l);
               iterations_[l] = it + 1;
               if (decision_ != 0) break;  // leave, or the break task did not run (failure)
             }
@@ -224,11 +254,11 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     iterations_.assign(g.loops.size(), 0);
     counters_.reset();
     const bool pin = options().pin;
-    TGRAPH_TSAN_RELEASE(&submit_token_);
-#pragma omp parallel num_threads(static_cast<int>(options().threads))
-    {
+    const auto region = TGRAPH_OMP_REGION {  // omp_region.hpp
+      TGRAPH_TSAN_ACQUIRE(&detail::region_token);
       TGRAPH_TSAN_ACQUIRE(&submit_token_);
-      if (pin) detail::pin_current_thread(static_cast<std::uint32_t>(omp_get_thread_num()));
+      // Once per thread and slot: the runtime keeps its team's threads from region to region.
+      detail::bind_current_thread(pin, static_cast<std::uint32_t>(omp_get_thread_num()));
 #pragma omp single
       {
         try {
@@ -238,7 +268,11 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
         }
       }  // the implicit barrier waits for every task
       TGRAPH_TSAN_RELEASE(&join_token_);
-    }
+    };
+    TGRAPH_TSAN_RELEASE(&submit_token_);
+    TGRAPH_TSAN_RELEASE(&detail::region_token);
+#pragma omp parallel num_threads(static_cast<int>(options().threads))
+    region();
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
     counters_.copy_to(stats);

@@ -6,6 +6,7 @@
 #include <thread>
 #include <vector>
 
+#include "pinning.hpp"
 #include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
 
@@ -54,6 +55,9 @@ Topology& topology() {
   return t;
 }
 
+/// The calling thread's binding by the rule: the slot whose PU it is bound to, or -1.
+thread_local std::int64_t t_bound_slot = -1;
+
 }  // namespace
 
 std::mutex& hwloc_mutex() {
@@ -63,10 +67,32 @@ std::mutex& hwloc_mutex() {
 
 bool pin_current_thread(std::uint32_t p) {
   Topology& t = topology();
+  t_bound_slot = -1;
   if (!t.topo || t.order.empty()) return false;
-  std::lock_guard<std::mutex> lock(hwloc_mutex());  // hwloc calls are rare; keep them serial
+  // No lock: binding reads the loaded topology only, which hwloc allows from any thread.
   hwloc_obj_t pu = t.order[p % t.order.size()];
-  return hwloc_set_cpubind(t.topo, pu->cpuset, HWLOC_CPUBIND_THREAD) == 0;
+  if (hwloc_set_cpubind(t.topo, pu->cpuset, HWLOC_CPUBIND_THREAD) != 0) return false;
+  t_bound_slot = p;
+  return true;
+}
+
+bool bind_current_thread(bool pin, std::uint32_t slot) {
+  if (pin) return t_bound_slot == static_cast<std::int64_t>(slot) || pin_current_thread(slot);
+  if (t_bound_slot < 0) return true;
+  Topology& t = topology();
+  t_bound_slot = -1;
+  if (!t.topo) return false;
+  // Back to every PU the process may use (a binding an earlier executor left).
+  return hwloc_set_cpubind(t.topo, hwloc_topology_get_allowed_cpuset(t.topo),
+                           HWLOC_CPUBIND_THREAD) == 0;
+}
+
+std::int64_t bound_slot() { return t_bound_slot; }
+
+int pinned_pu_logical(std::uint32_t p) {
+  Topology& t = topology();
+  if (!t.topo || t.order.empty()) return -1;
+  return static_cast<int>(t.order[p % t.order.size()]->logical_index);
 }
 
 void save_binding(SavedBinding& s) {
@@ -84,6 +110,7 @@ void save_binding(SavedBinding& s) {
 void restore_binding(SavedBinding& s) {
   Topology& t = topology();
   if (!t.topo || !s.set) return;
+  t_bound_slot = -1;  // whatever it was before, it is no longer bound by the rule
   std::lock_guard<std::mutex> lock(hwloc_mutex());
   hwloc_set_cpubind(t.topo, static_cast<hwloc_bitmap_t>(s.set), HWLOC_CPUBIND_THREAD);
 }

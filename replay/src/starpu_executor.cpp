@@ -33,7 +33,9 @@
 #include <vector>
 
 #include "common.hpp"
+#include "pinning.hpp"
 #include "planned_executor.hpp"
+#include "sync.hpp"
 #include "tsan.hpp"
 
 namespace tgraph::replay {
@@ -182,9 +184,16 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     conf.catch_signals = 0;  // leave SIGINT/SIGSEGV to the application
     conf.calibrate = 0;
     conf.bus_calibrate = 0;
-    // StarPU binds worker i to core i; with more workers than cores (or --no-pin) binding
-    // would stack workers on one core, so leave them to the OS.
-    const bool bind = o.pin && o.threads <= std::thread::hardware_concurrency();
+    // Pinning (ExecOptions::pin): the rule of every policy, worker i on slot i's PU (StarPU
+    // names PUs by hwloc's logical index); the submitting thread shares slot 0's core (bound in
+    // run()), so K workers and the submitter take K cores, as the calling thread of the other
+    // policies is their thread 0. StarPU cannot run tasks on the submitting thread itself.
+    const bool bind = o.pin && detail::pinned_pu_logical(0) >= 0;
+    if (bind) {
+      conf.use_explicit_workers_bindid = 1;
+      for (std::uint32_t i = 0; i < o.threads; ++i)
+        conf.workers_bindid[i] = static_cast<unsigned>(detail::pinned_pu_logical(i));
+    }
     int rc = 0;
     {
       std::optional<ScopedEnv> nobind;
@@ -391,6 +400,8 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    if (options().pin) main_binding_.save_once();  // restored when the executor is destroyed
+    detail::bind_current_thread(options().pin, 0);  // the submitter on slot 0's core
     step_ = {&plan, &x, &w};
     instances_.clear();
     error_ = nullptr;
@@ -417,6 +428,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
 
   std::shared_ptr<Registry> registry_;
   detail::ThreadSlots counters_;
+  detail::MainThreadBinding main_binding_;
   starpu_codelet codelet_{};
   detail::StepContext<StarpuPlan> step_;
   std::deque<Instance> instances_;  // this step's instances (stable addresses)
@@ -432,6 +444,11 @@ std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o) {
   return std::make_unique<StarpuExecutor>(o);
 }
 
+std::optional<std::uint32_t> max_threads(Policy policy) {
+  if (policy == Policy::kStarpu) return static_cast<std::uint32_t>(STARPU_MAXCPUS);
+  return std::nullopt;
+}
+
 }  // namespace tgraph::replay
 
 #else  // !TGRAPH_HAVE_STARPU
@@ -444,6 +461,8 @@ std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o) {
       "--policy starpu: tgraph was built without StarPU (install Debian's libstarpu-dev, "
       "pkg-config starpu-1.3, and configure again)");
 }
+
+std::optional<std::uint32_t> max_threads(Policy /*policy*/) { return std::nullopt; }
 
 }  // namespace tgraph::replay
 

@@ -8,9 +8,14 @@
 // predecessors + loop-carried predecessors + the break of iteration i - 1 (the gate) +
 // (v, i - 1) itself. A completed instance decrements its successors and spawns those that
 // reach zero.
+//
+// Pinning (ExecOptions::pin): as oneTBB's users pin, through a task_scheduler_observer on the
+// executor's arena: a thread entering the arena binds itself to its arena slot's core (the
+// rule of every policy, pinning.hpp), once for as long as it keeps that slot.
 #include <oneapi/tbb/global_control.h>
 #include <oneapi/tbb/task_arena.h>
 #include <oneapi/tbb/task_group.h>
+#include <oneapi/tbb/task_scheduler_observer.h>
 
 #include <algorithm>
 #include <atomic>
@@ -18,7 +23,9 @@
 #include <vector>
 
 #include "common.hpp"
+#include "pinning.hpp"
 #include "planned_executor.hpp"
+#include "sync.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tsan.hpp"
 #include "worksteal_task.hpp"
@@ -47,12 +54,32 @@ struct WsPlan {
   std::unique_ptr<std::atomic<std::uint32_t>[]> count0;  // non-loop tasks
 };
 
+/// Binds each thread that enters the arena to its slot's core (or, without pinning, undoes
+/// a binding an earlier pinned executor left on oneTBB's shared worker threads).
+class PinningObserver final : public tbb::task_scheduler_observer {
+ public:
+  PinningObserver(tbb::task_arena& arena, bool pin, std::uint32_t threads)
+      : tbb::task_scheduler_observer(arena), pin_(pin), threads_(threads) {
+    observe(true);
+  }
+  ~PinningObserver() override { observe(false); }
+  void on_scheduler_entry(bool /*worker*/) override {
+    const int idx = tbb::this_task_arena::current_thread_index();
+    detail::bind_current_thread(pin_, static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % threads_);
+  }
+
+ private:
+  bool pin_;
+  std::uint32_t threads_;
+};
+
 class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
  public:
   explicit WorkstealExecutor(const ExecOptions& o)
       : PlannedExecutor(Policy::kWorksteal, o),
         control_(tbb::global_control::max_allowed_parallelism, o.threads),
         arena_(static_cast<int>(o.threads)),
+        pinning_(arena_, o.pin, o.threads),
         counters_(o.threads) {}
 
  private:
@@ -206,6 +233,7 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
            ExecStepStats& stats) override {
     const StepGraph& g = x.graph;
     if (fresh) detail::touch_all(g, w);  // no affinity: touched by the calling thread
+    if (options().pin) main_binding_.save_once();  // the calling thread takes slot 0's core
     step_ = {&plan, &x, &w};
     iterations_.assign(g.loops.size(), 0);
     counters_.reset();
@@ -241,8 +269,10 @@ class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
     if (error) std::rethrow_exception(error);
   }
 
+  detail::MainThreadBinding main_binding_;  // restored after the observer is gone
   tbb::global_control control_;
   tbb::task_arena arena_;
+  PinningObserver pinning_;
   detail::ThreadSlots counters_;
   detail::StepContext<WsPlan> step_;
   tbb::task_group* tg_ = nullptr;

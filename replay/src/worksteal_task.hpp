@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Internal: the functor oneTBB runs for one task instance. Its call operator lives in its
-// own file so that ThreadSanitizer can be told (by file) that reading the functor's fields,
-// which TBB hands from the spawning thread through its uninstrumented deques, is not a race.
+// own file, not instrumented by ThreadSanitizer: reading the functor's fields, which TBB hands
+// from the spawning thread through its uninstrumented deques, is not a race.
 #pragma once
 
 #include <cstdint>

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
-// The barrier policy's phases: one per dependency level (default) or one per operation.
+// The barrier policy's phases: an omp for per operation with nowait where it is safe
+// (default), one per dependency level, or one per operation with a barrier after each.
 #include <gtest/gtest.h>
 
+#include "random_graph.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/synthetic.hpp"
@@ -66,10 +68,87 @@ TEST(BarrierRule, TwoInterleavedChainsTakeOnePhasePerLevelNotPerTask) {
   EXPECT_EQ(phases(g, BarrierRule::kOperation), 10u);  // a0 | b0 | a1 | b1 ...
 }
 
+/// A CG-like sequence over `n` objects: axpy_i (RW x_i), scale_i (RW x_i), dot_i (R x_i, CW
+/// s), then use_i (R s, RW y_i): each operation reads only its own object's results of the
+/// one before, but for the dot product's sum.
+StepGraph cg_like(int n) {
+  StepGraph g;
+  const KindId axpy = g.intern_kind("axpy"), scale = g.intern_kind("scale"),
+               dot = g.intern_kind("dot"), use = g.intern_kind("use");
+  for (int i = 0; i < n; ++i) g.objects.push_back({"o" + std::to_string(i)});
+  for (int i = 0; i < n; ++i) g.data.push_back({"x" + std::to_string(i), static_cast<ObjectId>(i), 64});
+  for (int i = 0; i < n; ++i) g.data.push_back({"y" + std::to_string(i), static_cast<ObjectId>(i), 64});
+  const auto s = static_cast<DatumId>(g.data.size());
+  g.data.push_back({"s", kNoObject, 8});
+  StableKey key = 1;
+  const auto x = [](int i) { return static_cast<DatumId>(i); };
+  for (int i = 0; i < n; ++i)
+    g.add_task(axpy, static_cast<ObjectId>(i), std::vector<Access>{{x(i), AccessMode::RW}}, 0, key++);
+  for (int i = 0; i < n; ++i)
+    g.add_task(scale, static_cast<ObjectId>(i), std::vector<Access>{{x(i), AccessMode::RW}}, 0, key++);
+  for (int i = 0; i < n; ++i)
+    g.add_task(dot, static_cast<ObjectId>(i),
+               std::vector<Access>{{x(i), AccessMode::R}, {s, AccessMode::CW}}, 0, key++);
+  for (int i = 0; i < n; ++i)
+    g.add_task(use, static_cast<ObjectId>(i),
+               std::vector<Access>{{s, AccessMode::R}, {static_cast<DatumId>(n + i), AccessMode::RW}},
+               0, key++);
+  g.derive_edges();
+  return g;
+}
+
+TEST(BarrierRule, OmpForDropsTheBarriersBetweenOperationsOnTheSameObjects) {
+  const StepGraph g = cg_like(4);
+  // axpy, scale and dot on each thread's own objects without a barrier; one before the
+  // reducer (every thread's writers) and one before use (it reads the sum); one at the end.
+  EXPECT_EQ(phases(g, BarrierRule::kOmpFor), 3u);
+  EXPECT_EQ(phases(g, BarrierRule::kOperation), 5u);  // axpy | scale | dot | reduce | use
+  EXPECT_EQ(phases(g, BarrierRule::kLevel), 5u);
+  // The sums are the sequential run's under every rule.
+  for (BarrierRule rule : {BarrierRule::kOmpFor, BarrierRule::kLevel, BarrierRule::kOperation}) {
+    ExecOptions o;
+    o.threads = 2;
+    o.pin = false;
+    o.barrier.rule = rule;
+    auto ex = make_executor(Policy::kBarrier, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    ex->run_step(g, nullptr, w);
+    EXPECT_EQ(test::final_state(w, g), test::sequential_state(g, 1)) << to_string(rule);
+  }
+}
+
+TEST(BarrierRule, OmpForKeepsABarrierWhereAnOperationReadsAnotherThreadsObject) {
+  // Interleaved chains put each task alone in its phase, on thread 0: no barrier but the last.
+  EXPECT_EQ(phases(interleaved_chains(5), BarrierRule::kOmpFor), 1u);
+  // Shifted reads: b_i reads x_(i+1), written by a_(i+1), on the other thread for i = 1.
+  StepGraph g;
+  const KindId a = g.intern_kind("a"), b = g.intern_kind("b");
+  for (int i = 0; i < 4; ++i) {
+    g.objects.push_back({"o" + std::to_string(i)});
+    g.data.push_back({"x" + std::to_string(i), static_cast<ObjectId>(i), 64});
+  }
+  for (int i = 0; i < 4; ++i) g.data.push_back({"y" + std::to_string(i), static_cast<ObjectId>(i), 64});
+  for (int i = 0; i < 4; ++i)
+    g.add_task(a, static_cast<ObjectId>(i),
+               std::vector<Access>{{static_cast<DatumId>(i), AccessMode::W}}, 0,
+               static_cast<StableKey>(i + 1));
+  for (int i = 0; i < 4; ++i)
+    g.add_task(b, static_cast<ObjectId>(i),
+               std::vector<Access>{{static_cast<DatumId>((i + 1) % 4), AccessMode::R},
+                                   {static_cast<DatumId>(4 + i), AccessMode::W}},
+               0, static_cast<StableKey>(i + 5));
+  g.derive_edges();
+  EXPECT_EQ(phases(g, BarrierRule::kOmpFor), 2u);
+}
+
 TEST(BarrierRule, NamesAndParsing) {
   EXPECT_EQ(to_string(BarrierRule::kLevel), "level");
   EXPECT_EQ(to_string(BarrierRule::kOperation), "operation");
+  EXPECT_EQ(to_string(BarrierRule::kOmpFor), "omp-for");
   EXPECT_EQ(parse_barrier_rule("operation"), BarrierRule::kOperation);
+  EXPECT_EQ(parse_barrier_rule("omp-for"), BarrierRule::kOmpFor);
+  EXPECT_EQ(ExecOptions{}.barrier.rule, BarrierRule::kOmpFor);  // the default
   EXPECT_FALSE(parse_barrier_rule("task").has_value());  // the flag's error: tests/apps
 }
 

@@ -35,6 +35,7 @@ const Variant kVariants[] = {
     {Policy::kWorksteal, false, "worksteal"},
     {Policy::kBarrier, false, "barrier"},
     {Policy::kBarrier, false, "barrier_operation", BarrierRule::kOperation},
+    {Policy::kBarrier, false, "barrier_omp_for", BarrierRule::kOmpFor},
     {Policy::kOmpTasks, false, "omp_tasks"},
 };
 

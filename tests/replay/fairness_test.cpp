@@ -127,14 +127,20 @@ TEST(FairReduction, EveryPolicyReachesTheSequentialSums) {
 // phase per writer.
 TEST(FairReduction, BarrierRunsACwGroupAsOnePhase) {
   const StepGraph g = cw_group(16, 0);
-  ExecOptions o;
-  o.threads = 2;
-  auto ex = make_executor(Policy::kBarrier, o);
-  SyntheticWorkload w({.cost_scale = 0.0});
-  w.set_step(g);
-  const ExecStepStats s = ex->run_step(g, nullptr, w);
-  // init | 16 writers | reducer | reader: 4 phases, one barrier each per thread.
-  for (const ThreadCounters& t : s.threads) EXPECT_EQ(t.waits, 4u);
+  // Barriers each thread passes: by operation, init | 16 writers | reducer | reader, one
+  // barrier after each; by omp-for, none between the reducer and the reader (both on thread
+  // 0, the reader needs nothing else).
+  for (const auto& [rule, barriers] :
+       {std::pair{BarrierRule::kOperation, 4u}, std::pair{BarrierRule::kOmpFor, 3u}}) {
+    ExecOptions o;
+    o.threads = 2;
+    o.barrier.rule = rule;
+    auto ex = make_executor(Policy::kBarrier, o);
+    SyntheticWorkload w({.cost_scale = 0.0});
+    w.set_step(g);
+    const ExecStepStats s = ex->run_step(g, nullptr, w);
+    for (const ThreadCounters& t : s.threads) EXPECT_EQ(t.waits, barriers) << to_string(rule);
+  }
 }
 
 }  // namespace

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
 // The omp-tasks policy beyond what every policy is tested for (executor_test, fairness_test):
-// CW groups declared mutexinoutset, loops decided by the submitting thread, no taskwait.
+// CW groups declared mutexinoutset, loops decided by the submitting thread, no taskwait,
+// taskwait depend on the break task.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -76,6 +78,26 @@ TEST(OmpTasks, WithoutATaskwaitPerIterationTheUnrolledStepStillMatches) {
     SyntheticWorkload w({.cost_scale = 0.0});
     EXPECT_EQ(omp_state(g, o, w, 2), test::sequential_state(g, 2)) << "seed " << seed;
   }
+}
+
+TEST(OmpTasks, SaysWhichOpenMPRuntimeRuns) {
+  // libgomp unless the ctest that preloads LLVM's libomp says otherwise (tests/replay).
+  const char* want = std::getenv("TGRAPH_EXPECT_OPENMP_RUNTIME");
+  EXPECT_EQ(openmp_runtime(), want != nullptr ? std::string(want) : std::string("gnu"));
+}
+
+TEST(OmpTasks, WaitingForTheBreakTaskOnlyStillMatches) {
+  // taskwait depend(in:) on the break task: unrolled (replay) and host-decided (live) loops.
+  for (std::uint32_t seed = 1; seed <= 4; ++seed)
+    for (std::uint32_t k : {2u, 3u}) {
+      const StepGraph g = test::random_graph(seed * 23 + k);
+      ExecOptions o = omp_options(k);
+      o.omp_tasks.wait_depend = true;
+      SyntheticWorkload known({.cost_scale = 0.0});
+      EXPECT_EQ(omp_state(g, o, known, 2), test::sequential_state(g, 2)) << "seed " << seed;
+      LiveLikeWorkload live;
+      EXPECT_EQ(omp_state(g, o, live, 2), test::sequential_state(g, 2)) << "seed " << seed;
+    }
 }
 
 TEST(OmpTasks, LoopsWithoutAKnownCountAreDecidedIterationByIteration) {

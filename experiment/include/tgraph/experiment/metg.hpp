@@ -82,6 +82,8 @@ struct MetgResult {
   std::vector<std::string> shapes;
   std::vector<MetgPoint> points;
   std::vector<MetgRecord> records;  ///< every (policy, shape, threads) run
+  /// Why some (policy, threads) were not run (StarPU above its build's CPU workers).
+  std::vector<std::string> skipped;
   std::vector<std::string> files;
   std::string command() const;
 };
@@ -91,7 +93,8 @@ struct MetgResult {
 MetgResult run_metg(const MetgOptions& options, Progress& progress);
 
 /// results.json: `metg` (the records reaching 50 %: policy, shape, threads, metg_ns, task_ns,
-/// efficiency), `unreached` (the others), `points`, the definition, machine, date, files.
+/// efficiency), `unreached` (the others), `skipped` (why a policy did not run at some thread
+/// counts), `points`, the definition, machine, date, files.
 std::string metg_json(const MetgResult& result, int indent = -1);
 /// The METG table printed on stdout.
 std::string metg_text(const MetgResult& result);

@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
@@ -67,7 +68,7 @@ struct PartitionOptions {
 
 /// Options of the barrier baseline (Policy::kBarrier) only.
 struct BarrierOptions {
-  BarrierRule rule = BarrierRule::kLevel;  ///< what one phase holds
+  BarrierRule rule = BarrierRule::kOmpFor;  ///< what one phase holds, where barriers go
 };
 
 /// Options of the StarPU baseline (Policy::kStarpu) only.
@@ -81,13 +82,20 @@ struct OmpTasksOptions {
   /// convergence writes; libgomp's dependence lists stay short). Off: the whole step is
   /// submitted at once, as the other dynamic baselines unroll it.
   bool iteration_wait = true;
+  /// The wait after each iteration (unrolled with iteration_wait, or live) is OpenMP 5.0's
+  /// `taskwait depend(in: ...)` on the loop's break task: the submitting thread waits for
+  /// the break (the residual's test) only, while the rest of the iteration runs on. Off: a
+  /// plain `taskwait` drains every task submitted so far.
+  bool wait_depend = false;
 };
 
 /// How an executor runs: the options every policy reads, then each policy's own (an
 /// executor reads only its own part; the others are ignored).
 struct ExecOptions {
   std::uint32_t threads = 1;  ///< threads (processors); partition: must equal Assignment::k
-  bool pin = true;            ///< bind thread p to a core with hwloc (partition, barrier)
+  /// Every policy: bind thread p (slot p of the runtime's team, arena or workers; the
+  /// calling thread is slot 0) to pinned_pu(p), once per executor while it keeps its slot.
+  bool pin = true;
   std::int64_t spin_ns = kDefaultSpinNs;  ///< spin this long before parking (0: park at once)
   std::optional<CwMode> cw;               ///< default: kReduce for every policy
   /// Temporaries of kReduce; default: kPerProcessor for partition, kPerWriter for the
@@ -219,7 +227,19 @@ class Executor {
 /// policy runs on one thread whatever `options.threads` asks).
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options);
 
+/// The most threads `policy` can run in this build (StarPU: its STARPU_MAXCPUS CPU workers),
+/// nullopt when only make_executor's own limit applies.
+std::optional<std::uint32_t> max_threads(Policy policy);
+
 /// Thread p's processing unit under pinning (hwloc, one PU per core first), for reports.
 int pinned_pu(std::uint32_t p);
+
+/// The OpenMP runtime the OpenMP policies (barrier, omp-tasks) of this process run on:
+/// "gnu" (GCC's libgomp, which tgraph is built against) or "llvm" (LLVM's libomp, through
+/// its libgomp-compatible entry points when it is preloaded: see docs/replay.md).
+std::string_view openmp_runtime();
+/// The file of LLVM's OpenMP runtime (libomp) found when tgraph was configured, for a
+/// process that preloads it (empty when none was found).
+std::string_view llvm_openmp_library();
 
 }  // namespace tgraph::replay

@@ -12,7 +12,7 @@ enum class Policy : unsigned char {
   kSequential = 0,  ///< one thread, program order
   kPartition = 1,   ///< one pinned thread per processor of an Assignment, signal/wait
   kWorksteal = 2,   ///< oneTBB, dependency counting over the dataflow graph, no affinity
-  kBarrier = 3,     ///< a parallel loop per operation, barrier after each (OpenMP)
+  kBarrier = 3,     ///< a parallel loop per operation, barriers between them (OpenMP)
   kStarpu = 4,      ///< StarPU tasks with one data handle per datum (implicit dependencies)
   kOmpTasks = 5,    ///< OpenMP tasks with one `depend` object per datum (libgomp)
 };
@@ -55,9 +55,14 @@ enum class BarrierRule : unsigned char {
   /// One phase per run of consecutive tasks of one kind in program order (the paper's "one
   /// parallel loop per operation"), cut where a task depends on the run.
   kOperation = 1,
+  /// As an OpenMP user writes a CG solver (the default): the phases of kOperation, each an
+  /// `omp for` with a static schedule (the i-th task of every phase on the same thread),
+  /// `nowait` where no task before the next barrier depends on another thread's task since
+  /// the last one; a barrier ends every loop iteration.
+  kOmpFor = 2,
 };
 
-/// "level" or "operation".
+/// "level", "operation" or "omp-for".
 std::string_view to_string(BarrierRule rule);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<BarrierRule> parse_barrier_rule(std::string_view name);
