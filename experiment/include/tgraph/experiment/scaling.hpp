@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// `tgraph experiment scaling`: live runs (measure::run_live, as `tgraph run` makes them) of
+// bars64, falling64, torso and cloth256-s64 for the partition strategies and every baseline
+// at each thread count, with where each run's time goes: speed-up, the main thread's serial
+// share, inflation of the task bodies, the threads' waiting share, parks, repartitions.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tgraph/experiment/machine.hpp"
+#include "tgraph/experiment/progress.hpp"
+
+namespace tgraph::experiment {
+
+/// What to run (the flags of `tgraph experiment scaling`).
+struct ScalingOptions {
+  bool quick = false;                   ///< few steps, threads 1,2, a smoke run
+  std::string out_dir;                  ///< "": tgraph-experiment-scaling
+  std::string threads;                  ///< thread list (parse_thread_list); "": default
+  std::string methods;                  ///< comma list of strategies and baselines; "": all
+  std::optional<std::uint32_t> steps;   ///< steps of every scene; unset: each scene's own
+  std::optional<std::uint32_t> repeat;  ///< timed passes per run (medians); unset: 1
+};
+
+/// A scene of the sweep with its step count.
+struct ScalingScene {
+  std::string scene;              ///< built-in scene
+  std::optional<int> subobjects;  ///< cloth scenes: sub-objects (a square)
+  std::uint32_t steps = 1;
+  /// "bars64", "cloth256-s64".
+  std::string label() const;
+};
+
+/// The default thread counts on a machine of `cores` cores: the powers of two up to it, and
+/// the count of cores itself (12 cores: 1, 2, 4, 8, 12).
+std::vector<std::uint32_t> scaling_thread_list(std::uint32_t cores);
+
+/// The runs of the sweep, resolved from the options and the machine.
+struct ScalingPlan {
+  std::vector<ScalingScene> scenes;
+  std::vector<std::string> methods;  ///< strategies (partition policy), then baselines
+  std::vector<std::uint32_t> threads;
+  std::uint32_t repeat = 1;
+  std::uint32_t cores = 1;
+  bool quick = false;
+  std::string out_dir;
+  std::vector<std::string> notes;  ///< what the plan left out or warns about, and why
+  /// Live runs: one per scene, method and thread count, plus one reference run per scene.
+  std::size_t runs() const;
+  /// `tgraph experiment scaling ...` reproducing this plan.
+  std::string command() const;
+};
+
+/// Resolves `options` on a machine with `cores` cores. Defaults: bars64 (20 steps), falling64
+/// (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier, omp-tasks and
+/// starpu (when built); scaling_thread_list(cores); one pass. --quick: 2, 3, 3 and 1 steps,
+/// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::UsageError names the bad flag (an unknown method, sequential or
+/// partition as a method, starpu in a build without it, steps or repeat of 0).
+ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
+
+/// One live run of the sweep. The figures (docs/design.md has them too):
+/// - speedup: the scene's sequential wall time (the uninstrumented engine, timed once per
+///   scene as run_live times it: the fastest of the first min(threads, 4) cores) over the
+///   run's wall time (median of the timed passes);
+/// - serial_share: the main thread's record + partition (the time the step waited for it) +
+///   prepare, summed over the steps, over that sequential wall time;
+/// - inflation: the threads' busy time (task bodies, observed pass) over the same task
+///   instances' sequential time (each kind's instances x its mean in the observed sequential
+///   pass of the same run);
+/// - wait_share: the threads' time outside task bodies (waiting, parked, searching for work,
+///   idle) over threads x the executor's wall time, summed over the observed pass's steps
+///   (only the partition executor reports its waits apart, so the share counts them all);
+/// - parks_per_step: the threads' parks (futex waits) per step, first timed pass;
+/// - partitioned_steps: steps at which the partitioner was called, first timed pass (0 for
+///   the baselines).
+struct ScalingRecord {
+  std::string scene;   ///< ScalingScene::label()
+  std::string policy;  ///< replay::Policy name
+  std::string method;  ///< the strategy under the partition policy, else the policy's name
+  std::uint32_t threads = 1;
+  double speedup = 0;
+  double serial_share = 0;
+  double inflation = 0;
+  double wait_share = 0;
+  double parks_per_step = 0;
+  std::uint32_t partitioned_steps = 0;
+  // Beside the record (results.csv, the text table), not in results.json's `scaling`:
+  std::uint32_t steps = 0;
+  std::int64_t wall_ns = 0;             ///< median pass
+  std::int64_t sequential_wall_ns = 0;  ///< the scene's reference
+};
+
+/// A run that was not made or did not finish.
+struct ScalingMiss {
+  std::string scene, policy, method;
+  std::uint32_t threads = 1;
+  std::string reason;
+};
+
+/// The sequential reference of one scene.
+struct ScalingReference {
+  std::string scene;
+  std::uint32_t steps = 0;
+  std::uint32_t cores_timed = 0;        ///< cores the uninstrumented engine was timed on
+  std::int64_t sequential_wall_ns = 0;  ///< fastest core's median pass
+};
+
+/// Everything the sweep produced.
+struct ScalingResult {
+  ScalingPlan plan;
+  MachineInfo machine;
+  std::string date;  ///< UTC, ISO 8601
+  double seconds = 0;
+  std::vector<ScalingReference> references;
+  std::vector<ScalingRecord> records;
+  /// Runs the policy refused (StarPU above its CPU workers): not made, with its message.
+  std::vector<ScalingMiss> skipped;
+  std::vector<ScalingMiss> failed;  ///< runs that threw
+  std::vector<std::string> files;   ///< written, in the output folder
+};
+
+/// Runs the sweep and writes results.json, results.csv and one speed-up chart per scene
+/// (speedup-<scene>.svg/png) into the output folder, atomically; progress lines on
+/// `progress`. A run that fails is recorded in `failed` and the others go on.
+ScalingResult run_scaling(const ScalingOptions& options, Progress& progress);
+
+/// results.json: `scaling` (the records, with exactly the keys scene, policy, method, threads,
+/// speedup, serial_share, inflation, wait_share, parks_per_step, partitioned_steps),
+/// `skipped`, `failed`, `references`, the definitions, command, machine, date, files.
+std::string scaling_json(const ScalingResult& result, int indent = -1);
+/// The table printed on stdout.
+std::string scaling_text(const ScalingResult& result);
+
+}  // namespace tgraph::experiment

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/experiment/scaling.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::experiment {
+namespace {
+
+std::vector<std::string> labels(const ScalingPlan& p) {
+  std::vector<std::string> out;
+  for (const ScalingScene& s : p.scenes) out.push_back(s.label() + ":" + std::to_string(s.steps));
+  return out;
+}
+
+TEST(ScalingThreads, DefaultIsThePowersOfTwoUpToTheCoresAndTheCoresThemselves) {
+  EXPECT_EQ(scaling_thread_list(1), (std::vector<std::uint32_t>{1}));
+  EXPECT_EQ(scaling_thread_list(2), (std::vector<std::uint32_t>{1, 2}));
+  EXPECT_EQ(scaling_thread_list(12), (std::vector<std::uint32_t>{1, 2, 4, 8, 12}));
+  EXPECT_EQ(scaling_thread_list(16), (std::vector<std::uint32_t>{1, 2, 4, 8, 16}));
+}
+
+TEST(ScalingPlan, DefaultsAreTheFourScenesEveryMethodAndOnePass) {
+  const ScalingPlan p = plan_scaling({}, 16);
+  EXPECT_EQ(labels(p), (std::vector<std::string>{"bars64:20", "falling64:60", "torso:60",
+                                                 "cloth256-s64:5"}));
+  for (const char* m : {"owner", "metis", "sticky", "worksteal", "barrier", "omp-tasks"})
+    EXPECT_NE(std::find(p.methods.begin(), p.methods.end(), m), p.methods.end()) << m;
+#ifdef TGRAPH_HAVE_STARPU
+  EXPECT_EQ(p.methods.back(), "starpu");
+#endif
+  EXPECT_EQ(p.threads, (std::vector<std::uint32_t>{1, 2, 4, 8, 16}));
+  EXPECT_EQ(p.repeat, 1u);
+  EXPECT_EQ(p.out_dir, "tgraph-experiment-scaling");
+  EXPECT_EQ(p.runs(), 4 * (1 + p.methods.size() * 5));
+}
+
+TEST(ScalingPlan, QuickRunsFewStepsOnOneAndTwoThreadsOfEveryScene) {
+  ScalingOptions o;
+  o.quick = true;
+  const ScalingPlan p = plan_scaling(o, 16);
+  EXPECT_EQ(labels(p), (std::vector<std::string>{"bars64:2", "falling64:3", "torso:3",
+                                                 "cloth256-s64:1"}));
+  EXPECT_EQ(p.threads, (std::vector<std::uint32_t>{1, 2}));
+  EXPECT_EQ(p.methods, (std::vector<std::string>{"owner", "sticky", "worksteal", "barrier"}));
+  EXPECT_NE(p.command().find("--quick --threads 1,2 --methods owner,sticky,worksteal,barrier"),
+            std::string::npos)
+      << p.command();
+}
+
+TEST(ScalingPlan, FlagsOverrideTheDefaultsAndCountsAboveTheCoresAreNoted) {
+  ScalingOptions o;
+  o.threads = "1,4";
+  o.methods = "sticky,worksteal,sticky";
+  o.steps = 7;
+  o.repeat = 3;
+  o.out_dir = "d";
+  const ScalingPlan p = plan_scaling(o, 2);
+  EXPECT_EQ(p.threads, (std::vector<std::uint32_t>{1, 4}));
+  EXPECT_EQ(p.methods, (std::vector<std::string>{"sticky", "worksteal"}));
+  for (const ScalingScene& s : p.scenes) EXPECT_EQ(s.steps, 7u) << s.label();
+  EXPECT_EQ(p.repeat, 3u);
+  EXPECT_EQ(p.command(),
+            "tgraph experiment scaling --threads 1,4 --methods sticky,worksteal --steps 7 "
+            "--repeat 3 --out d");
+  ASSERT_EQ(p.notes.size(), 1u);
+  EXPECT_NE(p.notes[0].find("oversubscribed"), std::string::npos) << p.notes[0];
+}
+
+TEST(ScalingPlan, RejectsBadFlagsNamingThem) {
+  auto message = [](ScalingOptions o) {
+    try {
+      plan_scaling(o, 2);
+    } catch (const UsageError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  ScalingOptions o;
+  o.methods = "owner,nosuch";
+  EXPECT_NE(message(o).find("--methods owner,nosuch: unknown method 'nosuch'"), std::string::npos)
+      << message(o);
+  o.methods = "sequential";
+  EXPECT_NE(message(o).find("--methods sequential"), std::string::npos) << message(o);
+  o.methods = "partition";
+  EXPECT_NE(message(o).find("name the partitioning strategy"), std::string::npos) << message(o);
+  o.methods.clear();
+  o.threads = "0";
+  EXPECT_NE(message(o).find("--threads"), std::string::npos) << message(o);
+  o.threads.clear();
+  o.steps = 0;
+  EXPECT_EQ(message(o), "--steps must be at least 1");
+  o.steps.reset();
+  o.repeat = 0;
+  EXPECT_EQ(message(o), "--repeat must be at least 1");
+}
+
+}  // namespace
+}  // namespace tgraph::experiment
