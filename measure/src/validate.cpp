@@ -2,6 +2,7 @@
 // `tgraph validate`'s pipeline: live run, capture + replay, simulation.
 #include "tgraph/measure/validate.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -12,9 +13,12 @@
 #include "tgraph/measure/replay_trace.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulator.hpp"
+#include "tgraph/replay/thread_binding.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::measure {
+
+namespace tr = tgraph::replay;
 
 Validation validate(const ValidateOptions& o) {
   Validation v;
@@ -48,8 +52,12 @@ Validation validate(const ValidateOptions& o) {
       serial.push_back(static_cast<std::uint64_t>(m.record_ns + m.partition_ns + m.prepare_ns));
       r.serial_ns += serial.back();
     }
-    // The simulated threads wait as the live run's did: spinning this long, then parked.
+    // The simulated threads wait as the live run's did: spinning this long, then parked. The
+    // partition executor spins on up to kLongSpinNs while the thread it waits for runs, where
+    // every thread has a core of its own.
     model.spin_budget_ns = static_cast<double>(lo.exec.spin_ns);
+    if (partition && lo.exec.threads <= tr::hardware_pus())
+      model.spin_budget_ns = std::max(model.spin_budget_ns, static_cast<double>(tr::kLongSpinNs));
 
     // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
     const Trace trace = capture_trace(o.scene, o.steps);

@@ -2,6 +2,8 @@
 // Internal: spin-then-park waiting on 64-bit counters, thread pinning.
 #pragma once
 
+#include "tgraph/replay/executor.hpp"
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -30,9 +32,9 @@ inline std::int64_t wait_ticks() {
 /// (about 2 ms, the first time it is asked); 1 where the ticks are now_ns().
 double wait_tick_ns();
 
-/// How long a wait spins at most while the thread it waits for runs (Parking::wait with an
-/// `awake` test): beyond spin_ns, and only where every thread has a core of its own.
-inline constexpr std::int64_t kLongSpinNs = 1'000'000;
+// kLongSpinNs (executor.hpp): how long a wait spins at most while the thread it waits for
+// runs (Parking::wait with an `awake` test): beyond spin_ns, and only where every thread has
+// a core of its own.
 
 /// A 64-bit counter alone on its cache line.
 struct alignas(64) PaddedCounter {

@@ -25,6 +25,9 @@ class ExecPlan;  // one step structure's plan, of the executor's own type (repla
 /// Default spin time before a waiting thread parks in the kernel (see docs/replay.md and
 /// bench/replay: a futex hand-off costs 9-36 µs on this machine, a spinning one 0.1 µs).
 inline constexpr std::int64_t kDefaultSpinNs = 50'000;
+/// How long the partition executor's waits spin at most, beyond spin_ns, while the thread
+/// they wait for runs, where every thread has a core of its own (then they park).
+inline constexpr std::int64_t kLongSpinNs = 1'000'000;
 
 /// Default watchdog timeout (PartitionOptions::timeout_ms): generous, a step of a real trace
 /// takes milliseconds.
