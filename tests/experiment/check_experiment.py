@@ -109,6 +109,11 @@ with tempfile.TemporaryDirectory() as tmp:
     kinds = {v["kind"] for v in specs["chart-0"]["data"]["values"]}
     check(kinds == {"measured", "predicted", "reference"}, f"speed-up chart kinds {kinds}")
     check(j["paper"]["figure"] in html, "the paper's figure is not in the report")
+    # The predictions' cost model named: the defaults unless a calibration file was read.
+    model = j.get("cost_model", "")
+    check(model == "defaults" or os.path.isfile(model), f"cost_model {model!r}")
+    check(("cost model's defaults (no calibration file)" if model == "defaults" else
+           "cost model's calibration file " + model) in html, "the report does not name the cost model")
 
     if name == "heterogeneous":
         steps = list(csv.DictReader(open(os.path.join(out, "steps.csv"))))
