@@ -5,41 +5,32 @@
 # one missing, so a broken lookup cannot silently drop tests. Included after the modules and
 # tests are added: it reads what they found from their targets.
 
-# _tgraph_has_definition(TARGET PROPERTY DEFINITION OUT): whether TARGET's PROPERTY (a list of
-# compile definitions) holds DEFINITION.
-function(_tgraph_has_definition target property definition out)
-  set(${out} FALSE PARENT_SCOPE)
+# _tgraph_require(TARGET PROPERTY DEFINITION WHAT): appends WHAT to _tgraph_missing unless
+# TARGET's PROPERTY (a list of compile definitions) holds DEFINITION.
+function(_tgraph_require target property definition what)
   if(TARGET ${target})
     get_target_property(_defs ${target} ${property})
     if(_defs AND "${definition}" IN_LIST _defs)
-      set(${out} TRUE PARENT_SCOPE)
+      return()
     endif()
   endif()
+  set(_tgraph_missing ${_tgraph_missing} "${what}" PARENT_SCOPE)
 endfunction()
 
 if(TGRAPH_REQUIRE_ALL)
   set(_tgraph_missing "")
-  _tgraph_has_definition(tgraph_partition INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_SIMGRID=1 _ok)
-  if(NOT _ok)
-    list(APPEND _tgraph_missing "SimGrid (pkg-config simgrid, Debian libsimgrid-dev)")
-  endif()
-  _tgraph_has_definition(tgraph_replay INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_STARPU=1 _ok)
-  if(NOT _ok)
-    list(APPEND _tgraph_missing "StarPU (pkg-config starpu-1.3, Debian libstarpu-dev)")
-  endif()
+  _tgraph_require(tgraph_partition INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_SIMGRID=1
+                  "SimGrid (pkg-config simgrid, Debian libsimgrid-dev)")
+  _tgraph_require(tgraph_replay INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_STARPU=1
+                  "StarPU (pkg-config starpu-1.3, Debian libstarpu-dev)")
   if(NOT TARGET tgraph_mpi)
     list(APPEND _tgraph_missing "OpenMPI (find_package(MPI COMPONENTS CXX), Debian libopenmpi-dev)")
   elseif(NOT CMAKE_CXX_COMPILER MATCHES "smpicxx")
     # An SMPI build (SimGrid's smpicxx) leaves out both on purpose (mpi/CMakeLists.txt).
-    _tgraph_has_definition(tgraph_mpi COMPILE_DEFINITIONS TGRAPH_HAVE_STARPU_MPI=1 _ok)
-    if(NOT _ok)
-      list(APPEND _tgraph_missing "StarPU-MPI (pkg-config starpumpi-1.3, Debian libstarpu-dev)")
-    endif()
-    _tgraph_has_definition(tgraph_mpi INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_PTSCOTCH=1 _ok)
-    if(NOT _ok)
-      list(APPEND _tgraph_missing
-           "PT-Scotch (scotch/ptscotch.h, libptscotch, libptscotcherr, Debian libptscotch-dev)")
-    endif()
+    _tgraph_require(tgraph_mpi COMPILE_DEFINITIONS TGRAPH_HAVE_STARPU_MPI=1
+                    "StarPU-MPI (pkg-config starpumpi-1.3, Debian libstarpu-dev)")
+    _tgraph_require(tgraph_mpi INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_PTSCOTCH=1
+                    "PT-Scotch (scotch/ptscotch.h, libptscotch, libptscotcherr, Debian libptscotch-dev)")
   endif()
   # The browser test of the HTML report (tests/viz) is the only user of Chromium.
   if(TGRAPH_BUILD_TESTS AND NOT TGRAPH_CHROMIUM)
