@@ -32,23 +32,41 @@ tgraph_install_packages() {
   fi
 }
 
-# tgraph_build PRESET [TARGET...]: configure once, then build incrementally. A folder not
-# configured yet gets the preset's generator (Ninja), or TGRAPH_GENERATOR when set; one
-# already configured keeps its own.
+# tgraph_build PRESET [-DNAME=VALUE...] [TARGET...]: configure once, then build incrementally.
+# A folder not configured yet gets the preset's generator (Ninja), or TGRAPH_GENERATOR when
+# set; one already configured keeps its own, and is configured again only when a -D value
+# given differs from its cache (e.g. -DTGRAPH_REQUIRE_ALL=ON on a folder built without it).
 tgraph_build() {
   local preset="$1"; shift
+  local defs=() targets=() d
+  for d in "$@"; do
+    case "$d" in
+      -D*) defs+=("$d") ;;
+      *) targets+=("$d") ;;
+    esac
+  done
   cd "$TGRAPH_ROOT"
   if [ ! -f "build/$preset/CMakeCache.txt" ]; then
     if [ -n "${TGRAPH_GENERATOR:-}" ]; then
-      cmake --preset "$preset" -G "$TGRAPH_GENERATOR" >/dev/null
+      cmake --preset "$preset" -G "$TGRAPH_GENERATOR" "${defs[@]}" >/dev/null
     else
-      cmake --preset "$preset" >/dev/null
+      cmake --preset "$preset" "${defs[@]}" >/dev/null
     fi
+  else
+    for d in "${defs[@]}"; do
+      local name="${d#-D}" value="${d#*=}"
+      name="${name%%=*}"
+      name="${name%%:*}"
+      if ! grep -qx "$name:[A-Z]*=$value" "build/$preset/CMakeCache.txt"; then
+        cmake -S . -B "build/$preset" "${defs[@]}" >/dev/null
+        break
+      fi
+    done
   fi
   local jobs
   jobs="$(nproc 2>/dev/null || echo 2)"
-  if [ $# -gt 0 ]; then
-    cmake --build "build/$preset" -j "$jobs" --target "$@"
+  if [ ${#targets[@]} -gt 0 ]; then
+    cmake --build "build/$preset" -j "$jobs" --target "${targets[@]}"
   else
     cmake --build "build/$preset" -j "$jobs"
   fi
@@ -56,7 +74,8 @@ tgraph_build() {
 
 # Optional: Debian's chromium for the browser test of the HTML report (tests/viz). Installed
 # when running as root; otherwise, or when apt fails, a notice says the test will be skipped,
-# unless TGRAPH_REQUIRE_BROWSER=1 (CI sets it), which makes a missing browser an error.
+# unless TGRAPH_REQUIRE_ALL=1 (CI sets it; the configure then fails too, see scripts/test) or
+# TGRAPH_REQUIRE_BROWSER=1 (the browser alone), which make a missing browser an error.
 tgraph_install_browser() {
   command -v chromium >/dev/null 2>&1 && return 0
   if [ "$(id -u)" -eq 0 ] &&
@@ -65,9 +84,10 @@ tgraph_install_browser() {
     echo "tgraph: installed chromium (browser test of the HTML report)" >&2
     return 0
   fi
-  if [ "${TGRAPH_REQUIRE_BROWSER:-0}" = "1" ]; then
+  if [ "${TGRAPH_REQUIRE_ALL:-0}" = "1" ] || [ "${TGRAPH_REQUIRE_BROWSER:-0}" = "1" ]; then
     echo "tgraph: error: chromium is not installed and could not be installed (run as root:" \
-      "apt-get install chromium); TGRAPH_REQUIRE_BROWSER=1 asks for the browser test" >&2
+      "apt-get install chromium); TGRAPH_REQUIRE_ALL=1 (or TGRAPH_REQUIRE_BROWSER=1) asks for" \
+      "the browser test" >&2
     return 1
   fi
   echo "tgraph: NOTICE: chromium is not installed and could not be installed (run as root:" \

@@ -71,6 +71,16 @@ std::string format(const char* fmt, ...) {
   return s;
 }
 
+// The cost model in words: the defaults' constants and where a calibration comes from.
+std::string cost_model_words(const std::string& name, const tp::CostModel& m) {
+  if (name == "defaults")
+    return format("its defaults (%.0f ns a signal, %.2f ns a byte; no calibration file: "
+                  "`tgraph calibrate` writes one)",
+                  m.sync_latency_ns, m.per_byte_ns);
+  return format("the calibration file %s (%.0f ns a signal, %.2f ns a byte)", name.c_str(),
+                m.sync_latency_ns, m.per_byte_ns);
+}
+
 }  // namespace
 
 DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::string&)>& say_fn) {
@@ -92,7 +102,9 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   const Metrics m0 = compute_metrics(trace.steps.front());
   res.tasks = m0.tasks;
   res.parallelism = m0.parallelism;
+  // The default calibration file when `tgraph calibrate` wrote one, else the defaults.
   const tp::CostModel model = tp::select_cost_model("calibrated", "");
+  res.cost_model = model.source == tp::CostModel::defaults().source ? "defaults" : model.source;
 
   std::vector<viz::MethodRow> rows, predictions;  // predictions: K < threads, not replayed
   std::vector<viz::StepSeries> series;
@@ -169,7 +181,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   c.notes = {
       "Wall times are medians of " + std::to_string(o.repeat) +
       " passes; speed-up is against sequential replay timed in the same run. Predicted speed-ups "
-      "come from the calibrated cost model (tgraph evaluate)."};
+      "come from the cost model (tgraph evaluate) with " +
+      cost_model_words(res.cost_model, model) + "."};
   c.rows = rows;
   c.rows.insert(c.rows.end(), predictions.begin(), predictions.end());
   c.series = series;
@@ -186,7 +199,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
 std::string demo_json(const DemoResult& r) {
   nlohmann::json j = {{"scene", r.scene},        {"steps", r.steps},
                       {"threads", r.threads},    {"trace", r.trace_path},
-                      {"report", r.report_path}, {"rows", nlohmann::json::array()}};
+                      {"report", r.report_path}, {"cost_model", r.cost_model},
+                      {"rows", nlohmann::json::array()}};
   for (const viz::MethodRow& row : r.rows)
     j["rows"].push_back({{"method", row.method},
                          {"partitioned", row.partitioned},
@@ -228,7 +242,14 @@ std::string demo_text(const DemoResult& r) {
                   row.sequential_ms.value_or(0), row.speedup.value_or(0),
                   row.efficiency.value_or(0));
   }
-  s += format("\ntrace: %s\nreport: %s\n", r.trace_path.c_str(), r.report_path.c_str());
+  const std::string model =
+      r.cost_model == "defaults" ? "defaults (no calibration file)" : "from " + r.cost_model;
+  s += format("\npredicted: cost model %s\n", model.c_str());
+  const auto absolute = [](const std::string& p) {
+    return std::filesystem::absolute(p).lexically_normal().string();
+  };
+  s += format("trace: %s\nreport: %s\n", absolute(r.trace_path).c_str(),
+              absolute(r.report_path).c_str());
   return s;
 }
 

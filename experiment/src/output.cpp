@@ -171,8 +171,10 @@ viz::SeriesPage page_of(const ExperimentResult& res) {
           "against the uninstrumented sequential engine in the same run, medians of " +
           std::to_string(p.repeat) + " passes of " + std::to_string(p.steps) +
           " steps. Predicted (never mixed with measured values): the simulator on the captured "
-          "trace with the calibrated cost model, at every thread count including those beyond "
-          "this machine's " +
+          "trace with the cost model's " +
+          (res.cost_model == "defaults" ? std::string("defaults (no calibration file)")
+                                        : "calibration file " + res.cost_model) +
+          ", at every thread count including those beyond this machine's " +
           std::to_string(p.cores) + " cores."};
   if (p.replay)
     page.notes.push_back(
@@ -365,6 +367,7 @@ std::string experiment_json(const ExperimentResult& res, int indent) {
       {"command", p.command()},
       {"date", res.date},
       {"seconds", res.seconds},
+      {"cost_model", res.cost_model},
       {"machine",
        {{"summary", res.machine.summary()},
         {"model", res.machine.model},

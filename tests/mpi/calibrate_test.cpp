@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -68,11 +70,21 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   // The replay's own time per task instance: measured (a replay has some), in nanoseconds.
   EXPECT_GT(m.task_overhead_ns, 0.0);
   EXPECT_LT(m.task_overhead_ns, 1e6);
-  // And per message and side, in nanoseconds
-  // (written even as 0: two ranks on a loaded machine can measure no difference).
+  // And per message and side, in nanoseconds: written even as 0 (the measurement is clamped
+  // there: two ranks on a loaded machine can measure no difference beyond the two task
+  // instances), but a message costs its sender and receiver some time (240-515 ns measured
+  // on a quiet machine, docs/results.md): of three calibrations, one at least measures it.
   EXPECT_NE(read_file_text(file).find("\"mpi_message_overhead_ns\""), std::string::npos);
-  EXPECT_GE(m.mpi_message_overhead_ns, 0.0);
-  EXPECT_LT(m.mpi_message_overhead_ns, 1e6);
+  std::string measured = std::to_string(m.mpi_message_overhead_ns);
+  double most = m.mpi_message_overhead_ns;
+  for (int again = 0; again < 2 && most <= 0.0; ++again) {
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << read_file_text((dir / "out.txt").string());
+    const double o = partition::load_calibration(file).mpi_message_overhead_ns;
+    measured += ", " + std::to_string(o);
+    most = std::max(most, o);
+  }
+  EXPECT_GT(most, 0.0) << "measured per message and side (ns): " << measured;
+  EXPECT_LT(most, 1e6) << "measured per message and side (ns): " << measured;
   // No file to add to: exit 2.
   const std::string missing = std::string(TGRAPH_MPIEXEC) + " --mca orte_tmpdir_base " +
                               dir.string() + " -np 2 --oversubscribe " + TGRAPH_MPI_BIN +

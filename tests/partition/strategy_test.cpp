@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <future>
 #include <random>
 #include <set>
@@ -76,7 +77,6 @@ TEST_P(EveryStrategy, GivesValidAssignmentsOnRandomGraphs) {
       const Result r = make_strategy(GetParam())->partition(g, k, {}, {});
       ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
       for (ProcId p : r.assignment.proc) ASSERT_LT(p, k);
-      EXPECT_GE(r.stats.partition_ms, 0.0);
       EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults())) << GetParam() << " seed " << seed;
     }
   }
@@ -85,6 +85,43 @@ TEST_P(EveryStrategy, GivesValidAssignmentsOnRandomGraphs) {
 INSTANTIATE_TEST_SUITE_P(Strategies, EveryStrategy,
                          ::testing::Values("single", "roundrobin", "random", "owner", "metis",
                                            "metis-relabel", "scotch", "sticky", "list"));
+
+// A strategy that takes a known time: every task on processor 0, after sleeping 20 ms.
+class SleepingStrategy : public Strategy {
+ public:
+  std::string_view name() const override { return "sleeping"; }
+
+ private:
+  Result do_partition(const StepGraph& g, std::uint32_t, const Previous&, const Options&) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    Result r;
+    r.assignment.proc.assign(g.tasks.size(), 0);
+    return r;
+  }
+};
+
+TEST(Strategy, TimesThePartitionCallInMilliseconds) {
+  const StepGraph g = testing::random_graph(5, 30, 6, false);
+  SleepingStrategy s;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Result r = s.partition(g, 2, {}, {});
+  const double outside_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  // At least the 20 ms slept (not timed, or in seconds: below), at most what the caller
+  // measured around the call (in microseconds or nanoseconds: above).
+  EXPECT_GE(r.stats.partition_ms, 20.0);
+  EXPECT_LE(r.stats.partition_ms, outside_ms);
+  // Every registered strategy is timed too: a partition of 50 tasks takes some time.
+  const StepGraph h = testing::random_graph(9, 50, 8, true);
+  for (const std::string& n : strategy_names()) {
+    const auto u0 = std::chrono::steady_clock::now();
+    const Result q = make_strategy(n)->partition(h, 3, {}, {});
+    const double around_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - u0).count();
+    EXPECT_GT(q.stats.partition_ms, 0.0) << n;
+    EXPECT_LE(q.stats.partition_ms, around_ms) << n;
+  }
+}
 
 class GraphPartitioner : public ::testing::TestWithParam<std::string> {};
 

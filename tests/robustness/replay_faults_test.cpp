@@ -357,15 +357,52 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
       "body does not return, ending the process");
 }
 
+// A workload whose body of one task sleeps, once, long enough for every thread to stall
+// behind it (a slow body, which returns).
+class SlowWorkload : public Workload {
+ public:
+  SlowWorkload(TaskId t, std::chrono::milliseconds sleep) : t_(t), sleep_(sleep) {}
+  std::atomic<std::uint64_t> ran{0};
+  void run(const TaskRun& r) override {
+    // relaxed: one body sleeps, whichever; the counts are read after the step.
+    if (r.origin == t_ && !slept_.exchange(true, std::memory_order_relaxed))
+      std::this_thread::sleep_for(sleep_);
+    ran.fetch_add(1, std::memory_order_relaxed);
+  }
+  bool stop_after(LoopId, std::uint32_t iteration) override { return iteration >= 1; }
+
+ private:
+  TaskId t_;
+  std::chrono::milliseconds sleep_;
+  std::atomic<bool> slept_{false};
+};
+
+// The same stall of a second ends the step under a 100 ms watchdog, and not under timeout 0:
+// 0 turns the watchdog off (neither a timeout of 0 ms nor a setting the executor ignores).
 TEST(Watchdog, IsOffWithTimeoutZero) {
   const StepGraph& g = falling_step();
   const Assignment a = by_object(g, 2);
+  const TaskId slow = cross_producer(g, a);
+  ASSERT_NE(slow, kNoTask);
   ExecOptions o;
   o.threads = 2;
   o.pin = false;
+  o.spin_ns = 1000;
+  o.partition.timeout_ms = 100;
+  {
+    auto ex = make_executor(Policy::kPartition, o);
+    SlowWorkload w(slow, std::chrono::milliseconds(1000));
+    try {
+      ex->run_step(g, &a, w);
+      ADD_FAILURE() << "a stall of 1 s under a 100 ms watchdog: no exception";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("replay stopped making progress for ", 0), 0u)
+          << e.what();
+    }
+  }
   o.partition.timeout_ms = 0;
   auto ex = make_executor(Policy::kPartition, o);
-  FaultyWorkload w;
+  SlowWorkload w(slow, std::chrono::milliseconds(1000));
   EXPECT_NO_THROW(ex->run_step(g, &a, w));
   EXPECT_GE(w.ran.load(), g.tasks.size());
 }

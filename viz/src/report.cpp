@@ -108,18 +108,15 @@ const char* kStyle =
     ".graph-tools{font-size:0.85em;color:#555;margin-bottom:4px}"
     ".graph-tools button{font-size:1em;min-width:2.2em;margin-right:4px}";
 
-// Pan and zoom on the step graph (Panzoom, inlined). The first view shows the whole graph
-// when its labels stay readable (scale >= kReadable), else the left end at the scale that
-// fits the graph's height (readable labels, the rest a drag away). The wheel zooms at the
-// pointer, dragging pans; buttons zoom in and out, go back to the first view ("reset") or
-// show the whole graph ("whole"). Sets data-panzoom="ready" and data-start-scale on
-// #graph-step once bound (what the browser test reads).
+// Pan and zoom on the step graph (Panzoom, inlined). The first view shows the whole graph,
+// fitted to the box and centred; the wheel zooms at the pointer, dragging pans; buttons zoom
+// in and out, or go back to the whole graph. Sets data-panzoom="ready" and data-start-scale
+// on #graph-step once bound (what the browser test reads).
 const char* kPanZoomScript = R"js(
 (function () {
   const box = document.getElementById('graph-step');
   if (!box) return;
   const svg = box.querySelector('svg');
-  const kReadable = 0.6;
   const w = svg.width.baseVal.value, h = svg.height.baseVal.value;  // px
   const W = box.clientWidth, H = box.clientHeight;
   const whole = Math.min(W / w, H / h);
@@ -129,24 +126,17 @@ const char* kPanZoomScript = R"js(
     return {scale: s, x: (left - (w / 2) * (1 - s)) / s, y: (top - (h / 2) * (1 - s)) / s};
   }
   const all = at(whole, (W - whole * w) / 2, (H - whole * h) / 2);
-  const readable = Math.min(1, Math.max(kReadable, H / h));
-  const view = whole >= kReadable ? all
-                                  : at(readable, 8, Math.max(0, (H - readable * h) / 2));
   const pz = Panzoom(svg, {canvas: true, maxScale: 8, minScale: Math.min(whole, 1) / 2, step: 0.3,
-                           startScale: view.scale, startX: view.x, startY: view.y});
+                           startScale: all.scale, startX: all.x, startY: all.y});
   box.addEventListener('wheel', function (e) { pz.zoomWithWheel(e); });
   const actions = {
     in: function () { pz.zoomIn(); },
     out: function () { pz.zoomOut(); },
-    reset: function () { pz.reset(); },
-    whole: function () {
-      pz.zoom(all.scale, {force: true});
-      pz.pan(all.x, all.y, {force: true});
-    }
+    whole: function () { pz.reset(); }
   };
   for (const b of document.querySelectorAll('[data-zoom]'))
     b.addEventListener('click', actions[b.dataset.zoom]);
-  box.dataset.startScale = String(view.scale);
+  box.dataset.startScale = String(all.scale);
   box.dataset.panzoom = 'ready';
 })();
 )js";
@@ -340,7 +330,6 @@ std::string report_html(const ReportContent& c) {
             "</h2><div class=\"graphs\"><figure class=\"step-figure\"><div "
             "class=\"graph-tools\"><button data-zoom=\"in\" title=\"zoom in\">+</button>"
             "<button data-zoom=\"out\" title=\"zoom out\">&minus;</button><button "
-            "data-zoom=\"reset\" title=\"back to the first view\">reset</button><button "
             "data-zoom=\"whole\" title=\"the whole graph in the box\">whole graph</button> "
             "wheel: zoom &middot; drag: pan &middot; hover a node or an edge: its text</div><div "
             "class=\"graph\" "

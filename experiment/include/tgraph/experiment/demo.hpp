@@ -32,6 +32,9 @@ struct DemoResult {
   double parallelism = 0;   ///< work / span of the first step
   std::string trace_path;
   std::string report_path;
+  /// The cost model of the predictions: "defaults" (CostModel::defaults(), no calibration
+  /// file) or the path of the calibration file read.
+  std::string cost_model;
   /// One row per strategy at `threads`, then the baselines (predictions at smaller K are in
   /// the report only).
   std::vector<viz::MethodRow> rows;
@@ -47,9 +50,11 @@ struct DemoResult {
 DemoResult run_demo(const DemoOptions& options,
                     const std::function<void(const std::string&)>& say = {});
 
-/// `tgraph demo --json`: one JSON object (scene, steps, threads, trace, report, rows).
+/// `tgraph demo --json`: one JSON object (scene, steps, threads, trace, report, cost_model,
+/// rows).
 std::string demo_json(const DemoResult& result);
-/// `tgraph demo`'s table, as printed on stdout.
+/// `tgraph demo`'s table, as printed on stdout: the cost model of its predictions, then the
+/// trace's and the report's absolute paths.
 std::string demo_text(const DemoResult& result);
 
 }  // namespace tgraph::experiment

@@ -120,6 +120,9 @@ struct ExperimentResult {
   MachineInfo machine;
   std::string date;    ///< UTC, ISO 8601
   double seconds = 0;  ///< wall time of the whole experiment
+  /// The cost model of the predictions: "defaults" (no calibration file) or the path of the
+  /// calibration file read.
+  std::string cost_model;
   std::vector<ResultRow> rows;
   std::vector<StepRow> steps;
   std::vector<SeriesSummary> series;
