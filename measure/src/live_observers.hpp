@@ -49,7 +49,9 @@ class CostObserver : public replay::Observer {
   }
   /// Writes the measured means into `g` (the next step): by task index when `g` has the
   /// structure of the measured step, else by stable key; tasks never measured get 1 ns.
-  void apply(const StepGraph& measured, StepGraph& g) const {
+  /// `match` (optional): partition::match_by_key(g, measured), when the caller has it.
+  void apply(const StepGraph& measured, StepGraph& g,
+             const std::vector<TaskId>* match = nullptr) const {
     if (exec_ == nullptr) {
       for (Task& t : g.tasks) t.cost_ns = 1;
       return;
@@ -68,6 +70,13 @@ class CostObserver : public replay::Observer {
     for (TaskId t = 0; t < sum_.size(); ++t) {
       const TaskId o = exec_->origin[t];
       if (o != kNoTask && o < cost.size() && runs_[t] > 0) cost[o] = mean(t);
+    }
+    if (match != nullptr && match->size() == g.tasks.size()) {
+      for (TaskId t = 0; t < g.tasks.size(); ++t) {
+        const TaskId m = (*match)[t];
+        g.tasks[t].cost_ns = m != kNoTask && m < cost.size() ? std::max<std::uint64_t>(1, cost[m]) : 1;
+      }
+      return;
     }
     std::unordered_map<StableKey, std::uint64_t> by_key;
     by_key.reserve(cost.size());

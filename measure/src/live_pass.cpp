@@ -69,9 +69,13 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
       if (!reused) m.graph_update_ns = cur.graph_update_ns;
       const std::int64_t t1 = replay::now_ns();
       if (partition) {
+        // A changed structure: its tasks matched in the previous one by stable key, once for
+        // the costs and the carried-over assignment.
+        std::vector<TaskId> match;
+        if (have_prev && !reused) match = partition::match_by_key(cur.graph, *prev_graph);
         if (feed_costs) {
           if (have_prev) {
-            costs.apply(reused ? cur.graph : *prev_graph, cur.graph);
+            costs.apply(reused ? cur.graph : *prev_graph, cur.graph, reused ? nullptr : &match);
           } else {
             for (Task& t : cur.graph.tasks) t.cost_ns = 1;
           }
@@ -80,7 +84,8 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
         const std::uint32_t k = ex.threads();
         // An assignment made for `g` (maybe of an earlier structure), for the current step.
         auto adopt = [&](Assignment a, const StepGraph& g) {
-          if (!cur.graph.same_structure(g)) a = partition::carry_over(cur.graph, k, &g, &a);
+          if (&g != &cur.graph && !cur.graph.same_structure(g))
+            a = partition::carry_over(cur.graph, k, &g, &a);
           if (a.proc != assignment.proc || a.order != assignment.order) m.reassigned = true;
           assignment = std::move(a);
           trigger.reset();
@@ -96,7 +101,8 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
           std::shared_ptr<const Assignment> before;
           if (changed) {
             before = std::make_shared<const Assignment>(assignment);
-            adopt(partition::carry_over(cur.graph, k, prev_graph.get(), before.get()), cur.graph);
+            adopt(partition::carry_over(cur.graph, k, prev_graph.get(), before.get(), &match),
+                  cur.graph);
           }
           if (auto done = bg->take()) {
             m.background_partition_ns += done->partition_ns;

@@ -221,7 +221,7 @@ StepPartitioner step_partitioner(std::string_view method, const Options& options
 }
 
 Assignment carry_over(const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
-                      const Assignment* prev) {
+                      const Assignment* prev, const std::vector<TaskId>* match_given) {
   if (k == 0) throw UsageError("k must be at least 1");
   if ((prev_graph == nullptr) != (prev == nullptr))
     throw UsageError("previous step: graph and assignment must be given together");
@@ -234,7 +234,13 @@ Assignment carry_over(const StepGraph& g, std::uint32_t k, const StepGraph* prev
   const std::vector<std::uint64_t> work = detail::task_work(g);
   std::vector<std::uint64_t> load(k, 0);
   std::vector<bool> placed(n, false);
-  const std::vector<TaskId> match = match_by_key(g, *prev_graph);
+  std::vector<TaskId> own;
+  const std::vector<TaskId>* m = match_given;
+  if (m == nullptr || m->size() != n) {
+    own = match_by_key(g, *prev_graph);
+    m = &own;
+  }
+  const std::vector<TaskId>& match = *m;
   for (TaskId t = 0; t < n; ++t)
     if (match[t] != kNoTask && match[t] < prev->proc.size()) {
       a.proc[t] = prev->proc[match[t]];
@@ -316,10 +322,21 @@ void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& wor
                        std::uint32_t k, const std::vector<bool>& placed,
                        std::vector<ProcId>& proc, std::vector<std::uint64_t>& load) {
   const auto n = static_cast<TaskId>(g.tasks.size());
-  std::vector<std::vector<ProcId>> holders(g.data.size());  // processors holding each datum
+  // Only the data the unplaced tasks touch need their holders (a step carried over from the
+  // previous one has few new tasks): marked first, the others never looked at again.
+  constexpr std::uint32_t kUnused = UINT32_MAX;
+  std::vector<std::uint32_t> slot(g.data.size(), kUnused);
+  std::uint32_t used = 0;
+  for (TaskId t = 0; t < n; ++t)
+    if (!placed[t])
+      for (const Access& acc : g.accesses_of(t))
+        if (slot[acc.datum] == kUnused) slot[acc.datum] = used++;
+  if (used == 0) return;
+  std::vector<std::vector<ProcId>> holders(used);  // processors holding each marked datum
   auto hold = [&](TaskId t, ProcId p) {
     for (const Access& acc : g.accesses_of(t)) {
-      auto& h = holders[acc.datum];
+      if (slot[acc.datum] == kUnused) continue;
+      auto& h = holders[slot[acc.datum]];
       if (std::find(h.begin(), h.end(), p) == h.end()) h.push_back(p);
     }
   };
@@ -330,7 +347,8 @@ void place_by_affinity(const StepGraph& g, const std::vector<std::uint64_t>& wor
     if (placed[t]) continue;
     std::fill(score.begin(), score.end(), 0);
     for (const Access& acc : g.accesses_of(t))
-      for (ProcId p : holders[acc.datum]) score[p] += std::max<std::uint64_t>(g.data[acc.datum].bytes, 1);
+      for (ProcId p : holders[slot[acc.datum]])
+        score[p] += std::max<std::uint64_t>(g.data[acc.datum].bytes, 1);
     ProcId best = static_cast<ProcId>(std::min_element(load.begin(), load.end()) - load.begin());
     for (ProcId p = 0; p < k; ++p)
       if (score[p] > score[best] || (score[p] == score[best] && load[p] < load[best])) best = p;

@@ -196,8 +196,9 @@ StepPartitioner step_partitioner(std::string_view method, const Options& options
 /// touch, else the least loaded (sticky's incremental placement, without its rebalance).
 /// Without a previous step (both null): the owner-compute rule, `owner`. A live run applies
 /// it at once and lets the strategy's own assignment follow from a background thread.
+/// `match` (optional): match_by_key(g, *prev_graph), when the caller has it already.
 Assignment carry_over(const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
-                      const Assignment* prev);
+                      const Assignment* prev, const std::vector<TaskId>* match = nullptr);
 
 /// Imbalance of `a` on `g` as its processors meet: the most loaded processor's work outside
 /// the heavy loops (each dynamic loop holding at least `loop_share` of the step's work, cost
