@@ -65,12 +65,17 @@ class PinningObserver final : public tbb::task_scheduler_observer {
   ~PinningObserver() override { observe(false); }
   void on_scheduler_entry(bool /*worker*/) override {
     const int idx = tbb::this_task_arena::current_thread_index();
-    detail::bind_current_thread(pin_, static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % threads_);
+    detail::bind_current_thread(pin_.load(std::memory_order_relaxed),
+                                static_cast<std::uint32_t>(idx < 0 ? 0 : idx) %
+                                    threads_.load(std::memory_order_relaxed));
   }
 
  private:
-  bool pin_;
-  std::uint32_t threads_;
+  // Written once before observe(true); oneTBB's observer list orders that before any entry,
+  // but inside libtbb, which ThreadSanitizer does not see: atomics (relaxed is enough, the
+  // order comes from oneTBB) so that the tsan build does not report the read as a race.
+  std::atomic<bool> pin_;
+  std::atomic<std::uint32_t> threads_;
 };
 
 class WorkstealExecutor final : public detail::PlannedExecutor<WsPlan> {
