@@ -152,6 +152,11 @@ TEST(Adapter, ABodyThatDependsOnItsThreadIsReportedAsDiffersNamingItsRegion) {
   };
   LiveOptions o = options(2, 2);
   o.policy = replay::Policy::kPartition;
+  // The partitioner's placement at the second step (in the foreground: the first step has
+  // the owner rule before any cost is measured), and no stealing: the main thread, idle,
+  // would otherwise take processor 1's tasks and run the planted body on its own thread.
+  o.background_partition = false;
+  o.exec.partition.steal = false;
   const LiveResult r = run_live(
       [] {
         auto e = std::make_shared<Tiny>();
