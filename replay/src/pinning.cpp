@@ -45,14 +45,13 @@ struct Topology {
         order.push_back(hwloc_get_obj_by_type(topo, HWLOC_OBJ_PU, static_cast<unsigned>(i)));
     }
   }
-  ~Topology() {
-    if (topo) hwloc_topology_destroy(topo);
-  }
 };
 
+// Never destroyed: oneTBB's worker threads outlive static destruction and may still enter an
+// arena (and bind themselves) while the process exits.
 Topology& topology() {
-  static Topology t;
-  return t;
+  static Topology* t = new Topology;
+  return *t;
 }
 
 /// The calling thread's binding by the rule: the slot whose PU it is bound to, or -1.

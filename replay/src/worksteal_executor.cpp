@@ -65,11 +65,17 @@ class PinningObserver final : public tbb::task_scheduler_observer {
     TGRAPH_TSAN_RELEASE(this);
     observe(true);
   }
-  ~PinningObserver() override { observe(false); }
+  ~PinningObserver() override {
+    // observe(false) waits for the entries in progress (inside libtbb): after it, this
+    // object may go.
+    observe(false);
+    TGRAPH_TSAN_ACQUIRE(this);
+  }
   void on_scheduler_entry(bool /*worker*/) override {
     TGRAPH_TSAN_ACQUIRE(this);
     const int idx = tbb::this_task_arena::current_thread_index();
     detail::bind_current_thread(pin_, static_cast<std::uint32_t>(idx < 0 ? 0 : idx) % threads_);
+    TGRAPH_TSAN_RELEASE(this);
   }
 
  private:
