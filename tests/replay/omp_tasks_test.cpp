@@ -81,13 +81,22 @@ TEST(OmpTasks, WithoutATaskwaitPerIterationTheUnrolledStepStillMatches) {
 }
 
 TEST(OmpTasks, SaysWhichOpenMPRuntimeRuns) {
-  // libgomp unless the ctest that preloads LLVM's libomp says otherwise (tests/replay).
+  // The runtime the build links (clang's -fopenmp: LLVM's libomp; GCC's: libgomp) unless the
+  // ctest that preloads LLVM's libomp says otherwise (tests/replay).
   const char* want = std::getenv("TGRAPH_EXPECT_OPENMP_RUNTIME");
-  EXPECT_EQ(openmp_runtime(), want != nullptr ? std::string(want) : std::string("gnu"));
+#if defined(__clang__)
+  const std::string linked = "llvm";
+#else
+  const std::string linked = "gnu";
+#endif
+  EXPECT_EQ(openmp_runtime(), want != nullptr ? std::string(want) : linked);
 }
 
 TEST(OmpTasks, WaitingForTheBreakTaskOnlyStillMatches) {
   // taskwait depend(in:) on the break task: unrolled (replay) and host-decided (live) loops.
+  // The executor refuses it on LLVM's runtime (libomp 14 aborts on it), which a clang build
+  // links.
+  if (openmp_runtime() == "llvm") GTEST_SKIP() << "taskwait depend is refused on LLVM's runtime";
   for (std::uint32_t seed = 1; seed <= 4; ++seed)
     for (std::uint32_t k : {2u, 3u}) {
       const StepGraph g = test::random_graph(seed * 23 + k);
