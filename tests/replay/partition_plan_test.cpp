@@ -22,17 +22,7 @@ using detail::PartitionPlan;
 using detail::WaitKind;
 using detail::WaitPoint;
 
-// Tasks of kind "t" on one object, each with the given accesses, in program order.
-StepGraph chain_graph(const std::vector<std::vector<Access>>& tasks, std::size_t data) {
-  StepGraph g;
-  const KindId kind = g.intern_kind("t");
-  g.objects.push_back({"o"});
-  for (std::size_t d = 0; d < data; ++d) g.data.push_back({"d" + std::to_string(d), 0, 8});
-  for (std::size_t i = 0; i < tasks.size(); ++i)
-    g.add_task(kind, 0, tasks[i], 0, static_cast<StableKey>(i + 1));
-  g.derive_edges();
-  return g;
-}
+using test::chain_graph;
 
 // t0 writes d0; t1 reads d0, writes d1; t2 reads d1.
 StepGraph three_task_chain() {

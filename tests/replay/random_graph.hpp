@@ -20,6 +20,19 @@
 
 namespace tgraph::replay::test {
 
+/// Tasks of kind "t" on one object, each with the given accesses, in program order, over
+/// `data` data of 8 bytes ("d0", "d1", ...).
+inline StepGraph chain_graph(const std::vector<std::vector<Access>>& tasks, std::size_t data) {
+  StepGraph g;
+  const KindId kind = g.intern_kind("t");
+  g.objects.push_back({"o"});
+  for (std::size_t d = 0; d < data; ++d) g.data.push_back({"d" + std::to_string(d), 0, 8});
+  for (std::size_t i = 0; i < tasks.size(); ++i)
+    g.add_task(kind, 0, tasks[i], 0, static_cast<StableKey>(i + 1));
+  g.derive_edges();
+  return g;
+}
+
 /// A random program: straight-line segments and do-while loops whose body ends with a task
 /// writing the condition and the break reading it. Accesses: R 40%, CW 30%, W 15%, RW 15%.
 inline StepGraph random_graph(std::uint32_t seed, int segments = 4, int per_segment = 10,
