@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common.hpp"
 #include "tgraph/experiment/threads.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
@@ -146,15 +147,6 @@ std::vector<std::string> parse_policies(const std::string& text) {
     if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
   }
   return out;
-}
-
-std::string utc_date() {
-  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
-  std::tm tm{};
-  gmtime_r(&now, &tm);
-  std::ostringstream s;
-  s << std::put_time(&tm, "%Y-%m-%dT%H:%M:%SZ");
-  return s.str();
 }
 
 /// Times `g` under one executor: a warm-up step, then the median of `repeat` steps.
@@ -303,7 +295,7 @@ MetgResult run_metg(const MetgOptions& options, Progress& progress) {
   res.options = options;
   if (res.options.out_dir.empty()) res.options.out_dir = "tgraph-experiment-metg";
   res.machine = probe_machine();
-  res.date = utc_date();
+  res.date = detail::utc_now();
   const std::uint32_t cores = std::max(1u, res.machine.cores);
   if (options.threads.empty()) {
     for (std::uint32_t k = 1; k <= cores; ++k) res.threads.push_back(k);

@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 
+#include "common.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -12,30 +13,13 @@
 namespace tgraph::experiment {
 namespace {
 
+using detail::join;
+using detail::split_list;
+
 // The paper compares its partitioned executor with work stealing and per-operation
 // barriers; the toolkit adds METIS, Scotch, sticky, OpenMP tasks and StarPU.
 const std::vector<std::string> kAllMethods = {"owner",   "metis",     "scotch", "sticky", "worksteal",
                                               "barrier", "omp-tasks", "starpu"};
-
-std::vector<std::string> split_list(std::string_view text) {
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', at), text.size());
-    out.emplace_back(text.substr(at, comma - at));
-    at = comma + 1;
-  }
-  return out;
-}
-
-std::string join(const std::vector<std::string>& v, const char* sep = ",") {
-  std::string s;
-  for (const std::string& x : v) {
-    if (!s.empty()) s += sep;
-    s += x;
-  }
-  return s;
-}
 
 bool is_strategy(const std::string& m) {
   const std::vector<std::string> names = partition::strategy_names();

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 
+#include "common.hpp"
 #include "output.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
@@ -28,20 +29,13 @@
 namespace tgraph::experiment {
 namespace {
 
+using detail::utc_now;
+
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
 namespace meas = tgraph::measure;
 
 double ms(double ns) { return ns / 1e6; }
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
 
 samples::SceneOptions scene_options(const SceneVariant& v) {
   samples::SceneOptions so;
@@ -213,11 +207,7 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
   res.date = utc_now();
   const ExperimentPlan& p = res.plan;
   const std::string name(to_string(p.name));
-  std::error_code ec;
-  std::filesystem::create_directories(p.out_dir, ec);
-  if (ec || !std::filesystem::is_directory(p.out_dir))
-    throw UsageError("--out " + p.out_dir + ": cannot create the results folder" +
-                     (ec ? " (" + ec.message() + ")" : std::string(" (a file is in the way)")));
+  detail::make_results_folder(p.out_dir);
   progress.set_total(p.runs());
   progress.note("experiment " + name + " on " + res.machine.summary() + ": measured at " +
                 std::to_string(p.threads.measured.size()) +

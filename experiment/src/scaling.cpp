@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common.hpp"
 #include "tgraph/experiment/threads.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
@@ -30,6 +31,10 @@
 namespace tgraph::experiment {
 namespace {
 
+using detail::join;
+using detail::split_list;
+using detail::utc_now;
+
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
 namespace meas = tgraph::measure;
@@ -37,35 +42,6 @@ namespace meas = tgraph::measure;
 // The partition strategies the issue measures, then every baseline policy.
 const std::vector<std::string> kDefaultMethods = {"owner",   "metis",     "sticky", "worksteal",
                                                   "barrier", "omp-tasks", "starpu"};
-
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-std::vector<std::string> split_list(std::string_view text) {
-  std::vector<std::string> out;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', at), text.size());
-    out.emplace_back(text.substr(at, comma - at));
-    at = comma + 1;
-  }
-  return out;
-}
-
-std::string join(const std::vector<std::string>& v, const char* sep = ",") {
-  std::string s;
-  for (const std::string& x : v) {
-    if (!s.empty()) s += sep;
-    s += x;
-  }
-  return s;
-}
 
 std::vector<std::string> parse_methods(std::string_view text) {
   const std::vector<std::string> strategies = tp::strategy_names();
@@ -324,11 +300,7 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
   res.plan = plan_scaling(options, res.machine.cores);
   res.date = utc_now();
   const ScalingPlan& p = res.plan;
-  std::error_code ec;
-  std::filesystem::create_directories(p.out_dir, ec);
-  if (ec || !std::filesystem::is_directory(p.out_dir))
-    throw UsageError("--out " + p.out_dir + ": cannot create the results folder" +
-                     (ec ? " (" + ec.message() + ")" : std::string(" (a file is in the way)")));
+  detail::make_results_folder(p.out_dir);
   progress.set_total(p.runs());
   progress.note("experiment scaling on " + res.machine.summary() + ": " +
                 std::to_string(p.scenes.size()) + " scenes, " + std::to_string(p.methods.size()) +
