@@ -169,7 +169,12 @@ PROBE = """<script>
     function () { p.wheel = svg.style.transform; document.querySelector('[data-zoom="whole"]').click(); },
     function () {
       p.whole = svg.style.transform;
+      // Panzoom animates its buttons (a CSS transition on transform): the box measured is
+      // the one the transition ends on, not a frame of it.
+      var transition = svg.style.transition;
+      svg.style.transition = 'none';
       p.whole_width = svg.getBoundingClientRect().width;
+      svg.style.transition = transition;
       p.box_width = box.getBoundingClientRect().width;
       document.querySelector('[data-zoom="in"]').click();
     },
