@@ -147,7 +147,6 @@ void replay(const Args& a, meas::ReplayOptions& o, const tp::NamedOptions& model
   } else if (!a.assignment.empty()) {
     throw UsageError("an assignment file is only used by --policy partition");
   }
-  if (o.exec.threads == 0) throw UsageError("--threads must be at least 1");
   if (o.first_step >= trace.steps.size() && !trace.steps.empty())
     throw UsageError("--first-step " + std::to_string(o.first_step) + ": the trace has " +
                      std::to_string(trace.steps.size()) + " steps");

@@ -21,6 +21,9 @@ void add_validate(CLI::App& app) {
   cmd->add_option("--method", o->method,
                   "Partitioning strategy, or a baseline policy (worksteal, barrier, sequential)");
   cmd->add_option("--steps", o->steps, "Steps (default 20)");
+  cmd->add_option("--split", o->scene_options.split,
+                  "Deformable objects: split each internal force field into N tasks (overrides split=)")
+      ->check(CLI::Range(1, 1024));
   cmd->add_option("--repeat", o->repeat,
                   "Rounds of live pass, capture, replay pass and simulation (medians; default 3)");
   cmd->add_option("--calibration", o->calibration,

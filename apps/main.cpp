@@ -6,6 +6,7 @@
 #include <new>
 
 #include "commands.hpp"
+#include "option_words.hpp"
 #include "tgraph/version.hpp"
 
 int main(int argc, char** argv) {
@@ -29,7 +30,7 @@ int main(int argc, char** argv) {
     const bool bad_input =
         dynamic_cast<const CLI::ParseError*>(&e) || dynamic_cast<const tgraph::Error*>(&e);
     const bool no_memory = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
-    std::cerr << "tgraph: " << (no_memory ? "out of memory" : e.what()) << "\n";
+    std::cerr << "tgraph: " << (no_memory ? "out of memory" : error_line(e)) << "\n";
     return bad_input ? 2 : 1;  // Failure and other errors of the work: 1
   }
   return 0;

@@ -9,6 +9,7 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/mpi/session.hpp"
 #include "tgraph/version.hpp"
+#include "../option_words.hpp"
 #include "verbs.hpp"
 
 int main(int argc, char** argv) {
@@ -34,7 +35,7 @@ int main(int argc, char** argv) {
       const bool bad_input = dynamic_cast<const tgraph::Error*>(&e) != nullptr;
       const bool no_memory = dynamic_cast<const std::bad_alloc*>(&e) != nullptr;
       std::cerr << "tgraph-mpi: rank " << session.rank() << ": "
-                << (no_memory ? "out of memory" : e.what()) << "\n";
+                << (no_memory ? "out of memory" : tgraph::app::error_line(e)) << "\n";
       // The other ranks may be blocked in a collective: end the whole job.
       MPI_Abort(MPI_COMM_WORLD, bad_input ? 2 : 1);
       return bad_input ? 2 : 1;

@@ -42,8 +42,9 @@ Validation validate(const ValidateOptions& o) {
     lo.repeat = 1;
     lo.observe = false;
     const std::string scene = o.scene;
-    const LiveResult live =
-        run_live([scene] { return make_live_engine(scene); }, part ? &*part : nullptr, lo);
+    const samples::SceneOptions so = o.scene_options;
+    const LiveResult live = run_live([scene, so] { return make_live_engine(scene, so); },
+                                     part ? &*part : nullptr, lo);
     r.live_ns = live.wall_ns;
     r.engine_ns = live.baseline_wall_ns;
     // The main thread's work between the steps' tasks, as this live run measured it.
@@ -60,7 +61,7 @@ Validation validate(const ValidateOptions& o) {
       model.spin_budget_ns = std::max(model.spin_budget_ns, static_cast<double>(tr::kLongSpinNs));
 
     // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
-    const Trace trace = capture_trace(o.scene, o.steps);
+    const Trace trace = capture_trace(o.scene, o.steps, o.scene_options);
     for (const StepGraph& g : trace.steps) r.host_ns += g.host_ns;
     std::optional<TraceAssignment> assignment;
     if (partition)

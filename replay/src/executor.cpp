@@ -341,9 +341,9 @@ std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
 std::unique_ptr<Executor> make_omp_tasks_executor(const ExecOptions& o);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
-  if (options.threads == 0) throw UsageError("--threads must be at least 1");
+  if (options.threads == 0) throw OptionError("threads", "must be at least 1");
   if (options.threads > 1024 && policy != Policy::kSequential)
-    throw UsageError("--threads must be at most 1024");
+    throw OptionError("threads", "must be at most 1024");
   switch (policy) {
     case Policy::kSequential: {  // one thread, whatever was asked for
       ExecOptions o = options;

@@ -103,6 +103,14 @@ TEST_F(Cli, UnknownSceneExits2) {
   EXPECT_FALSE(fs::exists(dir_ / "x.tgt"));
 }
 
+TEST_F(Cli, AModulesOptionErrorNamesTheFlag) {
+  // The executor refuses threads = 0 naming its field; tgraph says the flag.
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  const Result r = run("replay f.tgt --policy worksteal --threads 0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "tgraph: --threads: must be at least 1\n");
+}
+
 TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {
   ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
   Result r = run("export f.tgt --step 3 --format json");

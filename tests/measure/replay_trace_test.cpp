@@ -83,7 +83,7 @@ TEST(ReplayTrace, RejectsMissingAssignmentsAndZeroThreads) {
     replay_trace(trace, nullptr, quick(Policy::kWorksteal, 0));
     FAIL() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--threads must be at least 1");
+    EXPECT_STREQ(e.what(), "threads: must be at least 1");  // the field; tgraph says --threads
   }
   ReplayOptions o = quick(Policy::kSequential, 1);
   o.first_step = 2;

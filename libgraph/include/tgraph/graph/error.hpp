@@ -45,6 +45,47 @@ class UsageError : public Error {
   using Error::Error;
 };
 
+/// A bad value or combination of an API call's options, named by the options' fields, not
+/// by a command line's words: the modules know fields, the front ends (apps/, Python) know
+/// their flags. `option` is the field at fault (snake_case, e.g. "threads"); `problem` may
+/// name other fields as `{field}`. what() is "threads: must be at least 1", each `{field}`
+/// written as the bare field name; a front end writes it in its own words with render().
+class OptionError : public UsageError {
+ public:
+  OptionError(std::string option, std::string problem)
+      : UsageError(render_with(option, problem, [](const std::string& f) { return f; })),
+        option_(std::move(option)),
+        problem_(std::move(problem)) {}
+  /// The field at fault.
+  const std::string& option() const { return option_; }
+  /// The problem, with `{field}` where it names another field.
+  const std::string& problem() const { return problem_; }
+  /// "<name(option)>: <problem>", every `{field}` of the problem replaced by name(field).
+  template <class Name>
+  std::string render(const Name& name) const {
+    return render_with(option_, problem_, name);
+  }
+
+ private:
+  template <class Name>
+  static std::string render_with(const std::string& option, const std::string& problem,
+                                 const Name& name) {
+    std::string s = name(option) + ": ";
+    for (std::size_t i = 0; i < problem.size(); ++i) {
+      const std::size_t close = problem[i] == '{' ? problem.find('}', i) : std::string::npos;
+      if (close == std::string::npos) {
+        s += problem[i];
+        continue;
+      }
+      s += name(problem.substr(i + 1, close - i - 1));
+      i = close;
+    }
+    return s;
+  }
+  std::string option_;
+  std::string problem_;
+};
+
 }  // namespace tgraph
 
 #if defined(TGRAPH_ENABLE_ASSERT)

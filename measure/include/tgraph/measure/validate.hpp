@@ -8,12 +8,14 @@
 #include <vector>
 
 #include "tgraph/measure/method.hpp"
+#include "tgraph/samples/scene.hpp"
 
 namespace tgraph::measure {
 
 /// What to validate.
 struct ValidateOptions {
   std::string scene;
+  samples::SceneOptions scene_options;  ///< the scene's overrides (split), live and captured
   std::string method = "owner";  ///< strategy, or a baseline policy (choose_method)
   std::uint32_t threads = 1;
   std::uint32_t steps = 20;

@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: MIT
+// How the command line says a module's OptionError: the options' fields as flags.
+#pragma once
+
+#include <exception>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+
+namespace tgraph::app {
+
+/// The flag of an options field: "threads_per_rank" -> "--threads-per-rank".
+inline std::string flag_of(std::string field) {
+  for (char& c : field)
+    if (c == '_') c = '-';
+  return "--" + field;
+}
+
+/// The one line a command prints for an error: an OptionError in the command line's words,
+/// anything else as it is.
+inline std::string error_line(const std::exception& e) {
+  if (const auto* o = dynamic_cast<const OptionError*>(&e)) return o->render(flag_of);
+  return e.what();
+}
+
+}  // namespace tgraph::app
