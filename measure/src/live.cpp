@@ -98,7 +98,8 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     if (!ex) ex = make();
     detail::PassOptions po;
     po.feed_costs = partition;
-    po.keep_assignments = po.keep_state = pass == 0 && o.check;
+    po.keep_state = pass == 0 && o.check;
+    po.keep_assignments = pass == 0 && (o.check || o.keep_assignments);
     passes.push_back(detail::run_pass(make_engine, partitioner, *ex, o, po));
     res.plans_built += ex->plans_built();
     res.order_fallbacks += ex->order_fallbacks();
@@ -121,6 +122,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   res.parks = first.parks;
   res.pass_wall_ns = wall.pass_totals();
   res.steps = first.steps;  // the first pass's plan and structure figures
+  if (o.keep_assignments) res.assignments = first.assignments;
   for (std::uint32_t s = 0; s < o.steps; ++s) {
     LiveStepMeasure& m = res.steps[s];
     m.wall_ns = wall.step_median(s);

@@ -316,6 +316,7 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
       pred ? nlohmann::json(v.predicted_over_replay) : nlohmann::json(nullptr);
   j["model"] = v.model;
   j["model_terms"] = v.model_terms;
+  j["rounds_with_live_assignments"] = v.rounds_with_live_assignments;
   return j.dump() + "\n";
 }
 
@@ -346,6 +347,9 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
     std::string terms;
     for (const std::string& t : v.model_terms) terms += (terms.empty() ? "" : ", ") + t;
     out += "  model " + v.model + ": " + terms + "\n";
+    std::snprintf(line, sizeof line, "  assignments     the live run's in %u of %zu rounds\n",
+                  v.rounds_with_live_assignments, v.rounds.size());
+    out += line;
   }
   return out;
 }

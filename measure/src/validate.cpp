@@ -20,6 +20,18 @@ namespace tgraph::measure {
 
 namespace tr = tgraph::replay;
 
+namespace {
+
+/// Whether `ran` (a live run's assignments) assigns every step of `trace`, task for task.
+bool live_ran(const Trace& trace, const std::vector<Assignment>& ran, std::uint32_t k) {
+  if (ran.size() != trace.steps.size()) return false;
+  for (std::size_t s = 0; s < ran.size(); ++s)
+    if (!validate(trace.steps[s], ran[s], k).empty()) return false;
+  return true;
+}
+
+}  // namespace
+
 Validation validate(const ValidateOptions& o) {
   Validation v;
   v.choice = choose_method(o.method);
@@ -41,6 +53,7 @@ Validation validate(const ValidateOptions& o) {
     lo.steps = o.steps;
     lo.repeat = 1;
     lo.observe = false;
+    lo.keep_assignments = partition;
     const std::string scene = o.scene;
     const samples::SceneOptions so = o.scene_options;
     const LiveResult live = run_live([scene, so] { return make_live_engine(scene, so); },
@@ -63,9 +76,16 @@ Validation validate(const ValidateOptions& o) {
     // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
     const Trace trace = capture_trace(o.scene, o.steps, o.scene_options);
     for (const StepGraph& g : trace.steps) r.host_ns += g.host_ns;
+    // The replay and the simulator run what the live run ran: its assignment of each step,
+    // the carried-over ones of changed structures included, when the capture recorded the
+    // same steps (the scenes are deterministic); else the strategy's partition of the capture.
     std::optional<TraceAssignment> assignment;
-    if (partition)
+    if (partition && live_ran(trace, live.assignments, v.threads)) {
+      assignment = TraceAssignment{v.choice.method, v.threads, live.assignments, {}};
+      ++v.rounds_with_live_assignments;
+    } else if (partition) {
       assignment = partition::partition_trace(trace, v.choice.method, v.threads).assignment;
+    }
     ReplayOptions ro;
     ro.policy = v.choice.policy;
     ro.exec.threads = v.threads;

@@ -61,6 +61,10 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   EXPECT_EQ(j.at("method"), "metis");
   EXPECT_EQ(j.at("threads"), 2);
   EXPECT_DOUBLE_EQ(j.at("replay_over_live").get<double>(), v.replay_over_live);
+  // The capture records the live run's steps, so every round replays and simulates the
+  // assignments the live run used.
+  EXPECT_EQ(v.rounds_with_live_assignments, 3u);
+  EXPECT_EQ(j.at("rounds_with_live_assignments"), 3);
 }
 
 TEST(Validate, ABaselinePolicyHasNoPrediction) {
@@ -72,6 +76,7 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
   EXPECT_TRUE(j.at("predicted_ns").is_null());
   EXPECT_TRUE(j.at("predicted_over_live").is_null());
   EXPECT_GT(j.at("replay_over_live").get<double>(), 0.0);
+  EXPECT_EQ(v.rounds_with_live_assignments, 0u);
 }
 
 TEST(Validate, RefusesZeroThreadsStepsOrRounds) {

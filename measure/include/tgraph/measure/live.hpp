@@ -39,6 +39,9 @@ struct LiveOptions {
   bool observe = true;            ///< one more pass with observers (threads, kinds), plus a
                                   ///< sequential one for the per-kind comparison
   bool check = false;             ///< compare the final state with a sequential reference
+  /// Keep the assignment each step of the first pass ran (LiveResult::assignments): what a
+  /// model of this run must simulate, carried-over steps included.
+  bool keep_assignments = false;
   std::uint32_t cost_stride = 8;  ///< cost feedback samples loop iterations 0, 1, every n-th
   /// Partition policy: call the partitioner at every step. Default: at the first step, once
   /// costs were first measured, when the structure changed, and when the trigger
@@ -116,6 +119,8 @@ struct LiveResult {
   std::uint64_t plans_built = 0, order_fallbacks = 0;
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;  ///< first pass
   std::vector<KindTime> kinds;                                         ///< observed passes
+  /// Partition policy with LiveOptions::keep_assignments: the first pass's, one per step.
+  std::vector<Assignment> assignments;
   /// The check of the final state (LiveOptions::check; nullopt: not checked).
   std::optional<Check> check;
   std::string check_reference;  ///< what the final state was compared with

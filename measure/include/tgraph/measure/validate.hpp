@@ -49,6 +49,10 @@ struct Validation {
   double replay_over_live = 0, predicted_over_live = 0, predicted_over_replay = 0;
   std::string model;                     ///< the cost model's source
   std::vector<std::string> model_terms;  ///< what the prediction charged
+  /// Partition policy: the rounds whose replay and prediction ran the assignments the live
+  /// run used, step by step (carried-over steps included); the others (a capture whose
+  /// steps do not match the live run's) ran the strategy's offline partition of the capture.
+  std::uint32_t rounds_with_live_assignments = 0;
 };
 
 /// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a
