@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The verbs of the `tgraph` command line. Each verb lives in its own cmd_<verb>.cpp and
-// only parses flags and calls the modules.
+// The verbs of `tgraph`: each cmd_<verb>.cpp binds flags, calls the modules and prints.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -18,24 +17,18 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/samples/capture_run.hpp"
-
-namespace tgraph::partition {
-struct NamedOptions;
-}  // namespace tgraph::partition
+#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
 
 /// The work itself failed (exit 1), as opposed to bad input (tgraph::Error, exit 2).
-class Failure : public std::runtime_error {
- public:
+struct Failure : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// Values of a verb's flags that no module's option struct holds (each verb owns one; module
-/// options such as partition::NamedOptions or replay::LiveOptions hold the rest).
+/// Values of a verb's flags that no module's option struct holds (each verb owns one).
 struct Args {
-  std::string input, assignment, output, method, policy, format, cw, timeline, chrome, csv;
+  std::string input, assignment, output, method, policy, format, timeline, chrome, csv;
   std::string compare, range, collapse = "none";
   std::vector<std::string> names;
   std::vector<std::uint32_t> counts;
@@ -53,8 +46,7 @@ struct Args {
 struct SerialFlags {
   std::string live;                        ///< a `tgraph run --json` output
   std::optional<std::uint64_t> serial_ns;  ///< the same for every step
-  /// The per-step values for a trace of `steps` steps (empty: neither flag); UsageError when
-  /// the run has fewer steps than the trace.
+  /// Per step of a `steps`-step trace (empty: neither flag); UsageError for a shorter run.
   std::vector<std::uint64_t> per_step(std::size_t steps) const;
 };
 /// Adds `--live` and `--serial-ns` to `cmd`.
@@ -66,44 +58,23 @@ inline void warn(const std::string& text) { std::cerr << "tgraph: warning: " << 
 inline void print_json(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 /// Threads a verb uses by default: all hardware threads (at least 1).
 inline std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
-/// Header of a trace captured from a scene (samples).
-using samples::scene_header;
 
-// Registration of each verb (one function per cmd_*.cpp).
-void add_info(CLI::App& app);
-void add_export(CLI::App& app);
-void add_diff(CLI::App& app);
-void add_capture(CLI::App& app);
-void add_generate(CLI::App& app);
-void add_demo(CLI::App& app);
-void add_experiment(CLI::App& app);
-void add_partition_verbs(CLI::App& app);  // partition, evaluate, compare, import, calibrate
 /// The partitioning flags of `partition`, `compare` and `run` (strategy, phases, cost model).
 void add_strategy_flags(CLI::App* cmd, partition::NamedOptions& n);
-void add_replay_verbs(CLI::App& app);     // replay, run
-void add_validate(CLI::App& app);         // validate (live vs replay vs simulator)
-void add_viz_verbs(CLI::App& app);        // viz, then add_timeline and add_report
-void add_timeline(CLI::App& app);
-void add_report(CLI::App& app);
-void add_simulate(CLI::App& app);         // simulate (builtin or SimGrid)
-void add_platform(CLI::App& app);         // platform (SimGrid platform file)
+/// Registers a verb or a family (add_partition_verbs: partition, evaluate, compare, import,
+/// calibrate; add_replay_verbs: replay, run; add_viz_verbs: viz, timeline, report).
+using AddVerbs = void(CLI::App& app);
+AddVerbs add_info, add_export, add_diff, add_capture, add_generate, add_demo, add_experiment,
+    add_partition_verbs, add_replay_verbs, add_validate, add_viz_verbs, add_timeline, add_report,
+    add_simulate, add_platform;
 
 /// Every verb, in the order `tgraph --help` lists them (main() and the command-line fuzz
 /// target register the same set).
 inline void add_all_verbs(CLI::App& app) {
-  add_demo(app);
-  add_experiment(app);
-  add_capture(app);
-  add_generate(app);
-  add_info(app);
-  add_export(app);
-  add_diff(app);
-  add_partition_verbs(app);
-  add_simulate(app);
-  add_platform(app);
-  add_replay_verbs(app);
-  add_validate(app);
-  add_viz_verbs(app);
+  for (AddVerbs* add : {add_demo, add_experiment, add_capture, add_generate, add_info, add_export,
+                        add_diff, add_partition_verbs, add_simulate, add_platform, add_replay_verbs,
+                        add_validate, add_viz_verbs})
+    add(app);
 }
 
 }  // namespace tgraph::app

@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include "recorded_step.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/measure/report.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -22,23 +23,15 @@ class CallbackEngine final : public LiveEngine {
 
   LiveStep record_step(bool allow_reuse) override {
     capture::Recorder& rec = recorder(capture::Mode::kDeferred);
-    LiveStep step;
     if (allow_reuse && c_.same_every_step && recorded_) {
-      step.reuse_previous = true;
-      return step;
+      LiveStep same;
+      same.reuse_previous = true;
+      return same;
     }
     rec.begin_step();
     c_.step(rec);
-    capture::StepProgram p = rec.end_step_program();
-    if (rec.errors() != 0)
-      throw UsageError("engine: the recorder counted " + std::to_string(rec.errors()) +
-                       " API misuses");
+    LiveStep step = detail::take_recorded_step(rec, "engine");
     recorded_ = true;
-    step.graph = std::move(p.graph);
-    step.bodies = std::move(p.bodies);
-    step.conditions = std::move(p.conditions);
-    step.accumulators = std::move(p.accumulators);
-    step.graph_update_ns = rec.last_edge_update().ns;
     return step;
   }
 
@@ -51,13 +44,7 @@ class CallbackEngine final : public LiveEngine {
 
   std::vector<StateRegion> state() const override {
     if (c_.state) return c_.state();
-    std::vector<StateRegion> r;
-    if (!rec_) return r;
-    const std::vector<Datum>& data = rec_->data();
-    for (DatumId d = 0; d < data.size(); ++d)
-      if (rec_->datum_ptr(d) != nullptr)
-        r.push_back({data[d].name, rec_->datum_ptr(d), data[d].bytes});
-    return r;
+    return rec_ ? detail::recorded_state(*rec_) : std::vector<StateRegion>{};
   }
 
  private:

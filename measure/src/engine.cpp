@@ -4,7 +4,7 @@
 
 #include <utility>
 
-#include "tgraph/capture/recorder.hpp"
+#include "recorded_step.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::measure {
@@ -23,17 +23,7 @@ class SceneEngine final : public LiveEngine {
       same.reuse_previous = true;
       return same;
     }
-    capture::StepProgram p = rec_.end_step_program();
-    if (rec_.errors() != 0)
-      throw UsageError("scene " + scene_->name() + ": the recorder counted " +
-                       std::to_string(rec_.errors()) + " API misuses");
-    LiveStep step;
-    step.graph = std::move(p.graph);
-    step.bodies = std::move(p.bodies);
-    step.conditions = std::move(p.conditions);
-    step.accumulators = std::move(p.accumulators);
-    step.graph_update_ns = rec_.last_edge_update().ns;
-    return step;
+    return detail::take_recorded_step(rec_, "scene " + scene_->name());
   }
 
   void plain_step() override {
@@ -42,14 +32,7 @@ class SceneEngine final : public LiveEngine {
     used_ = &plain_;
   }
 
-  std::vector<StateRegion> state() const override {
-    std::vector<StateRegion> r;
-    const std::vector<Datum>& data = used_->data();
-    for (DatumId d = 0; d < data.size(); ++d)
-      if (used_->datum_ptr(d) != nullptr)
-        r.push_back({data[d].name, used_->datum_ptr(d), data[d].bytes});
-    return r;
-  }
+  std::vector<StateRegion> state() const override { return detail::recorded_state(*used_); }
 
  private:
   std::unique_ptr<samples::Scene> scene_;
@@ -59,6 +42,28 @@ class SceneEngine final : public LiveEngine {
 };
 
 }  // namespace
+
+LiveStep detail::take_recorded_step(capture::Recorder& rec, const std::string& engine) {
+  capture::StepProgram p = rec.end_step_program();
+  if (rec.errors() != 0)
+    throw UsageError(engine + ": the recorder counted " + std::to_string(rec.errors()) +
+                     " API misuses");
+  LiveStep step;
+  step.graph = std::move(p.graph);
+  step.bodies = std::move(p.bodies);
+  step.conditions = std::move(p.conditions);
+  step.accumulators = std::move(p.accumulators);
+  step.graph_update_ns = rec.last_edge_update().ns;
+  return step;
+}
+
+std::vector<StateRegion> detail::recorded_state(const capture::Recorder& rec) {
+  std::vector<StateRegion> r;
+  const std::vector<Datum>& data = rec.data();
+  for (DatumId d = 0; d < data.size(); ++d)
+    if (rec.datum_ptr(d) != nullptr) r.push_back({data[d].name, rec.datum_ptr(d), data[d].bytes});
+  return r;
+}
 
 std::unique_ptr<LiveEngine> make_live_engine(const std::string& scene,
                                              const samples::SceneOptions& options) {

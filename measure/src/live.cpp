@@ -66,8 +66,8 @@ void time_baseline_pass(const EngineFactory& make_engine, const LiveOptions& o, 
 
 LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
                     const LiveOptions& o) {
-  if (o.steps == 0) throw UsageError("live run: at least one step");
-  if (o.repeat == 0) throw UsageError("live run: at least one timed pass");
+  if (o.steps == 0) throw OptionError("steps", "must be at least 1");
+  if (o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   if (o.policy == tr::Policy::kPartition && (partitioner == nullptr || !*partitioner))
     throw UsageError("the partition policy needs a partitioning method");
   LiveResult res;

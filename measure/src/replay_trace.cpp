@@ -65,8 +65,8 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
                           TimelineObserver* timeline) {
   if (trace.steps.empty()) throw UsageError("the trace has no steps");
   if (o.first_step >= trace.steps.size())
-    throw UsageError("replay: first step " + std::to_string(o.first_step) + ", the trace has " +
-                     std::to_string(trace.steps.size()) + " steps");
+    throw OptionError("first_step", std::to_string(o.first_step) + " is past the trace's " +
+                                        std::to_string(trace.steps.size()) + " steps");
   const std::uint32_t last =
       o.steps == 0 ? static_cast<std::uint32_t>(trace.steps.size())
                    : std::min<std::uint32_t>(static_cast<std::uint32_t>(trace.steps.size()),
@@ -78,7 +78,7 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       throw UsageError("the assignment covers " + std::to_string(assignments->steps.size()) +
                        " steps, " + std::to_string(last) + " are replayed");
   }
-  if (o.repeat == 0) throw UsageError("replay: at least one timed pass");
+  if (o.repeat == 0) throw OptionError("repeat", "must be at least 1");
 
   ReplayResult r;
   r.policy = o.policy;

@@ -75,9 +75,9 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     // from GCC-built code ("Assertion failure at kmp_taskdeps.h(26): n >= 0", falling64 at 2
     // threads, docs/replay.md): refused rather than crash the process.
     if (o.omp_tasks.wait_depend && openmp_runtime() == "llvm")
-      throw UsageError(
-          "--omp-wait depend: LLVM's OpenMP runtime aborts on taskwait depend from this build "
-          "(libomp 14, kmp_taskdeps.h assertion); use --omp-wait all or --openmp-runtime gnu");
+      throw OptionError("omp_wait",
+                        "depend aborts LLVM's OpenMP runtime from this build (libomp 14, "
+                        "kmp_taskdeps.h assertion); use {omp_wait} all or {openmp_runtime} gnu");
   }
 
  private:

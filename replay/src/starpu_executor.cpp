@@ -161,16 +161,18 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
         registry_(std::make_shared<Registry>()),
         counters_(o.threads) {
     if (o.threads > STARPU_MAXCPUS)
-      throw UsageError("--policy starpu: --threads " + std::to_string(o.threads) +
-                       ": this StarPU build has at most " + std::to_string(STARPU_MAXCPUS) +
-                       " CPU workers (STARPU_MAXCPUS)");
+      throw OptionError("threads",
+                        "at most " + std::to_string(STARPU_MAXCPUS) +
+                            " with {policy} starpu (this StarPU build's CPU workers, "
+                            "STARPU_MAXCPUS); got " + std::to_string(o.threads));
     if (!known_scheduler(o.starpu.sched))
-      throw UsageError("--starpu-sched " + o.starpu.sched +
-                       ": not a StarPU scheduler; expected one of " + scheduler_names());
+      throw OptionError("starpu_sched", "'" + o.starpu.sched +
+                                            "' is not a StarPU scheduler; expected one of " +
+                                            scheduler_names());
     if (g_starpu_in_use.exchange(true))
       throw UsageError(
-          "--policy starpu: another StarPU executor is alive in this process (StarPU is one "
-          "runtime per process); destroy it first");
+          "StarPU: another StarPU executor is alive in this process (StarPU is one runtime per "
+          "process); destroy it first");
     setenv("STARPU_SILENT", "1", 0);  // StarPU's banners would spoil --json on stdout
     starpu_conf conf;
     starpu_conf_init(&conf);
@@ -202,14 +204,15 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     }
     if (rc != 0) {
       g_starpu_in_use.store(false);
-      throw Error("--policy starpu: starpu_init failed (" + std::to_string(rc) + ")");
+      throw Error("StarPU: starpu_init failed (" + std::to_string(rc) + ")");
     }
     if (starpu_cpu_worker_get_count() != o.threads) {
       const unsigned got = starpu_cpu_worker_get_count();
       starpu_shutdown();
       g_starpu_in_use.store(false);
-      throw UsageError("--policy starpu: asked for " + std::to_string(o.threads) +
-                       " CPU workers, StarPU started " + std::to_string(got));
+      throw OptionError("threads", std::to_string(o.threads) +
+                                       " CPU workers for {policy} starpu, StarPU started " +
+                                       std::to_string(got));
     }
     starpu_pause();  // idle workers poll; paused they sleep (between steps, baselines)
     starpu_codelet_init(&codelet_);
@@ -356,7 +359,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
     TGRAPH_TSAN_RELEASE(&g_submit_token);
     if (const int rc = starpu_task_submit(task); rc != 0) {
       starpu_task_destroy(task);
-      throw Error("--policy starpu: starpu_task_submit failed (" + std::to_string(rc) + ")");
+      throw Error("StarPU: starpu_task_submit failed (" + std::to_string(rc) + ")");
     }
     return wait ? task : nullptr;
   }
@@ -386,8 +389,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
               starpu_task* brk = submit(loop.last - 1, it, Check::kDecide, true);
               const Instance& in = instances_.back();
               if (const int rc = starpu_task_wait(brk); rc != 0)
-                throw Error("--policy starpu: starpu_task_wait failed (" + std::to_string(rc) +
-                            ")");
+                throw Error("StarPU: starpu_task_wait failed (" + std::to_string(rc) + ")");
               TGRAPH_TSAN_ACQUIRE(&join_token_);
               stats.loop_iterations[l] = it + 1;
               if (in.decision != 0) break;  // leave, or the break task did not run (failure)
@@ -457,9 +459,9 @@ namespace tgraph::replay {
 
 std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o) {
   (void)o;
-  throw UsageError(
-      "--policy starpu: tgraph was built without StarPU (install Debian's libstarpu-dev, "
-      "pkg-config starpu-1.3, and configure again)");
+  throw OptionError("policy",
+                    "starpu needs StarPU, and tgraph was built without StarPU (install Debian's "
+                    "libstarpu-dev, pkg-config starpu-1.3, and configure again)");
 }
 
 std::optional<std::uint32_t> max_threads(Policy /*policy*/) { return std::nullopt; }

@@ -109,6 +109,13 @@ TEST_F(Cli, AModulesOptionErrorNamesTheFlag) {
   const Result r = run("replay f.tgt --policy worksteal --threads 0");
   EXPECT_EQ(r.code, 2);
   EXPECT_EQ(r.err, "tgraph: --threads: must be at least 1\n");
+  // StarPU's executor names its scheduler field (or the policy, in a build without StarPU).
+  const Result s = run("replay f.tgt --policy starpu --threads 1 --starpu-sched no-such");
+  EXPECT_EQ(s.code, 2);
+  EXPECT_TRUE(one_line(s.err)) << s.err;
+  EXPECT_TRUE(s.err.starts_with("tgraph: --starpu-sched: 'no-such' is not a StarPU scheduler") ||
+              s.err.starts_with("tgraph: --policy: starpu needs StarPU"))
+      << s.err;
 }
 
 TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {

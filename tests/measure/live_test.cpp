@@ -39,16 +39,23 @@ partition::StepPartitioner partitioner_for(const std::string& method) {
   };
 }
 
-LiveResult live(const std::string& scene, Policy policy, const std::string& method, std::uint32_t k,
-                std::uint32_t steps, CwMode cw = CwMode::kReduce) {
+// A run of `steps` steps on k threads without the timed uninstrumented engine and without
+// the observed passes (what the tests below look at is in the timed pass).
+LiveOptions quiet_options(std::uint32_t k, std::uint32_t steps) {
   LiveOptions o;
-  o.policy = policy;
   o.exec.threads = k;
   o.exec.spin_ns = 20'000;
-  o.exec.cw = cw;
   o.steps = steps;
   o.baseline = false;
   o.observe = false;
+  return o;
+}
+
+LiveResult live(const std::string& scene, Policy policy, const std::string& method, std::uint32_t k,
+                std::uint32_t steps, CwMode cw = CwMode::kReduce) {
+  LiveOptions o = quiet_options(k, steps);
+  o.policy = policy;
+  o.exec.cw = cw;
   o.check = true;
   const partition::StepPartitioner p =
       policy == Policy::kPartition ? partitioner_for(method) : nullptr;
@@ -185,12 +192,7 @@ TEST(Live, PartitionsAfreshOnceCostsAreMeasuredThenFromThePreviousStep) {
     calls.push_back({pg != nullptr, unit});
     return sticky->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
   };
-  LiveOptions o;
-  o.exec.threads = 2;
-  o.exec.spin_ns = 20'000;
-  o.steps = 5;
-  o.baseline = false;
-  o.observe = false;
+  LiveOptions o = quiet_options(2, 5);
   o.repartition_every_step = true;  // a call at every step but the first
   o.background_partition = false;
   const LiveResult r = run_live([] { return make_live_engine("bars64"); }, &p, o);
@@ -243,12 +245,7 @@ TEST(Live, NoStepWaitsForABackgroundPartitioner) {
     if (recorded.load() < 6) timed_out = true;
     return metis->partition(g, k, partition::Previous{pg, pa}, {}).assignment;
   };
-  LiveOptions o;
-  o.exec.threads = 2;
-  o.exec.spin_ns = 20'000;
-  o.steps = 6;
-  o.baseline = false;
-  o.observe = false;
+  LiveOptions o = quiet_options(2, 6);
   o.check = true;
   const LiveResult r = run_live(
       [&] { return std::make_unique<CountingEngine>(make_live_engine("bars64"), recorded); }, &p,

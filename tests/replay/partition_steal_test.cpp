@@ -17,8 +17,6 @@
 namespace tgraph::replay {
 namespace {
 
-using detail::CombineRole;
-using detail::OpKind;
 using detail::PartitionPlan;
 using detail::WaitKind;
 using detail::WaitPoint;
@@ -77,8 +75,8 @@ TEST(PartitionSteal, BreaksAndCombinedReductionsStayWithTheirProcessorsAndLoopWa
   std::size_t stealable = 0;
   for (const auto& pp : plan.procs)
     for (const detail::Op& op : pp.ops) {
-      if (op.kind != OpKind::kTask) continue;
-      const bool excluded = op.is_break || op.combine != CombineRole::kNone || in_combine[op.task];
+      if (op.kind != detail::OpKind::kTask) continue;
+      const bool excluded = op.is_break || op.combine != detail::CombineRole::kNone || in_combine[op.task];
       EXPECT_EQ(plan.stealable[op.task] != 0, !excluded) << x.graph.kind_name(op.task);
       stealable += plan.stealable[op.task];
       if (!plan.stealable[op.task]) {

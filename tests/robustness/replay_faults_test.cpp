@@ -237,6 +237,16 @@ TaskId cross_producer(const StepGraph& g, const Assignment& a) {
   return kNoTask;
 }
 
+// Partition executor options on k unpinned threads whose watchdog fires after `timeout_ms`.
+ExecOptions watched(std::uint32_t k, std::int64_t timeout_ms) {
+  ExecOptions o;
+  o.threads = k;
+  o.pin = false;
+  o.spin_ns = 1000;
+  o.partition.timeout_ms = timeout_ms;
+  return o;
+}
+
 TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
   const StepGraph& g = falling_step();
   const int before = process_threads();
@@ -244,11 +254,7 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
     const Assignment a = by_object(g, k);
     const TaskId lost = cross_producer(g, a);
     ASSERT_NE(lost, kNoTask);
-    ExecOptions o;
-    o.threads = k;
-    o.pin = false;
-    o.spin_ns = 1000;
-    o.partition.timeout_ms = 200;
+    ExecOptions o = watched(k, 200);
     // Every cross-processor producer gets its own wait (none is implied by a later one of
     // the same processor), so the lost signal is always waited for.
     o.partition.elide_waits = false;
@@ -300,11 +306,7 @@ TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
   const detail::Combine& c = plan.combines[0];
   reducer = plan.procs[c.home].ops[c.head].task;
   ASSERT_NE(lost, kNoTask);
-  ExecOptions o;
-  o.threads = 2;
-  o.pin = false;
-  o.spin_ns = 1000;
-  o.partition.timeout_ms = 200;
+  ExecOptions o = watched(2, 200);
   auto ex = detail::make_partition_executor_for_tests(o, {.lose_signal = lost});
   FaultyWorkload w;
   try {
@@ -384,11 +386,7 @@ TEST(Watchdog, IsOffWithTimeoutZero) {
   const Assignment a = by_object(g, 2);
   const TaskId slow = cross_producer(g, a);
   ASSERT_NE(slow, kNoTask);
-  ExecOptions o;
-  o.threads = 2;
-  o.pin = false;
-  o.spin_ns = 1000;
-  o.partition.timeout_ms = 100;
+  ExecOptions o = watched(2, 100);
   {
     auto ex = make_executor(Policy::kPartition, o);
     SlowWorkload w(slow, std::chrono::milliseconds(1000));

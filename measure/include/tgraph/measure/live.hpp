@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tgraph/measure/engine.hpp"
+#include "tgraph/measure/method.hpp"
 #include "tgraph/measure/state.hpp"
 #include "tgraph/measure/step_record.hpp"
 #include "tgraph/partition/strategy.hpp"
@@ -138,5 +139,27 @@ struct LiveResult {
 /// temporaries, for CwMode::kSerialize and the sequential policy the plain program order.
 LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
                     const LiveOptions& options);
+
+/// `tgraph run`: a samples scene live under one method.
+struct SceneRun {
+  std::string scene;  ///< a built-in scene or a scene file
+  samples::SceneOptions scene_options;
+  std::optional<std::uint32_t> steps;  ///< default: the scene's
+  MethodChoice method;
+  partition::NamedOptions strategy;  ///< the partition policy's partitioner
+  LiveOptions live;                  ///< its policy, steps and loop_share come from the above
+  bool json = false;                 ///< report as one JSON line (else text)
+};
+
+/// The run and its report.
+struct SceneRunReport {
+  LiveResult result;
+  std::string report;  ///< the JSON line or the text, ready to print
+};
+
+/// Runs `run.scene` live (run_live over make_live_engine), the partition policy's steps
+/// partitioned by partition::step_partitioner; InputError for an unknown scene, OptionError
+/// for the options run_live refuses.
+SceneRunReport run_scene(const SceneRun& run);
 
 }  // namespace tgraph::measure

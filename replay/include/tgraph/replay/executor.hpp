@@ -244,5 +244,9 @@ std::string_view openmp_runtime();
 /// The file of LLVM's OpenMP runtime (libomp) found when tgraph was configured, for a
 /// process that preloads it (empty when none was found).
 std::string_view llvm_openmp_library();
+/// Makes the process run on OpenMP runtime `name` ("gnu" or "llvm"): returns when it already
+/// does; for "llvm", starts the process again (same arguments, /proc/self/cmdline) with
+/// llvm_openmp_library() preloaded. OptionError("openmp_runtime") when it cannot.
+void use_openmp_runtime(std::string_view name);
 
 }  // namespace tgraph::replay
