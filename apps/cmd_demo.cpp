@@ -20,7 +20,7 @@ void add_demo(CLI::App& app) {
   cmd->add_option("--steps", o->steps, "Steps to capture");
   cmd->add_option("--threads", o->threads, "Replay threads (default: all hardware threads)");
   cmd->add_option("--repeat", o->repeat, "Timed passes per replay (medians)");
-  cmd->add_option("--out", o->out_dir, "Folder for the trace and report.html");
+  cmd->add_option("--out", o->out, "Folder for the trace and report.html");
   cmd->add_flag("--json", *json, "Print one JSON object");
   cmd->callback([o, json] {
     const auto say = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };

@@ -4,22 +4,18 @@
 # results.json, one record per (policy, shape, threads), sane values, the charts written.
 # No timing assertions (the figures depend on the machine and its load).
 #   check_metg.py TGRAPH
-import json
 import os
 import sys
 import tempfile
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-from experiment_check import check, problems, run_experiment  # noqa: E402
+from experiment_check import check, problems, run_quick_json  # noqa: E402
 
 tgraph = sys.argv[1]
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "metg")
-    run = run_experiment(tgraph, ["metg", "--quick", "--out", out, "--json"], timeout=600)
-    printed = json.loads(run.stdout)
-    j = json.load(open(os.path.join(out, "results.json")))
-    check(printed["metg"] == j["metg"], "--json and results.json disagree on metg")
+    j = run_quick_json(tgraph, "metg", out, timeout=600)
     print(f"metg: {len(j['metg'])} records reached 50 %, {len(j['unreached'])} not, "
           f"{j['seconds']:.0f} s")
     shapes = ["trivial", "stencil", "fft", "random_nearest", "bars64"]
