@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
-// `tgraph demo` (and `tgraph` alone): capture a built-in scene, partition it with every
-// strategy, evaluate each offline, replay each on all cores against the baselines, print the
-// comparison and write the HTML report (the pipeline: experiment/demo.hpp).
+// `tgraph demo` (and `tgraph` alone): the pipeline of experiment/demo.hpp, from a capture to
+// the HTML report.
 #include <cstdio>
 #include <iostream>
 

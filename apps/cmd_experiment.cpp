@@ -1,6 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `tgraph experiment NAME`: one of the paper's experiments, metg or scaling
-// (experiment::run_named).
+// `tgraph experiment NAME`: the paper's experiments, metg or scaling (experiment::run_named).
 #include <cstdio>
 #include <iostream>
 
@@ -16,23 +15,19 @@ void add_experiment(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "experiment", "Run one of the paper's experiments: live speed-ups, replays, predictions");
   cmd->add_option("name", a->method,
-                  "independent, heterogeneous, domain or medical (the paper's), metg (Task "
-                  "Bench's minimum effective task granularity for every policy) or scaling "
-                  "(live runs of four scenes for every method and thread count, with where "
-                  "the time goes)")
+                  "independent, heterogeneous, domain or medical (the paper's), metg (Task Bench's "
+                  "METG per policy) or scaling (live runs per method and thread count)")
       ->required()
       ->check(CLI::IsMember(experiment::all_experiment_names()));
   add_thread_list(cmd, "--threads", o->threads,
-                  "Thread counts, e.g. 1-4,8,16 (default: 1 to the cores, then powers of 2 to "
-                  "64; scaling: powers of 2 up to the cores); counts above the cores are "
+                  "Thread counts, e.g. 1-4,8,16 (default: the experiment's); above the cores: "
                   "predicted only (scaling: run oversubscribed)");
   cmd->add_option("--out", o->out, "Results folder (default tgraph-experiment-NAME)");
   cmd->add_flag("--quick", o->quick, "Few steps, one pass (a smoke run)");
   cmd->add_option("--steps", o->steps, "Steps per run (default: the experiment's)");
   cmd->add_option("--repeat", o->repeat, "Timed passes per run, medians (default 3; scaling: 1)");
   cmd->add_option("--methods", o->methods,
-                  "Comma list of strategies and baselines (metg: of policies; default: the "
-                  "experiment's)")
+                  "Strategies and baselines, e.g. owner,worksteal (metg: policies)")
       ->delimiter(',');
   cmd->add_option("--subobjects", o->subobjects,
                   "domain: comma list of sub-object counts (perfect squares; default 16,64)")

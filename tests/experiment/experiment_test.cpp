@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "../option_error.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::experiment {
@@ -42,14 +43,9 @@ TEST(ThreadList, CountsAreSortedWithoutDuplicates) {
 }
 
 TEST(ThreadList, RejectsZeroAndCountsAboveTheLimitNamingTheField) {
-  for (const Ks& bad : {Ks{0}, Ks{1, 0}, Ks{kMaxThreads + 1}}) {
-    try {
-      thread_counts(bad);
-      ADD_FAILURE() << "accepted " << bad.back();
-    } catch (const OptionError& e) {
-      EXPECT_EQ(e.option(), "threads") << e.what();
-    }
-  }
+  for (const Ks& bad : {Ks{0}, Ks{1, 0}, Ks{kMaxThreads + 1}})
+    EXPECT_EQ(test::option_error([&bad] { thread_counts(bad); }).rfind("threads: ", 0), 0u)
+        << bad.back();
   EXPECT_EQ(thread_counts({kMaxThreads}), (Ks{kMaxThreads}));
 }
 
@@ -155,43 +151,56 @@ TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {
 }
 
 TEST(Plan, RejectsBadOptionsNamingTheField) {
-  // The field at fault and the problem ("methods", "unknown method ..."), or "accepted".
-  const auto error = [](ExperimentOptions o) {
-    try {
-      plan_experiment(o, 2);
-    } catch (const OptionError& e) {
-      return e.option() + ": " + e.problem();
-    }
-    return std::string("accepted");
-  };
   ExperimentOptions o;
+  const auto error = [&o] { return test::option_error([&o] { plan_experiment(o, 2); }); };
   o.methods = {"owner", "nonsense"};
-  EXPECT_EQ(error(o).rfind("methods: unknown method 'nonsense'", 0), 0u) << error(o);
+  EXPECT_EQ(error().rfind("methods: unknown method 'nonsense'", 0), 0u) << error();
   o.methods = {"sequential"};
-  EXPECT_EQ(error(o), "methods: sequential is every run's reference, not a method");
+  EXPECT_EQ(error(), "methods: sequential is every run's reference, not a method");
   o.methods = {"partition"};
-  EXPECT_EQ(error(o).rfind("methods: name the partitioning strategy", 0), 0u) << error(o);
+  EXPECT_EQ(error().rfind("methods: name the partitioning strategy", 0), 0u) << error();
   o = {};
   o.subobjects = {4};  // not the domain experiment
-  EXPECT_EQ(error(o), "subobjects: applies to the domain experiment only");
+  EXPECT_EQ(error(), "subobjects: applies to the domain experiment only");
   o.name = ExperimentName::kDomain;
   for (int bad : {5, 0, -4, 8, 4225}) {
     o.subobjects = {4, bad};
-    EXPECT_EQ(error(o), "subobjects: " + std::to_string(bad) +
+    EXPECT_EQ(error(), "subobjects: " + std::to_string(bad) +
                             " is not a perfect square from 1 to 4096 (expected e.g. 4,16,64)");
   }
   o = {};
   o.steps = 0;
-  EXPECT_EQ(error(o), "steps: must be at least 1");
+  EXPECT_EQ(error(), "steps: must be at least 1");
   o = {};
   o.repeat = 0;
-  EXPECT_EQ(error(o), "repeat: must be at least 1");
+  EXPECT_EQ(error(), "repeat: must be at least 1");
   o = {};
   o.threads = {2, 0};
-  EXPECT_EQ(error(o).rfind("threads: 0 threads is out of range", 0), 0u) << error(o);
+  EXPECT_EQ(error().rfind("threads: 0 threads is out of range", 0), 0u) << error();
+}
+
+TEST(Named, RefusesTheOptionsAnExperimentDoesNotTake) {
+  ExperimentOptions o;
+  Progress quiet(nullptr, false);
+  const auto error = [&](const char* name) {
+    return test::option_error([&] { run_named(name, o, quiet); });
+  };
+  o.subobjects = {4};
+  for (const char* name : {"independent", "metg", "scaling"})
+    EXPECT_EQ(error(name), "subobjects: applies to the domain experiment only") << name;
+  o = {};
+  o.replay = false;
+  EXPECT_EQ(error("scaling"), "replay: the scaling experiment makes live runs only");
+  o = {};
+  o.methods = {"owner"};  // metg's methods are replay policies
+  EXPECT_EQ(error("metg").rfind("methods: unknown policy 'owner'", 0), 0u) << error("metg");
+  EXPECT_THROW(run_named("nosuch", o, quiet), UsageError);
 }
 
 TEST(Names, RoundTrip) {
+  EXPECT_EQ(all_experiment_names(), (std::vector<std::string>{"independent", "heterogeneous",
+                                                              "domain", "medical", "metg",
+                                                              "scaling"}));
   for (const std::string& n : experiment_names()) {
     const std::optional<ExperimentName> e = parse_experiment_name(n);
     ASSERT_TRUE(e.has_value()) << n;

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "../option_error.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::experiment {
@@ -73,29 +74,21 @@ TEST(ScalingPlan, FlagsOverrideTheDefaultsAndCountsAboveTheCoresAreNoted) {
 }
 
 TEST(ScalingPlan, RejectsBadOptionsNamingTheField) {
-  // The field at fault ("methods"), or "accepted".
-  auto field = [](ScalingOptions o) {
-    try {
-      plan_scaling(o, 2);
-    } catch (const OptionError& e) {
-      return e.option();
-    }
-    return std::string("accepted");
-  };
-  for (const char* bad : {"nosuch", "sequential", "partition"}) {
-    ScalingOptions o;
-    o.methods = {"owner", bad};
-    EXPECT_EQ(field(o), "methods") << bad;
-  }
   ScalingOptions o;
+  const auto error = [&o] { return test::option_error([&o] { plan_scaling(o, 2); }); };
+  for (const char* bad : {"nosuch", "sequential", "partition"}) {
+    o.methods = {"owner", bad};
+    EXPECT_EQ(error().rfind("methods: ", 0), 0u) << bad;
+  }
+  o = {};
   o.threads = {0};
-  EXPECT_EQ(field(o), "threads");
+  EXPECT_EQ(error(), "threads: 0 threads is out of range (expected 1 to 1024)");
   o = {};
   o.steps = 0;
-  EXPECT_EQ(field(o), "steps");
+  EXPECT_EQ(error(), "steps: must be at least 1");
   o = {};
   o.repeat = 0;
-  EXPECT_EQ(field(o), "repeat");
+  EXPECT_EQ(error(), "repeat: must be at least 1");
 }
 
 }  // namespace
