@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
-// `tgraph demo` (and `tgraph` alone): capture a built-in scene, partition it with every
-// strategy, evaluate each offline, replay each on all cores against the baselines, print the
-// comparison and write the HTML report (the pipeline: experiment/demo.hpp).
+// `tgraph demo` (and `tgraph` alone): the pipeline of experiment/demo.hpp, from a capture to
+// the HTML report.
 #include <cstdio>
 #include <iostream>
 
@@ -20,7 +19,7 @@ void add_demo(CLI::App& app) {
   cmd->add_option("--steps", o->steps, "Steps to capture");
   cmd->add_option("--threads", o->threads, "Replay threads (default: all hardware threads)");
   cmd->add_option("--repeat", o->repeat, "Timed passes per replay (medians)");
-  cmd->add_option("--out", o->out_dir, "Folder for the trace and report.html");
+  cmd->add_option("--out", o->out, "Folder for the trace and report.html");
   cmd->add_flag("--json", *json, "Print one JSON object");
   cmd->callback([o, json] {
     const auto say = [](const std::string& s) { std::fprintf(stderr, "%s\n", s.c_str()); };

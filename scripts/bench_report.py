@@ -236,8 +236,7 @@ def ratios(all_runs):
     i = all_runs.get("incremental_bench", {})
     out = []
 
-    out.append("### Capture on/off")
-    out.append("")
+    out += ["### Capture on/off", ""]
     out.append("`samples_bench`, `BM_CaptureOverhead/<scene>` (the three modes stepped in "
                "lockstep; median over the repetitions of each repetition's median per-step "
                "ratio):")
@@ -274,8 +273,7 @@ def ratios(all_runs):
                    f"per access (its slope).")
     out.append("")
 
-    out.append("### Sticky versus a full METIS")
-    out.append("")
+    out += ["### Sticky versus a full METIS", ""]
     out.append("After a contact change (`incremental_bench`, `BM_FallingPartition`: median "
                "over the falling steps whose structure changed of each step's partitioning "
                "time):")
@@ -308,8 +306,7 @@ def ratios(all_runs):
         out.append(f"| {scene} | {k} | {fmt(m)} | {fmt(st)} | {fmt(ratio(st, m))} |")
     out.append("")
 
-    out.append("### Executor overhead per task")
-    out.append("")
+    out += ["### Executor overhead per task", ""]
     seq_row = r.get("BM_TaskOverhead/sequential/threads:1", {}).get("median")
     seq_ns = med(r, "BM_TaskOverhead/sequential/threads:1", "ns_per_task")
     instances = ""
@@ -369,8 +366,7 @@ def ratios(all_runs):
                        f"1 on a quiet machine), hand-off {fmt(probe('probe_handoff_ns'))} ns.")
     out.append("")
 
-    out.append("### Signal -> wait")
-    out.append("")
+    out += ["### Signal -> wait", ""]
     spin = med(r, "BM_SignalWait/spin", "latency_ns")
     futex = med(r, "BM_SignalWait/futex", "latency_ns")
     h = {sp: med(r, f"BM_Handoff/work_ns:0/spin_ns:{sp}", "handoff_ns") for sp in (0, 5000, 50000)}
@@ -386,8 +382,7 @@ def ratios(all_runs):
                        f"(`BM_Handoff/work_ns:0/spin_ns:{sp}`) | {fmt(v)} |")
     out.append("")
 
-    out.append("### Graph rebuild after a contact change / step time")
-    out.append("")
+    out += ["### Graph rebuild after a contact change / step time", ""]
     step = med(i, "BM_FallingStep", "median_ms")
     step_c = med(i, "BM_FallingStep", "changes_median_ms")
     out.append(f"`incremental_bench`: an uninstrumented falling step takes {fmt(step)} ms "
@@ -413,8 +408,7 @@ def ratios(all_runs):
                "so the parts need not add up to the total.)")
     out.append("")
 
-    out.append("### Dependency extraction and traces")
-    out.append("")
+    out += ["### Dependency extraction and traces", ""]
     rows = []
     for name in g:
         mm = re.match(r"BM_DeriveEdges/tasks:(\d+)$", name)

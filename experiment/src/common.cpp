@@ -4,19 +4,34 @@
 #include <algorithm>
 #include <ctime>
 #include <filesystem>
+#include <optional>
 #include <system_error>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/partition/strategy.hpp"
+#include "tgraph/replay/policy.hpp"
 
 namespace tgraph::experiment::detail {
 
-std::vector<std::string> split_list(std::string_view text) {
+std::vector<std::string> check_methods(const std::vector<std::string>& methods) {
+  const std::vector<std::string> strategies = partition::strategy_names();
   std::vector<std::string> out;
-  std::size_t at = 0;
-  while (at <= text.size()) {
-    const std::size_t comma = std::min(text.find(',', at), text.size());
-    out.emplace_back(text.substr(at, comma - at));
-    at = comma + 1;
+  for (const std::string& m : methods) {
+    const std::optional<replay::Policy> p = replay::parse_policy(m);
+    if (p == replay::Policy::kSequential)
+      throw OptionError("methods", "sequential is every run's reference, not a method");
+    if (p == replay::Policy::kPartition)
+      throw OptionError("methods", "name the partitioning strategy (owner, metis, sticky, ...) "
+                                   "instead of partition");
+    if (!p && std::find(strategies.begin(), strategies.end(), m) == strategies.end())
+      throw OptionError("methods", "unknown method '" + m + "' (expected strategies " +
+                                       join(strategies, ", ") +
+                                       " or baselines worksteal, barrier, omp-tasks, starpu)");
+#ifndef TGRAPH_HAVE_STARPU
+    if (p == replay::Policy::kStarpu)
+      throw OptionError("methods", "starpu is not in this build (libstarpu-dev was not found)");
+#endif
+    if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   }
   return out;
 }
@@ -28,6 +43,12 @@ std::string join(const std::vector<std::string>& v, const char* sep) {
     s += x;
   }
   return s;
+}
+
+std::string join(const std::vector<std::uint32_t>& v) {
+  std::vector<std::string> items;
+  for (std::uint32_t x : v) items.push_back(std::to_string(x));
+  return join(items);
 }
 
 std::string utc_now() {
@@ -43,8 +64,8 @@ void make_results_folder(const std::string& dir) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec || !std::filesystem::is_directory(dir))
-    throw UsageError("--out " + dir + ": cannot create the results folder" +
-                     (ec ? " (" + ec.message() + ")" : std::string(" (a file is in the way)")));
+    throw OptionError("out", "cannot create the results folder " + dir +
+                                 (ec ? " (" + ec.message() + ")" : " (a file is in the way)"));
 }
 
 }  // namespace tgraph::experiment::detail

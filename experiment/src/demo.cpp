@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "common.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
@@ -84,9 +85,9 @@ std::string cost_model_words(const std::string& name, const tp::CostModel& m) {
 }  // namespace
 
 DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::string&)>& say_fn) {
-  if (o.steps < 1) throw UsageError("demo: --steps must be >= 1");
-  if (o.threads < 1) throw UsageError("demo: --threads must be >= 1");
-  std::filesystem::create_directories(o.out_dir);
+  if (o.steps < 1) throw OptionError("steps", "must be at least 1");
+  if (o.threads < 1) throw OptionError("threads", "must be at least 1");
+  detail::make_results_folder(o.out);
   const auto say = [&](const std::string& s) {
     if (say_fn) say_fn(s);
   };
@@ -97,7 +98,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   res.steps = o.steps;
   res.threads = o.threads;
   res.repeat = o.repeat;
-  res.trace_path = o.out_dir + "/" + o.scene + ".tgt";
+  res.trace_path = o.out + "/" + o.scene + ".tgt";
   write_trace(res.trace_path, trace);
   const Metrics m0 = compute_metrics(trace.steps.front());
   res.tasks = m0.tasks;
@@ -109,7 +110,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   std::vector<viz::MethodRow> rows, predictions;  // predictions: K < threads, not replayed
   std::vector<viz::StepSeries> series;
   std::vector<TraceAssignment> assignments;
-  std::vector<std::uint32_t> ks;  // predicted at powers of two below --threads, measured at it
+  std::vector<std::uint32_t> ks;  // predicted at powers of two below `threads`, measured at it
   for (std::uint32_t k = 2; k < o.threads; k *= 2) ks.push_back(k);
   ks.push_back(o.threads);
   for (const std::string& method : tp::strategy_names()) {
@@ -190,7 +191,7 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   c.timeline = observed_timeline(trace, assignments[best], o);
   c.timeline_caption =
       rows[best].method + " on " + std::to_string(o.threads) + " threads, observed pass.";
-  res.report_path = o.out_dir + "/report.html";
+  res.report_path = o.out + "/report.html";
   write_file_atomic(res.report_path, viz::report_html(c));
   res.rows = std::move(rows);
   return res;

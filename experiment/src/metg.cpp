@@ -129,21 +129,20 @@ StepGraph sized_bars64(const StepGraph& captured, std::uint64_t task_ns, std::ui
 /// every measured thread count has parallel slack.
 std::uint32_t shape_width(std::uint32_t cores) { return std::max(4u, 2 * cores); }
 
-std::vector<std::string> parse_policies(const std::string& text) {
+std::vector<std::string> check_policies(const std::vector<std::string>& names) {
   std::vector<std::string> out;
-  if (text.empty()) {
+  if (names.empty()) {
     out = {"sequential", "partition", "worksteal", "barrier", "omp-tasks"};
 #ifdef TGRAPH_HAVE_STARPU
     out.push_back("starpu");
 #endif
     return out;
   }
-  std::stringstream ss(text);
-  for (std::string p; std::getline(ss, p, ',');) {
+  for (const std::string& p : names) {
     if (!tr::parse_policy(p))
-      throw UsageError("--policies " + text + ": unknown policy '" + p +
-                       "' (expected sequential, partition, worksteal, barrier, omp-tasks, "
-                       "starpu)");
+      throw OptionError("methods", "unknown policy '" + p +
+                                       "' (expected sequential, partition, worksteal, barrier, "
+                                       "omp-tasks, starpu)");
     if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
   }
   return out;
@@ -212,8 +211,7 @@ viz::SeriesChart efficiency_chart(const MetgResult& res, const std::string& shap
 
 void write_outputs(MetgResult& res) {
   namespace fs = std::filesystem;
-  const std::string dir = res.options.out_dir;
-  fs::create_directories(dir);
+  const std::string dir = res.options.out;
   std::vector<std::pair<std::string, std::string>> files;
   std::ostringstream csv;
   csv << "policy,shape,threads,task_ns,instances,wall_ns,efficiency,work_efficiency,"
@@ -285,24 +283,25 @@ StepGraph metg_graph(MetgShape shape, std::uint32_t width, std::uint32_t steps,
 std::string MetgResult::command() const {
   std::string s = "tgraph experiment metg";
   if (options.quick) s += " --quick";
-  if (!options.threads.empty()) s += " --threads " + options.threads;
-  if (!options.policies.empty()) s += " --policies " + options.policies;
-  return s + " --out " + options.out_dir;
+  if (!options.threads.empty()) s += " --threads " + detail::join(threads);
+  if (!options.methods.empty()) s += " --methods " + detail::join(policies);
+  return s + " --out " + options.out;
 }
 
 MetgResult run_metg(const MetgOptions& options, Progress& progress) {
   MetgResult res;
   res.options = options;
-  if (res.options.out_dir.empty()) res.options.out_dir = "tgraph-experiment-metg";
+  if (res.options.out.empty()) res.options.out = "tgraph-experiment-metg";
   res.machine = probe_machine();
   res.date = detail::utc_now();
   const std::uint32_t cores = std::max(1u, res.machine.cores);
   if (options.threads.empty()) {
     for (std::uint32_t k = 1; k <= cores; ++k) res.threads.push_back(k);
   } else {
-    res.threads = parse_thread_list(options.threads, "--threads");
+    res.threads = thread_counts(options.threads);
   }
-  res.policies = parse_policies(options.policies);
+  res.policies = check_policies(options.methods);
+  detail::make_results_folder(res.options.out);
   for (MetgShape s : kShapes) res.shapes.emplace_back(to_string(s));
   const Sweep sweep = sweep_for(options.quick);
   const auto t0 = std::chrono::steady_clock::now();
@@ -479,7 +478,7 @@ std::string metg_text(const MetgResult& res) {
       s << "\n";
     }
   for (const std::string& line : res.skipped) s << line << "\n";
-  s << "files in " << res.options.out_dir << ":";
+  s << "files in " << res.options.out << ":";
   for (const std::string& f : res.files) s << " " << f;
   s << "\n";
   return s.str();

@@ -1,65 +1,32 @@
 // SPDX-License-Identifier: MIT
 // Experiment names, their defaults, the plan of runs, and what the paper reports.
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 
 #include "common.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/strategy.hpp"
-#include "tgraph/replay/policy.hpp"
 
 namespace tgraph::experiment {
 namespace {
 
 using detail::join;
-using detail::split_list;
 
 // The paper compares its partitioned executor with work stealing and per-operation
 // barriers; the toolkit adds METIS, Scotch, sticky, OpenMP tasks and StarPU.
 const std::vector<std::string> kAllMethods = {"owner",   "metis",     "scotch", "sticky", "worksteal",
                                               "barrier", "omp-tasks", "starpu"};
 
-bool is_strategy(const std::string& m) {
-  const std::vector<std::string> names = partition::strategy_names();
-  return std::find(names.begin(), names.end(), m) != names.end();
-}
-
-std::vector<std::string> parse_methods(std::string_view text) {
-  std::vector<std::string> out;
-  for (const std::string& m : split_list(text)) {
-    const std::optional<replay::Policy> p = replay::parse_policy(m);
-    if (p == replay::Policy::kSequential)
-      throw UsageError("--methods " + std::string(text) +
-                       ": sequential is the reference of every run, not a method");
-    if (p == replay::Policy::kPartition)
-      throw UsageError("--methods " + std::string(text) +
-                       ": name the partitioning strategy (owner, metis, ...) instead of partition");
-    if (!p && !is_strategy(m))
-      throw UsageError("--methods " + std::string(text) + ": unknown method '" + m +
-                       "' (expected strategies " + join(partition::strategy_names(), ", ") +
-                       " or baselines worksteal, barrier, omp-tasks, starpu)");
-#ifndef TGRAPH_HAVE_STARPU
-    if (p == replay::Policy::kStarpu)
-      throw UsageError("--methods " + std::string(text) +
-                       ": starpu is not in this build (libstarpu-dev was not found)");
-#endif
-    if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
-  }
-  return out;
-}
-
-std::vector<int> parse_subobjects(std::string_view text) {
+// The sub-object counts, without duplicates; OptionError for one that is not a perfect
+// square from 1 to 4096 (a sheet cut into n x n pieces).
+std::vector<int> check_subobjects(const std::vector<int>& counts) {
   std::vector<int> out;
-  for (const std::string& item : split_list(text)) {
-    int v = 0;
-    const auto [ptr, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+  for (int v : counts) {
     const int root = static_cast<int>(std::lround(std::sqrt(static_cast<double>(std::max(v, 0)))));
-    if (item.empty() || ec != std::errc() || ptr != item.data() + item.size() || v < 1 ||
-        root * root != v || v > 4096)
-      throw UsageError("--subobjects " + std::string(text) + ": '" + item +
-                       "' is not a perfect square from 1 to 4096 (expected e.g. 4,16,64)");
+    if (v < 1 || v > 4096 || root * root != v)
+      throw OptionError("subobjects", std::to_string(v) +
+                                          " is not a perfect square from 1 to 4096 (expected "
+                                          "e.g. 4,16,64)");
     if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
   }
   return out;
@@ -92,6 +59,12 @@ std::vector<std::string> experiment_names() {
   return {"independent", "heterogeneous", "domain", "medical"};
 }
 
+std::vector<std::string> all_experiment_names() {
+  std::vector<std::string> names = experiment_names();
+  names.insert(names.end(), {"metg", "scaling"});
+  return names;
+}
+
 std::string SceneVariant::label() const {
   return subobjects ? scene + "-s" + std::to_string(*subobjects) : scene;
 }
@@ -109,9 +82,7 @@ std::size_t ExperimentPlan::runs() const {
 
 std::string ExperimentPlan::command() const {
   std::string s = "tgraph experiment " + std::string(to_string(name));
-  std::vector<std::string> ks;
-  for (std::uint32_t k : threads.all()) ks.push_back(std::to_string(k));
-  s += " --threads " + join(ks) + " --steps " + std::to_string(steps) + " --repeat " +
+  s += " --threads " + join(threads.all()) + " --steps " + std::to_string(steps) + " --repeat " +
        std::to_string(repeat) + " --methods " + join(methods);
   if (name == ExperimentName::kDomain) {
     std::vector<std::string> subs;
@@ -129,14 +100,14 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
   ExperimentPlan p;
   p.name = o.name;
   p.cores = std::max(cores, 1u);
-  p.out_dir = o.out_dir.empty() ? "tgraph-experiment-" + std::string(to_string(o.name)) : o.out_dir;
+  p.out_dir = o.out.empty() ? "tgraph-experiment-" + std::string(to_string(o.name)) : o.out;
   const std::vector<std::uint32_t> ks =
-      o.threads.empty() ? default_thread_list(p.cores) : parse_thread_list(o.threads);
+      o.threads.empty() ? default_thread_list(p.cores) : thread_counts(o.threads);
   p.threads = split_threads(ks, p.cores);
-  if (o.steps && *o.steps == 0) throw UsageError("--steps must be at least 1");
-  if (o.repeat && *o.repeat == 0) throw UsageError("--repeat must be at least 1");
+  if (o.steps && *o.steps == 0) throw OptionError("steps", "must be at least 1");
+  if (o.repeat && *o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   if (!o.subobjects.empty() && o.name != ExperimentName::kDomain)
-    throw UsageError("--subobjects applies to the domain experiment only");
+    throw OptionError("subobjects", "applies to the domain experiment only");
 
   std::vector<std::string> methods = kAllMethods;
   std::uint32_t steps = 0;
@@ -156,7 +127,7 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
     case ExperimentName::kDomain: {
       const std::vector<int> subs =
           o.subobjects.empty() ? (o.quick ? std::vector<int>{16} : std::vector<int>{16, 64})
-                               : parse_subobjects(o.subobjects);
+                               : check_subobjects(o.subobjects);
       for (const char* scene : {"cloth128", "cloth256", "cloth512"})
         for (int s : subs) p.scenes.push_back({scene, s});
       methods = {"owner"};
@@ -175,7 +146,7 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
     p.notes.push_back("starpu: not in this build (libstarpu-dev was not found), no starpu runs");
   }
 #endif
-  p.methods = o.methods.empty() ? methods : parse_methods(o.methods);
+  p.methods = o.methods.empty() ? methods : detail::check_methods(o.methods);
   p.steps = o.steps.value_or(steps);
   p.repeat = o.repeat.value_or(o.quick ? 1 : 3);
   p.replay = o.replay.value_or(replay);

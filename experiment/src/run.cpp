@@ -29,8 +29,6 @@
 namespace tgraph::experiment {
 namespace {
 
-using detail::utc_now;
-
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
 namespace meas = tgraph::measure;
@@ -201,14 +199,9 @@ std::size_t ExperimentResult::failures() const {
 
 ExperimentResult run_experiment(const ExperimentOptions& options, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  ExperimentResult res;
-  res.machine = probe_machine();
-  res.plan = plan_experiment(options, res.machine.cores);
-  res.date = utc_now();
+  ExperimentResult res = detail::start_experiment<ExperimentResult>(options, plan_experiment, progress);
   const ExperimentPlan& p = res.plan;
   const std::string name(to_string(p.name));
-  detail::make_results_folder(p.out_dir);
-  progress.set_total(p.runs());
   progress.note("experiment " + name + " on " + res.machine.summary() + ": measured at " +
                 std::to_string(p.threads.measured.size()) +
                 " thread counts (<= " + std::to_string(p.cores) + " cores), predicted at " +

@@ -32,8 +32,6 @@ namespace tgraph::experiment {
 namespace {
 
 using detail::join;
-using detail::split_list;
-using detail::utc_now;
 
 namespace tp = tgraph::partition;
 namespace tr = tgraph::replay;
@@ -42,30 +40,6 @@ namespace meas = tgraph::measure;
 // The partition strategies the issue measures, then every baseline policy.
 const std::vector<std::string> kDefaultMethods = {"owner",   "metis",     "sticky", "worksteal",
                                                   "barrier", "omp-tasks", "starpu"};
-
-std::vector<std::string> parse_methods(std::string_view text) {
-  const std::vector<std::string> strategies = tp::strategy_names();
-  std::vector<std::string> out;
-  for (const std::string& m : split_list(text)) {
-    const std::optional<tr::Policy> p = tr::parse_policy(m);
-    const std::string flag = "--methods " + std::string(text);
-    if (p == tr::Policy::kSequential)
-      throw UsageError(flag + ": sequential is every run's reference, not a method");
-    if (p == tr::Policy::kPartition)
-      throw UsageError(flag + ": name the partitioning strategy (owner, metis, sticky, ...) "
-                              "instead of partition");
-    if (!p && std::find(strategies.begin(), strategies.end(), m) == strategies.end())
-      throw UsageError(flag + ": unknown method '" + m + "' (expected strategies " +
-                       join(strategies, ", ") + " or baselines worksteal, barrier, omp-tasks, "
-                       "starpu)");
-#ifndef TGRAPH_HAVE_STARPU
-    if (p == tr::Policy::kStarpu)
-      throw UsageError(flag + ": starpu is not in this build (libstarpu-dev was not found)");
-#endif
-    if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
-  }
-  return out;
-}
 
 samples::SceneOptions scene_options(const ScalingScene& s) {
   samples::SceneOptions so;
@@ -238,11 +212,9 @@ std::size_t ScalingPlan::runs() const {
 }
 
 std::string ScalingPlan::command() const {
-  std::vector<std::string> ks;
-  for (std::uint32_t k : threads) ks.push_back(std::to_string(k));
   std::string s = "tgraph experiment scaling";
   if (quick) s += " --quick";
-  s += " --threads " + join(ks) + " --methods " + join(methods);
+  s += " --threads " + join(threads) + " --methods " + join(methods);
   if (!scenes.empty() &&
       std::all_of(scenes.begin(), scenes.end(),
                   [&](const ScalingScene& x) { return x.steps == scenes.front().steps; }) &&
@@ -255,11 +227,11 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
   ScalingPlan p;
   p.cores = std::max(cores, 1u);
   p.quick = o.quick;
-  p.out_dir = o.out_dir.empty() ? "tgraph-experiment-scaling" : o.out_dir;
-  if (o.steps && *o.steps == 0) throw UsageError("--steps must be at least 1");
-  if (o.repeat && *o.repeat == 0) throw UsageError("--repeat must be at least 1");
+  p.out_dir = o.out.empty() ? "tgraph-experiment-scaling" : o.out;
+  if (o.steps && *o.steps == 0) throw OptionError("steps", "must be at least 1");
+  if (o.repeat && *o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   if (!o.threads.empty())
-    p.threads = parse_thread_list(o.threads);
+    p.threads = thread_counts(o.threads);
   else if (o.quick)
     p.threads = {1, 2};
   else
@@ -284,7 +256,7 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
     p.notes.push_back("starpu: not in this build (libstarpu-dev was not found), no starpu runs");
 #endif
   } else {
-    p.methods = parse_methods(o.methods);
+    p.methods = detail::check_methods(o.methods);
   }
   p.repeat = o.repeat.value_or(1);
   if (p.threads.back() > p.cores)
@@ -295,13 +267,8 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
 
 ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
-  ScalingResult res;
-  res.machine = probe_machine();
-  res.plan = plan_scaling(options, res.machine.cores);
-  res.date = utc_now();
+  ScalingResult res = detail::start_experiment<ScalingResult>(options, plan_scaling, progress);
   const ScalingPlan& p = res.plan;
-  detail::make_results_folder(p.out_dir);
-  progress.set_total(p.runs());
   progress.note("experiment scaling on " + res.machine.summary() + ": " +
                 std::to_string(p.scenes.size()) + " scenes, " + std::to_string(p.methods.size()) +
                 " methods, " + std::to_string(p.threads.size()) + " thread counts; " +

@@ -39,8 +39,9 @@ Validation validate(const ValidateOptions& o) {
   std::optional<partition::StepPartitioner> part;
   if (partition) part = partition::step_partitioner(v.choice.method);
   v.threads = v.choice.policy == replay::Policy::kSequential ? 1 : o.threads;
-  if (v.threads == 0 || o.steps == 0 || o.repeat == 0)
-    throw UsageError("validate: threads, steps and rounds must be at least 1");
+  if (v.threads == 0) throw OptionError("threads", "must be at least 1");
+  if (o.steps == 0) throw OptionError("steps", "must be at least 1");
+  if (o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   partition::CostModel model = partition::select_cost_model("calibrated", o.calibration);
   v.model = model.source;
 

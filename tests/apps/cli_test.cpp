@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/version.hpp"
@@ -116,6 +117,44 @@ TEST_F(Cli, AModulesOptionErrorNamesTheFlag) {
   EXPECT_TRUE(s.err.starts_with("tgraph: --starpu-sched: 'no-such' is not a StarPU scheduler") ||
               s.err.starts_with("tgraph: --policy: starpu needs StarPU"))
       << s.err;
+}
+
+TEST_F(Cli, ExperimentVizTimelineValidateAndDemoErrorsNameTheFlag) {
+  // Each family of the modules' option errors (and of the lists the command line parses):
+  // exit 2, one line, starting with the flag. None of them starts the work.
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  ASSERT_EQ(run("replay f.tgt --threads 2 --steps 2 --repeat 1 --timeline r.json").code, 0);
+  const std::pair<const char*, const char*> cases[] = {
+      {"experiment independent --threads 1,,2", "tgraph: --threads 1,,2: expected counts"},
+      {"experiment independent --threads 4-2", "tgraph: --threads 4-2: expected counts"},
+      {"experiment metg --threads 2000", "tgraph: --threads 2000: expected counts"},
+      {"experiment independent --methods owner,nosuch", "tgraph: --methods: unknown method 'nosuch'"},
+      {"experiment scaling --methods sequential", "tgraph: --methods: sequential is every run's"},
+      {"experiment metg --methods owner", "tgraph: --methods: unknown policy 'owner'"},
+      {"experiment domain --subobjects 5", "tgraph: --subobjects: 5 is not a perfect square"},
+      {"experiment medical --subobjects 4", "tgraph: --subobjects: applies to the domain"},
+      {"experiment scaling --no-replay", "tgraph: --replay: the scaling experiment makes live"},
+      {"experiment independent --steps 0", "tgraph: --steps: must be at least 1"},
+      {"experiment scaling --repeat 0", "tgraph: --repeat: must be at least 1"},
+      {"experiment independent --out f.tgt", "tgraph: --out: cannot create the results folder"},
+      {"demo --steps 0", "tgraph: --steps: must be at least 1"},
+      {"validate --scene fig2 --repeat 0", "tgraph: --repeat: must be at least 1"},
+      {"viz f.tgt --collapse processor -o x.svg", "tgraph: --collapse: f.tgt step 0: processor"},
+      {"viz f.tgt --max-nodes 2 -o x.svg", "tgraph: --max-nodes: f.tgt step 0: the picture"},
+      {"timeline r.json --steps 3:1 -o x.svg", "tgraph: --steps 3:1: expected a:b"},
+      {"timeline r.json --steps 7:9 -o x.svg", "tgraph: --steps: no task in steps 7 to 9"}};
+  for (const auto& [args, start] : cases) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_TRUE(one_line(r.err)) << args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(start, 0), 0u) << args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "x.svg"));
+  // A good list: ranges and repeats, sorted once (metg's quick sweep of one policy: seconds).
+  const nlohmann::json j =
+      run_json("experiment metg --quick --threads 2,1-2 --methods sequential --out m --json");
+  EXPECT_EQ(j["threads"], (nlohmann::json{1, 2}));
+  EXPECT_EQ(j["command"], "tgraph experiment metg --quick --threads 1,2 --methods sequential --out m");
 }
 
 TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {

@@ -4,22 +4,18 @@
 # results.json, one record per (policy, shape, threads), sane values, the charts written.
 # No timing assertions (the figures depend on the machine and its load).
 #   check_metg.py TGRAPH
-import json
 import os
 import sys
 import tempfile
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-from experiment_check import check, problems, run_experiment  # noqa: E402
+from experiment_check import check, problems, run_quick_json  # noqa: E402
 
 tgraph = sys.argv[1]
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "metg")
-    run = run_experiment(tgraph, ["metg", "--quick", "--out", out, "--json"], timeout=600)
-    printed = json.loads(run.stdout)
-    j = json.load(open(os.path.join(out, "results.json")))
-    check(printed["metg"] == j["metg"], "--json and results.json disagree on metg")
+    j = run_quick_json(tgraph, "metg", out, timeout=600)
     print(f"metg: {len(j['metg'])} records reached 50 %, {len(j['unreached'])} not, "
           f"{j['seconds']:.0f} s")
     shapes = ["trivial", "stencil", "fft", "random_nearest", "bars64"]
@@ -51,14 +47,15 @@ with tempfile.TemporaryDirectory() as tmp:
         ok = [p["granularity_ns"] for p in pts if p["efficiency"] >= 0.5]
         check(ok and r["metg_ns"] == min(ok), f"metg_ns of {r} is not the smallest at >= 50 %")
     # The sequential policy is the reference (efficiency 1 up to the noise between two timed
-    # runs of it): it reaches 50 % on every shape, with a granularity at least half the task
-    # duration there. (Not required at the smallest duration: on a loaded machine two
-    # sequential runs of 1 us tasks can differ by more than 2x.)
+    # runs of it): it reaches 50 % on every shape, and its granularity is at least half the
+    # task duration at every swept duration but the smallest (where, on a loaded machine, the
+    # spins' calibration is off by more than 2x: 360 ns was seen for 1 us tasks).
     for s in shapes:
         r = seen.get(("sequential", s, 1), {})
         check("metg_ns" in r, f"sequential {s} has no METG")
-        if "metg_ns" in r:
-            check(r["metg_ns"] >= 0.5 * r["task_ns"], f"sequential {s}: granularity {r}")
+        for p in j["points"]:
+            if (p["policy"], p["shape"]) == ("sequential", s) and p["task_ns"] > grid[0]:
+                check(p["granularity_ns"] >= 0.5 * p["task_ns"], f"sequential {s}: granularity {p}")
     for p in j["points"]:
         check(p["wall_ns"] > 0 and p["instances"] > 0, f"point {p}")
         g = p["threads"] * p["wall_ns"] / p["instances"]

@@ -6,13 +6,12 @@
 # the machine and its load).
 #   check_scaling.py TGRAPH
 import csv
-import json
 import os
 import sys
 import tempfile
 
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
-from experiment_check import check, problems, run_experiment  # noqa: E402
+from experiment_check import check, problems, run_quick_json  # noqa: E402
 
 tgraph = sys.argv[1]
 KEYS = {"scene", "policy", "method", "threads", "speedup", "serial_share", "inflation",
@@ -22,10 +21,7 @@ BASELINES = {"worksteal", "barrier", "omp-tasks", "starpu"}
 
 with tempfile.TemporaryDirectory() as tmp:
     out = os.path.join(tmp, "scaling")
-    run = run_experiment(tgraph, ["scaling", "--quick", "--out", out, "--json"], timeout=600)
-    printed = json.loads(run.stdout)
-    j = json.load(open(os.path.join(out, "results.json")))
-    check(printed["scaling"] == j["scaling"], "--json and results.json disagree on scaling")
+    j = run_quick_json(tgraph, "scaling", out, timeout=600)
     print(f"scaling: {len(j['scaling'])} records, {len(j['skipped'])} skipped, "
           f"{j['seconds']:.0f} s")
     check(j["threads"] == [1, 2], f"threads {j['threads']}: --quick asks for 1,2")

@@ -46,7 +46,7 @@ DemoResult tiny_demo(const fs::path& out) {
   o.steps = 2;
   o.threads = 2;
   o.repeat = 1;
-  o.out_dir = out.string();
+  o.out = out.string();
   return run_demo(o);
 }
 

@@ -1,6 +1,9 @@
 # SPDX-License-Identifier: MIT
-# Shared by check_experiment.py and check_metg.py: running `tgraph experiment ...` and the
-# problems that check() collects (the scripts report them all at the end).
+# Shared by check_experiment.py, check_metg.py and check_scaling.py: running `tgraph
+# experiment ...` and the problems that check() collects (the scripts report them all at the
+# end).
+import json
+import os
 import subprocess
 import sys
 
@@ -21,3 +24,12 @@ def run_experiment(tgraph, args, timeout):
     if run.returncode != 0:
         sys.exit(f"exit {run.returncode}\nstdout:\n{run.stdout}\nstderr:\n{run.stderr}")
     return run
+
+
+def run_quick_json(tgraph, name, out, timeout):
+    """Runs `tgraph experiment NAME --quick --out OUT --json`; returns OUT/results.json,
+    checked to hold the records printed on stdout (its key NAME)."""
+    run = run_experiment(tgraph, [name, "--quick", "--out", out, "--json"], timeout)
+    j = json.load(open(os.path.join(out, "results.json")))
+    check(json.loads(run.stdout)[name] == j[name], f"--json and results.json disagree on {name}")
+    return j

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The pure parts of the experiments: thread lists, the measured/predicted split, plans,
+// The pure parts of the experiments: thread counts, the measured/predicted split, plans,
 // CSV and JSON writing, the progress lines.
 #include "tgraph/experiment/experiment.hpp"
 
@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "../option_error.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::experiment {
@@ -35,22 +36,17 @@ std::vector<std::string> lines(const std::string& text) {
   return out;
 }
 
-TEST(ThreadList, ParsesCountsAndRangesSortedWithoutDuplicates) {
-  EXPECT_EQ(parse_thread_list("1,2,4"), (Ks{1, 2, 4}));
-  EXPECT_EQ(parse_thread_list("8,1-4,2"), (Ks{1, 2, 3, 4, 8}));
-  EXPECT_EQ(parse_thread_list("16"), (Ks{16}));
-  EXPECT_EQ(parse_thread_list("3-3"), (Ks{3}));
+TEST(ThreadList, CountsAreSortedWithoutDuplicates) {
+  EXPECT_EQ(thread_counts({8, 1, 2, 3, 4, 2}), (Ks{1, 2, 3, 4, 8}));
+  EXPECT_EQ(thread_counts({16}), (Ks{16}));
+  EXPECT_EQ(thread_counts({}), Ks{});
 }
 
-TEST(ThreadList, RejectsBadItemsNamingTheFlag) {
-  for (const char* bad : {"", "a", "0", "1,,2", "2000", "4-1", "1-", "-3", "1.5", " 1"}) {
-    try {
-      parse_thread_list(bad);
-      ADD_FAILURE() << "accepted '" << bad << "'";
-    } catch (const UsageError& e) {
-      EXPECT_EQ(std::string(e.what()).rfind("--threads ", 0), 0u) << e.what();
-    }
-  }
+TEST(ThreadList, RejectsZeroAndCountsAboveTheLimitNamingTheField) {
+  for (const Ks& bad : {Ks{0}, Ks{1, 0}, Ks{kMaxThreads + 1}})
+    EXPECT_EQ(test::option_error([&bad] { thread_counts(bad); }).rfind("threads: ", 0), 0u)
+        << bad.back();
+  EXPECT_EQ(thread_counts({kMaxThreads}), (Ks{kMaxThreads}));
 }
 
 TEST(ThreadList, DefaultIsEveryCoreThenPowersOfTwoToSixtyFour) {
@@ -103,12 +99,12 @@ TEST(Plan, IndependentDefaultsAndQuick) {
 TEST(Plan, FlagsOverrideTheDefaults) {
   ExperimentOptions o;
   o.name = ExperimentName::kMedical;
-  o.threads = "1-3,8";
+  o.threads = {8, 1, 2, 3};
   o.steps = 7;
   o.repeat = 5;
-  o.methods = "owner,worksteal,owner";
+  o.methods = {"owner", "worksteal", "owner"};
   o.replay = false;
-  o.out_dir = "out";
+  o.out = "out";
   const ExperimentPlan p = plan_experiment(o, 2);
   EXPECT_EQ(p.scenes[0].scene, "torso");
   EXPECT_EQ(p.threads.measured, (Ks{1, 2}));
@@ -125,7 +121,7 @@ TEST(Plan, FlagsOverrideTheDefaults) {
 TEST(Plan, DomainHasEveryClothAndSubObjectCount) {
   ExperimentOptions o;
   o.name = ExperimentName::kDomain;
-  o.subobjects = "4,16";
+  o.subobjects = {4, 16, 4};
   const ExperimentPlan p = plan_experiment(o, 2);
   std::vector<std::string> labels;
   for (const SceneVariant& v : p.scenes) labels.push_back(v.label());
@@ -139,7 +135,7 @@ TEST(Plan, DomainHasEveryClothAndSubObjectCount) {
 TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {
   ExperimentOptions o;
   o.name = ExperimentName::kHeterogeneous;
-  o.threads = "1,2,16";
+  o.threads = {1, 2, 16};
   const ExperimentPlan p = plan_experiment(o, 4);
   EXPECT_EQ(p.scenes[0].scene, "falling64");
   o.quick = true;  // the small scene, up to its first contacts
@@ -147,47 +143,64 @@ TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {
   o.quick = false;
   EXPECT_EQ(p.series_methods, (std::vector<std::string>{"sticky", "metis", "metis-relabel"}));
   EXPECT_EQ(p.series_threads, 2u);
-  o.threads = "8,16";  // nothing measured: predictions only, no per-step runs
+  o.threads = {8, 16};  // nothing measured: predictions only, no per-step runs
   const ExperimentPlan q = plan_experiment(o, 4);
   EXPECT_TRUE(q.series_methods.empty());
   EXPECT_EQ(q.runs(), 0u);
   EXPECT_FALSE(q.notes.empty());
 }
 
-TEST(Plan, RejectsBadFlagsNamingThem) {
-  const auto message = [](ExperimentOptions o) {
-    try {
-      plan_experiment(o, 2);
-    } catch (const UsageError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
-  };
+TEST(Plan, RejectsBadOptionsNamingTheField) {
   ExperimentOptions o;
-  o.methods = "owner,nonsense";
-  EXPECT_NE(message(o).find("--methods"), std::string::npos);
-  o.methods = "sequential";
-  EXPECT_NE(message(o).find("reference"), std::string::npos);
+  const auto error = [&o] { return test::option_error([&o] { plan_experiment(o, 2); }); };
+  o.methods = {"owner", "nonsense"};
+  EXPECT_EQ(error().rfind("methods: unknown method 'nonsense'", 0), 0u) << error();
+  o.methods = {"sequential"};
+  EXPECT_EQ(error(), "methods: sequential is every run's reference, not a method");
+  o.methods = {"partition"};
+  EXPECT_EQ(error().rfind("methods: name the partitioning strategy", 0), 0u) << error();
   o = {};
-  o.subobjects = "4";
-  EXPECT_NE(message(o).find("--subobjects"), std::string::npos);  // not the domain experiment
+  o.subobjects = {4};  // not the domain experiment
+  EXPECT_EQ(error(), "subobjects: applies to the domain experiment only");
   o.name = ExperimentName::kDomain;
-  for (const char* bad : {"5", "0", "x", "4,", "-4"}) {
-    o.subobjects = bad;
-    EXPECT_NE(message(o).find("--subobjects"), std::string::npos) << bad;
+  for (int bad : {5, 0, -4, 8, 4225}) {
+    o.subobjects = {4, bad};
+    EXPECT_EQ(error(), "subobjects: " + std::to_string(bad) +
+                            " is not a perfect square from 1 to 4096 (expected e.g. 4,16,64)");
   }
   o = {};
   o.steps = 0;
-  EXPECT_NE(message(o).find("--steps"), std::string::npos);
+  EXPECT_EQ(error(), "steps: must be at least 1");
   o = {};
   o.repeat = 0;
-  EXPECT_NE(message(o).find("--repeat"), std::string::npos);
+  EXPECT_EQ(error(), "repeat: must be at least 1");
   o = {};
-  o.threads = "2,x";
-  EXPECT_NE(message(o).find("--threads"), std::string::npos);
+  o.threads = {2, 0};
+  EXPECT_EQ(error().rfind("threads: 0 threads is out of range", 0), 0u) << error();
+}
+
+TEST(Named, RefusesTheOptionsAnExperimentDoesNotTake) {
+  ExperimentOptions o;
+  Progress quiet(nullptr, false);
+  const auto error = [&](const char* name) {
+    return test::option_error([&] { run_named(name, o, quiet); });
+  };
+  o.subobjects = {4};
+  for (const char* name : {"independent", "metg", "scaling"})
+    EXPECT_EQ(error(name), "subobjects: applies to the domain experiment only") << name;
+  o = {};
+  o.replay = false;
+  EXPECT_EQ(error("scaling"), "replay: the scaling experiment makes live runs only");
+  o = {};
+  o.methods = {"owner"};  // metg's methods are replay policies
+  EXPECT_EQ(error("metg").rfind("methods: unknown policy 'owner'", 0), 0u) << error("metg");
+  EXPECT_THROW(run_named("nosuch", o, quiet), UsageError);
 }
 
 TEST(Names, RoundTrip) {
+  EXPECT_EQ(all_experiment_names(), (std::vector<std::string>{"independent", "heterogeneous",
+                                                              "domain", "medical", "metg",
+                                                              "scaling"}));
   for (const std::string& n : experiment_names()) {
     const std::optional<ExperimentName> e = parse_experiment_name(n);
     ASSERT_TRUE(e.has_value()) << n;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "../option_error.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/measure/report.hpp"
 
@@ -79,16 +80,17 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
   EXPECT_EQ(v.rounds_with_live_assignments, 0u);
 }
 
-TEST(Validate, RefusesZeroThreadsStepsOrRounds) {
+TEST(Validate, RefusesZeroThreadsStepsOrRoundsNamingTheField) {
   ValidateOptions o = falling("owner", 1, 1);
+  const auto error = [&o] { return test::option_error([&o] { validate(o); }); };
   o.threads = 0;
-  EXPECT_THROW(validate(o), UsageError);
+  EXPECT_EQ(error(), "threads: must be at least 1");
   o.threads = 1;
   o.steps = 0;
-  EXPECT_THROW(validate(o), UsageError);
+  EXPECT_EQ(error(), "steps: must be at least 1");
   o.steps = 1;
   o.repeat = 0;
-  EXPECT_THROW(validate(o), UsageError);
+  EXPECT_EQ(error(), "repeat: must be at least 1");
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include <set>
 #include <sstream>
 
+#include "../option_error.hpp"
 #include "../partition/test_graphs.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
@@ -206,8 +207,10 @@ TEST(GraphView, TraceStepViewTitlesTheFileTheStepAndTheAssignment) {
   try {
     trace_step_view(trace, path, 1, nullptr, small);
     FAIL() << "no error";
-  } catch (const UsageError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind("/data/run/fig2.tgt: step 1: ", 0), 0u) << e.what();
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.option(), "max_nodes");
+    EXPECT_EQ(e.problem().rfind("/data/run/fig2.tgt step 1: the picture would have ", 0), 0u)
+        << e.what();
   }
 }
 
@@ -409,20 +412,26 @@ TEST(QuotientView, LabelsProcessorsWithLoadAndPairsWithCutAndSignals) {
   EXPECT_EQ(svg.find("legend"), std::string::npos);
 }
 
+// What make_graph_view's OptionError says for `o`, or "accepted".
+std::string view_error(const StepGraph& g, const ViewOptions& o) {
+  return test::option_error([&] { make_graph_view(g, o); });
+}
+
 TEST(GraphView, Bars64WithoutCollapseIsRefusedWithAHint) {
   const StepGraph g = capture_step("bars64", 1);
   ViewOptions o;
   try {
     make_graph_view(g, o);
     FAIL() << "expected a refusal";
-  } catch (const UsageError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("--collapse"), std::string::npos) << what;
-    EXPECT_NE(what.find("--max-edges 4000"), std::string::npos) << what;
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.option(), "max_edges");
+    EXPECT_NE(e.problem().find("more than 4000: aggregate with {collapse} object"),
+              std::string::npos)
+        << e.what();
   }
   o.max_nodes = 100;
   o.max_edges = 0;
-  EXPECT_THROW(make_graph_view(g, o), UsageError);
+  EXPECT_EQ(view_error(g, o).rfind("max_nodes: the picture would have ", 0), 0u);
 }
 
 TEST(GraphView, RejectsAnAssignmentThatDoesNotFit) {
@@ -431,13 +440,13 @@ TEST(GraphView, RejectsAnAssignmentThatDoesNotFit) {
   a.proc.pop_back();
   ViewOptions o;
   o.assignment = &a;
-  EXPECT_THROW(make_graph_view(g, o), UsageError);
+  EXPECT_EQ(view_error(g, o).rfind("assignment: has ", 0), 0u) << view_error(g, o);
   a = by_object(g);
   a.proc[0] = 7;
-  EXPECT_THROW(make_graph_view(g, o), UsageError);
+  EXPECT_EQ(view_error(g, o), "assignment: processor 7 out of range (k = 2)");
   ViewOptions p;
   p.collapse = Collapse::kProcessor;
-  EXPECT_THROW(make_graph_view(g, p), UsageError);
+  EXPECT_EQ(view_error(g, p), "collapse: processor needs an assignment (.tga)");
   EXPECT_THROW(parse_collapse("objects"), UsageError);
   EXPECT_THROW(graph_format_of("x.jpeg"), UsageError);
 }

@@ -114,22 +114,22 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   const Assignment* a = o.assignment;
   if (a) {
     if (a->proc.size() != g.tasks.size())
-      throw UsageError("--assign: the assignment has " + std::to_string(a->proc.size()) +
-                       " tasks, the step has " + std::to_string(g.tasks.size()));
-    if (a->k == 0) throw UsageError("--assign: the assignment has k = 0");
+      throw OptionError("assignment", "has " + std::to_string(a->proc.size()) +
+                                          " tasks, the step has " + std::to_string(g.tasks.size()));
+    if (a->k == 0) throw OptionError("assignment", "has k = 0");
     for (ProcId p : a->proc)
       if (p >= a->k)
-        throw UsageError("--assign: processor " + std::to_string(p) +
-                         " out of range (k = " + std::to_string(a->k) + ")");
+        throw OptionError("assignment", "processor " + std::to_string(p) +
+                                            " out of range (k = " + std::to_string(a->k) + ")");
   }
   if (o.collapse == Collapse::kProcessor && !a)
-    throw UsageError("--collapse processor needs an assignment (--assign A.tga)");
-  auto too_many = [&](std::size_t count, const char* what, std::size_t limit) {
-    return UsageError(
-        "the picture would have " + std::to_string(count) + " " + what + ", more than --max-" +
-        what + " " + std::to_string(limit) +
-        ": aggregate with --collapse object, kind, processor or loop (or raise --max-" + what +
-        ")");
+    throw OptionError("collapse", "processor needs an assignment (.tga)");
+  // The limit's field (max_nodes, max_edges) names the problem; aggregating is the way out.
+  auto too_many = [&](std::size_t count, const std::string& what, std::size_t limit) {
+    return OptionError("max_" + what, "the picture would have " + std::to_string(count) + " " +
+                                          what + ", more than " + std::to_string(limit) +
+                                          ": aggregate with {collapse} object, kind, processor "
+                                          "or loop (or raise the limit)");
   };
   if (o.collapse == Collapse::kNone && o.max_nodes != 0 && g.tasks.size() > o.max_nodes)
     throw too_many(g.tasks.size(), "nodes", o.max_nodes);
@@ -199,8 +199,8 @@ GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std
   }
   try {
     return make_graph_view(g, options);
-  } catch (const UsageError& e) {
-    throw UsageError(trace_name + ": step " + std::to_string(step) + ": " + e.what());
+  } catch (const OptionError& e) {
+    throw OptionError(e.option(), trace_name + " step " + std::to_string(step) + ": " + e.problem());
   }
 }
 

@@ -214,28 +214,17 @@ std::string timeline_title(const Timeline& t, const std::string& path) {
          std::to_string(t.waits.size()) + " blocking waits";
 }
 
-std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text) {
-  auto bad = [&] {
-    return UsageError("--steps " + std::string(text) +
-                      ": expected a:b, a: or a (step numbers, a <= b)");
-  };
-  auto number = [&](std::string_view s, std::uint32_t fallback) {
-    if (s.empty()) return fallback;
-    std::uint32_t v = 0;
+std::optional<std::pair<std::uint32_t, std::uint32_t>> parse_step_range(std::string_view text) {
+  const auto number = [](std::string_view s, std::uint32_t& v) {  // empty: v stays
     const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (ec != std::errc() || p != s.data() + s.size()) throw bad();
-    return v;
+    return s.empty() || (ec == std::errc() && p == s.data() + s.size());
   };
-  const auto colon = text.find(':');
-  if (colon == std::string_view::npos) {
-    const std::uint32_t a = number(text, 0);
-    if (text.empty()) throw bad();
-    return {a, a};
-  }
-  const std::uint32_t a = number(text.substr(0, colon), 0);
-  const std::uint32_t b = number(text.substr(colon + 1), 0xffffffffu);
-  if (a > b) throw bad();
-  return {a, b};
+  const std::size_t colon = std::min(text.find(':'), text.size());
+  std::uint32_t a = 0, b = 0xffffffffu;
+  if (text.empty() || !number(text.substr(0, colon), a) ||
+      !number(colon == text.size() ? text : text.substr(colon + 1), b) || a > b)
+    return std::nullopt;
+  return std::pair{a, b};
 }
 
 Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last) {
@@ -249,9 +238,9 @@ Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last
   if (out.tasks.empty()) {
     std::uint32_t hi = 0;
     for (const TimelineTask& e : t.tasks) hi = std::max(hi, e.step);
-    throw UsageError("--steps " + std::to_string(first) + ":" + std::to_string(last) +
-                     ": no task in that range (the timeline has steps 0 to " + std::to_string(hi) +
-                     ")");
+    throw OptionError("steps", "no task in steps " + std::to_string(first) + " to " +
+                                   std::to_string(last) + " (the timeline has steps 0 to " +
+                                   std::to_string(hi) + ")");
   }
   return out;
 }

@@ -19,7 +19,7 @@ struct DemoOptions {
   int steps = 10;                       ///< steps captured
   std::uint32_t threads = 1;            ///< replay threads (the command line: all hardware threads)
   std::uint32_t repeat = 3;             ///< timed passes per replay (medians)
-  std::string out_dir = "tgraph-demo";  ///< folder for the trace and report.html
+  std::string out = "tgraph-demo";      ///< folder for the trace and report.html
 };
 
 /// What the demo measured.
@@ -40,8 +40,8 @@ struct DemoResult {
   std::vector<viz::MethodRow> rows;
 };
 
-/// Runs the demo and writes `<out_dir>/<scene>.tgt` and `<out_dir>/report.html`; `say`
-/// (optional) receives progress lines. Bad options: tgraph::UsageError; a capture that
+/// Runs the demo and writes `<out>/<scene>.tgt` and `<out>/report.html`; `say` (optional)
+/// receives progress lines. Bad options: tgraph::OptionError; a capture that
 /// misused the API: std::runtime_error.
 ///
 ///   DemoResult r = run_demo({.scene = "bars64", .threads = 2}, [](const std::string& s) {

@@ -33,18 +33,20 @@ std::string_view to_string(ExperimentName name);
 std::optional<ExperimentName> parse_experiment_name(std::string_view name);
 /// The four names, in the paper's order.
 std::vector<std::string> experiment_names();
+/// Every experiment run_named runs: the paper's four, then "metg" and "scaling".
+std::vector<std::string> all_experiment_names();
 
 /// What to run (the flags of `tgraph experiment`); empty or unset fields take the
 /// experiment's defaults (plan_experiment).
 struct ExperimentOptions {
   ExperimentName name = ExperimentName::kIndependent;
-  std::string threads;                  ///< thread list (parse_thread_list); "": default
-  std::string out_dir;                  ///< "": tgraph-experiment-<name>
+  std::vector<std::uint32_t> threads;   ///< thread counts (thread_counts); empty: default
+  std::string out;                      ///< results folder; "": tgraph-experiment-<name>
   bool quick = false;                   ///< fewer steps, one pass, fewer variants
   std::optional<std::uint32_t> steps;   ///< steps per run
   std::optional<std::uint32_t> repeat;  ///< timed passes per run (medians)
-  std::string methods;                  ///< comma list of strategies and baselines; "": default
-  std::string subobjects;               ///< domain: comma list of sub-object counts; "": default
+  std::vector<std::string> methods;     ///< strategies and baselines; empty: the experiment's
+  std::vector<int> subobjects;          ///< domain: sub-object counts (squares); empty: default
   std::optional<bool> replay;           ///< synthetic replays too; unset: the experiment's default
 };
 
@@ -81,9 +83,9 @@ struct ExperimentPlan {
   std::string command() const;
 };
 
-/// Resolves `options` on a machine with `cores` cores; tgraph::UsageError names the bad
-/// flag (unknown method, starpu in a build without it, sub-objects outside `domain`, a
-/// sub-object count that is not a perfect square, steps or repeat of 0).
+/// Resolves `options` on a machine with `cores` cores; tgraph::OptionError names the bad
+/// field (unknown method, starpu in a build without it, sub-objects outside `domain`, a
+/// sub-object count that is not a perfect square, a thread count, steps or repeat of 0).
 ExperimentPlan plan_experiment(const ExperimentOptions& options, std::uint32_t cores);
 
 /// What the paper reports for an experiment, for the report beside ours.
@@ -142,5 +144,18 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
 std::string experiment_json(const ExperimentResult& result, int indent = -1);
 /// The summary printed on stdout: one table per scene, the per-step summaries, the files.
 std::string experiment_text(const ExperimentResult& result);
+
+/// What an experiment of run_named produced, as `tgraph experiment` prints it.
+struct NamedRun {
+  std::string text;          ///< experiment_text, metg_text or scaling_text
+  std::string json;          ///< results.json on one line
+  std::size_t failures = 0;  ///< runs that failed
+};
+
+/// Runs the experiment `name` (one of all_experiment_names()): the paper's through
+/// run_experiment; metg (run_metg) takes quick, threads, out and methods (its policies);
+/// scaling (run_scaling) those and steps and repeat. OptionError on `subobjects` or `replay`
+/// where the experiment does not take them.
+NamedRun run_named(std::string_view name, const ExperimentOptions& options, Progress& progress);
 
 }  // namespace tgraph::experiment

@@ -37,9 +37,11 @@ StepGraph metg_graph(MetgShape shape, std::uint32_t width, std::uint32_t steps,
 /// What to run (the flags of `tgraph experiment metg`).
 struct MetgOptions {
   bool quick = false;    ///< coarse duration grid, one timed pass, small graphs
-  std::string out_dir;   ///< "": tgraph-experiment-metg
-  std::string threads;   ///< thread list (parse_thread_list); "": 1 to the cores
-  std::string policies;  ///< comma list; "": sequential and every parallel policy built
+  std::string out;                     ///< results folder; "": tgraph-experiment-metg
+  std::vector<std::uint32_t> threads;  ///< thread counts (thread_counts); empty: 1 to the cores
+  /// The replay policies swept (the other experiments' methods); empty: sequential and every
+  /// parallel policy built.
+  std::vector<std::string> methods;
 };
 
 /// One timed point: a policy on a shape at a thread count and a task duration.
@@ -89,7 +91,7 @@ struct MetgResult {
 };
 
 /// Runs the sweep and writes results.json, results.csv and one efficiency chart per shape
-/// (efficiency-<shape>.svg/png) into the output folder, atomically. Bad flags: UsageError.
+/// (efficiency-<shape>.svg/png) into the output folder, atomically. Bad options: OptionError.
 MetgResult run_metg(const MetgOptions& options, Progress& progress);
 
 /// results.json: `metg` (the records reaching 50 %: policy, shape, threads, metg_ns, task_ns,

@@ -18,9 +18,9 @@ namespace tgraph::experiment {
 /// What to run (the flags of `tgraph experiment scaling`).
 struct ScalingOptions {
   bool quick = false;                   ///< few steps, threads 1,2, a smoke run
-  std::string out_dir;                  ///< "": tgraph-experiment-scaling
-  std::string threads;                  ///< thread list (parse_thread_list); "": default
-  std::string methods;                  ///< comma list of strategies and baselines; "": all
+  std::string out;                      ///< results folder; "": tgraph-experiment-scaling
+  std::vector<std::uint32_t> threads;   ///< thread counts (thread_counts); empty: default
+  std::vector<std::string> methods;     ///< strategies and baselines; empty: all
   std::optional<std::uint32_t> steps;   ///< steps of every scene; unset: each scene's own
   std::optional<std::uint32_t> repeat;  ///< timed passes per run (medians); unset: 1
 };
@@ -57,8 +57,9 @@ struct ScalingPlan {
 /// Resolves `options` on a machine with `cores` cores. Defaults: bars64 (20 steps), falling64
 /// (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier, omp-tasks and
 /// starpu (when built); scaling_thread_list(cores); one pass. --quick: 2, 3, 3 and 1 steps,
-/// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::UsageError names the bad flag (an unknown method, sequential or
-/// partition as a method, starpu in a build without it, steps or repeat of 0).
+/// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
+/// field (an unknown method, sequential or partition as a method, starpu in a build without
+/// it, a thread count, steps or repeat of 0).
 ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
 
 /// One live run of the sweep. The figures (docs/design.md has them too):

@@ -5,7 +5,6 @@
 
 #include <cstdint>
 #include <span>
-#include <string_view>
 #include <vector>
 
 namespace tgraph::experiment {
@@ -13,11 +12,9 @@ namespace tgraph::experiment {
 /// Largest thread count an experiment accepts.
 inline constexpr std::uint32_t kMaxThreads = 1024;
 
-/// Parses a thread list such as "1,2,4", "1-8" or "1-4,8,16": sorted, without duplicates.
-/// Throws tgraph::UsageError naming `flag` and the bad item (empty list, 0, a reversed
-/// range, a count above kMaxThreads, anything not a number).
-std::vector<std::uint32_t> parse_thread_list(std::string_view text,
-                                             std::string_view flag = "--threads");
+/// `threads` ascending, without duplicates; tgraph::OptionError on `threads` for a count of 0
+/// or above kMaxThreads.
+std::vector<std::uint32_t> thread_counts(std::vector<std::uint32_t> threads);
 
 /// The default list: every count from 1 to `cores`, then the powers of two above `cores`
 /// up to `max_threads` (2 cores, 64: 1, 2, 4, 8, 16, 32, 64).

@@ -57,8 +57,8 @@ struct Validation {
 
 /// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a
 /// capture of the same steps, its replay under the same policy (one pass) and the
-/// simulation of the partition. UsageError for zero threads, steps or rounds, or an unknown
-/// method.
+/// simulation of the partition. OptionError for zero threads (but for the sequential
+/// policy), steps or repeat; UsageError for an unknown method.
 Validation validate(const ValidateOptions& options);
 
 }  // namespace tgraph::measure

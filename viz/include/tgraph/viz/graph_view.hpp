@@ -93,7 +93,7 @@ struct ViewOptions {
   Collapse collapse = Collapse::kNone;
   const Assignment* assignment = nullptr;  ///< colours, cross edges, sync nodes
   bool critical_path = false;
-  /// Refuse (UsageError) when the picture would have more nodes than this (0: no limit).
+  /// Refuse (OptionError) when the picture would have more nodes than this (0: no limit).
   std::size_t max_nodes = 2000;
   /// Likewise for edges (0: no limit): dot's layout time grows with the edges (bars64's
   /// 11,206 task-level edges take minutes), so large pictures are refused before layout.
@@ -127,14 +127,14 @@ struct GraphView {
   double nodesep = 0.25;    ///< inches between neighbours of one rank (dot's nodesep)
 };
 
-/// Builds the picture of `g` (edges derived). Throws UsageError when the assignment does
-/// not fit the step, when --collapse processor has no assignment, and when the result has
-/// more than `max_nodes` nodes or `max_edges` edges (the message suggests --collapse).
+/// Builds the picture of `g` (edges derived). Throws OptionError when the assignment does
+/// not fit the step, when collapse kProcessor has no assignment, and when the result has
+/// more than `max_nodes` nodes or `max_edges` edges (the message suggests `collapse`).
 GraphView make_graph_view(const StepGraph& g, const ViewOptions& options);
 /// `tgraph viz`: the picture of step `step` of `trace` (read from `trace_name`), titled
 /// "<file name>, step S" plus ", <method> on K processors" when `assignment` (whose step S
 /// colours it) is given. UsageError when the trace has no such step; make_graph_view's
-/// errors are prefixed with "<trace_name>: step S: ".
+/// OptionError problems are prefixed with "<trace_name> step S: ".
 GraphView trace_step_view(const Trace& trace, const std::string& trace_name, std::size_t step,
                           const TraceAssignment* assignment, ViewOptions options);
 

@@ -14,10 +14,11 @@
 
 namespace tgraph::viz {
 
-/// Steps [first, last] (inclusive) of `t`; throws UsageError when none is in range.
+/// Steps [first, last] (inclusive) of `t`; OptionError on `steps` when none is in range.
 Timeline select_steps(const Timeline& t, std::uint32_t first, std::uint32_t last);
-/// Parses "a:b", "a:" or "a" (a step range for --steps); throws UsageError naming the flag.
-std::pair<std::uint32_t, std::uint32_t> parse_step_range(std::string_view text);
+/// Parses a step range "a:b", "a:" (to the last), ":b" (from 0) or "a" (one step); nullopt
+/// for anything else, and when a > b.
+std::optional<std::pair<std::uint32_t, std::uint32_t>> parse_step_range(std::string_view text);
 
 /// Output formats of a timeline picture.
 enum class TimelineFormat : std::uint8_t { kSvg = 0, kPng = 1 };
