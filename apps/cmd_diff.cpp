@@ -14,7 +14,7 @@ void add_diff(CLI::App& app) {
   auto steps = std::make_shared<std::vector<std::size_t>>();
   auto* cmd = app.add_subcommand("diff", "Structural difference of two steps by stable task key");
   cmd->add_option("trace", o->input, "Trace file (.tgt)")->required();
-  cmd->add_option("--steps", *steps, "The two steps A B (0-based)")->required()->expected(2);
+  cmd->add_option("steps", *steps, "The two steps A B (0-based)")->required()->expected(2);
   cmd->add_option("--assignment,-a", o->assignment,
                   "Assignment file (.tga): also list tasks whose processor changed");
   cmd->add_flag("--json", o->json, "Print one JSON object");
@@ -22,8 +22,8 @@ void add_diff(CLI::App& app) {
     const Trace trace = read_trace(o->input);
     if (steps->size() != 2) throw UsageError("--steps: expected two step indices A B");
     const std::size_t a = (*steps)[0], b = (*steps)[1];
-    const StepGraph &ga = step_at(trace, a, o->input, "--steps"),
-                    &gb = step_at(trace, b, o->input, "--steps");
+    const StepGraph &ga = step_at(trace, a, o->input, "steps"),
+                    &gb = step_at(trace, b, o->input, "steps");
     StepDiff d = diff_steps(ga, gb);
     if (!o->assignment.empty()) {
       const TraceAssignment as = partition::load_assignment(o->assignment, trace, o->input);
