@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `tgraph generate --tasks N --pattern P -o T.tgt`: a synthetic trace of any size
 // (tgraph::generate_trace), for scaling studies of the graph core, partitioners and executors.
-#include <chrono>
+#include <iostream>
 
 #include "commands.hpp"
 #include "tgraph/graph/generate.hpp"
@@ -35,29 +35,8 @@ void add_generate(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a, o] {
     o->pattern = *pattern_from_string(a->format);  // checked by IsMember above
-    const auto t0 = std::chrono::steady_clock::now();
-    const Trace trace = generate_trace(*o, static_cast<std::uint32_t>(*a->steps));
-    write_trace(a->output, trace);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const StepGraph& g = trace.steps.front();
-    const std::uint64_t edges = g.edges.size() + g.carried_edges.size();
-    if (a->json) {
-      print_json({{"trace", a->output},
-                  {"pattern", a->format},
-                  {"steps", trace.steps.size()},
-                  {"tasks", g.tasks.size()},
-                  {"data", g.data.size()},
-                  {"accesses", g.accesses.size()},
-                  {"edges", edges},
-                  {"seed", o->seed},
-                  {"seconds", seconds}});
-    } else {
-      std::cout << "wrote " << a->output << ": " << trace.steps.size() << " step(s) of "
-                << g.tasks.size() << " tasks, " << g.data.size() << " data, "
-                << g.accesses.size() << " accesses, " << edges << " edges (" << a->format
-                << ", seed " << o->seed << ") in " << seconds << " s\n";
-    }
+    const GeneratedFile f = generate_file(*o, static_cast<std::uint32_t>(*a->steps), a->output);
+    std::cout << (a->json ? generated_json(f) + "\n" : generated_text(f));
   });
 }
 

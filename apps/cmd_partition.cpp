@@ -42,7 +42,7 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
                   "With phases on: each dynamic loop holding at least this share of the step's "
                   "work is one more constraint, balanced on its own (default 0.1; 0: off)")
       ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--scotch-strategy", n.scotch, "Scotch flavour: default, quality, speed, balance")
+  cmd->add_option("--scotch-strategy", n.scotch_strategy, "Scotch flavour: default, quality, speed, balance")
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
   cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");
   cmd->add_option("--threshold", o.sticky_threshold,
@@ -88,11 +88,8 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga)");
   add_strategy_flags(cmd, *n);
   cmd->callback([a, n] {
-    const Trace trace = read_trace(a->input);
-    if (a->k == 0) throw UsageError("-k: expected at least 1");
-    const auto r = tp::partition_trace(trace, a->method, a->k, n->options());
+    const auto r = tp::partition_file(a->input, a->method, a->k, n->options(), a->output);
     for (const std::string& w : r.warnings) warn(w);
-    if (!a->output.empty()) tp::write_assignment(a->output, r.assignment, trace);
     std::cout << (a->json ? tp::partition_json(r, a->output) + "\n"
                           : tp::partition_text(r, a->output));
   });

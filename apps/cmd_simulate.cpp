@@ -14,14 +14,7 @@ namespace tgraph::app {
 namespace tp = tgraph::partition;
 
 std::vector<std::uint64_t> SerialFlags::per_step(std::size_t steps) const {
-  if (serial_ns) return std::vector<std::uint64_t>(steps, *serial_ns);
-  if (live.empty()) return {};
-  std::vector<std::uint64_t> v = tp::load_serial_work(live);
-  if (v.size() < steps)
-    throw UsageError("--live " + live + ": the run has " + std::to_string(v.size()) +
-                     " steps, the trace " + std::to_string(steps));
-  v.resize(steps);
-  return v;
+  return tp::serial_work(live, serial_ns, steps);
 }
 
 void add_serial_flags(CLI::App* cmd, SerialFlags& f) {
@@ -72,7 +65,7 @@ void add_simulate(CLI::App& app) {
   cmd->callback([a, f, serial] {
     tp::SimulatedPlatform p;
     p.model = tp::select_cost_model(f->model, f->calibration);
-    if (!f->cluster.empty()) p.cluster = tp::parse_cluster(f->cluster, "--cluster");
+    if (!f->cluster.empty()) p.cluster = tp::parse_cluster(f->cluster);
     p.file = f->platform;
     p.intra_node =
         f->intra_node == "link" ? tp::IntraNodeTransfer::link : tp::IntraNodeTransfer::reader;
@@ -105,11 +98,7 @@ void add_platform(CLI::App& app) {
                   "Calibration file (default: " + tp::default_calibration_path() + " if present)");
   cmd->add_option("-o,--output", a->output, "Platform file to write (.xml)")->required();
   cmd->callback([a, f] {
-    const tp::ClusterShape c = tp::cluster_shape(f->nodes, f->cores);
-    const tp::CostModel m = tp::select_cost_model("calibrated", f->calibration);
-    write_file_atomic(a->output, tp::platform_xml(c, m));
-    std::cout << "wrote " << a->output << ": " << c.nodes << " nodes x " << c.cores
-              << " cores, costs from " << m.source << "\n";
+    std::cout << tp::write_platform(a->output, f->nodes, f->cores, f->calibration);
   });
 }
 

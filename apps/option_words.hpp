@@ -9,8 +9,10 @@
 
 namespace tgraph::app {
 
-/// The flag of an options field: "threads_per_rank" -> "--threads-per-rank".
+/// The flag of an options field: "threads_per_rank" -> "--threads-per-rank"; a one-letter
+/// field is a short flag ("k" -> "-k").
 inline std::string flag_of(std::string field) {
+  if (field.size() == 1) return "-" + field;
   for (char& c : field)
     if (c == '_') c = '-';
   return "--" + field;

@@ -14,6 +14,31 @@ macro(tgraph_pkg_config name)
   endif()
   set_property(GLOBAL PROPERTY TGRAPH_PKG_CONFIG_${name} "${_tgraph_pc_MODULES}")
 endmacro()
+
+# tgraph_optional_pkg(TARGET NAME MODULE m WHAT w DEBIAN d DEFINE D [PUBLIC] [SOURCES s...]
+#                     FOUND text MISSING text): an optional dependency that one module uses
+# privately. When pkg-config finds m, TARGET compiles SOURCES, links PkgConfig::NAME and
+# defines D=1 (PUBLIC: also for what links TARGET, so that tests and tools can tell); a
+# status line either way ("w <version> found: FOUND", "w (pkg-config m, Debian d) not
+# found: MISSING").
+macro(tgraph_optional_pkg target name)
+  cmake_parse_arguments(_tgraph_opt "PUBLIC" "MODULE;WHAT;DEBIAN;DEFINE;FOUND;MISSING" "SOURCES"
+                        ${ARGN})
+  tgraph_pkg_config(${name} OPTIONAL MODULES ${_tgraph_opt_MODULE})
+  if(${name}_FOUND)
+    message(STATUS "tgraph: ${_tgraph_opt_WHAT} ${${name}_VERSION} found: ${_tgraph_opt_FOUND}")
+    target_sources(${target} PRIVATE ${_tgraph_opt_SOURCES})
+    target_link_libraries(${target} PRIVATE PkgConfig::${name})
+    if(_tgraph_opt_PUBLIC)
+      target_compile_definitions(${target} PUBLIC ${_tgraph_opt_DEFINE}=1)
+    else()
+      target_compile_definitions(${target} PRIVATE ${_tgraph_opt_DEFINE}=1)
+    endif()
+  else()
+    message(STATUS "tgraph: ${_tgraph_opt_WHAT} (pkg-config ${_tgraph_opt_MODULE}, Debian "
+                   "${_tgraph_opt_DEBIAN}) not found: ${_tgraph_opt_MISSING}")
+  endif()
+endmacro()
 find_package(Threads REQUIRED)
 find_package(ZLIB REQUIRED)
 find_package(Eigen3 3.4 REQUIRED CONFIG)

@@ -6,10 +6,14 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <limits>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
 
 namespace tgraph {
 namespace {
@@ -51,8 +55,8 @@ void draw_costs(StepGraph& g, const GenerateOptions& o, std::uint32_t step) {
 void cells(StepGraph& g, const GenerateOptions& o) {
   const std::uint64_t n = o.tasks;
   const std::uint64_t width = o.width != 0 ? o.width : std::max<std::uint64_t>(1, n / 16);
-  if (width > n) throw UsageError("--width: expected at most --tasks (" + std::to_string(n) + ")");
-  if (2 * width > kMaxIds) throw UsageError("--width: expected at most 2^31 - 1 columns");
+  if (width > n) throw OptionError("width", "expected at most {tasks} (" + std::to_string(n) + ")");
+  if (2 * width > kMaxIds) throw OptionError("width", "expected at most 2^31 - 1 columns");
   const KindId kind = g.intern_kind(std::string(to_string(o.pattern)));
   g.objects.reserve(width);
   for (std::uint64_t i = 0; i < width; ++i) g.objects.push_back({"c" + std::to_string(i)});
@@ -116,7 +120,7 @@ void cells(StepGraph& g, const GenerateOptions& o) {
 /// whose scalar the objects then read, as in the engine: edges stay linear in the tasks.
 void domain(StepGraph& g, const GenerateOptions& o) {
   const std::uint64_t objects = std::max<std::uint64_t>(1, o.tasks * 4 / 25);
-  if (5 * objects + 5 > kMaxIds) throw UsageError("--tasks: too many for the domain pattern");
+  if (5 * objects + 5 > kMaxIds) throw OptionError("tasks", "too many for the domain pattern");
   const KindId kf = g.intern_kind("addForce"), kc = g.intern_kind("contact"),
                kd = g.intern_kind("addDForce"), kpq = g.intern_kind("dotPQ"),
                ks = g.intern_kind("cgScalars"), ku = g.intern_kind("cgUpdate"),
@@ -204,8 +208,8 @@ std::optional<Pattern> pattern_from_string(std::string_view name) {
 }
 
 StepGraph generate_step(const GenerateOptions& o, std::uint32_t step) {
-  if (o.tasks == 0) throw UsageError("--tasks: expected at least 1");
-  if (o.tasks > kMaxIds) throw UsageError("--tasks: expected at most 2^32 - 2");
+  if (o.tasks == 0) throw OptionError("tasks", "expected at least 1");
+  if (o.tasks > kMaxIds) throw OptionError("tasks", "expected at most 2^32 - 2");
   StepGraph g;
   switch (o.pattern) {
     case Pattern::kTrivial:
@@ -215,7 +219,7 @@ StepGraph generate_step(const GenerateOptions& o, std::uint32_t step) {
       cells(g, o);
       break;
     case Pattern::kDomain:
-      if (o.iterations == 0) throw UsageError("--iterations: expected at least 1");
+      if (o.iterations == 0) throw OptionError("iterations", "expected at least 1");
       domain(g, o);
       break;
   }
@@ -240,6 +244,46 @@ Trace generate_trace(const GenerateOptions& o, std::uint32_t steps) {
     }
   }
   return trace;
+}
+
+GeneratedFile generate_file(const GenerateOptions& o, std::uint32_t steps,
+                            const std::string& output) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Trace trace = generate_trace(o, steps);
+  write_trace(output, trace);
+  GeneratedFile f;
+  f.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  f.output = output;
+  f.options = o;
+  f.steps = trace.steps.size();
+  const StepGraph& g = trace.steps.front();
+  f.tasks = g.tasks.size();
+  f.data = g.data.size();
+  f.accesses = g.accesses.size();
+  f.edges = g.edges.size() + g.carried_edges.size();
+  return f;
+}
+
+std::string generated_json(const GeneratedFile& f) {
+  return nlohmann::json{{"trace", f.output},
+                        {"pattern", to_string(f.options.pattern)},
+                        {"steps", f.steps},
+                        {"tasks", f.tasks},
+                        {"data", f.data},
+                        {"accesses", f.accesses},
+                        {"edges", f.edges},
+                        {"seed", f.options.seed},
+                        {"seconds", f.seconds}}
+      .dump();
+}
+
+std::string generated_text(const GeneratedFile& f) {
+  std::ostringstream s;
+  s << "wrote " << f.output << ": " << f.steps << " step(s) of " << f.tasks << " tasks, "
+    << f.data << " data, " << f.accesses << " accesses, " << f.edges << " edges ("
+    << to_string(f.options.pattern) << ", seed " << f.options.seed << ") in " << f.seconds
+    << " s\n";
+  return s.str();
 }
 
 }  // namespace tgraph

@@ -117,6 +117,9 @@ struct Hasher {
   }
   template <class T>
   void value(const T& v) { bytes(&v, sizeof v); }
+  /// The fields of one record, in order.
+  template <class... T>
+  void values(const T&... v) { (value(v), ...); }
   void str(const std::string& s) {
     value(s.size());
     bytes(s.data(), s.size());
@@ -134,28 +137,13 @@ std::uint64_t StepGraph::structural_hash() const {
   h.value(data.size());
   for (const auto& d : data) {
     h.str(d.name);
-    h.value(d.object);
-    h.value(d.bytes);
+    h.values(d.object, d.bytes);
   }
   h.value(tasks.size());
-  for (const auto& t : tasks) {
-    h.value(t.kind);
-    h.value(t.object);
-    h.value(t.access_count);
-    h.value(t.loop);
-    h.value(t.key);
-  }
-  for (const auto& a : accesses) {
-    h.value(a.datum);
-    h.value(static_cast<std::uint8_t>(a.mode));
-  }
+  for (const auto& t : tasks) h.values(t.kind, t.object, t.access_count, t.loop, t.key);
+  for (const auto& a : accesses) h.values(a.datum, static_cast<std::uint8_t>(a.mode));
   h.value(loops.size());
-  for (const auto& l : loops) {
-    h.value(l.condition);
-    h.value(l.first);
-    h.value(l.last);
-    h.value(l.max_iterations);
-  }
+  for (const auto& l : loops) h.values(l.condition, l.first, l.last, l.max_iterations);
   return h.h;
 }
 

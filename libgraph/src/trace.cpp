@@ -25,10 +25,10 @@ std::string machine_description() {
 }
 
 const StepGraph& step_at(const Trace& trace, std::size_t step, const std::string& trace_name,
-                         const std::string& flag) {
+                         const std::string& field) {
   if (step >= trace.steps.size())
-    throw UsageError(flag + " " + std::to_string(step) + ": trace " + trace_name + " has " +
-                     std::to_string(trace.steps.size()) + " steps");
+    throw OptionError(field, "trace " + trace_name + " has " + std::to_string(trace.steps.size()) +
+                                 " steps, no step " + std::to_string(step));
   return trace.steps[step];
 }
 

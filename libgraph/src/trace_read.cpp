@@ -276,6 +276,21 @@ class TraceDecoder {
                    ", found " + std::to_string(id));
   }
 
+  // The u32 id `field` read from `p`, checked against `n` (object ids: kNoObject allowed).
+  std::uint32_t read_id(ByteReader& p, const char* field, std::size_t n, const char* what) const {
+    const std::size_t at = p.pos();
+    const std::uint32_t id = p.u32(field);
+    check_id(at, id, n, what);
+    return id;
+  }
+  std::uint32_t read_object(ByteReader& p, const char* field, std::size_t n,
+                            const char* what) const {
+    const std::size_t at = p.pos();
+    const std::uint32_t id = p.u32(field);
+    check_object(at, id, n, what);
+    return id;
+  }
+
   void read_structure(ByteReader& p, StepGraph& g) {
     const std::uint32_t n_kinds = p.count("kinds", kStringMin);
     g.kinds.reserve(n_kinds);
@@ -290,9 +305,7 @@ class TraceDecoder {
     for (std::uint32_t i = 0; i < n_data; ++i) {
       Datum d;
       d.name = p.str("datum name");
-      const std::size_t at = p.pos();
-      d.object = p.u32("u32 datum object");
-      check_object(at, d.object, n_objects, "datum");
+      d.object = read_object(p, "u32 datum object", n_objects, "datum");
       d.bytes = p.u64("u64 datum bytes");
       g.data.push_back(std::move(d));
     }
@@ -315,13 +328,9 @@ class TraceDecoder {
     std::uint64_t next_access = 0;
     for (std::uint32_t i = 0; i < n_tasks; ++i) {
       Task& t = g.tasks[i];
-      std::size_t at = p.pos();
-      t.kind = p.u32("u32 task kind");
-      check_id(at, t.kind, n_kinds, "task kind id");
-      at = p.pos();
-      t.object = p.u32("u32 task object");
-      check_object(at, t.object, n_objects, "task");
-      at = p.pos();
+      t.kind = read_id(p, "u32 task kind", n_kinds, "task kind id");
+      t.object = read_object(p, "u32 task object", n_objects, "task");
+      const std::size_t at = p.pos();
       t.access_count = p.u32("u32 task access count");
       if (t.access_count > n_accesses - next_access)
         fail(at, "id out of range: expected task " + std::to_string(i) + " to own at most the " +
@@ -343,10 +352,8 @@ class TraceDecoder {
     std::uint64_t prev_last = 0;
     for (std::uint32_t l = 0; l < n_loops; ++l) {
       Loop& loop = g.loops[l];
-      std::size_t at = p.pos();
-      loop.condition = p.u32("u32 loop condition");
-      check_id(at, loop.condition, n_data, "loop condition datum id");
-      at = p.pos();
+      loop.condition = read_id(p, "u32 loop condition", n_data, "loop condition datum id");
+      const std::size_t at = p.pos();
       loop.first = p.u32("u32 loop first task");
       loop.last = p.u32("u32 loop last task");
       loop.max_iterations = p.u32("u32 loop max iterations");
@@ -395,12 +402,8 @@ class TraceDecoder {
     const std::uint32_t n_contacts = p.count("contacts", kContactSize);
     g.contacts.resize(n_contacts);
     for (auto& c : g.contacts) {
-      at = p.pos();
-      c.a = p.u32("u32 contact object a");
-      check_id(at, c.a, g.objects.size(), "contact object id");
-      at = p.pos();
-      c.b = p.u32("u32 contact object b");
-      check_id(at, c.b, g.objects.size(), "contact object id");
+      c.a = read_id(p, "u32 contact object a", g.objects.size(), "contact object id");
+      c.b = read_id(p, "u32 contact object b", g.objects.size(), "contact object id");
     }
 
     at = p.pos();

@@ -59,51 +59,49 @@ void encode_file_header(std::vector<std::uint8_t>& out, const TraceHeader& heade
   finish_frame(out, at, FrameType::Header);
 }
 
+// A list of the format: its length as u32 (UsageError naming `what` if it does not fit),
+// then each element as `element` writes it.
+template <class List, class Element>
+void encode_list(ByteWriter& w, const List& list, const char* what, Element element) {
+  w.count(list.size(), what);
+  for (const auto& e : list) element(e);
+}
+
 void encode_structure(ByteWriter& w, const StepGraph& g) {
-  w.count(g.kinds.size(), "kinds");
-  for (const auto& k : g.kinds) w.str(k);
-  w.count(g.objects.size(), "objects");
-  for (const auto& o : g.objects) w.str(o.name);
-  w.count(g.data.size(), "data");
-  for (const auto& d : g.data) {
+  encode_list(w, g.kinds, "kinds", [&](const std::string& k) { w.str(k); });
+  encode_list(w, g.objects, "objects", [&](const ObjectInfo& o) { w.str(o.name); });
+  encode_list(w, g.data, "data", [&](const Datum& d) {
     w.str(d.name);
     w.u32(d.object);
     w.u64(d.bytes);
-  }
-  w.count(g.accesses.size(), "accesses");
-  for (const auto& a : g.accesses) {
+  });
+  encode_list(w, g.accesses, "accesses", [&](const Access& a) {
     w.u32(a.datum);
     w.u8(static_cast<std::uint8_t>(a.mode));
-  }
-  w.count(g.tasks.size(), "tasks");
-  for (const auto& t : g.tasks) {
+  });
+  encode_list(w, g.tasks, "tasks", [&](const Task& t) {
     w.u32(t.kind);
     w.u32(t.object);
     w.u32(t.access_count);  // access_begin is the running sum (validate() requires it)
     w.u32(t.loop);
     w.u64(t.key);
-  }
-  w.count(g.loops.size(), "loops");
-  for (const auto& l : g.loops) {
+  });
+  encode_list(w, g.loops, "loops", [&](const Loop& l) {
     w.u32(l.condition);
     w.u32(l.first);
     w.u32(l.last);
     w.u32(l.max_iterations);
-  }
+  });
 }
 
 void encode_step_values(ByteWriter& w, const StepGraph& g) {
-  w.count(g.tasks.size(), "tasks");
-  for (const auto& t : g.tasks) w.u64(t.cost_ns);
-  w.count(g.loops.size(), "loops");
-  for (const auto& l : g.loops) w.u32(l.iterations);
-  w.count(g.contacts.size(), "contacts");
-  for (const auto& c : g.contacts) {
+  encode_list(w, g.tasks, "tasks", [&](const Task& t) { w.u64(t.cost_ns); });
+  encode_list(w, g.loops, "loops", [&](const Loop& l) { w.u32(l.iterations); });
+  encode_list(w, g.contacts, "contacts", [&](const Contact& c) {
     w.u32(c.a);
     w.u32(c.b);
-  }
-  w.count(g.groups.size(), "groups");
-  for (const auto g_id : g.groups) w.u32(g_id);
+  });
+  encode_list(w, g.groups, "groups", [&](std::uint32_t group) { w.u32(group); });
   w.u64(g.host_ns);
 }
 

@@ -299,8 +299,8 @@ double imbalance(const std::vector<std::int64_t>& load) {
 
 PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::uint32_t cores,
                                   const partition::Options& options, MPI_Comm comm) {
-  if (nodes == 0) throw UsageError("--nodes: expected at least 1");
-  if (cores == 0) throw UsageError("--cores: expected at least 1");
+  if (nodes == 0) throw OptionError("nodes", "expected at least 1");
+  if (cores == 0) throw OptionError("cores", "expected at least 1");
   // Debian's Scotch is multi-threaded with thread pinning: one thread per rank.
   setenv("SCOTCH_PTHREAD_NUMBER", "1", 0);
   int rank = 0, ranks = 1;

@@ -17,12 +17,13 @@ Layout checked_layout(const Trace& trace, const TraceAssignment& assignment,
   MPI_Comm_size(MPI_COMM_WORLD, &size);
   Layout layout{static_cast<std::uint32_t>(size), options.threads_per_rank};
   if (kSingleThreaded && layout.threads_per_rank != 1)
-    throw UsageError("--threads-per-rank: an SMPI build runs one processor per rank (found " +
-                     std::to_string(layout.threads_per_rank) + ")");
+    throw OptionError("threads_per_rank", "an SMPI build runs one processor per rank (found " +
+                                              std::to_string(layout.threads_per_rank) + ")");
   if (assignment.k != layout.processors())
-    throw UsageError(
-        "the assignment has " + std::to_string(assignment.k) +
-        " processors; ranks x --threads-per-rank = " + std::to_string(layout.processors()));
+    throw OptionError("threads_per_rank",
+                      "ranks x {threads_per_rank} = " + std::to_string(layout.processors()) +
+                          " but the assignment has " + std::to_string(assignment.k) +
+                          " processors");
   steps = std::min<std::size_t>(trace.steps.size(), options.steps.value_or(trace.steps.size()));
   if (assignment.steps.size() < steps)
     throw UsageError("the assignment has fewer steps than the trace");

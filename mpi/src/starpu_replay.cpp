@@ -76,9 +76,10 @@ class StarpuMpiRun {
  public:
   StarpuMpiRun(const Layout& layout, RankWorkload& w) : layout_(layout), w_(w) {
     if (layout.threads_per_rank > STARPU_MAXCPUS)
-      throw UsageError("--policy starpu-mpi: --threads-per-rank " +
-                       std::to_string(layout.threads_per_rank) + ": this StarPU has at most " +
-                       std::to_string(STARPU_MAXCPUS) + " CPU workers");
+      throw OptionError("policy", "starpu-mpi: {threads_per_rank} " +
+                                      std::to_string(layout.threads_per_rank) +
+                                      ": this StarPU has at most " +
+                                      std::to_string(STARPU_MAXCPUS) + " CPU workers");
     // Banners would spoil --json; byte counts per destination need the statistics; several
     // ranks share a machine, so StarPU must not bind each rank's workers to cores 0..T-1.
     setenv("STARPU_SILENT", "1", 0);
@@ -96,14 +97,15 @@ class StarpuMpiRun {
     conf.calibrate = 0;
     conf.bus_calibrate = 0;
     if (const int rc = starpu_mpi_init_conf(nullptr, nullptr, 0, MPI_COMM_WORLD, &conf); rc != 0)
-      throw Error("--policy starpu-mpi: starpu_mpi_init_conf failed (" + std::to_string(rc) + ")");
+      throw Error("StarPU-MPI: starpu_mpi_init_conf failed (" + std::to_string(rc) + ")");
     g_run = this;
     const unsigned got = starpu_cpu_worker_get_count();
     if (got != layout.threads_per_rank) {
       shutdown();
-      throw UsageError("--policy starpu-mpi: asked for " +
-                       std::to_string(layout.threads_per_rank) +
-                       " CPU workers per rank, StarPU-MPI started " + std::to_string(got));
+      throw OptionError("policy", "starpu-mpi: asked for " +
+                                      std::to_string(layout.threads_per_rank) +
+                                      " CPU workers per rank, StarPU-MPI started " +
+                                      std::to_string(got));
     }
     workers_.resize(layout.threads_per_rank);
     starpu_worker_get_ids_by_type(STARPU_CPU_WORKER, workers_.data(),
@@ -198,8 +200,7 @@ class StarpuMpiRun {
           static_cast<int>(begin_[t + 1] - begin_[t]), STARPU_EXECUTE_ON_NODE, rank,
           STARPU_EXECUTE_ON_WORKER, worker, STARPU_VALUE, &arg, sizeof(arg), 0);
       if (rc != 0)
-        throw Error("--policy starpu-mpi: starpu_mpi_task_insert failed (" + std::to_string(rc) +
-                    ")");
+        throw Error("StarPU-MPI: starpu_mpi_task_insert failed (" + std::to_string(rc) + ")");
     };
     done_.store(0, std::memory_order_relaxed);
     Watchdog dog(*this, si, watchdog_s);
@@ -411,7 +412,7 @@ MpiReplayResult replay_starpu_mpi(const Trace& trace, const TraceAssignment& ass
   std::size_t steps = 0;
   const Layout layout = checked_layout(trace, assignment, options, steps);
   if (options.test_drop_message)
-    throw UsageError("--test-drop-message: not with --policy starpu-mpi");
+    throw OptionError("test_drop_message", "not with {policy} starpu-mpi");
   MpiReplayResult result;
   result.policy = MpiPolicy::kStarpuMpi;
   result.ranks = layout.ranks;
@@ -467,9 +468,9 @@ bool have_starpu_mpi() { return false; }
 
 MpiReplayResult replay_starpu_mpi(const Trace&, const TraceAssignment&,
                                   const MpiReplayOptions&) {
-  throw UsageError(
-      "--policy starpu-mpi: tgraph-mpi was built without StarPU-MPI (Debian libstarpu-dev, "
-      "pkg-config starpumpi-1.3; not in an SMPI build)");
+  throw OptionError("policy",
+                    "starpu-mpi: tgraph-mpi was built without StarPU-MPI (Debian libstarpu-dev, "
+                    "pkg-config starpumpi-1.3; not in an SMPI build)");
 }
 
 }  // namespace tgraph::mpi

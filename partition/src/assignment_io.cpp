@@ -196,7 +196,7 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
 TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
                                   const std::string& path, const std::string& method,
                                   std::uint32_t k, PartitionNotes* notes) {
-  if (k == 0) throw UsageError("--threads must be at least 1");
+  if (k == 0) throw OptionError("threads", "must be at least 1");
   if (path.empty()) {
     const std::string m = method.empty() ? default_method(trace) : method;
     TracePartition p = partition_trace(trace, m, k, Options{});
@@ -205,8 +205,8 @@ TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_n
   }
   TraceAssignment a = load_assignment(path, trace, trace_name);
   if (a.k != k)
-    throw UsageError(path + ": assignment has k = " + std::to_string(a.k) + " but --threads is " +
-                     std::to_string(k));
+    throw OptionError("threads", std::to_string(k) + " does not fit " + path +
+                                     ": assignment has k = " + std::to_string(a.k));
   return a;
 }
 

@@ -4,6 +4,8 @@
 #include <cstdio>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/assignment_io.hpp"
 
 namespace tgraph::partition {
 
@@ -63,14 +65,23 @@ void mark_pareto(std::vector<CompareRow>& rows, Objective objective, bool Compar
 
 }  // namespace
 
+TracePartition partition_file(const std::string& trace_path, const std::string& method,
+                              std::uint32_t k, const Options& options, const std::string& output) {
+  const Trace trace = read_trace(trace_path);
+  if (k == 0) throw OptionError("k", "expected at least 1");
+  TracePartition r = partition_trace(trace, method, k, options);
+  if (!output.empty()) write_assignment(output, r.assignment, trace);
+  return r;
+}
+
 Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
                    const std::vector<std::uint32_t>& ks, const Options& options,
                    const std::vector<double>& sticky_migration_costs) {
   for (const std::string& m : methods) (void)make_strategy(m);  // unknown names fail first
   for (std::uint32_t k : ks)
-    if (k == 0) throw UsageError("-k: expected values >= 1");
+    if (k == 0) throw OptionError("k", "expected values >= 1");
   for (double cost : sticky_migration_costs)
-    if (!(cost >= 0.0)) throw UsageError("--sticky-migration-cost: expected values >= 0");
+    if (!(cost >= 0.0)) throw OptionError("sticky_migration_cost", "expected values >= 0");
   Comparison c;
   c.model = options.model.source;
   auto run = [&](const std::string& m, std::uint32_t k, const Options& o,

@@ -59,6 +59,18 @@ CostModel select_cost_model(const std::string& model, const std::string& calibra
   return CostModel::defaults();
 }
 
+std::vector<std::uint64_t> serial_work(const std::string& live,
+                                       std::optional<std::uint64_t> serial_ns, std::size_t steps) {
+  if (serial_ns) return std::vector<std::uint64_t>(steps, *serial_ns);
+  if (live.empty()) return {};
+  std::vector<std::uint64_t> v = load_serial_work(live);
+  if (v.size() < steps)
+    throw OptionError("live", live + ": the run has " + std::to_string(v.size()) +
+                                  " steps, the trace " + std::to_string(steps));
+  v.resize(steps);
+  return v;
+}
+
 CostModel load_calibration(const std::string& path) {
   const std::vector<std::uint8_t> bytes = read_file_bytes(path);
   CostModel m = parse_calibration(

@@ -50,7 +50,7 @@ std::string_view to_string(GraphFileFormat f) {
 
 GraphFileFormat parse_graph_file_format(std::string_view name) {
   return parse_enum(name, {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch},
-                    "--format");
+                    "format");
 }
 
 std::string graph_file(const Trace& trace, std::size_t step, const std::string& trace_name,

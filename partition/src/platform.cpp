@@ -5,17 +5,22 @@
 #include <cstdio>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 
 namespace tgraph::partition {
 
 namespace {
 
-std::uint64_t parse_count(std::string_view text, std::string_view whole, std::string_view flag) {
+OptionError not_a_shape(std::string_view whole, std::string_view field) {
+  return OptionError(std::string(field),
+                     "expected NxC (nodes x cores, e.g. 64x16), found '" + std::string(whole) + "'");
+}
+
+std::uint64_t parse_count(std::string_view text, std::string_view whole, std::string_view field) {
   std::uint64_t v = 0;
   const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
   if (text.empty() || ec != std::errc() || end != text.data() + text.size())
-    throw UsageError(std::string(flag) + ": expected NxC (nodes x cores, e.g. 64x16), found '" +
-                     std::string(whole) + "'");
+    throw not_a_shape(whole, field);
   return v;
 }
 
@@ -34,30 +39,28 @@ std::string bandwidth(double per_byte_ns) {
 
 ClusterShape cluster_shape(std::uint64_t nodes, std::uint64_t cores) {
   if (nodes < 1 || nodes > kMaxNodes)
-    throw UsageError("--nodes: expected 1 to " + std::to_string(kMaxNodes) + ", found " +
-                     std::to_string(nodes));
+    throw OptionError("nodes", "expected 1 to " + std::to_string(kMaxNodes) + ", found " +
+                                   std::to_string(nodes));
   if (cores < 1 || cores > kMaxCores)
-    throw UsageError("--cores: expected 1 to " + std::to_string(kMaxCores) + ", found " +
-                     std::to_string(cores));
+    throw OptionError("cores", "expected 1 to " + std::to_string(kMaxCores) + ", found " +
+                                   std::to_string(cores));
   return {static_cast<std::uint32_t>(nodes), static_cast<std::uint32_t>(cores)};
 }
 
-ClusterShape parse_cluster(std::string_view text, std::string_view flag) {
+ClusterShape parse_cluster(std::string_view text, std::string_view field) {
   const auto x = text.find_first_of("xX");
-  if (x == std::string_view::npos)
-    throw UsageError(std::string(flag) + ": expected NxC (nodes x cores, e.g. 64x16), found '" +
-                     std::string(text) + "'");
-  const std::uint64_t n = parse_count(text.substr(0, x), text, flag);
-  const std::uint64_t c = parse_count(text.substr(x + 1), text, flag);
+  if (x == std::string_view::npos) throw not_a_shape(text, field);
+  const std::uint64_t n = parse_count(text.substr(0, x), text, field);
+  const std::uint64_t c = parse_count(text.substr(x + 1), text, field);
   if (n < 1 || n > kMaxNodes || c < 1 || c > kMaxCores)
-    throw UsageError(std::string(flag) + ": expected 1 to " + std::to_string(kMaxNodes) +
-                     " nodes of 1 to " + std::to_string(kMaxCores) + " cores, found '" +
-                     std::string(text) + "'");
+    throw OptionError(std::string(field), "expected 1 to " + std::to_string(kMaxNodes) +
+                                              " nodes of 1 to " + std::to_string(kMaxCores) +
+                                              " cores, found '" + std::string(text) + "'");
   return {static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(c)};
 }
 
 std::string platform_xml(const ClusterShape& c, const CostModel& m) {
-  std::string source;  // inside an XML comment: no "--", no markup
+  std::string source;  // inside an XML comment: no double hyphen, no markup
   for (char ch : m.source) source += ch == '-' || ch == '<' || ch == '>' || ch == '&' ? '_' : ch;
   std::string config;
   for (std::string_view item : kSimgridNetworkConfig) {
@@ -80,6 +83,15 @@ std::string platform_xml(const ClusterShape& c, const CostModel& m) {
          "\"/>\n"
          "  </zone>\n"
          "</platform>\n";
+}
+
+std::string write_platform(const std::string& output, std::uint64_t nodes, std::uint64_t cores,
+                           const std::string& calibration) {
+  const ClusterShape c = cluster_shape(nodes, cores);
+  const CostModel m = select_cost_model("calibrated", calibration);
+  write_file_atomic(output, platform_xml(c, m));
+  return "wrote " + output + ": " + std::to_string(c.nodes) + " nodes x " +
+         std::to_string(c.cores) + " cores, costs from " + m.source + "\n";
 }
 
 }  // namespace tgraph::partition

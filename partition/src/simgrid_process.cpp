@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <simgrid/s4u.hpp>
+#include <xbt/log.h>
 #include <stdexcept>
 #include <string>
 
@@ -60,12 +61,11 @@ void send_message(int fd, char tag, const std::string& text) {
       write_file_atomic(temp, platform_xml(*platform.cluster, platform.model));
       file = temp;
     }
-    std::vector<std::string> args = {"tgraph-simulate", "--log=root.thresh:critical"};
-    std::vector<char*> argv;
-    for (std::string& s : args) argv.push_back(s.data());
-    argv.push_back(nullptr);
-    int argc = static_cast<int>(args.size());
-    sg::Engine engine(&argc, argv.data());
+    std::string program = "tgraph-simulate";
+    char* argv[] = {program.data(), nullptr};
+    int argc = 1;
+    sg::Engine engine(&argc, argv);
+    xbt_log_control_set("root.thresh:critical");
     for (std::string_view item : kSimgridNetworkConfig) sg::Engine::set_config(std::string(item));
     try {
       engine.load_platform(file);

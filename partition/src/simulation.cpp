@@ -72,13 +72,13 @@ Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, Simulati
       break;
     case SimulationEngine::simgrid:
       if (platform.file.empty() && !platform.cluster)
-        throw UsageError("--engine simgrid: expected --platform P.xml or --cluster NxC");
+        throw OptionError("engine", "simgrid needs {platform} P.xml or {cluster} NxC");
 #ifdef TGRAPH_HAVE_SIMGRID
       r = detail::simgrid_predict(trace, a, platform);
 #else
-      throw UsageError(
-          "--engine simgrid: this tgraph was built without SimGrid (Debian libsimgrid-dev, "
-          "pkg-config simgrid)");
+      throw OptionError("engine",
+                        "simgrid: this tgraph was built without SimGrid (Debian libsimgrid-dev, "
+                        "pkg-config simgrid)");
 #endif
       break;
   }

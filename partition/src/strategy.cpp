@@ -9,6 +9,7 @@
 
 #include "strategies.hpp"
 #include "tgraph/graph/diff.hpp"
+#include "tgraph/graph/enum_names.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::partition {
@@ -24,9 +25,7 @@ std::string_view to_string(Objective o) {
 }
 
 Objective parse_objective(std::string_view s) {
-  if (s == "cut") return Objective::kCut;
-  if (s == "vol") return Objective::kVolume;
-  throw UsageError("--objective: expected cut or vol, got '" + std::string(s) + "'");
+  return parse_enum(s, {Objective::kCut, Objective::kVolume}, "objective");
 }
 
 std::string_view to_string(ScotchFlavour f) {
@@ -44,12 +43,10 @@ std::string_view to_string(ScotchFlavour f) {
 }
 
 ScotchFlavour parse_scotch_flavour(std::string_view s) {
-  if (s == "default") return ScotchFlavour::kDefault;
-  if (s == "quality") return ScotchFlavour::kQuality;
-  if (s == "speed") return ScotchFlavour::kSpeed;
-  if (s == "balance") return ScotchFlavour::kBalance;
-  throw UsageError("--scotch-strategy: expected default, quality, speed or balance, got '" +
-                   std::string(s) + "'");
+  return parse_enum(s,
+                    {ScotchFlavour::kDefault, ScotchFlavour::kQuality, ScotchFlavour::kSpeed,
+                     ScotchFlavour::kBalance},
+                    "scotch_strategy");
 }
 
 std::string_view to_string(Rebalance r) {
@@ -63,9 +60,7 @@ std::string_view to_string(Rebalance r) {
 }
 
 Rebalance parse_rebalance(std::string_view s) {
-  if (s == "greedy") return Rebalance::kGreedy;
-  if (s == "scotch") return Rebalance::kScotch;
-  throw UsageError("--rebalance: expected greedy or scotch, got '" + std::string(s) + "'");
+  return parse_enum(s, {Rebalance::kGreedy, Rebalance::kScotch}, "rebalance");
 }
 
 std::string_view to_string(StickyFallback f) {
@@ -81,16 +76,23 @@ std::string_view to_string(StickyFallback f) {
 }
 
 StickyFallback parse_sticky_fallback(std::string_view s) {
-  if (s == "fresh") return StickyFallback::kFresh;
-  if (s == "repartition") return StickyFallback::kRepartition;
-  if (s == "refine") return StickyFallback::kRefine;
-  throw UsageError("--sticky-fallback: expected fresh, repartition or refine, got '" + std::string(s) + "'");
+  return parse_enum(
+      s, {StickyFallback::kFresh, StickyFallback::kRepartition, StickyFallback::kRefine},
+      "sticky_fallback");
+}
+
+std::string_view to_string(TaskOrder o) {
+  switch (o) {
+    case TaskOrder::kProgram:
+      return "program";
+    case TaskOrder::kList:
+      return "list";
+  }
+  return "?";
 }
 
 TaskOrder parse_task_order(std::string_view s) {
-  if (s == "program") return TaskOrder::kProgram;
-  if (s == "list") return TaskOrder::kList;
-  throw UsageError("--order: expected program or list, got '" + std::string(s) + "'");
+  return parse_enum(s, {TaskOrder::kProgram, TaskOrder::kList}, "order");
 }
 
 std::vector<TaskId> match_by_key(const StepGraph& g, const StepGraph& prev) {
@@ -204,7 +206,7 @@ CostModel NamedOptions::cost_model() const { return select_cost_model(model, cal
 Options NamedOptions::options() const {
   Options o = values;
   o.objective = parse_objective(objective);
-  o.scotch = parse_scotch_flavour(scotch);
+  o.scotch = parse_scotch_flavour(scotch_strategy);
   o.rebalance = parse_rebalance(rebalance);
   o.sticky_fallback = parse_sticky_fallback(sticky_fallback);
   o.order = parse_task_order(order);

@@ -39,8 +39,8 @@ TraceHeader scene_header(const Scene& scene, std::uint64_t seed) {
 
 CaptureRun capture_scene(const CaptureOptions& o) {
   if (!o.no_capture && o.output.empty())
-    throw UsageError("capture: -o/--output is required (or --no-capture)");
-  if (o.steps && *o.steps < 1) throw UsageError("capture: --steps must be >= 1");
+    throw OptionError("output", "is required (or {no_capture})");
+  if (o.steps && *o.steps < 1) throw OptionError("steps", "must be at least 1");
   std::unique_ptr<Scene> scene = make_scene(o.scene, o.scene_options);
   CaptureRun run;
   run.scene = scene->name();
@@ -53,7 +53,7 @@ CaptureRun capture_scene(const CaptureOptions& o) {
   capture::Recorder rec(o.no_capture ? capture::Mode::kOff : capture::Mode::kCapture);
   run.mode = std::string(capture::to_string(rec.mode()));
   rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
-  if (o.cost_passes == 0) throw UsageError("capture: --cost-passes must be >= 1");
+  if (o.cost_passes == 0) throw OptionError("cost_passes", "must be at least 1");
   rec.set_cost_passes(o.cost_passes);
   run.cost_passes = o.cost_passes;
   std::unique_ptr<TraceWriter> writer;

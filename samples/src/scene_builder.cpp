@@ -19,7 +19,7 @@ std::unique_ptr<Scene> SceneBuilder::build(std::string_view text) {
   if (!scene_) Directive(file_, number, "", {}).fail("no 'scene name=...' line");
   if (scene_->bodies().empty()) Directive(file_, number, "", {}).fail("the scene has no objects");
   if (options_.dt) {
-    if (!(*options_.dt > 0.0) || !std::isfinite(*options_.dt)) throw UsageError("--dt must be > 0");
+    if (!(*options_.dt > 0.0) || !std::isfinite(*options_.dt)) throw OptionError("dt", "must be > 0");
     scene_->solver().dt = *options_.dt;
   }
   if (options_.coupling) scene_->solver().coupling = *options_.coupling;
@@ -149,7 +149,8 @@ void SceneBuilder::instance_common(Directive& d, Body& b, double spacing, bool f
 int SceneBuilder::split_of(Directive& d) {
   const int split = d.integer("split", 1, 1, 1024);
   if (options_.split) {
-    if (*options_.split < 1 || *options_.split > 1024) throw UsageError("--split must be in [1, 1024]");
+    if (*options_.split < 1 || *options_.split > 1024)
+      throw OptionError("split", "must be in [1, 1024]");
     return *options_.split;
   }
   return split;

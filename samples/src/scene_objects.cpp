@@ -293,7 +293,7 @@ void SceneBuilder::cloth(Directive& d) {
   if (options_.subobjects) {
     const int s = static_cast<int>(std::lround(std::sqrt(static_cast<double>(*options_.subobjects))));
     if (*options_.subobjects < 1 || s * s != *options_.subobjects)
-      throw UsageError("--subobjects must be a perfect square (1, 4, 9, 16, ...)");
+      throw OptionError("subobjects", "must be a perfect square (1, 4, 9, 16, ...)");
     split = s;
   }
   if (split > n) d.fail("split must not exceed nodes");

@@ -157,11 +157,35 @@ TEST_F(Cli, ExperimentVizTimelineValidateAndDemoErrorsNameTheFlag) {
   EXPECT_EQ(j["command"], "tgraph experiment metg --quick --threads 1,2 --methods sequential --out m");
 }
 
+// The modules' option errors of generate, capture and partition, in the flags' words.
+TEST_F(Cli, ModuleOptionErrorsOfGenerateCaptureAndPartitionNameTheFlags) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"generate --tasks 10 --width 11 -o g.tgt", "--width: expected at most --tasks (10)"},
+      {"generate --tasks 10 --pattern domain --iterations 0 -o g.tgt", "--iterations: "},
+      {"capture --scene fig2 --steps 0 -o f.tgt", "--steps: must be at least 1"},
+      {"capture --scene fig2 --steps 1", "--output: is required (or --no-capture)"},
+      {"capture --scene fig2 --dt -1 --steps 1 -o f.tgt", "--dt: must be > 0"},
+      {"capture --scene cloth128 --subobjects 3 --steps 1 -o f.tgt", "--subobjects: "},
+      {"compare g.tgt --methods list -k 0", "-k: expected values >= 1"},
+      {"partition g.tgt -m list -k 0", "-k: expected at least 1"},
+      {"partition g.tgt -m list -k 2 --order fifo", "--order: "},
+      {"compare g.tgt --methods list -k 2 --sticky-migration-cost -1",
+       "--sticky-migration-cost: expected values >= 0"},
+  };
+  ASSERT_EQ(run("generate --tasks 12 --width 4 -o g.tgt").code, 0);
+  for (const auto& [args, starts] : cases) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_EQ(r.err.rfind(std::string("tgraph: ") + starts, 0), 0u) << args << ": " << r.err;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+  }
+}
+
 TEST_F(Cli, ExportRejectsStepOutOfRangeAndBadFormat) {
   ASSERT_EQ(run("capture --scene fig2 --steps 3 -o f.tgt").code, 0);
   Result r = run("export f.tgt --step 3 --format json");
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("--step"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err, "tgraph: --step: trace f.tgt has 3 steps, no step 3\n");
   r = run("export f.tgt --format dot");
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(one_line(r.err)) << r.err;
@@ -453,9 +477,15 @@ TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {
   const auto jl = nlohmann::json::parse(l.out);
   EXPECT_EQ(jl["lowered"], true);
   EXPECT_EQ(jl["per_step"].size(), 3u);
+  const Result none = run("simulate f.tgt f.tga --engine simgrid");
+  EXPECT_EQ(none.code, 2);
+  EXPECT_EQ(none.err.rfind("tgraph: --engine: simgrid ", 0), 0u) << none.err;
+  EXPECT_TRUE(one_line(none.err)) << none.err;
   for (const char* bad : {"--cluster 4", "--cluster 0x4", "--cluster 1x3"}) {
     const Result r = run(std::string("simulate f.tgt f.tga --engine simgrid ") + bad);
     EXPECT_EQ(r.code, 2) << bad;
+    if (std::string(bad) != "--cluster 1x3")  // that one is well formed but too small
+      EXPECT_EQ(r.err.rfind("tgraph: --cluster: expected ", 0), 0u) << r.err;
     EXPECT_TRUE(one_line(r.err)) << bad << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << bad;
   }
@@ -469,6 +499,9 @@ TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {
   std::uint64_t sum = 0;
   for (const auto& st : js["per_step"]) sum += st["makespan_ns"].get<std::uint64_t>();
   EXPECT_EQ(js["makespan_ns"].get<std::uint64_t>(), sum);
+  const Result no_nodes = run("platform --nodes 0 --cores 2 -o p.xml");
+  EXPECT_EQ(no_nodes.code, 2);
+  EXPECT_EQ(no_nodes.err, "tgraph: --nodes: expected 1 to 1048576, found 0\n");
   ASSERT_EQ(run("platform --nodes 2 --cores 2 -o p.xml").code, 0);
   const Result p = run("simulate f.tgt f.tga --engine simgrid --platform p.xml --json");
   ASSERT_EQ(p.code, 0) << p.err;

@@ -23,22 +23,22 @@ std::string_view to_string(Colour c) {
 
 TEST(ParseEnum, ReturnsTheValueOfEachName) {
   for (Colour c : {Colour::kRed, Colour::kGreen, Colour::kBlue})
-    EXPECT_EQ(parse_enum(to_string(c), {Colour::kRed, Colour::kGreen, Colour::kBlue}, "--colour"),
+    EXPECT_EQ(parse_enum(to_string(c), {Colour::kRed, Colour::kGreen, Colour::kBlue}, "colour"),
               c);
 }
 
 TEST(ParseEnum, RejectsAnotherNameListingTheNamesInOrder) {
   try {
-    parse_enum("pink", {Colour::kRed, Colour::kGreen, Colour::kBlue}, "--colour");
+    parse_enum("pink", {Colour::kRed, Colour::kGreen, Colour::kBlue}, "colour");
     FAIL() << "no error";
-  } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--colour pink: expected red, green or blue");
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "colour: expected red, green or blue, got 'pink'");
   }
   try {
-    parse_enum("", {Colour::kRed}, "--colour");
+    parse_enum("", {Colour::kRed}, "colour");
     FAIL() << "no error";
-  } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--colour : expected red");
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "colour: expected red, got ''");
   }
 }
 

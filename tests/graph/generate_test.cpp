@@ -3,11 +3,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/generate.hpp"
 #include "tgraph/graph/metrics.hpp"
+#include "tgraph/graph/trace_io.hpp"
 
 namespace tgraph {
 namespace {
@@ -94,7 +97,34 @@ TEST(Generate, StepsShareTheStructureAndDrawTheirOwnCosts) {
   EXPECT_EQ(t.header.scene, "generated-stencil");
 }
 
+TEST(Generate, FileHoldsTheTraceItsReportDescribes) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "tgraph_generate_test.tgt").string();
+  const GeneratedFile f = generate_file({.tasks = 12, .width = 4, .seed = 9}, 2, path);
+  const Trace t = read_trace(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(t.steps.size(), 2u);
+  EXPECT_EQ(t, generate_trace({.tasks = 12, .width = 4, .seed = 9}, 2));
+  EXPECT_EQ(f.tasks, 12u);
+  EXPECT_EQ(f.data, 8u);
+  EXPECT_EQ(f.edges, t.steps[0].edges.size());
+  const nlohmann::json j = nlohmann::json::parse(generated_json(f));
+  EXPECT_EQ(j["trace"], path);
+  EXPECT_EQ(j["pattern"], "stencil");
+  EXPECT_EQ(j["steps"], 2);
+  EXPECT_EQ(j["tasks"], 12);
+  EXPECT_EQ(j["accesses"], f.accesses);
+  EXPECT_EQ(j["seed"], 9);
+  EXPECT_EQ(generated_text(f).rfind("wrote " + path + ": 2 step(s) of 12 tasks, 8 data, ", 0), 0u);
+}
+
 TEST(Generate, RejectsNoTasksAndAWidthAboveTheTasks) {
+  try {
+    generate_step({.tasks = 10, .width = 11});
+    ADD_FAILURE() << "a width above the tasks";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "width: expected at most tasks (10)");
+  }
   EXPECT_THROW(generate_step({.tasks = 0}), UsageError);
   EXPECT_THROW(generate_step({.tasks = 10, .width = 11}), UsageError);
   EXPECT_THROW(generate_step({.tasks = 10, .pattern = Pattern::kDomain, .iterations = 0}),

@@ -689,46 +689,34 @@ TEST(TraceReader, RejectsAbsurdCountsWithoutAllocatingForThem) {
   EXPECT_READ_ERROR(header, "offset 20: absurd count: expected a scene string of at most 0 bytes");
 }
 
-TEST(TraceReader, RejectsKindIdOutOfRange) {
-  RawStep s;
-  s.tasks[0].kind = 2;
-  EXPECT_READ_ERROR(trace_of(s), "id out of range: expected task kind id < 2, found 2");
-}
-
-TEST(TraceReader, RejectsObjectIdOutOfRange) {
-  RawStep s;
-  s.tasks[1].object = 7;
-  EXPECT_READ_ERROR(trace_of(s),
-                    "id out of range: expected task object id < 2 or 4294967295 (none), found 7");
-  RawStep d;
-  d.data[0].object = 2;
-  EXPECT_READ_ERROR(trace_of(d), "expected datum object id < 2");
-  RawStep c;
-  c.contacts = {{0, 5}};
-  EXPECT_READ_ERROR(trace_of(c), "expected contact object id < 2, found 5");
-}
-
-TEST(TraceReader, RejectsDatumIdOutOfRange) {
-  RawStep s;
-  s.accesses[2].datum = 2;
-  EXPECT_READ_ERROR(trace_of(s), "id out of range: expected access datum id < 2, found 2");
-  RawStep l;
-  l.loops[0].condition = 3;
-  EXPECT_READ_ERROR(trace_of(l), "expected loop condition datum id < 2, found 3");
-}
-
-TEST(TraceReader, RejectsLoopIdOutOfRange) {
-  RawStep s;
-  s.tasks[1].loop = 1;
-  EXPECT_READ_ERROR(trace_of(s),
-                    "id out of range: expected task loop id (or 4294967295 for none) < 1, found 1");
-}
-
-TEST(TraceReader, RejectsTaskIdsOfALoopOutOfRange) {
-  RawStep s;
-  s.loops[0].last = 3;
-  EXPECT_READ_ERROR(trace_of(s),
-                    "malformed loop 0: expected first < last <= 2 tasks, found [1, 3)");
+// Each id of a step's tables past the end of the table it points into: one RawStep
+// changed in one place, the message naming the table, the bound and the id found.
+TEST(TraceReader, RejectsEveryIdOutOfRange) {
+  struct Case {
+    void (*change)(RawStep&);
+    const char* error;
+  };
+  const Case cases[] = {
+      {[](RawStep& s) { s.tasks[0].kind = 2; },
+       "id out of range: expected task kind id < 2, found 2"},
+      {[](RawStep& s) { s.tasks[1].object = 7; },
+       "id out of range: expected task object id < 2 or 4294967295 (none), found 7"},
+      {[](RawStep& s) { s.data[0].object = 2; }, "expected datum object id < 2"},
+      {[](RawStep& s) { s.contacts = {{0, 5}}; }, "expected contact object id < 2, found 5"},
+      {[](RawStep& s) { s.accesses[2].datum = 2; },
+       "id out of range: expected access datum id < 2, found 2"},
+      {[](RawStep& s) { s.loops[0].condition = 3; },
+       "expected loop condition datum id < 2, found 3"},
+      {[](RawStep& s) { s.tasks[1].loop = 1; },
+       "id out of range: expected task loop id (or 4294967295 for none) < 1, found 1"},
+      {[](RawStep& s) { s.loops[0].last = 3; },
+       "malformed loop 0: expected first < last <= 2 tasks, found [1, 3)"},
+  };
+  for (const Case& c : cases) {
+    RawStep s;
+    c.change(s);
+    EXPECT_READ_ERROR(trace_of(s), c.error);
+  }
 }
 
 TEST(TraceReader, RejectsMalformedLoops) {
@@ -977,7 +965,7 @@ TEST(FileUtil, ReadFileTextReturnsTheBytesAsWritten) {
   EXPECT_THROW(read_file_text("/nonexistent-folder/none.json"), InputError);
 }
 
-TEST(Trace, StepAtNamesTheFlagTheTraceAndItsStepCount) {
+TEST(Trace, StepAtNamesTheFieldTheTraceAndItsStepCount) {
   Trace t;
   t.steps.resize(3);
   EXPECT_EQ(&step_at(t, 2, "f.tgt"), &t.steps[2]);
@@ -985,13 +973,13 @@ TEST(Trace, StepAtNamesTheFlagTheTraceAndItsStepCount) {
     step_at(t, 3, "f.tgt");
     FAIL() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--step 3: trace f.tgt has 3 steps");
+    EXPECT_STREQ(e.what(), "step: trace f.tgt has 3 steps, no step 3");
   }
   try {
-    step_at(t, 7, "g.tgt", "--steps");
+    step_at(t, 7, "g.tgt", "steps");
     FAIL() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--steps 7: trace g.tgt has 3 steps");
+    EXPECT_STREQ(e.what(), "steps: trace g.tgt has 3 steps, no step 7");
   }
 }
 

@@ -252,7 +252,7 @@ TEST(StarpuMpi, RefusedWithOneLineWhereNotBuilt) {
                             " --policy starpu-mpi --threads-per-rank 1",
                         dir);
   EXPECT_EQ(r.status, 2);
-  EXPECT_NE(r.err.find("--policy starpu-mpi"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--policy: starpu-mpi: "), std::string::npos) << r.err;
   fs::remove_all(dir);
 }
 

@@ -166,14 +166,14 @@ TEST(AssignmentFile, LoadOrPartitionChecksTheThreadCount) {
     load_or_partition(trace, "t.tgt", path, "owner", 3);
     ADD_FAILURE() << "accepted K = 2 on 3 threads";
   } catch (const UsageError& e) {
-    EXPECT_EQ(std::string(e.what()), path + ": assignment has k = 2 but --threads is 3");
+    EXPECT_EQ(std::string(e.what()), "threads: 3 does not fit " + path + ": assignment has k = 2");
   }
   for (const std::string& p : {std::string(), path}) {
     try {
       load_or_partition(trace, "t.tgt", p, "owner", 0);
       ADD_FAILURE() << "accepted 0 threads";
     } catch (const UsageError& e) {
-      EXPECT_STREQ(e.what(), "--threads must be at least 1");
+      EXPECT_STREQ(e.what(), "threads: must be at least 1");
     }
   }
   std::filesystem::remove(path);

@@ -4,11 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "test_graphs.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/assignment_io.hpp"
 
 namespace tgraph::partition {
 namespace {
@@ -230,6 +233,24 @@ TEST(Compare, PartitionJsonSeparatesFallbackFromRebalancedSteps) {
   EXPECT_EQ(j["fallback_steps"], fallback);
   EXPECT_EQ(j["rebalanced_steps"], rebalanced);
   EXPECT_EQ(fallback, 3u);
+}
+
+TEST(PartitionFile, WritesTheAssignmentPartitionTraceComputes) {
+  const std::string dir = ::testing::TempDir();
+  const std::string trace_path = dir + "tgraph_partition_file.tgt", out = dir + "tgraph_pf.tga";
+  const Trace trace = changing_trace();
+  write_trace(trace_path, trace);
+  const TracePartition r = partition_file(trace_path, "list", 3, Options{}, out);
+  EXPECT_EQ(r.assignment.steps, partition_trace(trace, "list", 3, Options{}).assignment.steps);
+  EXPECT_EQ(load_assignment(out, trace, trace_path).steps, r.assignment.steps);
+  try {
+    partition_file(trace_path, "list", 0, Options{}, "");
+    ADD_FAILURE() << "accepted k = 0";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "k: expected at least 1");
+  }
+  std::remove(trace_path.c_str());
+  std::remove(out.c_str());
 }
 
 }  // namespace

@@ -164,7 +164,7 @@ TEST(GraphFile, WritesTheNamedStepInTheChosenFormat) {
     graph_file(trace, 2, "t.tgt", GraphFileFormat::kJson);
     FAIL() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--step 2: trace t.tgt has 2 steps");
+    EXPECT_STREQ(e.what(), "step: trace t.tgt has 2 steps, no step 2");
   }
   for (GraphFileFormat f :
        {GraphFileFormat::kJson, GraphFileFormat::kMetis, GraphFileFormat::kScotch})

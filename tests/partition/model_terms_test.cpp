@@ -9,6 +9,7 @@
 #include <string>
 
 #include "test_graphs.hpp"
+#include "test_model.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulator.hpp"
@@ -16,23 +17,10 @@
 namespace tgraph::partition {
 namespace {
 
+using testing::assign;
 using testing::Builder;
 using testing::M;
-
-CostModel model(double latency) {
-  CostModel m;
-  m.sync_latency_ns = latency;
-  m.per_byte_ns = 0;
-  m.source = "test";
-  return m;
-}
-
-Assignment assign(std::uint32_t k, std::vector<ProcId> proc) {
-  Assignment a;
-  a.k = k;
-  a.proc = std::move(proc);
-  return a;
-}
+using testing::model;
 
 // t0 (cost 1000) writes x; t1 (cost 100) reads it.
 StepGraph producer_consumer() {
@@ -201,6 +189,16 @@ TEST(SerialWork, ReadsRecordPartitionAndPrepareOfALiveRunPerStep) {
                           {"record_ns": 1, "partition_ns": 0, "prepare_ns": 2}]})";
   }
   EXPECT_EQ(load_serial_work(path), (std::vector<std::uint64_t>{33, 3}));
+  // Per step of a trace: the first steps of the run, or one value for every step.
+  EXPECT_EQ(serial_work(path, std::nullopt, 1), (std::vector<std::uint64_t>{33}));
+  EXPECT_EQ(serial_work("", 5, 3), (std::vector<std::uint64_t>{5, 5, 5}));
+  EXPECT_EQ(serial_work("", std::nullopt, 3), (std::vector<std::uint64_t>{}));
+  try {
+    serial_work(path, std::nullopt, 3);
+    ADD_FAILURE() << "a run of 2 steps for a trace of 3";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(std::string(e.what()), "live: " + path + ": the run has 2 steps, the trace 3");
+  }
   {
     std::ofstream f(path);
     f << R"({"per_step": [{"record_ns": 10}]})";

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "test_graphs.hpp"
@@ -41,25 +42,35 @@ SimulatedPlatform on_file(const std::string& file, const CostModel& m) {
 }
 
 TEST(ParseCluster, ReadsNodesAndCores) {
-  const ClusterShape c = parse_cluster("64x16", "--cluster");
+  const ClusterShape c = parse_cluster("64x16");
   EXPECT_EQ(c.nodes, 64u);
   EXPECT_EQ(c.cores, 16u);
   EXPECT_EQ(c.processors(), 1024u);
-  EXPECT_EQ(parse_cluster("1X2", "--cluster").cores, 2u);
+  EXPECT_EQ(parse_cluster("1X2").cores, 2u);
 }
 
 TEST(ParseCluster, RejectsAnythingButTwoPositiveCounts) {
   for (const char* bad : {"", "64", "x16", "64x", "0x4", "4x0", "4x16x2", "-1x4", "ax4", "4x 2",
                           "99999999999x1", "1x5000"}) {
     try {
-      parse_cluster(bad, "--cluster");
+      parse_cluster(bad, "shape");
       ADD_FAILURE() << "accepted '" << bad << "'";
-    } catch (const UsageError& e) {
-      EXPECT_NE(std::string(e.what()).find("--cluster"), std::string::npos) << e.what();
+    } catch (const OptionError& e) {
+      EXPECT_EQ(e.option(), "shape") << e.what();
     }
   }
-  EXPECT_THROW(cluster_shape(0, 4), UsageError);
-  EXPECT_THROW(cluster_shape(4, kMaxCores + 1), UsageError);
+  try {
+    cluster_shape(0, 4);
+    ADD_FAILURE() << "accepted 0 nodes";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "nodes: expected 1 to 1048576, found 0");
+  }
+  try {
+    cluster_shape(4, kMaxCores + 1);
+    ADD_FAILURE() << "accepted 4097 cores";
+  } catch (const OptionError& e) {
+    EXPECT_STREQ(e.what(), "cores: expected 1 to 4096, found 4097");
+  }
 }
 
 // A cost model with these links: between two cores of a node (signal latency, ns per byte)
@@ -85,6 +96,20 @@ TEST(PlatformXml, TakesLinkLatencyAndBandwidthFromTheCostModel) {
   EXPECT_NE(xml.find("lat=\"750ns\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("bw=\"12500000000Bps\""), std::string::npos) << xml;
   EXPECT_NE(xml.find("<prop id=\"network/model\" value=\"CM02\"/>"), std::string::npos) << xml;
+}
+
+TEST(PlatformXml, WritePlatformWritesTheXmlOfTheCalibrationsLinks) {
+  const std::filesystem::path dir = tgraph::test::scratch_dir("tgraph_write_platform_");
+  const std::string cal = (dir / "c.json").string(), out = (dir / "p.xml").string();
+  std::ofstream(cal) << R"({"sync_latency_ns": 100, "per_byte_ns": 0.05})";
+  EXPECT_EQ(write_platform(out, 4, 16, cal),
+            "wrote " + out + ": 4 nodes x 16 cores, costs from " + cal + "\n");
+  CostModel m = parse_calibration(R"({"sync_latency_ns": 100, "per_byte_ns": 0.05})", cal);
+  m.source = cal;
+  std::ifstream f(out);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(f), {}), platform_xml({4, 16}, m));
+  EXPECT_THROW(write_platform(out, 0, 16, cal), OptionError);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Calibration, InterNodeFieldsAreOptionalWithDefaults) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "test_graphs.hpp"
+#include "test_model.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/partition/simulator.hpp"
@@ -11,23 +12,7 @@
 namespace tgraph::partition {
 namespace {
 
-using testing::Builder;
-using testing::M;
-
-CostModel model(double latency, double per_byte) {
-  CostModel m;
-  m.sync_latency_ns = latency;
-  m.per_byte_ns = per_byte;
-  m.source = "test";
-  return m;
-}
-
-Assignment assign(std::uint32_t k, std::vector<ProcId> proc) {
-  Assignment a;
-  a.k = k;
-  a.proc = std::move(proc);
-  return a;
-}
+using namespace testing;  // Builder, M, model, assign: the partition tests' graphs
 
 // t0 -> t1 -> t2 through data x and y (costs 3, 4, 5).
 StepGraph chain() {

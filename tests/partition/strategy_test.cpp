@@ -534,6 +534,15 @@ struct StickyMerge {
   Result r0, r1;
 };
 
+// `objects` objects in two collision groups (the first half, the second), then all in one.
+std::pair<StepGraph, StepGraph> apart_then_merged(int objects) {
+  std::vector<int> first, second;
+  for (int i = 0; i < objects; ++i) (i < objects / 2 ? first : second).push_back(i);
+  std::vector<int> all = first;
+  all.insert(all.end(), second.begin(), second.end());
+  return {testing::grouped_scene(objects, {first, second}), testing::grouped_scene(objects, {all})};
+}
+
 StickyMerge sticky_merge(const StepGraph& apart, const StepGraph& merged, std::uint32_t k,
                          const Options& o) {
   StickyMerge m{make_strategy("sticky"), {}, {}};
@@ -544,9 +553,7 @@ StickyMerge sticky_merge(const StepGraph& apart, const StepGraph& merged, std::u
 }
 
 TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplitByDefault) {
-  using testing::grouped_scene;
-  const StepGraph apart = grouped_scene(8, {{0, 1, 2, 3}, {4, 5, 6, 7}});
-  const StepGraph merged = grouped_scene(8, {{0, 1, 2, 3, 4, 5, 6, 7}});
+  const auto [apart, merged] = apart_then_merged(8);
   ASSERT_EQ(apart.loops.size(), 2u);
   ASSERT_EQ(merged.loops.size(), 1u);
   const Options fresh;
@@ -585,9 +592,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplitByDefault
 }
 
 TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
-  using testing::grouped_scene;
-  const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
-  const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
+  const auto [apart, merged] = apart_then_merged(12);
   Options o;
   o.sticky_fallback = StickyFallback::kRepartition;
   for (std::uint32_t k : {2u, 3u, 4u}) {
@@ -610,9 +615,7 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
 }
 
 TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
-  using testing::grouped_scene;
-  const StepGraph apart = grouped_scene(12, {{0, 1, 2, 3, 4, 5}, {6, 7, 8, 9, 10, 11}});
-  const StepGraph merged = grouped_scene(12, {{0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11}});
+  const auto [apart, merged] = apart_then_merged(12);
   Options refine;
   refine.sticky_fallback = StickyFallback::kRefine;
   refine.sticky_phases = 0;  // METIS as metis-relabel runs it

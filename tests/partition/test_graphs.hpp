@@ -8,11 +8,20 @@
 #include <string_view>
 #include <vector>
 
+#include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
 namespace tgraph::partition::testing {
 
 using M = AccessMode;
+
+/// K processors, processor per task, program order.
+inline Assignment assign(std::uint32_t k, std::vector<ProcId> proc) {
+  Assignment a;
+  a.k = k;
+  a.proc = std::move(proc);
+  return a;
+}
 
 /// prefix + decimal i (built by appending: GCC 12 warns falsely on "lit" + std::string&&).
 inline std::string name(std::string_view prefix, std::int64_t i) {

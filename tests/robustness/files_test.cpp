@@ -400,7 +400,7 @@ TEST_F(Files, ReplayRefusesAnAssignmentThatDoesNotFitBeforeAnyThreadStarts) {
   refused({"proc.tga", "--threads", "2"},
           "proc.tga: offset 54: step 0: task 0 on processor 7, expected < k = 2");
   // k = 2 replayed on 3 threads.
-  refused({"fig2.tga", "--threads", "3"}, "fig2.tga: assignment has k = 2 but --threads is 3");
+  refused({"fig2.tga", "--threads", "3"}, "--threads: 3 does not fit fig2.tga: assignment has k = 2");
   // The fitting one replays.
   EXPECT_EQ(run({"replay", "fig2.tgt", "fig2.tga", "--threads", "2", "--no-pin", "--repeat", "1"}),
             0)

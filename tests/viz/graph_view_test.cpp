@@ -200,7 +200,7 @@ TEST(GraphView, TraceStepViewTitlesTheFileTheStepAndTheAssignment) {
     trace_step_view(trace, path, 2, nullptr, {});
     FAIL() << "no error";
   } catch (const UsageError& e) {
-    EXPECT_STREQ(e.what(), "--step 2: trace /data/run/fig2.tgt has 2 steps");
+    EXPECT_STREQ(e.what(), "step: trace /data/run/fig2.tgt has 2 steps, no step 2");
   }
   ViewOptions small;
   small.max_nodes = 3;

@@ -70,7 +70,7 @@ std::string_view to_string(Collapse c) {
 Collapse parse_collapse(std::string_view s) {
   return parse_enum(
       s, {Collapse::kNone, Collapse::kObject, Collapse::kKind, Collapse::kProcessor, Collapse::kLoop},
-      "--collapse");
+      "collapse");
 }
 
 std::string_view to_string(NodeKind k) {

@@ -87,7 +87,7 @@ struct StepProgram {
 /// others, so that one preemption by the OS does not inflate the span; in deferred mode conditional_break returns true
 /// after recording the body once, and the executor iterates.
 ///
-/// Cost passes (set_cost_passes(N), `tgraph capture --cost-passes N`): in capture mode each
+/// Cost passes (set_cost_passes(N), the cost passes of `tgraph capture`): in capture mode each
 /// timed run of a task body, in a loop or not, runs N times and counts the median of the N
 /// timings, so that one preempted run does not set the task's cost. Before the first pass
 /// the recorder copies the data the task writes (W, RW, CW) from their storage (the `ptr`

@@ -10,11 +10,12 @@
 
 namespace tgraph {
 
-/// The one of `values` whose to_string() is `name`; otherwise a UsageError
-/// "<what> <name>: expected a, b or c" naming `values` in order. Example:
-///   parse_enum(s, {Collapse::kNone, Collapse::kObject}, "--collapse")
+/// The one of `values` whose to_string() is `name`; otherwise an OptionError of the options
+/// field `field`: "<field>: expected a, b or c, got '<name>'" naming `values` in order.
+/// Example:
+///   parse_enum(s, {Collapse::kNone, Collapse::kObject}, "collapse")
 template <class Enum>
-Enum parse_enum(std::string_view name, std::initializer_list<Enum> values, std::string_view what) {
+Enum parse_enum(std::string_view name, std::initializer_list<Enum> values, std::string_view field) {
   std::string names;
   std::size_t i = 0;
   for (Enum v : values) {
@@ -23,7 +24,7 @@ Enum parse_enum(std::string_view name, std::initializer_list<Enum> values, std::
     names += to_string(v);
     ++i;
   }
-  throw UsageError(std::string(what) + " " + std::string(name) + ": expected " + names);
+  throw OptionError(std::string(field), "expected " + names + ", got '" + std::string(name) + "'");
 }
 
 }  // namespace tgraph

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "tgraph/graph/step_graph.hpp"
@@ -41,7 +42,7 @@ struct GenerateOptions {
 };
 
 /// One generated step (edges not derived). Step `step` of a trace differs from step 0 only
-/// in its costs (the structure is the same). Throws UsageError when the options are out of
+/// in its costs (the structure is the same). Throws OptionError when the options are out of
 /// range (no tasks, more than 2^32 - 2 tasks or data, width above tasks).
 StepGraph generate_step(const GenerateOptions& options, std::uint32_t step = 0);
 
@@ -50,5 +51,22 @@ StepGraph generate_step(const GenerateOptions& options, std::uint32_t step = 0);
 ///   Trace t = generate_trace({.tasks = 1'000'000, .pattern = Pattern::kRandom}, 1);
 ///   write_trace("random.tgt", t);
 Trace generate_trace(const GenerateOptions& options, std::uint32_t steps);
+
+/// What generate_file() wrote: the first step's sizes (every step has them).
+struct GeneratedFile {
+  std::string output;
+  GenerateOptions options;
+  std::size_t steps = 0, tasks = 0, data = 0, accesses = 0;
+  std::size_t edges = 0;  ///< edges and loop-carried edges
+  double seconds = 0.0;   ///< generating and writing
+};
+
+/// generate_trace() written to `output` (`tgraph generate`), timed.
+GeneratedFile generate_file(const GenerateOptions& options, std::uint32_t steps,
+                            const std::string& output);
+/// One JSON object (trace, pattern, steps, tasks, data, accesses, edges, seed, seconds).
+std::string generated_json(const GeneratedFile& f);
+/// "wrote T.tgt: S step(s) of N tasks, ..." with a newline.
+std::string generated_text(const GeneratedFile& f);
 
 }  // namespace tgraph

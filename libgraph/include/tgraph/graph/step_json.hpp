@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// One step graph as JSON (`tgraph export --format json`).
+// One step graph as JSON (what `tgraph export` writes in its json format).
 #pragma once
 
 #include <cstddef>

@@ -72,7 +72,7 @@ struct SummaryOptions {
 ///   std::cout << trace_summary_text(s, "b.tgt");
 TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options = {});
 
-/// `tgraph info --json`: one JSON object (header, totals, "per_step" array).
+/// The JSON of `tgraph info`: one object (header, totals, "per_step" array).
 std::string trace_summary_json(const TraceSummary& s, const std::string& trace_name);
 /// `tgraph info`'s text: one "name   value" line per figure, then one line per step whose
 /// structure changed.

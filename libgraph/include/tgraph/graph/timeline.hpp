@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The timeline of an execution: which thread ran each task instance when, and where threads
 // waited. One model: replay's TimelineObserver records it, viz draws it and converts it to
-// Chrome trace events, `tgraph replay --timeline` writes it as JSON and `tgraph timeline`
+// Chrome trace events, `tgraph replay` writes it as JSON when asked for a timeline and `tgraph timeline`
 // reads it back.
 #pragma once
 

@@ -25,10 +25,11 @@ struct Trace {
   friend bool operator==(const Trace&, const Trace&) = default;
 };
 
-/// trace.steps[step]; UsageError "<flag> <step>: trace <trace_name> has N steps" when out of
-/// range (the verbs that take one step of a trace).
+/// trace.steps[step]; an OptionError of the options field `field` ("<field>: trace
+/// <trace_name> has N steps, no step <step>") when out of range (the verbs that take one
+/// step of a trace).
 const StepGraph& step_at(const Trace& trace, std::size_t step, const std::string& trace_name,
-                         const std::string& flag = "--step");
+                         const std::string& field = "step");
 
 /// This machine for trace headers: "<cpu model>, N hardware threads".
 std::string machine_description();

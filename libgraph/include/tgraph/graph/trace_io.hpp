@@ -33,7 +33,7 @@ struct WriteOptions {
 /// end frame, syncs and renames it to `path`, so an existing file at `path` is replaced only
 /// by a complete trace. A capture killed at any moment (or stopped by a failed write or a
 /// diverging simulation) leaves `<path>.partial`, whose complete steps read back with
-/// ReadOptions::recover (`tgraph info X.partial --recover`). Steps whose structure equals
+/// ReadOptions::recover (`tgraph info` reads X.partial so when asked to recover). Steps whose structure equals
 /// an earlier step's are stored as a reference plus costs, loop counts and contacts.
 ///
 ///   TraceWriter w("run.tgt", header);   // writes run.tgt.partial

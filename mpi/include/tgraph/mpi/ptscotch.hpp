@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `tgraph-mpi partition --method ptscotch`: a step's undirected task graph partitioned across
+// `tgraph-mpi partition` with the ptscotch method: a step's undirected task graph partitioned across
 // MPI ranks, nodes first with PT-Scotch (SCOTCH_dgraphPart on a graph built from per-rank
 // slices), then each node's tasks over its cores with sequential Scotch. PT-Scotch 7.0.3
 // cannot map onto a two-level nodes x cores target ("kdgraphMapRbMap: not implemented yet").
@@ -76,7 +76,7 @@ struct PtScotchRun {
   double max_rss_mib = 0;  ///< largest peak resident set of any rank
 };
 
-/// The report of `tgraph-mpi partition --json`: method, trace, output, ranks, nodes, cores,
+/// The JSON report of `tgraph-mpi partition`: method, trace, output, ranks, nodes, cores,
 /// k, steps, cut, node_cut, imbalance, read_ms, partition_ms, max_rss_mib and per_step (each
 /// step's tasks, edges, cut, node_cut, imbalance, node_imbalance and times).
 std::string ptscotch_json(const PtScotchTraceResult& r, const PtScotchRun& run);

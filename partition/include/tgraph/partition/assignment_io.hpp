@@ -48,9 +48,9 @@ struct PartitionNotes {
 
 /// The assignment `tgraph replay` runs on `k` threads: the .tga file `path` (checked against
 /// `trace`, named `trace_name` in errors, as load_assignment does, and its K against `k`:
-/// UsageError) or, when `path` is empty, `method` applied to every step (default_method
-/// when `method` is empty), with what it did in `notes` when given. UsageError naming
-/// --threads when `k` is 0.
+/// OptionError of the field "threads") or, when `path` is empty, `method` applied to every
+/// step (default_method when `method` is empty), with what it did in `notes` when given.
+/// OptionError of "threads" when `k` is 0.
 TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
                                   const std::string& path, const std::string& method,
                                   std::uint32_t k, PartitionNotes* notes = nullptr);

@@ -27,7 +27,13 @@ struct PartitionSummary {
 /// Adds up the per-step statistics of partition_trace().
 PartitionSummary summarize(const std::vector<Stats>& stats);
 
-/// `tgraph partition --json`: method, k, the summary, `output` and one object per step.
+/// `tgraph partition`: every step of the trace file `trace_path` partitioned with `method` on
+/// `k` processors (an OptionError of the field "k" when 0), the assignment written to
+/// `output` unless it is empty.
+TracePartition partition_file(const std::string& trace_path, const std::string& method,
+                              std::uint32_t k, const Options& options, const std::string& output);
+
+/// The JSON of `tgraph partition`: method, k, the summary, `output` and one object per step.
 std::string partition_json(const TracePartition& tp, const std::string& output);
 /// `tgraph partition`'s text: method, K, time, edgecut, moves (sticky: reused, fallback,
 /// rebalanced steps), and the file written when `output` is not empty.
@@ -85,9 +91,9 @@ Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
 /// The row's name in tables: the method, or "sticky@COST" for a sweep row.
 std::string row_label(const CompareRow& row);
 
-/// `tgraph compare --json`: {"trace", "model", "rows": [...], "sticky_moves": [...]}.
+/// The JSON of `tgraph compare`: {"trace", "model", "rows": [...], "sticky_moves": [...]}.
 std::string comparison_json(const Comparison& c, const std::string& trace_name);
-/// `tgraph compare --csv`: one header line, one line per row.
+/// The CSV of `tgraph compare`: one header line, one line per row.
 std::string comparison_csv(const Comparison& c);
 /// `tgraph compare`'s text table, followed by sticky's step kinds and moves per K and the
 /// Pareto points of each K.

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -35,7 +36,7 @@ struct CostModel {
   /// Where the constants come from ("default", "ideal" or the calibration file's path).
   std::string source = "default";
   /// One-way MPI message latency between two nodes (ns): the inter-node links of a
-  /// simulated platform (`tgraph platform`, `simulate --engine simgrid`). Calibration files
+  /// simulated platform (`tgraph platform`, the SimGrid engine of `tgraph simulate`). Calibration files
   /// without "mpi_latency_ns" get the default, 1500 ns (`mpirun -np 2 tgraph-mpi calibrate`
   /// measures it between local ranks).
   double mpi_latency_ns = 1500.0;
@@ -92,9 +93,14 @@ CostModel parse_calibration(std::string_view text, const std::string& name);
 CostModel select_cost_model(const std::string& model, const std::string& calibration);
 
 /// The main thread's serial work per step that a live run measured: per_step[].record_ns +
-/// partition_ns + prepare_ns of a `tgraph run --json` output (recording, the wait for
+/// partition_ns + prepare_ns of the JSON output of `tgraph run` (recording, the wait for
 /// partitioning, plan preparation). Throws InputError naming the file.
 std::vector<std::uint64_t> load_serial_work(const std::string& path);
+/// The serial work of each of a trace's `steps` steps: `serial_ns` for every step when
+/// given, else the first `steps` of load_serial_work(live) (an OptionError of the field
+/// "live" when the run has fewer), else none (empty).
+std::vector<std::uint64_t> serial_work(const std::string& live,
+                                       std::optional<std::uint64_t> serial_ns, std::size_t steps);
 
 /// What `tgraph calibrate` measured.
 struct Calibration {

@@ -58,7 +58,7 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
                 const std::string& a_name = "<assignment>",
                 const std::vector<std::uint64_t>* serial_ns = nullptr);
 
-/// `tgraph evaluate --json`: the totals' keys, method, k, model, steps, imbalance_max,
+/// The JSON of `tgraph evaluate`: the totals' keys, method, k, model, steps, imbalance_max,
 /// cyclic_steps, predicted_speedup_with_partitioning and (when `per_step`) one object per step.
 std::string report_json(const Report& report, bool per_step = true);
 

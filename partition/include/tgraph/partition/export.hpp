@@ -29,7 +29,7 @@ std::string metis_graph_file(const StepGraph& g);
 /// scotch_graph_file of library_graph(g).
 std::string scotch_graph_file(const StepGraph& g);
 
-/// The interchange formats of one step (`tgraph export --format`).
+/// The interchange formats of one step (the formats of `tgraph export`).
 enum class GraphFileFormat : std::uint8_t {
   kJson = 0,    ///< step_graph_json (libgraph): the whole step graph
   kMetis = 1,   ///< metis_graph_file
@@ -37,7 +37,7 @@ enum class GraphFileFormat : std::uint8_t {
 };
 /// "json", "metis" or "scotch".
 std::string_view to_string(GraphFileFormat f);
-/// Inverse of to_string; UsageError naming --format and the formats otherwise.
+/// Inverse of to_string; an OptionError of the field "format" listing the formats otherwise.
 GraphFileFormat parse_graph_file_format(std::string_view name);
 
 /// Step `step` of `trace` in `format` (`tgraph export`); UsageError naming `trace_name` when

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The weights METIS and Scotch see: libgraph's undirected task graph (the one that
-// `tgraph export --format metis|scotch` writes), in 32-bit form, optionally per phase.
+// `tgraph export` writes as metis or scotch), in 32-bit form, optionally per phase.
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Simulated clusters: the `--cluster NxC` shape and the SimGrid platform file of
+// Simulated clusters: the N x C shape of a cluster and the SimGrid platform file of
 // `tgraph platform` (a cluster zone whose links follow the cost model).
 #pragma once
 
@@ -14,7 +14,7 @@ namespace tgraph::partition {
 /// N identical nodes of C cores each. Processor p of an assignment runs on core p % C of
 /// node p / C.
 ///
-///   ClusterShape c = parse_cluster("64x16", "--cluster");   // c.nodes 64, c.cores 16
+///   ClusterShape c = parse_cluster("64x16");   // c.nodes 64, c.cores 16
 struct ClusterShape {
   std::uint32_t nodes = 1;
   std::uint32_t cores = 1;
@@ -27,10 +27,11 @@ struct ClusterShape {
 inline constexpr std::uint32_t kMaxNodes = 1u << 20;
 inline constexpr std::uint32_t kMaxCores = 4096;
 
-/// Parses "NxC" (1 <= N <= kMaxNodes, 1 <= C <= kMaxCores); throws UsageError naming `flag`.
-ClusterShape parse_cluster(std::string_view text, std::string_view flag);
-/// Checks a shape given as two numbers (`tgraph platform --nodes N --cores C`); throws
-/// UsageError naming the flag out of range.
+/// Parses "NxC" (1 <= N <= kMaxNodes, 1 <= C <= kMaxCores); otherwise an OptionError of the
+/// options field `field`.
+ClusterShape parse_cluster(std::string_view text, std::string_view field = "cluster");
+/// Checks a shape given as two numbers; otherwise an OptionError of the field "nodes" or
+/// "cores", the one out of range.
 ClusterShape cluster_shape(std::uint64_t nodes, std::uint64_t cores);
 
 /// The SimGrid platform (XML, DTD 4.1) of cluster `c` whose costs follow `m`:
@@ -45,6 +46,11 @@ ClusterShape cluster_shape(std::uint64_t nodes, std::uint64_t cores);
 ///   (CM02, no cross traffic, no TCP window bound).
 /// A per-byte cost of 0 becomes a bandwidth of 1e18 B/s (SimGrid needs a finite one).
 std::string platform_xml(const ClusterShape& c, const CostModel& m);
+/// `tgraph platform`: platform_xml() of a `nodes` x `cores` cluster (cluster_shape() checks
+/// them) whose links follow the calibration file `calibration` (select_cost_model), written
+/// to `output`; returns the line that says what was written.
+std::string write_platform(const std::string& output, std::uint64_t nodes, std::uint64_t cores,
+                           const std::string& calibration);
 
 /// The SimGrid configuration the engine and platform_xml() set, as "key:value" items.
 inline constexpr std::string_view kSimgridNetworkConfig[] = {

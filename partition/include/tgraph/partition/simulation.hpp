@@ -44,8 +44,8 @@ std::string to_string(IntraNodeTransfer t);
 ///   p.cluster = ClusterShape{4, 16};                 // or p.file = "P.xml"
 ///   Prediction r = simulate_trace(trace, assignment, SimulationEngine::simgrid, p);
 struct SimulatedPlatform {
-  std::string file;                    ///< `--platform P.xml` (SimGrid engine only), or empty
-  std::optional<ClusterShape> cluster; ///< `--cluster NxC`, or none
+  std::string file;                    ///< a platform file P.xml (SimGrid engine only), or empty
+  std::optional<ClusterShape> cluster; ///< an N x C cluster, or none
   CostModel model;                     ///< the built-in engine's costs; the links of `cluster`
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: who pays bytes in a node
   /// Built-in engine: the main thread's serial work before each step's tasks (ns per step,
@@ -76,7 +76,7 @@ struct Prediction {
   double simulation_ms = 0;       ///< wall time of the simulation itself
   double task_overhead_ns = 0;    ///< CostModel::task_overhead_ns charged per task instance
   double message_overhead_ns = 0;  ///< CostModel::mpi_message_overhead_ns (SimGrid engine)
-  bool lowered = false;           ///< the steps were lowered first (`simulate --lower`)
+  bool lowered = false;           ///< the steps were lowered first (`tgraph simulate`, lowered)
   std::vector<std::string> model_terms;  ///< what the prediction charged (model_terms())
 };
 
@@ -91,7 +91,7 @@ struct Prediction {
 Prediction simulate_trace(const Trace& trace, const TraceAssignment& a, SimulationEngine engine,
                           const SimulatedPlatform& platform);
 
-/// `tgraph simulate --json`: engine, makespan_ns, per_step[{step, makespan_ns, ...}], ...
+/// The JSON of `tgraph simulate`: engine, makespan_ns, per_step[{step, makespan_ns, ...}], ...
 std::string prediction_json(const Prediction& p);
 /// `tgraph simulate`'s text report: one line in total, then one per step.
 std::string prediction_text(const Prediction& p);

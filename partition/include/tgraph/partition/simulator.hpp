@@ -64,8 +64,8 @@ std::vector<std::uint64_t> predicted_makespans(
     const Trace& trace, const TraceAssignment& a, const CostModel& model,
     const std::vector<std::uint64_t>* serial_ns = nullptr);
 
-/// The terms a prediction with `model` charges (`model_terms` of `evaluate --json` and
-/// `simulate --json`): "sync_latency", "per_byte" (not with the ideal model),
+/// The terms a prediction with `model` charges (`model_terms` in the JSON of `tgraph evaluate`
+/// and `tgraph simulate`): "sync_latency", "per_byte" (not with the ideal model),
 /// "task_overhead", "park_wake", "inflation" when the model has them, then
 /// "serial_main_thread" when the serial work per step was given, else "host_time" when
 /// the trace has host time.

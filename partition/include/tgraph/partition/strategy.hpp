@@ -21,14 +21,14 @@ namespace tgraph::partition {
 enum class Objective : std::uint8_t { kCut = 0, kVolume = 1 };
 /// "cut" or "vol".
 std::string_view to_string(Objective o);
-/// Parses "cut" / "vol"; throws UsageError.
+/// Parses "cut" / "vol"; otherwise an OptionError of the field "objective".
 Objective parse_objective(std::string_view s);
 
 /// Scotch's strategy flavour (SCOTCH_STRAT* flags).
 enum class ScotchFlavour : std::uint8_t { kDefault = 0, kQuality = 1, kSpeed = 2, kBalance = 3 };
 /// "default", "quality", "speed" or "balance".
 std::string_view to_string(ScotchFlavour f);
-/// Parses a flavour name; throws UsageError.
+/// Parses a flavour name; otherwise an OptionError of the field "scotch_strategy".
 ScotchFlavour parse_scotch_flavour(std::string_view s);
 
 /// How `sticky` rebalances when imbalance exceeds its threshold.
@@ -38,7 +38,7 @@ enum class Rebalance : std::uint8_t {
 };
 /// "greedy" or "scotch".
 std::string_view to_string(Rebalance r);
-/// Parses a rebalance name; throws UsageError.
+/// Parses a rebalance name; otherwise an OptionError of the field "rebalance".
 Rebalance parse_rebalance(std::string_view s);
 
 /// What `sticky` does when a step's shape changed too much to patch (solver loops merged or
@@ -50,7 +50,7 @@ enum class StickyFallback : std::uint8_t {
 };
 /// "fresh", "repartition" or "refine".
 std::string_view to_string(StickyFallback f);
-/// Parses a fallback name; throws UsageError.
+/// Parses a fallback name; otherwise an OptionError of the field "sticky_fallback".
 StickyFallback parse_sticky_fallback(std::string_view s);
 
 /// How each processor orders its tasks when the strategy gives no order of its own.
@@ -58,7 +58,9 @@ enum class TaskOrder : std::uint8_t {
   kProgram = 0,  ///< the step's program order (Assignment::order left empty)
   kList = 1,     ///< a list schedule of the mapping: longest path to the end first (list_order)
 };
-/// Parses an order name ("program" or "list"); throws UsageError.
+/// "program" or "list".
+std::string_view to_string(TaskOrder o);
+/// Parses an order name; otherwise an OptionError of the field "order".
 TaskOrder parse_task_order(std::string_view s);
 
 /// Knobs of the strategies; each strategy reads the ones it understands.
@@ -89,11 +91,11 @@ struct Options {
 };
 
 /// Options with their enumerations and cost model by name, as the command line and scripts
-/// give them; options() checks the names (UsageError) and loads the model.
+/// give them; options() checks the names (OptionError naming the field) and loads the model.
 struct NamedOptions {
   Options values;                         ///< numbers and the sticky base method
   std::string objective = "cut";          ///< cut, vol
-  std::string scotch = "quality";         ///< default, quality, speed, balance
+  std::string scotch_strategy = "quality";  ///< Options::scotch: default, quality, speed, balance
   std::string rebalance = "greedy";       ///< greedy, scotch
   std::string sticky_fallback = "fresh";  ///< fresh, repartition, refine
   std::string order = "program";          ///< program, list

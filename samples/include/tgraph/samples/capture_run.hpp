@@ -55,12 +55,12 @@ class CaptureFailure : public std::runtime_error {
 };
 
 /// Runs the capture. Bad options or scene: tgraph::Error; failure of the run: CaptureFailure
-/// (the steps written before stay in `<output>.partial`, readable with --recover).
+/// (the steps written before stay in `<output>.partial`, readable with ReadOptions::recover).
 ///
 ///   CaptureRun r = capture_scene({.scene = "bars64", .steps = 20, .output = "b.tgt"});
 CaptureRun capture_scene(const CaptureOptions& options);
 
-/// `tgraph capture --json`: one JSON object.
+/// The JSON of `tgraph capture`: one object.
 std::string capture_json(const CaptureRun& run, const CaptureOptions& options);
 /// `tgraph capture`'s line.
 std::string capture_text(const CaptureRun& run, const CaptureOptions& options);
