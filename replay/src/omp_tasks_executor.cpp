@@ -270,9 +270,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
       TGRAPH_TSAN_RELEASE(&join_token_);
     };
     TGRAPH_TSAN_RELEASE(&submit_token_);
-    TGRAPH_TSAN_RELEASE(&detail::region_token);
-#pragma omp parallel num_threads(static_cast<int>(options().threads))
-    region();
+    detail::omp_parallel(static_cast<int>(options().threads), region);
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
     counters_.copy_to(stats);
