@@ -16,8 +16,8 @@
 //   omp_handwritten_bench --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 #include <omp.h>
 
-#include <algorithm>
 #include <cstdlib>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -54,23 +54,20 @@ HandStep prepare(const StepGraph& g) {
   h.out.resize(n);
   h.inout.resize(n);
   h.mutex.resize(n);
-  std::vector<Access> merged;
+  // A datum named twice by one task is one dependence, RW where the modes differ.
+  std::map<DatumId, AccessMode> mode;
   for (TaskId t = 0; t < n; ++t) {
-    merged.clear();  // a datum named twice by one task: once, inout where the modes differ
+    mode.clear();
     for (const Access& a : g.accesses_of(t)) {
-      auto m = std::find_if(merged.begin(), merged.end(),
-                            [&](const Access& b) { return b.datum == a.datum; });
-      if (m == merged.end())
-        merged.push_back(a);
-      else if (m->mode != a.mode)
-        m->mode = AccessMode::RW;
+      const auto [it, fresh] = mode.emplace(a.datum, a.mode);
+      if (!fresh && it->second != a.mode) it->second = AccessMode::RW;
     }
-    for (const Access& a : merged) {
-      auto& list = a.mode == AccessMode::R    ? h.in[t]
-                   : a.mode == AccessMode::W  ? h.out[t]
-                   : a.mode == AccessMode::RW ? h.inout[t]
-                                              : h.mutex[t];
-      list.push_back(static_cast<int>(a.datum));
+    for (const auto& [datum, m] : mode) {
+      auto& list = m == AccessMode::R    ? h.in[t]
+                   : m == AccessMode::W  ? h.out[t]
+                   : m == AccessMode::RW ? h.inout[t]
+                                         : h.mutex[t];
+      list.push_back(static_cast<int>(datum));
     }
   }
   return h;
