@@ -159,17 +159,31 @@ Assignment owner_like(const StepGraph& g, std::uint32_t k, std::uint32_t bars) {
   return a;
 }
 
-void BM_Policy(benchmark::State& state, Policy policy) {
+/// A bars64-like step, its owner-compute assignment and an executor of `policy` at the
+/// benchmark's thread count (its first argument).
+struct BarsRun {
+  StepGraph g;
+  Assignment a;
+  std::unique_ptr<Executor> ex;
+};
+
+BarsRun bars_run(const benchmark::State& state, Policy policy) {
   const auto k = static_cast<std::uint32_t>(state.range(0));
-  const StepGraph g = bars_like(64, 25);
-  const Assignment a = owner_like(g, k, 64);
+  BarsRun r;
+  r.g = bars_like(64, 25);
+  r.a = owner_like(r.g, k, 64);
   ExecOptions o;
   o.threads = k;
-  auto ex = make_executor(policy, o);
+  r.ex = make_executor(policy, o);
+  return r;
+}
+
+void BM_Policy(benchmark::State& state, Policy policy) {
+  const BarsRun r = bars_run(state, policy);
   SyntheticWorkload w;
-  w.set_step(g);
-  ex->run_step(g, &a, w);
-  for (auto _ : state) ex->run_step(g, &a, w);
+  w.set_step(r.g);
+  r.ex->run_step(r.g, &r.a, w);
+  for (auto _ : state) r.ex->run_step(r.g, &r.a, w);
 }
 
 /// The state of the host at this moment, for reading a ratio measured next to it.
@@ -238,12 +252,10 @@ HostProbe probe_host(const StepGraph& g) {
 }
 
 void BM_TaskOverhead(benchmark::State& state, Policy policy) {
-  const auto k = static_cast<std::uint32_t>(state.range(0));
-  const StepGraph g = bars_like(64, 25);
-  const Assignment a = owner_like(g, k, 64);
-  ExecOptions o;
-  o.threads = k;
-  std::unique_ptr<Executor> ex = make_executor(policy, o);
+  const BarsRun r = bars_run(state, policy);
+  const StepGraph& g = r.g;
+  const Assignment& a = r.a;
+  Executor* ex = r.ex.get();
   SyntheticWorkload w({.cost_scale = 0.0, .touch = false});
   w.set_step(g);
   const ExecStepStats first = ex->run_step(g, &a, w);

@@ -312,9 +312,7 @@ class BarrierExecutor final : public detail::PlannedExecutor<BarrierPlan> {
       TGRAPH_TSAN_RELEASE(&token);
     };
     TGRAPH_TSAN_RELEASE(&token);
-    TGRAPH_TSAN_RELEASE(&detail::region_token);
-#pragma omp parallel num_threads(k)
-    region();
+    detail::omp_parallel(k, region);
     TGRAPH_TSAN_ACQUIRE(&token);
     counters_.copy_to(stats);
     stats.loop_iterations = iterations;

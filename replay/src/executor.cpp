@@ -250,7 +250,7 @@ ExecStepStats Executor::run_step(const StepGraph& g, const Assignment* a, Worklo
       entry->has_assignment = true;
     }
     entry->exec = lower(g, use_assignment ? a : nullptr, mode, reduce, reducible,
-                        options_.incremental_plans ? &exec_edges_ : nullptr);
+                        options_.incremental_plans ? &exec_edges_ : nullptr, options_.threads);
     const std::int64_t t_lowered = now_ns();
     entry->plan = build(entry->exec, last_entry_ && options_.incremental_plans
                                          ? last_entry_->plan.get()

@@ -31,10 +31,13 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode) {
 }
 
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
-                const std::vector<bool>* reducible, EdgeDeriver* deriver) {
+                const std::vector<bool>* reducible, EdgeDeriver* deriver, std::uint32_t threads) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   auto proc = [&](TaskId t) -> ProcId { return a ? a->proc[t] : 0; };
-  const bool per_writer = scope == ReduceScope::kPerWriter;
+  // One thread needs no per-thread temporaries: its writers run one after the other.
+  const bool per_thread = scope == ReduceScope::kPerThread && threads > 1;
+  // Per writer and per thread, a group is lowered wherever it has two writers or more.
+  const bool per_writer = scope == ReduceScope::kPerWriter || per_thread;
 
   // 1. Find the CW groups that span processors (split at loop-region boundaries).
   std::unordered_map<std::uint64_t, ProcId> redirect;     // (task, datum) -> processor temp
@@ -44,6 +47,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   const bool lower_groups =
       mode == CwMode::kReduce &&
       (per_writer || (scope == ReduceScope::kPerProcessor && a != nullptr && a->k > 1));
+  const std::uint32_t slots_per_group = per_thread ? threads : 0;
   if (lower_groups) {
     // A CW group of derive_edges() can run on across a loop boundary (into the body, out of
     // it, or from the end of one iteration into the next): its members there have no edge
@@ -85,11 +89,18 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
         PendingReducer r;
         r.target = d;
         r.home = proc(s.members.front());
-        const ProcId home_slot = slot(s, 0);
-        for (ProcId p : slots)
-          if (p != home_slot) r.slots.push_back(p);
-        for (std::size_t i = 0; i < s.members.size(); ++i)
-          if (slot(s, i) != home_slot) redirect[pair_key(s.members[i], d)] = slot(s, i);
+        if (per_thread) {
+          // Every writer writes its thread's temporary, found at run time from the first of
+          // the group's block (ExecGraph::datum_on); the reducer adds all of them.
+          for (ProcId p = 0; p < slots_per_group; ++p) r.slots.push_back(p);
+          for (TaskId m : s.members) redirect[pair_key(m, d)] = 0;
+        } else {
+          const ProcId home_slot = slot(s, 0);
+          for (ProcId p : slots)
+            if (p != home_slot) r.slots.push_back(p);
+          for (std::size_t i = 0; i < s.members.size(); ++i)
+            if (slot(s, i) != home_slot) redirect[pair_key(s.members[i], d)] = slot(s, i);
+        }
         (reader != kNoTask ? before[reader] : after[last]).push_back(std::move(r));
       }
       s.members.clear();
@@ -147,6 +158,7 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   ExecGraph x;
   x.cw = mode;
   x.scope = lower_groups ? scope : ReduceScope::kNone;
+  x.thread_temps = slots_per_group;
   StepGraph& out = x.graph;
   out.kinds = g.kinds;
   out.objects = g.objects;
@@ -159,14 +171,17 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   auto temp = [&](DatumId d, ProcId p) {
     const auto key = pair_key(d, p);
     if (auto it = temp_of.find(key); it != temp_of.end()) return it->second;
-    Datum t = g.data[d];
-    t.name.push_back('@');
-    t.name.append(std::to_string(p));
-    out.data.push_back(std::move(t));
-    x.datum_origin.push_back(d);
-    const auto id = static_cast<DatumId>(out.data.size() - 1);
-    temp_of.emplace(key, id);
-    return id;
+    // Per thread, a datum's temporaries are made together, one block of consecutive ids.
+    const ProcId from = per_thread ? 0 : p, to = per_thread ? slots_per_group : p + 1;
+    for (ProcId q = from; q < to; ++q) {
+      Datum t = g.data[d];
+      t.name.push_back('@');
+      t.name.append(std::to_string(q));
+      out.data.push_back(std::move(t));
+      x.datum_origin.push_back(d);
+      temp_of.emplace(pair_key(d, q), static_cast<DatumId>(out.data.size() - 1));
+    }
+    return temp_of.at(key);
   };
   KindId reduce_kind = 0;
   bool have_reduce_kind = false;
@@ -190,7 +205,8 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
     // Per processor, the reducer and the home writers share a processor: CW leaves the
     // reducer free to go before them in an explicit order. Per writer, the first writer
     // may run on any thread: RW orders the reducer after it (consecutive CW accesses of
-    // one datum have no edge between them).
+    // one datum have no edge between them); per thread, RW orders it after the previous
+    // accesses of the datum, which no writer waits for.
     acc_buf.push_back({r.target, per_writer ? AccessMode::RW : AccessMode::CW});
     const TaskId rid = out.add_task(reduce_kind, g.data[r.target].object, acc_buf, 0,
                                     at.key * 1099511628211ull + r.target + 1);

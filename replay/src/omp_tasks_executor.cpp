@@ -87,7 +87,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
     plan->objects = static_cast<std::uint32_t>(g.data.size());
     const auto n = static_cast<TaskId>(g.tasks.size());
     plan->deps.resize(n);
-    const bool mutex_cw = x.scope != ReduceScope::kPerWriter;
+    const bool mutex_cw = x.scope != ReduceScope::kPerWriter && x.scope != ReduceScope::kPerThread;
     std::vector<Access> merged;
     std::vector<std::uint32_t> by_mode[4];
     for (TaskId t = 0; t < n; ++t) {
@@ -117,8 +117,15 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
             ordered = true;
             break;
           case AccessMode::CW:
-            by_mode[mutex_cw ? 3 : 2].push_back(a.datum);
-            ordered |= !mutex_cw;
+            if (x.thread_temps != 0 && x.datum_origin[a.datum] != a.datum) {
+              // Per-thread temporaries: the writers of a group run in any order, even at
+              // once, each on its thread's temporary; `in` on the block's first orders them
+              // after the previous reducer and before the next (inout), as RW would not.
+              by_mode[0].push_back(a.datum);
+            } else {
+              by_mode[mutex_cw ? 3 : 2].push_back(a.datum);
+              ordered |= !mutex_cw;
+            }
             break;
         }
       }
@@ -270,9 +277,7 @@ class OmpTasksExecutor final : public detail::PlannedExecutor<OmpPlan> {
       TGRAPH_TSAN_RELEASE(&join_token_);
     };
     TGRAPH_TSAN_RELEASE(&submit_token_);
-    TGRAPH_TSAN_RELEASE(&detail::region_token);
-#pragma omp parallel num_threads(static_cast<int>(options().threads))
-    region();
+    detail::omp_parallel(static_cast<int>(options().threads), region);
     TGRAPH_TSAN_ACQUIRE(&join_token_);
     stats.loop_iterations = iterations_;
     counters_.copy_to(stats);

@@ -46,8 +46,17 @@ std::string_view to_string(ReduceScope scope) {
       return "per-processor";
     case ReduceScope::kPerWriter:
       return "per-writer";
+    case ReduceScope::kPerThread:
+      return "per-thread";
   }
   return "?";
+}
+
+std::optional<ReduceScope> parse_reduce_scope(std::string_view name) {
+  for (ReduceScope s : {ReduceScope::kNone, ReduceScope::kPerProcessor, ReduceScope::kPerWriter,
+                        ReduceScope::kPerThread})
+    if (to_string(s) == name) return s;
+  return std::nullopt;
 }
 
 std::string_view to_string(BarrierRule rule) {

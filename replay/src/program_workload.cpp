@@ -65,7 +65,8 @@ void ProgramWorkload::run(const TaskRun& r) {
   for (const Access& a : x.graph.accesses_of(r.task)) {
     const DatumId origin = x.datum_origin[a.datum];
     if (origin == a.datum || n == 16) continue;
-    redirects[n++] = Redirect{accumulators_[origin]->target, temps_[a.datum].get()};
+    redirects[n++] =
+        Redirect{accumulators_[origin]->target, temps_[x.datum_on(a.datum, r.thread)].get()};
   }
   RedirectScope scope({redirects, n});
   body();

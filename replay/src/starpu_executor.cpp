@@ -263,7 +263,13 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
       bool ordered = false;  // a W or RW access orders consecutive instances already
       for (const Access& m : merged) {
         plan->buffer.push_back(m.datum);
-        plan->mode.push_back(to_starpu(m.mode, commute));
+        // Per-thread temporaries: a group's writers run in any order, even at once, each on
+        // its thread's temporary; R on the block's first orders them after the previous
+        // reducer and before the next (RW), as RW or COMMUTE would not.
+        plan->mode.push_back(x.thread_temps != 0 && m.mode == AccessMode::CW &&
+                                     x.datum_origin[m.datum] != m.datum
+                                 ? STARPU_R
+                                 : to_starpu(m.mode, commute));
         ordered |= m.mode == AccessMode::W || m.mode == AccessMode::RW;
       }
       if (g.tasks[t].loop != kNoLoop && !ordered) {

@@ -185,7 +185,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
   // stay comparable. A zero cost (a hand-made graph without costs) keeps the whole pass.
   std::uint64_t overwritten = 0, partial = 0;  // bytes of W data; of every other pass
   for (std::size_t i = 0; i < na; ++i) {
-    const Buffer* b = buffers_[acc_list[i].datum].get();
+    const Buffer* b = buffers_[x.datum_on(acc_list[i].datum, r.thread)].get();
     if (!b) continue;
     if (orig[i].mode == AccessMode::W)
       overwritten += b->words * 8;
@@ -205,7 +205,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
   std::uint64_t bytes = 0;
   for (std::size_t i = 0; i < na; ++i) {
     if (!reads(orig[i].mode)) continue;
-    const Buffer* b = buffers_[acc_list[i].datum].get();
+    const Buffer* b = buffers_[x.datum_on(acc_list[i].datum, r.thread)].get();
     if (!b) continue;
     const std::uint64_t words = words_of(*b);
     acc = acc * 31 + read_pass(b->w.get(), words);
@@ -213,7 +213,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
   }
   for (std::size_t i = 0; i < na; ++i) {
     if (!writes(orig[i].mode)) continue;
-    Buffer* b = buffers_[acc_list[i].datum].get();
+    Buffer* b = buffers_[x.datum_on(acc_list[i].datum, r.thread)].get();
     if (!b) continue;
     // A W task makes the whole new version (nothing of the old one survives it, so a process
     // that did not receive the old one holds the same words); RW and CW keep a tail that

@@ -41,16 +41,21 @@ StepGraph alternating_kinds(int n) {
   return g;
 }
 
-/// Barriers each thread passed in one step of `g` (one per phase run).
-std::uint64_t phases(const StepGraph& g, BarrierRule rule) {
+/// One step of `g` under the barrier policy at 2 threads with `rule`, bodies `w`.
+ExecStepStats run_barrier(const StepGraph& g, BarrierRule rule, SyntheticWorkload& w) {
   ExecOptions o;
   o.threads = 2;
   o.pin = false;
   o.barrier.rule = rule;
   auto ex = make_executor(Policy::kBarrier, o);
-  SyntheticWorkload w({.cost_scale = 0.0});
   w.set_step(g);
-  const ExecStepStats s = ex->run_step(g, nullptr, w);
+  return ex->run_step(g, nullptr, w);
+}
+
+/// Barriers each thread passed in one step of `g` (one per phase run).
+std::uint64_t phases(const StepGraph& g, BarrierRule rule) {
+  SyntheticWorkload w({.cost_scale = 0.0});
+  const ExecStepStats s = run_barrier(g, rule, w);
   EXPECT_EQ(s.threads.size(), 2u);
   EXPECT_EQ(s.threads[0].waits, s.threads[1].waits);
   return s.threads[0].waits;
@@ -106,14 +111,8 @@ TEST(BarrierRule, OmpForDropsTheBarriersBetweenOperationsOnTheSameObjects) {
   EXPECT_EQ(phases(g, BarrierRule::kLevel), 5u);
   // The sums are the sequential run's under every rule.
   for (BarrierRule rule : {BarrierRule::kOmpFor, BarrierRule::kLevel, BarrierRule::kOperation}) {
-    ExecOptions o;
-    o.threads = 2;
-    o.pin = false;
-    o.barrier.rule = rule;
-    auto ex = make_executor(Policy::kBarrier, o);
     SyntheticWorkload w({.cost_scale = 0.0});
-    w.set_step(g);
-    ex->run_step(g, nullptr, w);
+    run_barrier(g, rule, w);
     EXPECT_EQ(test::final_state(w, g), test::sequential_state(g, 1)) << to_string(rule);
   }
 }

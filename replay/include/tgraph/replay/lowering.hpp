@@ -33,6 +33,10 @@ struct Reduction {
 /// barrier, StarPU: any writer may run on any thread): the first writer adds into the
 /// datum itself, every later writer into a temporary of its own, and the `reduce` task adds
 /// the temporaries in program order, so the result does not depend on the threads.
+/// ReduceScope::kPerThread (the dynamic policies as their users write them): every writer
+/// adds into the temporary of the thread that runs it, one per thread (a block of
+/// consecutive exec data, reached through datum_on()), and the `reduce` task adds them in
+/// thread order: bounded memory, and the grouping of the writers is the run's.
 /// CwMode::kSerialize turns every CW into RW instead (writers in program order).
 struct ExecGraph {
   StepGraph graph;                       ///< edges derived
@@ -46,6 +50,15 @@ struct ExecGraph {
   ReduceScope scope = ReduceScope::kNone;  ///< temporaries used by kReduce
   /// Lowering added dependencies the original graph did not have (a CW writer made RW).
   bool added_edges = false;
+  /// kPerThread: the temporaries of each lowered group (the executor's threads); else 0.
+  std::uint32_t thread_temps = 0;
+
+  /// The exec datum that a task's access of exec datum `d` reaches when it runs on executor
+  /// thread `thread`: under kPerThread a writer's access names the first temporary of its
+  /// group's block and reaches its thread's; any other access reaches `d` itself.
+  DatumId datum_on(DatumId d, std::uint32_t thread) const {
+    return thread_temps != 0 && datum_origin[d] != d ? d + thread : d;
+  }
 };
 
 /// Lowers `g` (edges derived) for assignment `a` (nullptr: everything on processor 0).
@@ -54,9 +67,11 @@ struct ExecGraph {
 /// (optional, by original datum) marks the data whose CW groups may use temporaries; the
 /// groups of other data are serialised (live bodies that cannot be redirected). `deriver`
 /// (optional) derives the exec graph's edges from those of the exec graph it derived last
-/// (same edges as from scratch, faster after a small change).
+/// (same edges as from scratch, faster after a small change). `threads`: the executor's
+/// thread count, the temporaries per group under kPerThread (1: none needed, nothing lowered).
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScope scope,
-                const std::vector<bool>* reducible = nullptr, EdgeDeriver* deriver = nullptr);
+                const std::vector<bool>* reducible = nullptr, EdgeDeriver* deriver = nullptr,
+                std::uint32_t threads = 1);
 /// Same with the scope implied by `a`: kPerProcessor with an assignment, else kNone.
 ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode);
 

@@ -39,10 +39,17 @@ enum class ReduceScope : unsigned char {
   /// One temporary per writer after the group's first, added in program order (the dynamic
   /// policies: any writer may run on any thread, the combine stays deterministic).
   kPerWriter = 2,
+  /// One temporary per executor thread for every writer of the group, added in thread order
+  /// by the reducer (the dynamic policies as their users write them: oneTBB's
+  /// enumerable_thread_specific, OpenMP's `reduction`). Which writers share a temporary is
+  /// the run's: the sum is the sequential one within rounding, not bit for bit.
+  kPerThread = 3,
 };
 
-/// "none", "per-processor" or "per-writer".
+/// "none", "per-processor", "per-writer" or "per-thread".
 std::string_view to_string(ReduceScope scope);
+/// Inverse of to_string; nullopt for an unknown name.
+std::optional<ReduceScope> parse_reduce_scope(std::string_view name);
 
 /// What one parallel phase of the barrier policy holds (a barrier follows each phase).
 enum class BarrierRule : unsigned char {

@@ -1,0 +1,69 @@
+// SPDX-License-Identifier: MIT
+// ThreadSanitizer still sees the executors' own races under tgraph's suppressions
+// (tests/replay/tsan_suppressions.cpp, which names the runtime libraries only): a race
+// planted in an executor's state (tsan_planted_race, a process of its own) is reported,
+// naming the executor, and the same steps run apart are clean. Built in the tsan preset only.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+namespace {
+
+struct Outcome {
+  int status = -1;  ///< exit status (-1: did not exit)
+  std::string output;
+};
+
+/// Runs the planted-race program with `args`, its stderr with its stdout.
+Outcome run_planted(const std::string& args) {
+  const std::string command = std::string(TGRAPH_PLANTED_RACE) + " " + args + " 2>&1";
+  Outcome o;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return o;
+  std::array<char, 4096> buf{};
+  std::size_t n = 0;
+  while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) o.output.append(buf.data(), n);
+  const int raw = pclose(pipe);
+  if (raw != -1 && WIFEXITED(raw)) o.status = WEXITSTATUS(raw);
+  return o;
+}
+
+/// Whether a report's access (its stack's top frame, `    #0 ...`) lies in `file`: the
+/// race an entry such as `race_top:BarrierExecutor::run` used to suppress.
+bool top_frame_in(const std::string& output, const std::string& file) {
+  for (std::size_t at = output.find("    #0 "); at != std::string::npos;
+       at = output.find("    #0 ", at + 1)) {
+    const std::size_t end = output.find('\n', at);
+    if (output.substr(at, end - at).find(file) != std::string::npos) return true;
+  }
+  return false;
+}
+
+class PlantedRace : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(PlantedRace, IsReportedNamingTheExecutor) {
+  const std::string policy = GetParam();
+  const Outcome o = run_planted(policy + " together");
+  // TSan's exit status after a report (its exitcode option, 66 by default).
+  EXPECT_EQ(o.status, 66) << o.output;
+  EXPECT_NE(o.output.find("WARNING: ThreadSanitizer: data race"), std::string::npos) << o.output;
+  const std::string file = policy == "barrier" ? "barrier_executor.cpp" : "omp_tasks_executor.cpp";
+  EXPECT_TRUE(top_frame_in(o.output, "replay/src/" + file)) << o.output;
+}
+
+TEST_P(PlantedRace, RunApartTheSameStepsAreClean) {
+  const Outcome o = run_planted(std::string(GetParam()) + " apart");
+  EXPECT_EQ(o.status, 0) << o.output;
+  EXPECT_EQ(o.output.find("ThreadSanitizer"), std::string::npos) << o.output;
+}
+
+INSTANTIATE_TEST_SUITE_P(Policies, PlantedRace, ::testing::Values("barrier", "omp-tasks"),
+                         [](const auto& info) {
+                           return std::string(info.param) == "barrier" ? "barrier" : "omp_tasks";
+                         });
+
+}  // namespace
