@@ -67,8 +67,8 @@ void add_diff(CLI::App& app) {
   cmd->callback([o, steps] {
     const Trace trace = read_trace(o->input);
     const std::size_t a = (*steps)[0], b = (*steps)[1];  // expected(2): exactly two
-    const StepGraph &ga = step_at(trace, a, o->input, "--steps"),
-                    &gb = step_at(trace, b, o->input, "--steps");
+    const StepGraph &ga = step_at(trace, a, o->input, "steps"),
+                    &gb = step_at(trace, b, o->input, "steps");
     StepDiff d = diff_steps(ga, gb);
     if (!o->assignment.empty()) {
       const TraceAssignment as = partition::load_assignment(o->assignment, trace, o->input);

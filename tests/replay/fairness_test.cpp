@@ -43,13 +43,13 @@ TEST_P(DynamicBaseline, RunsCwWritersOfOneDatumOnTwoThreadsAtOnce) {
   SyntheticWorkload w;
   w.set_step(g);
   // Whether the second thread gets to steal a writer while the first runs depends on the
-  // machine's load (a loaded 2-core machine under TSan may not schedule it for 32 ms): up to
-  // five steps, one of which must overlap two writers. A policy that serialized the writers
-  // never would.
+  // machine's load (a loaded 2-core machine under TSan may not schedule it for 32 ms; at load
+  // average 15, five steps once saw none): up to ten steps, one of which must overlap two
+  // writers. A policy that serialized the writers never would.
   TimelineObserver timeline;
   ex->add_observer(timeline);
   bool overlap = false;
-  for (std::uint32_t attempt = 0; attempt < 5 && !overlap; ++attempt) {
+  for (std::uint32_t attempt = 0; attempt < 10 && !overlap; ++attempt) {
     ex->run_step(g, nullptr, w);
     const ExecGraph& x = *ex->last_exec();
     ASSERT_EQ(x.reductions.size(), 1u);
