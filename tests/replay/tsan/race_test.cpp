@@ -51,8 +51,13 @@ TEST_P(PlantedRace, IsReportedNamingTheExecutor) {
   // TSan's exit status after a report (its exitcode option, 66 by default).
   EXPECT_EQ(o.status, 66) << o.output;
   EXPECT_NE(o.output.find("WARNING: ThreadSanitizer: data race"), std::string::npos) << o.output;
+  // Which of the planted races TSan meets first depends on the interleaving: the executor's
+  // own run (barrier_executor.cpp), its step context (executor.cpp) or its thread slots
+  // (common.hpp, inlined into the executor's run). Each is the executor's state: an access
+  // in replay/src/, on a stack through the policy's executor.
   const std::string file = policy == "barrier" ? "barrier_executor.cpp" : "omp_tasks_executor.cpp";
-  EXPECT_TRUE(top_frame_in(o.output, "replay/src/" + file)) << o.output;
+  EXPECT_TRUE(top_frame_in(o.output, "replay/src/")) << o.output;
+  EXPECT_NE(o.output.find("replay/src/" + file), std::string::npos) << o.output;
 }
 
 TEST_P(PlantedRace, RunApartTheSameStepsAreClean) {
