@@ -626,8 +626,9 @@ TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
     // above METIS's, and every processor keeps work.
     const Result m1 = make_strategy("metis-relabel")->partition(merged, k, {&apart, &r0.assignment}, {});
     EXPECT_LT(r1.stats.moved_tasks, m1.stats.moved_tasks) << k;
-    const auto makespan = [&](const Assignment& a) {
-      return static_cast<double>(simulate(merged, a, CostModel::defaults()).makespan_ns);
+    const StepGraph& merged_step = merged;  // clang 14: a lambda cannot capture a binding
+    const auto makespan = [&merged_step](const Assignment& a) {
+      return static_cast<double>(simulate(merged_step, a, CostModel::defaults()).makespan_ns);
     };
     EXPECT_LE(makespan(r1.assignment), 1.05 * makespan(m1.assignment)) << k;
     const auto l = loads_of(merged, r1.assignment);
