@@ -9,8 +9,10 @@
 //    dependence objects one per datum, and a `taskwait` after each iteration of a loop (the
 //    convergence test reads the residual), its recorded count of iterations. Bodies are the
 //    replay's synthetic ones (SyntheticWorkload: the recorded cost, the data's memory pass).
-//  * OmpTasksPolicy/threads:N: `--policy omp-tasks` (make_executor, its defaults) on the same
-//    steps and bodies.
+//  * OmpTasksPolicy/threads:N: `--policy omp-tasks` (make_executor, its defaults: per-writer
+//    temporaries) on the same steps and bodies; OmpTasksPolicyMutex: the same with the CW
+//    groups whole, declared mutexinoutset as by hand (reduce scope none); OmpTasksPolicyPerThread:
+//    one temporary per thread (reduce scope per-thread).
 // Time per benchmark iteration: one pass over every step of the trace.
 //
 //   omp_handwritten_bench --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
@@ -19,6 +21,7 @@
 #include <cstdlib>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -136,10 +139,11 @@ void BM_OmpHandwritten(benchmark::State& state) {
   state.counters["steps"] = static_cast<double>(steps.size());
 }
 
-void BM_OmpTasksPolicy(benchmark::State& state) {
+void BM_OmpTasksPolicy(benchmark::State& state, std::optional<ReduceScope> scope) {
   const Trace& tr = trace();
   ExecOptions o;
   o.threads = static_cast<std::uint32_t>(state.range(0));
+  o.reduce_scope = scope;
   auto ex = make_executor(Policy::kOmpTasks, o);
   std::vector<std::unique_ptr<SyntheticWorkload>> ws;
   for (const StepGraph& g : tr.steps) {
@@ -155,8 +159,12 @@ void BM_OmpTasksPolicy(benchmark::State& state) {
 void register_all(bench::Size size) {
   const std::vector<std::int64_t> threads =
       size == bench::Size::kSmoke ? std::vector<std::int64_t>{2} : std::vector<std::int64_t>{1, 2};
-  for (auto* b : {benchmark::RegisterBenchmark("BM_OmpHandwritten", BM_OmpHandwritten),
-                  benchmark::RegisterBenchmark("BM_OmpTasksPolicy", BM_OmpTasksPolicy)}) {
+  for (auto* b :
+       {benchmark::RegisterBenchmark("BM_OmpHandwritten", BM_OmpHandwritten),
+        benchmark::RegisterBenchmark("BM_OmpTasksPolicy", BM_OmpTasksPolicy, std::nullopt),
+        benchmark::RegisterBenchmark("BM_OmpTasksPolicyMutex", BM_OmpTasksPolicy, ReduceScope::kNone),
+        benchmark::RegisterBenchmark("BM_OmpTasksPolicyPerThread", BM_OmpTasksPolicy,
+                                     ReduceScope::kPerThread)}) {
     b->ArgName("threads")->Unit(benchmark::kMillisecond)->UseRealTime();
     for (const std::int64_t t : threads) b->Arg(t);
     bench::timed(b, size, 1.0);

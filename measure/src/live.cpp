@@ -85,6 +85,12 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   res.cw = ex->cw();
   res.scope = ex->scope();
   ex.reset();
+  if (o.check && res.scope == tr::ReduceScope::kPerThread && res.cw == tr::CwMode::kReduce &&
+      res.threads > 1)
+    throw OptionError("reduce_scope",
+                      "per-thread temporaries sum in an order of the run's timing, which no "
+                      "reference run reproduces, and {check} compares bit for bit: use per-writer "
+                      "(the same work, a fixed order)");
   const bool partition = o.policy == tr::Policy::kPartition;
 
   std::vector<detail::PassResult> passes;

@@ -344,6 +344,14 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
   if (options.threads == 0) throw OptionError("threads", "must be at least 1");
   if (options.threads > 1024 && policy != Policy::kSequential)
     throw OptionError("threads", "must be at most 1024");
+  // The partition policy's temporaries are its processors' (kPerProcessor); the per-writer and
+  // per-thread scopes are the dynamic policies' choices (a sequential run takes any scope, to
+  // reproduce another policy's reduction order).
+  if (policy == Policy::kPartition && options.reduce_scope &&
+      *options.reduce_scope != ReduceScope::kPerProcessor)
+    throw OptionError("reduce_scope",
+                      "applies to the dynamic policies (worksteal, barrier, starpu, omp-tasks); the "
+                      "partition policy reduces per processor");
   switch (policy) {
     case Policy::kSequential: {  // one thread, whatever was asked for
       ExecOptions o = options;

@@ -430,6 +430,28 @@ TEST_F(Cli, BarrierRuleFlagChoosesThePhasesAndRejectsUnknownRules) {
   EXPECT_NE(bad.err.find("--barrier-rule"), std::string::npos) << bad.err;
 }
 
+// `--reduce-scope per-thread` gives a dynamic policy one temporary per thread (the JSON says
+// so); the partition policy refuses it, and so does `run --check` (a bit-for-bit comparison
+// that no reference reproduces for sums in the run's order), each in one line naming the flag.
+TEST_F(Cli, ReduceScopeFlagReachesTheDynamicPoliciesOnly) {
+  ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
+  for (const char* scope : {"per-writer", "per-thread"}) {
+    const Result r = run(std::string("replay f.tgt --policy worksteal --threads 2 --repeat 1 "
+                                     "--no-pin --json --reduce-scope ") + scope);
+    ASSERT_EQ(r.code, 0) << scope << ": " << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["reduce_scope"], scope);
+  }
+  for (const char* bad : {"replay f.tgt --policy partition --threads 2 --reduce-scope per-thread",
+                          "replay f.tgt --policy worksteal --reduce-scope per-task",
+                          "run --scene fig2 --steps 1 --threads 2 --method worksteal --check "
+                          "--reduce-scope per-thread"}) {
+    const Result r = run(bad);
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_TRUE(one_line(r.err)) << r.err;
+    EXPECT_NE(r.err.find("--reduce-scope"), std::string::npos) << r.err;
+  }
+}
+
 // `run` takes `partition`'s strategy flags: they reach the live partitioner (a calibration
 // file that does not exist fails when the strategy loads its cost model), are range-checked,
 // and a run with other phases still matches the sequential state bit for bit.
