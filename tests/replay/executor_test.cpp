@@ -441,7 +441,10 @@ TEST(Synthetic, SpinsForTheRecordedCost) {
   std::vector<std::int64_t> walls;
   for (int i = 0; i < 5; ++i) walls.push_back(ex->run_step(g, nullptr, w).wall_ns);
   std::sort(walls.begin(), walls.end());
-  EXPECT_GT(walls[2], 1'000'000);  // about 2 ms, not 2 µs (calibration under load may be off)
+  // About 2 ms, not 2 µs: a spin rate calibrated while a loaded machine preempted the
+  // calibration makes the body spin too few iterations (0.77 ms was seen at load 9 under
+  // TSan), so the bound is a tenth of the cost, still 100 times a unit error's 2 µs.
+  EXPECT_GT(walls[2], 200'000);
   EXPECT_LT(walls[0], 200'000'000);  // not a unit error either
   EXPECT_GT(SyntheticWorkload::calibration().spin_iterations_per_ns, 0.0);
 }
