@@ -95,9 +95,17 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(Live, EveryPolicyAndThreadCountMatchesItsReferenceOnBarsAndCloth) {
+#if defined(__SANITIZE_THREAD__)
+  // Under TSan (scripts/test's tsan block) two threads only: the whole matrix took 9 minutes
+  // there, counts 2 and 3 three and a half. Three threads run under TSan in
+  // FallingLive/partitionsticky3 and the adapter's roundrobin_3.
+  const std::uint32_t first = 2, last = 2;
+#else
+  const std::uint32_t first = 1, last = 4;
+#endif
   for (const char* scene : {"bars64", "cloth128"})
     for (Policy p : {Policy::kPartition, Policy::kWorksteal, Policy::kBarrier, Policy::kOmpTasks})
-      for (std::uint32_t k = 1; k <= 4; ++k) {
+      for (std::uint32_t k = first; k <= last; ++k) {
         // omp-tasks at 2 threads only: its thread counts are covered on random graphs
         // (executor_test), and libgomp's per-task cost makes whole scenes slow under TSan.
         if (p == Policy::kOmpTasks && k != 2) continue;
