@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// StarPU-MPI as the distributed peer (`tgraph-mpi replay --policy starpu-mpi`): the same
+// StarPU-MPI as the distributed peer (the MPI replay's starpu-mpi policy): the same
 // lowered graph (cumulative writes through per-processor reducers, as tgraph's own schedule
 // runs them: Debian's StarPU 1.3 has no STARPU_MPI_REDUX), the same bodies (RankWorkload) and
 // the same ownership, submitted the way StarPU-MPI applications are written:
