@@ -80,8 +80,9 @@ class StarpuMpiRun {
                                       std::to_string(layout.threads_per_rank) +
                                       ": this StarPU has at most " +
                                       std::to_string(STARPU_MAXCPUS) + " CPU workers");
-    // Banners would spoil --json; byte counts per destination need the statistics; several
-    // ranks share a machine, so StarPU must not bind each rank's workers to cores 0..T-1.
+    // Banners would spoil a JSON report; byte counts per destination need the statistics;
+    // several ranks share a machine, so StarPU must not bind each rank's workers to cores
+    // 0..T-1.
     setenv("STARPU_SILENT", "1", 0);
     setenv("STARPU_COMM_STATS", "1", 1);
     setenv("STARPU_WORKERS_NOBIND", "1", 0);
