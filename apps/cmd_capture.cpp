@@ -8,26 +8,20 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "option_words.hpp"
 #include "tgraph/samples/capture_run.hpp"
 
 namespace tgraph::app {
 
-namespace {
-// "fig2, bars64, ...": the built-in scenes, for the help text.
-std::string scene_list() {
-  std::string s;
-  for (const std::string& n : samples::builtin_scene_names()) s += (s.empty() ? "" : ", ") + n;
-  return s;
-}
-}  // namespace
-
 void add_capture(CLI::App& app) {
+  using enum samples::Coupling;
   auto o = std::make_shared<samples::CaptureOptions>();
   auto a = std::make_shared<Args>();
   auto* cmd = app.add_subcommand(
       "capture", "Run the instrumented engine on a scene and record each step's task graph");
   cmd->add_option("--scene", o->scene,
-                  "Built-in scene (" + scene_list() + ") or scene file")
+                  "Built-in scene (" + CLI::detail::join(samples::builtin_scene_names(), ", ") +
+                      ") or scene file")
       ->required();
   cmd->add_option("--steps", o->steps, "Steps to run (default: the scene's)");
   cmd->add_option("-o,--output", o->output, "Trace file to write (.tgt)");
@@ -38,22 +32,18 @@ void add_capture(CLI::App& app) {
   cmd->add_option("--split", o->scene_options.split,
                   "Deformable objects: split each internal force field into N tasks (overrides split=)")
       ->check(CLI::Range(1, 1024));
-  cmd->add_option("--coupling", a->policy,
-                  "Solver sharing: groups (one CG per collision group) or shared")
-      ->check(CLI::IsMember({"groups", "shared"}));
+  add_enum(cmd, "--coupling", o->scene_options.coupling, {kGroups, kShared},
+           "Solver sharing: groups (one CG per collision group) or shared");
   cmd->add_option("--cost-passes", o->cost_passes,
-                  "Time every task body this many times from the same state (its written data "
-                  "restored between passes) and keep the median (default 1)")
+                  "Time every task body N times from the same state (its written data restored "
+                  "between passes) and keep the median (default 1)")
       ->check(CLI::Range(1u, 1000u));
   cmd->add_flag("--no-capture", o->no_capture,
                 "Run the same steps uninstrumented (Mode::kOff), write nothing");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->callback([o, a] {
-    if (!a->policy.empty())  // --coupling
-      o->scene_options.coupling =
-          a->policy == "groups" ? samples::Coupling::kGroups : samples::Coupling::kShared;
     o->progress = isatty(STDERR_FILENO) != 0;
-    o->warn = warn;
+    o->warn = [](const std::string& w) { warn(name_fields(w, flag_of)); };
     // A file size limit (RLIMIT_FSIZE) then fails the write with EFBIG instead of killing us.
     ::signal(SIGXFSZ, SIG_IGN);
     const samples::CaptureRun r = samples::capture_scene(*o);

@@ -4,7 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "lists.hpp"
+#include "option_words.hpp"
 #include "tgraph/experiment/experiment.hpp"
 
 namespace tgraph::app {
@@ -19,9 +19,10 @@ void add_experiment(CLI::App& app) {
                   "METG per policy) or scaling (live runs per method and thread count)")
       ->required()
       ->check(CLI::IsMember(experiment::all_experiment_names()));
-  add_thread_list(cmd, "--threads", o->threads,
-                  "Thread counts, e.g. 1-4,8,16 (default: the experiment's); above the cores: "
-                  "predicted only (scaling: run oversubscribed)");
+  cmd->add_option_function<std::string>(
+      "--threads", [o](const std::string& t) { o->threads = experiment::parse_thread_list(t); },
+      "Thread counts, e.g. 1-4,8,16 (default: the experiment's); above the cores: predicted "
+      "only (scaling: run oversubscribed)");
   cmd->add_option("--out", o->out, "Results folder (default tgraph-experiment-NAME)");
   cmd->add_flag("--quick", o->quick, "Few steps, one pass (a smoke run)");
   cmd->add_option("--steps", o->steps, "Steps per run (default: the experiment's)");
@@ -36,6 +37,7 @@ void add_experiment(CLI::App& app) {
       "--replay,!--no-replay", [o](std::int64_t n) { o->replay = n > 0; },
       "Also replay the captured trace with synthetic bodies (default, except for domain), or not");
   cmd->add_flag("--json", a->json, "Print results.json on stdout");
+  o->words = experiment::words_with("tgraph experiment", flag_of);  // the command to rerun it
   cmd->callback([o, a] {
     experiment::Progress progress(stderr, experiment::Progress::is_terminal(stderr));
     const experiment::NamedRun r = experiment::run_named(a->method, *o, progress);

@@ -9,6 +9,7 @@
 namespace tgraph::app {
 
 void add_generate(CLI::App& app) {
+  using enum Pattern;
   auto a = std::make_shared<Args>();
   auto o = std::make_shared<GenerateOptions>();
   auto* cmd = app.add_subcommand(
@@ -16,11 +17,9 @@ void add_generate(CLI::App& app) {
   cmd->add_option("--tasks", o->tasks, "Tasks per step")
       ->required()
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{4294967294}));
-  a->format = "stencil";
-  cmd->add_option("--pattern", a->format,
-                  "trivial, stencil (1-D), random (degree cells over the width), tree (fft "
-                  "butterfly) or domain (a solver step with a CG loop); default stencil")
-      ->check(CLI::IsMember({"trivial", "stencil", "random", "tree", "domain"}));
+  add_enum(cmd, "--pattern", o->pattern, {kTrivial, kStencil, kRandom, kTree, kDomain},
+           "trivial, stencil (1-D), random (degree cells over the width), tree (fft butterfly) "
+           "or domain (a solver step with a CG loop); default stencil");
   cmd->add_option("--width", o->width, "Columns of the Task Bench shapes (default tasks / 16)");
   cmd->add_option("--degree", o->degree, "random: cells each task reads besides its own (2)")
       ->check(CLI::Range(0u, 64u));
@@ -28,14 +27,12 @@ void add_generate(CLI::App& app) {
       ->check(CLI::Range(1u, 100000u));
   cmd->add_option("--cost-ns", o->cost_ns, "Mean task cost in ns (1000; uniform in 1/2..3/2 of it)");
   cmd->add_option("--seed", o->seed, "Seed of the costs and random reads (1)");
-  a->steps = 1;
   cmd->add_option("--steps", a->steps, "Steps (same structure, costs drawn per step; 1)")
-      ->check(CLI::Range(1, 100000));
+      ->check(CLI::Range(1u, 100000u));
   cmd->add_option("-o,--output", a->output, "Trace file to write (.tgt)")->required();
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a, o] {
-    o->pattern = *pattern_from_string(a->format);  // checked by IsMember above
-    const GeneratedFile f = generate_file(*o, static_cast<std::uint32_t>(*a->steps), a->output);
+    const GeneratedFile f = generate_file(*o, a->steps, a->output);
     std::cout << (a->json ? generated_json(f) + "\n" : generated_text(f));
   });
 }

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The verbs that read a trace: `tgraph info` (summarize_trace), `tgraph export` (a step's graph:
-// partition::graph_file; a timeline's trace events: viz::chrome_trace), `tgraph diff` (diff_steps).
+// partition::graph_file; a timeline's trace events: viz::chrome_trace), `tgraph diff`
+// (diff_trace_steps).
 #include <iostream>
 
 #include "commands.hpp"
@@ -43,15 +44,11 @@ void add_export(CLI::App& app) {
       ->check(CLI::IsMember({"json", "metis", "scotch", "chrome"}));
   cmd->add_option("-o,--output", a->output, "Output file (default: standard output)");
   cmd->callback([a] {
-    const std::string text =
-        a->format == "chrome"
-            ? viz::chrome_trace(read_timeline(a->input))
-            : partition::graph_file(read_trace(a->input), a->step, a->input,
-                                    partition::parse_graph_file_format(a->format));
-    if (a->output.empty() || a->output == "-")
-      std::cout << text;
-    else
-      write_file_atomic(a->output, text);
+    write_output(a->output,
+                 a->format == "chrome"
+                     ? viz::chrome_trace(read_timeline(a->input))
+                     : partition::graph_file(read_trace(a->input), a->step, a->input,
+                                             partition::parse_graph_file_format(a->format)));
   });
 }
 
@@ -67,13 +64,8 @@ void add_diff(CLI::App& app) {
   cmd->callback([o, steps] {
     const Trace trace = read_trace(o->input);
     const std::size_t a = (*steps)[0], b = (*steps)[1];  // expected(2): exactly two
-    const StepGraph &ga = step_at(trace, a, o->input, "steps"),
-                    &gb = step_at(trace, b, o->input, "steps");
-    StepDiff d = diff_steps(ga, gb);
-    if (!o->assignment.empty()) {
-      const TraceAssignment as = partition::load_assignment(o->assignment, trace, o->input);
-      add_processor_changes(d, ga, as.steps[a], gb, as.steps[b]);
-    }
+    const auto as = partition::load_assignment_if(o->assignment, trace, o->input);
+    const StepDiff d = diff_trace_steps(trace, o->input, a, b, as ? &*as : nullptr);
     std::cout << (o->json ? step_diff_json(d, a, b) + "\n" : step_diff_text(d, a, b));
   });
 }

@@ -4,9 +4,7 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/stg.hpp"
-#include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
@@ -16,18 +14,12 @@ namespace tgraph::app {
 
 namespace tp = tgraph::partition;
 
-namespace {
-
-using Named = std::shared_ptr<tp::NamedOptions>;
-
 void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--model", n.model, "Cost model: calibrated (default) or ideal (free syncs)")
       ->check(CLI::IsMember({"ideal", "calibrated"}));
   cmd->add_option("--calibration", n.calibration,
                   "Calibration file (default: " + tp::default_calibration_path() + " if present)");
 }
-
-}  // namespace
 
 void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   tp::Options& o = n.values;
@@ -36,29 +28,28 @@ void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--objective", n.objective, "METIS objective: cut or vol")
       ->check(CLI::IsMember({"cut", "vol"}));
   cmd->add_option("--phases", o.phases,
-                  "METIS: balance each of N graph phases (0: the method's default: off for "
-                  "metis, 2 for sticky's partitions; 1: off)");
+                  "METIS: balance N graph phases (0: the method's default, off for metis, 2 for "
+                  "sticky's partitions; 1: off)");
   cmd->add_option("--loop-share", o.loop_share,
-                  "With phases on: each dynamic loop holding at least this share of the step's "
-                  "work is one more constraint, balanced on its own (default 0.1; 0: off)")
+                  "With phases: a dynamic loop with this share of the step's work is one more "
+                  "balanced constraint (default 0.1; 0: off)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--scotch-strategy", n.scotch_strategy, "Scotch flavour: default, quality, speed, balance")
       ->check(CLI::IsMember({"default", "quality", "speed", "balance"}));
   cmd->add_option("--sticky-base", o.sticky_base, "sticky: first step's method (metis)");
   cmd->add_option("--threshold", o.sticky_threshold,
-                  "sticky: rebalance when imbalance exceeds this x the last partition's (1.20; "
-                  "run: 1.05)");
+                  "sticky: rebalance above this x the last partition's imbalance (1.2; run 1.05)");
   cmd->add_option("--rebalance", n.rebalance, "sticky: greedy (whole objects) or scotch")
       ->check(CLI::IsMember({"greedy", "scotch"}));
   cmd->add_option("--sticky-fallback", n.sticky_fallback,
-                  "sticky, when solver loops merge or split: fresh (default; base method + relabel), refine (local search from the incremental placement) or "
-                  "repartition (Scotch graphRepart from the incremental placement)")
+                  "sticky, when solver loops merge or split: fresh (default; base method + "
+                  "relabel), or from the incremental placement refine or repartition (Scotch)")
       ->check(CLI::IsMember({"fresh", "repartition", "refine"}));
   cmd->add_option("--migration-cost", o.migration_cost,
                   "sticky: Scotch migration cost ratio (emraval, quantised to 0.01; default 1)");
   cmd->add_option("--order", n.order,
-                  "Each processor's task order for every method but list: program (the step's) or list "
-                  "(a list schedule of the mapping, longest path to the end first)")
+                  "Each processor's task order but for list: program (the step's) or list (a list "
+                  "schedule of the mapping, longest path to the end first)")
       ->check(CLI::IsMember({"program", "list"}));
   add_model_flags(cmd, n);
 }
@@ -77,13 +68,12 @@ CLI::App* verb(CLI::App& app, const char* name, const char* what, std::shared_pt
 
 void add_partition_verbs(CLI::App& app) {
   std::shared_ptr<Args> a;
-  Named n = std::make_shared<tp::NamedOptions>();
+  auto n = std::make_shared<tp::NamedOptions>();
   auto* cmd = verb(app, "partition", "Partition every step of a trace over K processors", a);
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
-  std::string names;
-  for (const auto& m : tp::strategy_names()) names += (names.empty() ? "" : ", ") + m;
   a->method = "metis";
-  cmd->add_option("--method,-m", a->method, "Strategy: " + names);
+  cmd->add_option("--method,-m", a->method,
+                  "Strategy: " + CLI::detail::join(tp::strategy_names(), ", "));
   cmd->add_option("-k", a->k, "Number of processors")->required();
   cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga)");
   add_strategy_flags(cmd, *n);
@@ -99,15 +89,10 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", a->assignment, "Assignment file (.tga)")->required();
   add_model_flags(cmd, *n);
-  auto serial = std::make_shared<SerialFlags>();
+  auto serial = std::make_shared<tp::SerialWork>();
   add_serial_flags(cmd, *serial);
   cmd->callback([a, n, serial] {
-    const Trace trace = read_trace(a->input);
-    const TraceAssignment as = tp::load_assignment(a->assignment, trace, a->input);
-    const std::vector<std::uint64_t> per_step = serial->per_step(trace.steps.size());
-    const tp::Report rep = tp::evaluate(trace, as, n->cost_model(), a->assignment,
-                                        per_step.empty() ? nullptr : &per_step);
-    std::cout << (a->json ? tp::report_json(rep) + "\n" : tp::report_text(rep));
+    std::cout << tp::evaluate_files(a->input, a->assignment, n->cost_model(), *serial, a->json);
   });
 
   n = std::make_shared<tp::NamedOptions>();
@@ -119,16 +104,13 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("-k", a->counts, "Comma-separated processor counts (default 2,4,8,16)")
       ->delimiter(',');
   cmd->add_option("--sticky-migration-cost", a->values,
-                  "Also run sticky with --sticky-fallback repartition at each of these migration "
-                  "costs (comma-separated) and mark the Pareto points")
+                  "Sticky (repartition fallback) at these migration costs too, Pareto marked")
       ->delimiter(',');
   cmd->add_option("--csv", a->csv, "Also write the table as CSV");
   add_strategy_flags(cmd, *n);
   cmd->callback([a, n] {
-    const tp::Comparison r =
-        tp::compare(read_trace(a->input), a->names, a->counts, n->options(), a->values);
-    if (!a->csv.empty()) write_file_atomic(a->csv, tp::comparison_csv(r));
-    std::cout << (a->json ? tp::comparison_json(r, a->input) + "\n" : tp::comparison_table(r));
+    std::cout << tp::compare_file(a->input, a->names, a->counts, n->options(), a->values, a->csv,
+                                  a->json);
   });
 
   cmd = verb(app, "import", "Turn a Standard Task Graph Set file into a one-step trace", a);
@@ -138,25 +120,18 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Trace file to write (.tgt)")->required();
   cmd->add_option("--unit-ns", a->unit_ns, "Nanoseconds per STG time unit (default 1000)")
       ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1000000000}));
-  cmd->add_option("--edge-bytes", a->edge_bytes,
-                  "Bytes of the datum each edge carries (default 8)");
+  cmd->add_option("--edge-bytes", a->edge_bytes, "Bytes of each edge's datum (default 8)");
   cmd->callback([a] {
-    const StgGraph stg = read_stg(a->input, a->unit_ns, a->edge_bytes);
-    write_trace(a->output, stg.trace);
-    std::cout << stg_import_report(stg, a->input, a->output, a->unit_ns, a->json);
+    std::cout << import_stg(a->input, a->output, a->unit_ns, a->edge_bytes, a->json);
   });
 
   auto cal = std::make_shared<tp::CalibrateOptions>();
-  cmd =
-      verb(app, "calibrate", "Measure signal/wait latency and transfer cost for the simulator", a);
+  cmd = verb(app, "calibrate", "Measure signal/wait latency and transfer costs for simulation", a);
   cmd->add_option("--out,-o", a->output,
                   "Output file (default " + tp::default_calibration_path() + ")");
   cmd->add_option("--rounds", cal->rounds, "Ping-pong round trips (default 20000)")
       ->check(CLI::Range(500, 10000000));
-  cmd->callback([a, cal] {
-    const tp::Calibration c = tp::measure_calibration(*cal);  // runtime_error: exit 1
-    std::cout << tp::calibration_report(c, tp::save_calibration(c, a->output), a->json);
-  });
+  cmd->callback([a, cal] { std::cout << tp::calibrate_file(*cal, a->output, a->json); });
 }
 
 }  // namespace tgraph::app

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The drawing verbs: `tgraph viz` (a step's graph: viz::trace_step_view), `tgraph timeline`
-// (a Gantt chart) and `tgraph report` (HTML: viz::report_from_files, partition::step_quotient).
+// The drawing verbs: `tgraph viz` (a step's graph: viz::draw_step), `tgraph timeline` (a Gantt
+// chart: viz::draw_timeline) and `tgraph report` (HTML: viz::write_report).
 #include <cstdio>
 
 #include "commands.hpp"
@@ -11,17 +11,9 @@
 #include "tgraph/viz/timeline.hpp"
 
 namespace tgraph::app {
-namespace {
-
-/// The assignment file `a.assignment` checked against `trace`; nullopt when none is given.
-std::optional<TraceAssignment> assignment_of(const Args& a, const Trace& trace) {
-  if (a.assignment.empty()) return std::nullopt;
-  return partition::load_assignment(a.assignment, trace, a.input);
-}
-
-}  // namespace
 
 void add_viz_verbs(CLI::App& app) {
+  using enum viz::Collapse;
   auto a = std::make_shared<Args>();
   auto o = std::make_shared<viz::ViewOptions>();
   auto* cmd = app.add_subcommand(
@@ -30,7 +22,8 @@ void add_viz_verbs(CLI::App& app) {
   cmd->add_option("--step", a->step, "Step index (0-based; default 0)");
   cmd->add_option("--assign", a->assignment,
                   "Assignment (.tga): colours by processor, signal/wait/reducer nodes");
-  cmd->add_option("--collapse", a->collapse, "none (default), object, kind, processor or loop");
+  add_enum(cmd, "--collapse", o->collapse, {kNone, kObject, kKind, kProcessor, kLoop},
+           "none (default), object, kind, processor or loop");
   cmd->add_flag("--critical-path", o->critical_path,
                 "Highlight the critical path (loops unrolled)");
   cmd->add_option("--max-nodes", o->max_nodes,
@@ -39,16 +32,12 @@ void add_viz_verbs(CLI::App& app) {
                   "Refuse pictures with more edges (default 4000; 0: no limit)");
   cmd->add_option("-o,--output", a->output, "Output file: .dot, .svg, .png or .pdf")->required();
   cmd->callback([a, o] {
-    const viz::GraphFormat format = viz::graph_format_of(a->output);
-    o->collapse = viz::parse_collapse(a->collapse);
     const Trace trace = read_trace(a->input);
     step_at(trace, a->step, a->input);  // before the assignment is checked against the trace
-    const std::optional<TraceAssignment> as = assignment_of(*a, trace);
-    const viz::GraphView v =
-        viz::trace_step_view(trace, a->input, a->step, as ? &*as : nullptr, *o);
-    write_file_atomic(a->output, viz::render_graph(v, format));
-    if (v.collapse != viz::Collapse::kNone && v.hidden_deps > 0)
-      std::fprintf(stderr, "tgraph viz: %s\n", viz::hidden_deps_note(v).c_str());
+    const auto as = partition::load_assignment_if(a->assignment, trace, a->input);
+    const std::string note =
+        viz::draw_step(trace, a->input, a->step, as ? &*as : nullptr, *o, a->output);
+    if (!note.empty()) std::fprintf(stderr, "tgraph viz: %s\n", note.c_str());
   });
   add_timeline(app);
   add_report(app);
@@ -62,16 +51,7 @@ void add_timeline(CLI::App& app) {
       ->required();
   cmd->add_option("--steps", a->range, "Step range a:b, a: or a (default: all)");
   cmd->add_option("-o,--output", a->output, "Output file: .svg or .png")->required();
-  cmd->callback([a] {
-    const viz::TimelineFormat format = viz::timeline_format_of(a->output);
-    Timeline t = read_timeline(a->input);
-    if (!a->range.empty()) {
-      const auto r = viz::parse_step_range(a->range);
-      if (!r) throw UsageError("--steps " + a->range + ": expected a:b, a: or a (steps, a <= b)");
-      t = viz::select_steps(t, r->first, r->second);
-    }
-    write_file_atomic(a->output, viz::render_timeline(t, format, viz::timeline_title(t, a->input)));
-  });
+  cmd->callback([a] { viz::draw_timeline(a->input, a->range, a->output); });
 }
 
 void add_report(CLI::App& app) {
@@ -88,14 +68,9 @@ void add_report(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output file (.html)")->required();
   cmd->callback([a] {
     const Trace trace = read_trace(a->input);
-    const std::optional<TraceAssignment> as = assignment_of(*a, trace);
-    viz::ReportContent c =
-        viz::report_from_files(trace, a->input, as ? &*as : nullptr, a->step, a->compare, a->names);
-    if (as && !c.graph_svg.empty())
-      viz::set_quotient(
-          c, partition::step_quotient(trace.steps[c.graph_step], as->steps[c.graph_step]),
-          as->method);
-    write_file_atomic(a->output, viz::report_html(c));
+    const auto as = partition::load_assignment_if(a->assignment, trace, a->input);
+    viz::write_report(trace, a->input, as ? &*as : nullptr, a->step, a->compare, a->names,
+                      partition::step_quotient, a->output);
     std::printf("report: %s\n", a->output.c_str());
   });
 }

@@ -5,9 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdint>
+#include <initializer_list>
 #include <iostream>
-#include <nlohmann/json.hpp>
-#include <optional>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -17,6 +16,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
@@ -29,33 +29,36 @@ struct Failure : std::runtime_error {
 /// Values of a verb's flags that no module's option struct holds (each verb owns one).
 struct Args {
   std::string input, assignment, output, method, policy, format, timeline, chrome, csv;
-  std::string compare, range, collapse = "none";
+  std::string compare, range;
   std::vector<std::string> names;
   std::vector<std::uint32_t> counts;
   std::vector<double> values;
-  std::optional<int> steps;
-  std::optional<int> split;  ///< run --split: force-field tasks per deformable object
   std::size_t step = 0;
-  std::uint32_t k = 0;
+  std::uint32_t k = 0, steps = 1;
   std::uint64_t unit_ns = 1000, edge_bytes = 8;
   bool json = false, recover = false;
 };
 
-/// `--live RUN.json` | `--serial-ns N` of evaluate and simulate: the main thread's serial work
-/// per step that the simulation charges instead of the trace's host time.
-struct SerialFlags {
-  std::string live;                        ///< a `tgraph run --json` output
-  std::optional<std::uint64_t> serial_ns;  ///< the same for every step
-  /// Per step of a `steps`-step trace (empty: neither flag); UsageError for a shorter run.
-  std::vector<std::uint64_t> per_step(std::size_t steps) const;
-};
-/// Adds `--live` and `--serial-ns` to `cmd`.
-void add_serial_flags(CLI::App* cmd, SerialFlags& f);
+/// Adds `--live` and `--serial-ns` of evaluate and simulate to `cmd`.
+void add_serial_flags(CLI::App* cmd, partition::SerialWork& w);
+/// Adds `--model` and `--calibration` (partition::NamedOptions::cost_model) to `cmd`.
+void add_model_flags(CLI::App* cmd, partition::NamedOptions& n);
+/// Adds `flag` to `cmd`, bound to the enum `out` (or an optional one): one of `values` by its
+/// to_string name; CLI::IsMember refuses any other.
+template <class T, class E>
+CLI::Option* add_enum(CLI::App* cmd, const std::string& flag, T& out,
+                      std::initializer_list<E> values, const std::string& help) {
+  std::vector<std::string> names;
+  for (E v : values) names.emplace_back(to_string(v));
+  const auto set = [&out, names, all = std::vector<E>(values)](const std::string& name) {
+    out = all[static_cast<std::size_t>(std::find(names.begin(), names.end(), name) -
+                                       names.begin())];
+  };
+  return cmd->add_option_function<std::string>(flag, set, help)->check(CLI::IsMember(names));
+}
 
 /// Prints "tgraph: warning: TEXT" on stderr (what the user should know; not an error).
 inline void warn(const std::string& text) { std::cerr << "tgraph: warning: " << text << '\n'; }
-/// Prints a JSON object on stdout (one line, as `--json` promises).
-inline void print_json(const nlohmann::json& j) { std::cout << j.dump() << std::endl; }
 /// Threads a verb uses by default: all hardware threads (at least 1).
 inline std::uint32_t default_threads() { return std::max(1u, std::thread::hardware_concurrency()); }
 

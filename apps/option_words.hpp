@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// How the command line says a module's OptionError: the options' fields as flags.
+// How the command line says the options' fields a module's error or warning names: as flags.
 #pragma once
 
 #include <exception>
@@ -18,10 +18,10 @@ inline std::string flag_of(std::string field) {
   return "--" + field;
 }
 
-/// The one line a command prints for an error: an OptionError in the command line's words,
-/// anything else as it is.
+/// The one line a command prints for an error: the options' fields a module's error names
+/// (OptionError, ErrorWithFields) in the command line's words, anything else as it is.
 inline std::string error_line(const std::exception& e) {
-  if (const auto* o = dynamic_cast<const OptionError*>(&e)) return o->render(flag_of);
+  if (const auto* o = dynamic_cast<const ErrorWithFields*>(&e)) return o->render(flag_of);
   return e.what();
 }
 

@@ -280,13 +280,16 @@ StepGraph metg_graph(MetgShape shape, std::uint32_t width, std::uint32_t steps,
   return g;
 }
 
-std::string MetgResult::command() const {
-  std::string s = "tgraph experiment metg";
-  if (options.quick) s += " --quick";
-  if (!options.threads.empty()) s += " --threads " + detail::join(threads);
-  if (!options.methods.empty()) s += " --methods " + detail::join(policies);
-  return s + " --out " + options.out;
+Invocation MetgResult::invocation() const {
+  Invocation inv{"metg", {}};
+  if (options.quick) inv.settings.push_back({"quick", std::nullopt});
+  if (!options.threads.empty()) inv.settings.push_back({"threads", detail::join(threads)});
+  if (!options.methods.empty()) inv.settings.push_back({"methods", detail::join(policies)});
+  inv.settings.push_back({"out", options.out});
+  return inv;
 }
+
+std::string MetgResult::command() const { return words_of(options.words, invocation()); }
 
 MetgResult run_metg(const MetgOptions& options, Progress& progress) {
   MetgResult res;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `tgraph experiment NAME`: one entry for the paper's four experiments, metg and scaling.
+// One entry for every experiment by name: the paper's four, metg and scaling.
 #include <optional>
 
 #include "common.hpp"
@@ -20,13 +20,13 @@ NamedRun run_named(std::string_view name, const ExperimentOptions& o, Progress& 
   if (!o.subobjects.empty())
     throw OptionError("subobjects", "applies to the domain experiment only");
   if (name == "metg") {
-    const MetgResult r = run_metg({o.quick, o.out, o.threads, o.methods}, progress);
+    const MetgResult r = run_metg({o.quick, o.out, o.threads, o.methods, o.words}, progress);
     return {metg_text(r), metg_json(r), 0};
   }
   if (name == "scaling") {
     if (o.replay) throw OptionError("replay", "the scaling experiment makes live runs only");
     const ScalingResult r =
-        run_scaling({o.quick, o.out, o.threads, o.methods, o.steps, o.repeat}, progress);
+        run_scaling({o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words}, progress);
     return {scaling_text(r), scaling_json(r), r.failed.size()};
   }
   throw UsageError("unknown experiment '" + std::string(name) + "' (expected " +

@@ -80,27 +80,33 @@ std::size_t ExperimentPlan::runs() const {
   return scenes.size() * per_scene + series_methods.size();
 }
 
-std::string ExperimentPlan::command() const {
-  std::string s = "tgraph experiment " + std::string(to_string(name));
-  s += " --threads " + join(threads.all()) + " --steps " + std::to_string(steps) + " --repeat " +
-       std::to_string(repeat) + " --methods " + join(methods);
+Invocation ExperimentPlan::invocation() const {
+  Invocation inv{std::string(to_string(name)),
+                 {{"threads", join(threads.all())},
+                  {"steps", std::to_string(steps)},
+                  {"repeat", std::to_string(repeat)},
+                  {"methods", join(methods)}}};
   if (name == ExperimentName::kDomain) {
     std::vector<std::string> subs;
     for (const SceneVariant& v : scenes)
       if (v.subobjects &&
           std::find(subs.begin(), subs.end(), std::to_string(*v.subobjects)) == subs.end())
         subs.push_back(std::to_string(*v.subobjects));
-    if (!subs.empty()) s += " --subobjects " + join(subs);
+    if (!subs.empty()) inv.settings.push_back({"subobjects", join(subs)});
   }
-  s += replay ? " --replay" : " --no-replay";
-  return s + " --out " + out_dir;
+  inv.settings.push_back({"replay", std::nullopt, replay});
+  inv.settings.push_back({"out", out_dir});
+  return inv;
 }
+
+std::string ExperimentPlan::command() const { return words_of(words, invocation()); }
 
 ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) {
   ExperimentPlan p;
   p.name = o.name;
   p.cores = std::max(cores, 1u);
   p.out_dir = o.out.empty() ? "tgraph-experiment-" + std::string(to_string(o.name)) : o.out;
+  p.words = o.words;
   const std::vector<std::uint32_t> ks =
       o.threads.empty() ? default_thread_list(p.cores) : thread_counts(o.threads);
   p.threads = split_threads(ks, p.cores);
@@ -119,7 +125,7 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
       break;
     case ExperimentName::kHeterogeneous:
       // The paper's scale: falling64's 64 objects are apart for ~45 steps, then contacts
-      // merge them. --quick runs the small `falling` scene up to its first contacts (step 43).
+      // merge them. A quick run takes the small `falling` scene up to its first contacts (step 43).
       p.scenes = {{o.quick ? "falling" : "falling64", std::nullopt}};
       steps = 60;
       p.series_methods = {"sticky", "metis", "metis-relabel"};

@@ -70,7 +70,7 @@ ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
   return ref;
 }
 
-// One live run as `tgraph run --method METHOD --threads K --repeat R` makes it, without its
+// One live run of METHOD on K threads, R timed passes (measure::run_live), without its
 // own baseline (the scene's reference stands for it), with the observed passes.
 meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
                           const ScalingPlan& p) {
@@ -211,23 +211,29 @@ std::size_t ScalingPlan::runs() const {
   return scenes.size() * (1 + methods.size() * threads.size());
 }
 
-std::string ScalingPlan::command() const {
-  std::string s = "tgraph experiment scaling";
-  if (quick) s += " --quick";
-  s += " --threads " + join(threads) + " --methods " + join(methods);
+Invocation ScalingPlan::invocation() const {
+  Invocation inv{"scaling", {}};
+  if (quick) inv.settings.push_back({"quick", std::nullopt});
+  inv.settings.push_back({"threads", join(threads)});
+  inv.settings.push_back({"methods", join(methods)});
   if (!scenes.empty() &&
       std::all_of(scenes.begin(), scenes.end(),
                   [&](const ScalingScene& x) { return x.steps == scenes.front().steps; }) &&
       scenes.size() > 1)
-    s += " --steps " + std::to_string(scenes.front().steps);
-  return s + " --repeat " + std::to_string(repeat) + " --out " + out_dir;
+    inv.settings.push_back({"steps", std::to_string(scenes.front().steps)});
+  inv.settings.push_back({"repeat", std::to_string(repeat)});
+  inv.settings.push_back({"out", out_dir});
+  return inv;
 }
+
+std::string ScalingPlan::command() const { return words_of(words, invocation()); }
 
 ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
   ScalingPlan p;
   p.cores = std::max(cores, 1u);
   p.quick = o.quick;
   p.out_dir = o.out.empty() ? "tgraph-experiment-scaling" : o.out;
+  p.words = o.words;
   if (o.steps && *o.steps == 0) throw OptionError("steps", "must be at least 1");
   if (o.repeat && *o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   if (!o.threads.empty())

@@ -359,4 +359,13 @@ std::string step_diff_text(const StepDiff& d, std::size_t a, std::size_t b) {
   return s;
 }
 
+StepDiff diff_trace_steps(const Trace& trace, const std::string& trace_name, std::size_t a,
+                          std::size_t b, const TraceAssignment* assignment) {
+  const StepGraph& ga = step_at(trace, a, trace_name, "steps");
+  const StepGraph& gb = step_at(trace, b, trace_name, "steps");
+  StepDiff d = diff_steps(ga, gb);
+  if (assignment) add_processor_changes(d, ga, assignment->steps[a], gb, assignment->steps[b]);
+  return d;
+}
+
 }  // namespace tgraph

@@ -209,4 +209,10 @@ void write_file_atomic(const std::string& path, std::string_view content) {
   }
 }
 
+void write_output(const std::string& path, std::string_view content) {
+  if (!path.empty() && path != "-") return write_file_atomic(path, content);
+  std::fwrite(content.data(), 1, content.size(), stdout);
+  std::fflush(stdout);
+}
+
 }  // namespace tgraph

@@ -8,6 +8,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/trace_io.hpp"
 
 namespace tgraph {
 
@@ -163,6 +164,13 @@ std::string stg_import_report(const StgGraph& stg, const std::string& input,
     out += ", stated critical path " + std::to_string(*stg.cp_length) +
            " units = " + std::to_string(*stg.cp_length * unit_ns) + " ns";
   return out + "\nwrote " + output + "\n";
+}
+
+std::string import_stg(const std::string& input, const std::string& output,
+                       std::uint64_t unit_ns, std::uint64_t edge_bytes, bool json) {
+  const StgGraph stg = read_stg(input, unit_ns, edge_bytes);
+  write_trace(output, stg.trace);
+  return stg_import_report(stg, input, output, unit_ns, json);
 }
 
 }  // namespace tgraph

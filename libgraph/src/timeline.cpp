@@ -83,7 +83,7 @@ Timeline parse_timeline(std::string_view text, const std::string& name) {
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded())
     throw InputError(name, std::nullopt,
-                     "not JSON (expected a replay timeline from tgraph replay --timeline)");
+                     "not JSON (expected a replay timeline, as timeline_json writes it)");
   if (!j.is_object() || !j.contains("tasks") || !j["tasks"].is_array())
     throw InputError(name, std::nullopt,
                      "not a replay timeline (expected a JSON object with a \"tasks\" array)");

@@ -187,9 +187,12 @@ class TraceDecoder {
   Trace unclosed(std::size_t pos, const std::string& kind, const std::string& detail) {
     if (!have_header_) fail(pos, "truncated header frame: " + detail);
     if (options_.recover) return std::move(trace_);
-    fail(pos, kind + (detail.empty() ? "" : ": " + detail) + " (" +
-                  steps_text(trace_.steps.size()) +
-                  "; capture interrupted?) — read with --recover");
+    // ReadOptions::recover reads them: the command line says its flag.
+    throw InputError(name_, pos,
+                     kind + (detail.empty() ? "" : ": " + detail) + " (" +
+                         steps_text(trace_.steps.size()) +
+                         "; capture interrupted?) — read with {recover}",
+                     kNamesFields);
   }
 
   void read_header(ByteReader& p) {

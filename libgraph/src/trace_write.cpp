@@ -191,7 +191,7 @@ struct TraceWriter::Impl {
           partial);
     } catch (...) {
       if (::ftruncate(fd, static_cast<::off_t>(written)) != 0) {
-        // Nothing more to do: the reader with --recover skips a partial last frame.
+        // Nothing more to do: the reader with ReadOptions::recover skips a partial last frame.
       }
       ::close(fd);
       fd = -1;

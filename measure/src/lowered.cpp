@@ -3,6 +3,9 @@
 
 #include <algorithm>
 
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::measure {
@@ -36,6 +39,27 @@ partition::Prediction simulate(const Trace& trace, const TraceAssignment& assign
   partition::Prediction r = partition::simulate_trace(low.trace, low.assignment, engine, platform);
   r.lowered = true;
   return r;
+}
+
+std::string simulate_command(const SimulateCommand& c) {
+  using partition::SimulationEngine;
+  partition::SimulatedPlatform p;
+  p.model = c.model.cost_model();
+  if (!c.cluster.empty()) p.cluster = partition::parse_cluster(c.cluster);
+  p.file = c.platform;
+  p.intra_node = c.intra_node;
+  if (c.engine == SimulationEngine::builtin && !p.file.empty())
+    throw OptionError("platform",
+                      "the builtin engine has no platform model (use {engine} simgrid)");
+  const Trace trace = read_trace(c.trace);
+  const TraceAssignment as = partition::load_assignment(c.assignment, trace, c.trace);
+  p.serial_ns = c.serial.per_step(trace.steps.size());
+  if (!p.serial_ns.empty() && c.engine != SimulationEngine::builtin)
+    throw UsageError("",
+                     "{live}/{serial_ns}: only the builtin engine charges the main thread's work",
+                     kNamesFields);
+  const partition::Prediction r = simulate(trace, as, c.engine, p, c.lower);
+  return c.json ? partition::prediction_json(r) + "\n" : partition::prediction_text(r);
 }
 
 }  // namespace tgraph::measure

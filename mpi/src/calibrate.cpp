@@ -50,7 +50,7 @@ World world(bool pair) {
   MPI_Comm_rank(MPI_COMM_WORLD, &w.rank);
   MPI_Comm_size(MPI_COMM_WORLD, &w.size);
   if (pair && w.size < 2)
-    throw UsageError("calibrate needs 2 ranks (mpirun -np 2 tgraph-mpi calibrate)");
+    throw UsageError("calibrate needs 2 ranks (2 MPI processes)");
   return w;
 }
 

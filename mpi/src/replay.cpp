@@ -9,7 +9,8 @@
 // time only to MPI calls and to explicit executions, so each rank runs its one processor's
 // program on the main thread, blocks in MPI_Waitsome where the threads would poll, charges
 // each task's recorded cost as flops on its host (1 flop per ns, the cost model of
-// `tgraph platform` and of `tgraph simulate --engine simgrid`) and reads the simulated clock.
+// partition::platform_xml, as SimGrid's partition::simulate_trace) and reads the simulated
+// clock.
 #include "tgraph/mpi/replay.hpp"
 
 #include <mpi.h>
@@ -50,8 +51,8 @@ void RankWorkload::run(const replay::TaskRun& r) {
   if (r.origin == kNoTask || step_ == nullptr) return;
   const double cost = static_cast<double>(step_->tasks[r.origin].cost_ns) * scale_;
 #ifdef TGRAPH_SMPI
-  // The data pass above is real work that SMPI does not time (smpirun
-  // --cfg=smpi/simulate-computation:no); the task's recorded cost is what the host executes.
+  // The data pass above is real work that SMPI does not time (smpirun with the configuration
+  // smpi/simulate-computation:no); the task's recorded cost is what the host executes.
   (void)t0;
   if (cost > 0) smpi_execute_flops(cost);
 #else

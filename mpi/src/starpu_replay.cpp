@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// StarPU-MPI as the distributed peer (`tgraph-mpi replay --policy starpu-mpi`): the same
+// StarPU-MPI as the distributed peer (the MPI replay's starpu-mpi policy): the same
 // lowered graph (cumulative writes through per-processor reducers, as tgraph's own schedule
 // runs them: Debian's StarPU 1.3 has no STARPU_MPI_REDUX), the same bodies (RankWorkload) and
 // the same ownership, submitted the way StarPU-MPI applications are written:
@@ -80,8 +80,9 @@ class StarpuMpiRun {
                                       std::to_string(layout.threads_per_rank) +
                                       ": this StarPU has at most " +
                                       std::to_string(STARPU_MAXCPUS) + " CPU workers");
-    // Banners would spoil --json; byte counts per destination need the statistics; several
-    // ranks share a machine, so StarPU must not bind each rank's workers to cores 0..T-1.
+    // Banners would spoil a JSON report; byte counts per destination need the statistics;
+    // several ranks share a machine, so StarPU must not bind each rank's workers to cores
+    // 0..T-1.
     setenv("STARPU_SILENT", "1", 0);
     setenv("STARPU_COMM_STATS", "1", 1);
     setenv("STARPU_WORKERS_NOBIND", "1", 0);

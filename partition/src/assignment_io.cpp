@@ -193,6 +193,12 @@ TraceAssignment load_assignment(const std::string& path, const Trace& trace,
   return a;
 }
 
+std::optional<TraceAssignment> load_assignment_if(const std::string& path, const Trace& trace,
+                                                  const std::string& trace_name) {
+  if (path.empty()) return std::nullopt;
+  return load_assignment(path, trace, trace_name);
+}
+
 TraceAssignment load_or_partition(const Trace& trace, const std::string& trace_name,
                                   const std::string& path, const std::string& method,
                                   std::uint32_t k, PartitionNotes* notes) {

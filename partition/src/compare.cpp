@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 
@@ -124,6 +125,15 @@ Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
     if (!seen) c.sticky_moves.push_back({k, *sticky, moved("metis"), moved("metis-relabel")});
   }
   return c;
+}
+
+std::string compare_file(const std::string& trace, const std::vector<std::string>& methods,
+                         const std::vector<std::uint32_t>& ks, const Options& options,
+                         const std::vector<double>& sticky_migration_costs,
+                         const std::string& csv, bool json) {
+  const Comparison c = compare(read_trace(trace), methods, ks, options, sticky_migration_costs);
+  if (!csv.empty()) write_file_atomic(csv, comparison_csv(c));
+  return json ? comparison_json(c, trace) + "\n" : comparison_table(c);
 }
 
 }  // namespace tgraph::partition

@@ -71,6 +71,10 @@ std::vector<std::uint64_t> serial_work(const std::string& live,
   return v;
 }
 
+std::vector<std::uint64_t> SerialWork::per_step(std::size_t steps) const {
+  return serial_work(live, serial_ns, steps);
+}
+
 CostModel load_calibration(const std::string& path) {
   const std::vector<std::uint8_t> bytes = read_file_bytes(path);
   CostModel m = parse_calibration(
@@ -168,9 +172,9 @@ std::vector<std::uint64_t> load_serial_work(const std::string& path) {
   try {
     j = nlohmann::json::parse(bytes.begin(), bytes.end());
   } catch (const nlohmann::json::exception&) {
-    throw InputError(path, std::nullopt, "expected the JSON of `tgraph run --json` (malformed JSON)");
+    throw InputError(path, std::nullopt, "expected a live run's JSON report (malformed JSON)");
   }
-  const char* what = "expected the JSON of `tgraph run --json`: per_step[] with record_ns, "
+  const char* what = "expected a live run's JSON report: per_step[] with record_ns, "
                      "partition_ns and prepare_ns";
   if (!j.is_object() || !j.contains("per_step") || !j["per_step"].is_array())
     throw InputError(path, std::nullopt, what);
@@ -249,6 +253,11 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
   std::snprintf(line, sizeof line, "measured in %.1f s\n", c.seconds);
   return out + line + "wrote " + path + "\n";
+}
+
+std::string calibrate_file(const CalibrateOptions& options, const std::string& path, bool json) {
+  const Calibration c = measure_calibration(options);  // runtime_error: a failure of the work
+  return calibration_report(c, save_calibration(c, path), json);
 }
 
 }  // namespace tgraph::partition

@@ -7,6 +7,8 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
+#include "tgraph/graph/trace_io.hpp"
+#include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 
@@ -209,6 +211,15 @@ QuotientGraph step_quotient(const StepGraph& g, const Assignment& a) {
     }
   q.edges = std::move(edges);
   return q;
+}
+
+std::string evaluate_files(const std::string& trace, const std::string& assignment,
+                           const CostModel& model, const SerialWork& serial, bool json) {
+  const Trace t = read_trace(trace);
+  const TraceAssignment as = load_assignment(assignment, t, trace);
+  const std::vector<std::uint64_t> per_step = serial.per_step(t.steps.size());
+  const Report rep = evaluate(t, as, model, assignment, per_step.empty() ? nullptr : &per_step);
+  return json ? report_json(rep) + "\n" : report_text(rep);
 }
 
 }  // namespace tgraph::partition

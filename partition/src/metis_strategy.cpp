@@ -30,7 +30,7 @@ std::mutex& metis_mutex() {
 }
 
 // METIS 5.1 prints diagnostics ("***Cannot bisect a graph with 0 vertices!") with printf on
-// stdout when K is large for the graph, which would corrupt `--json` output: stdout is
+// stdout when K is large for the graph, which would corrupt a JSON report on it: stdout is
 // pointed at /dev/null for the duration of the call (under the METIS mutex).
 class SilenceStdout {
  public:

@@ -139,7 +139,7 @@ Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
   }
   if (pid == 0) {
     ::close(fds[0]);
-    // SimGrid's own messages never reach tgraph's stdout (--json stays one object).
+    // SimGrid's own messages never reach tgraph's stdout (a JSON report there stays one object).
     const int out = log ? ::fileno(log) : ::open("/dev/null", O_WRONLY);
     ::dup2(out, STDOUT_FILENO);
     ::dup2(out, STDERR_FILENO);

@@ -173,7 +173,7 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
       throw UsageError(
           "StarPU: another StarPU executor is alive in this process (StarPU is one runtime per "
           "process); destroy it first");
-    setenv("STARPU_SILENT", "1", 0);  // StarPU's banners would spoil --json on stdout
+    setenv("STARPU_SILENT", "1", 0);  // StarPU's banners would spoil a JSON report on stdout
     starpu_conf conf;
     starpu_conf_init(&conf);
     conf.precedence_over_environment_variables = 1;  // our flags win over STARPU_NCPU etc.

@@ -59,14 +59,14 @@ void Watchdog::watch() {
       fired_step = step;
       char head[96];
       std::snprintf(head, sizeof head,
-                    "replay stopped making progress for %.1f s (--timeout): ", seconds);
+                    "replay stopped making progress for %.1f s (watchdog timeout): ", seconds);
       abort_(std::make_exception_ptr(std::runtime_error(head + report_())));
       since = now;
     } else if (exit_if_stuck_) {
       // The abort woke every wait; a thread still inside a task body cannot be interrupted.
       std::fprintf(stderr,
-                   "tgraph: replay stopped making progress (--timeout): %s; a task body does "
-                   "not return, ending the process\n",
+                   "tgraph: replay stopped making progress (watchdog timeout): %s; a task body "
+                   "does not return, ending the process\n",
                    report_().c_str());
       std::fflush(stderr);
       std::_Exit(1);

@@ -63,12 +63,10 @@ CaptureRun capture_scene(const CaptureOptions& o) {
   // A diverging simulation or a failed write stops the capture; the steps written before
   // stay in the partial file (TraceWriter: <output>.partial).
   const auto stop = [&](const std::string& why) {
-    std::string kept;
-    if (writer)
-      kept = "; the " + std::to_string(writer->steps_written()) +
-             " complete steps before it are in " + writer->partial_path() +
-             " (read with --recover)";
-    throw CaptureFailure("capture: " + why + kept);
+    if (!writer) throw CaptureFailure("capture: " + why);
+    throw CaptureFailure("capture: " + why + "; the " + std::to_string(writer->steps_written()) +
+                             " complete steps before it are in " + writer->partial_path() + " (",
+                         "read with {recover})", kNamesFields);
   };
   auto last_report = std::chrono::steady_clock::now();
   for (int s = 0; s < run.steps; ++s) {

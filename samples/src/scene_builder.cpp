@@ -141,7 +141,7 @@ void SceneBuilder::instance_common(Directive& d, Body& b, double spacing, bool f
   if (!collide_) b.surface.clear();
 }
 
-// split=N (or --split): the object's internal force field as up to N fields over
+// split=N (or SceneOptions::split): the object's internal force field as up to N fields over
 // consecutive runs of its elements or springs, each a task of its own (cumulative writes
 // into the object's force vectors), so one big object no longer serialises its force and
 // CG products. Run one after the other, the fields add the same terms into every node in

@@ -57,7 +57,7 @@ class SceneBuilder {
   // The attributes every object takes: parsed on an array's first instance (`first`),
   // copied to the others.
   void instance_common(Directive& d, Body& b, double spacing, bool first);
-  // split=N (or --split): up to N force fields per object (scene_builder.cpp).
+  // split=N (or SceneOptions::split): up to N force fields per object (scene_builder.cpp).
   int split_of(Directive& d);
   // `units` in order, cut into up to `split` consecutive runs; make(name, run) builds a field.
   template <class Unit, class Make>

@@ -66,7 +66,7 @@ void check_stability(Scene& scene, FrequencyBound& bound, const std::string& fil
   }
   const SolverSettings& s = scene.solver();
   const std::string where =
-      dt_from_options ? file + " with --dt" : file + ":" + std::to_string(dt_line > 0 ? dt_line : last_line);
+      dt_from_options ? file + " with {dt}" : file + ":" + std::to_string(dt_line > 0 ? dt_line : last_line);
   const double w2 = bound.omega2();
   if (w2 == 0.0) return;
   if (!std::isfinite(w2) || w2 > 1e200)

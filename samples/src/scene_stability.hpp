@@ -50,8 +50,9 @@ std::string short_num(double v);
 /// at the stiffest object's line of `file`); a time step above the explicit stability limit,
 /// or one that leaves CG too few iterations, is a warning on `scene` (the divergence checks of
 /// Scene::step stop a run that does blow up). `bound` holds the objects; the contacts are
-/// added here. Warnings name `file` "with --dt" when the time step came from the options,
-/// else the solver line `dt_line` (or `last_line` without one).
+/// added here. Warnings name `file` "with {dt}" (the field SceneOptions::dt, which a front end
+/// writes in its own words: name_fields) when the time step came from the options, else the
+/// solver line `dt_line` (or `last_line` without one).
 void check_stability(Scene& scene, FrequencyBound& bound, const std::string& file,
                      bool dt_from_options, int dt_line, int last_line);
 

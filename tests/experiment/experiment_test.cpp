@@ -49,6 +49,21 @@ TEST(ThreadList, RejectsZeroAndCountsAboveTheLimitNamingTheField) {
   EXPECT_EQ(thread_counts({kMaxThreads}), (Ks{kMaxThreads}));
 }
 
+TEST(ThreadList, ParsesCountsAndRangesAndNamesTheFieldOfABadList) {
+  EXPECT_EQ(parse_thread_list("2,1-3,8"), (Ks{2, 1, 2, 3, 8}));
+  EXPECT_EQ(parse_thread_list("1024"), (Ks{1024}));
+  const auto flag = [](const std::string& field) { return "--" + field; };
+  for (const std::string bad : {"1,,2", "4-2", "0", "1025", "x", "", "2-"}) {
+    try {
+      parse_thread_list(bad);
+      ADD_FAILURE() << "accepted '" << bad << "'";
+    } catch (const UsageError& e) {
+      EXPECT_EQ(e.render(flag), "--threads " + bad + ": expected counts from 1 to 1024, such as 1-4,8");
+      EXPECT_EQ(std::string(e.what()).rfind("threads " + bad + ": ", 0), 0u) << e.what();
+    }
+  }
+}
+
 TEST(ThreadList, DefaultIsEveryCoreThenPowersOfTwoToSixtyFour) {
   EXPECT_EQ(default_thread_list(2), (Ks{1, 2, 4, 8, 16, 32, 64}));
   EXPECT_EQ(default_thread_list(1), (Ks{1, 2, 4, 8, 16, 32, 64}));
@@ -114,6 +129,13 @@ TEST(Plan, FlagsOverrideTheDefaults) {
   EXPECT_EQ(p.repeat, 5u);
   EXPECT_EQ(p.runs(), 4u);
   EXPECT_EQ(p.command(),
+            "medical threads=1,2,3,8 steps=7 repeat=5 methods=owner,worksteal replay=off out=out");
+  // A front end writes the same settings in its own words (the command line's flags).
+  o.words = words_with("tgraph experiment", [](std::string field) {
+    std::replace(field.begin(), field.end(), '_', '-');
+    return "--" + field;
+  });
+  EXPECT_EQ(plan_experiment(o, 2).command(),
             "tgraph experiment medical --threads 1,2,3,8 --steps 7 --repeat 5 --methods "
             "owner,worksteal --no-replay --out out");
 }
@@ -129,7 +151,7 @@ TEST(Plan, DomainHasEveryClothAndSubObjectCount) {
                                               "cloth256-s16", "cloth512-s4", "cloth512-s16"}));
   EXPECT_EQ(p.methods, (std::vector<std::string>{"owner"}));
   EXPECT_FALSE(p.replay);
-  EXPECT_NE(p.command().find("--subobjects 4,16"), std::string::npos);
+  EXPECT_NE(p.command().find(" subobjects=4,16 "), std::string::npos) << p.command();
 }
 
 TEST(Plan, HeterogeneousRepartitionsEveryStepOnTheLargestMeasuredCount) {

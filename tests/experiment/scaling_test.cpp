@@ -49,7 +49,7 @@ TEST(ScalingPlan, QuickRunsFewStepsOnOneAndTwoThreadsOfEveryScene) {
                                                  "cloth256-s64:1"}));
   EXPECT_EQ(p.threads, (std::vector<std::uint32_t>{1, 2}));
   EXPECT_EQ(p.methods, (std::vector<std::string>{"owner", "sticky", "worksteal", "barrier"}));
-  EXPECT_NE(p.command().find("--quick --threads 1,2 --methods owner,sticky,worksteal,barrier"),
+  EXPECT_NE(p.command().find("quick threads=1,2 methods=owner,sticky,worksteal,barrier"),
             std::string::npos)
       << p.command();
 }
@@ -66,9 +66,7 @@ TEST(ScalingPlan, FlagsOverrideTheDefaultsAndCountsAboveTheCoresAreNoted) {
   EXPECT_EQ(p.methods, (std::vector<std::string>{"sticky", "worksteal"}));
   for (const ScalingScene& s : p.scenes) EXPECT_EQ(s.steps, 7u) << s.label();
   EXPECT_EQ(p.repeat, 3u);
-  EXPECT_EQ(p.command(),
-            "tgraph experiment scaling --threads 1,4 --methods sticky,worksteal --steps 7 "
-            "--repeat 3 --out d");
+  EXPECT_EQ(p.command(), "scaling threads=1,4 methods=sticky,worksteal steps=7 repeat=3 out=d");
   ASSERT_EQ(p.notes.size(), 1u);
   EXPECT_NE(p.notes[0].find("oversubscribed"), std::string::npos) << p.notes[0];
 }

@@ -413,7 +413,7 @@ TEST(TraceWriter, CompleteFramesReadBackBeforeClose) {
   EXPECT_EQ(open_bytes.size(), w.bytes_written());
   EXPECT_READ_ERROR(
       open_bytes,
-      "trace not closed (3 complete steps; capture interrupted?) — read with --recover");
+      "trace not closed (3 complete steps; capture interrupted?) — read with recover");
   ReadOptions recover;
   recover.recover = true;
   EXPECT_EQ(read_trace(w.partial_path(), recover), trace);
@@ -446,7 +446,7 @@ TEST(TraceWriter, CaptureKilledBySigkillLeavesItsCompleteStepsReadable) {
   ASSERT_TRUE(WIFSIGNALED(status));
   const Bytes bytes = slurp(p.string() + ".partial");
   EXPECT_FALSE(fs::exists(p));
-  EXPECT_READ_ERROR(bytes, "capture interrupted?) — read with --recover");
+  EXPECT_READ_ERROR(bytes, "capture interrupted?) — read with recover");
   expect_recovered_steps(bytes, header, 10);
 }
 
@@ -606,7 +606,7 @@ TEST(TraceReader, RejectsATruncatedFrame) {
   const std::size_t step_frame = 8 + header_frame().size();
   const Bytes cut(whole.begin(), whole.begin() + static_cast<std::ptrdiff_t>(step_frame + 20));
   EXPECT_READ_ERROR(cut, "offset " + std::to_string(step_frame) + ": truncated frame: expected ");
-  EXPECT_READ_ERROR(cut, "(0 complete steps; capture interrupted?) — read with --recover");
+  EXPECT_READ_ERROR(cut, "(0 complete steps; capture interrupted?) — read with recover");
   const Bytes cut_header(whole.begin(),
                          whole.begin() + static_cast<std::ptrdiff_t>(step_frame + 5));
   EXPECT_READ_ERROR(cut_header, "truncated frame header: expected 12 bytes, found 5");
@@ -761,7 +761,13 @@ TEST(TraceReader, RejectsAMissingEndFrameUnlessRecovering) {
       Buf().raw(file_header()).raw(header_frame()).raw(s.full_frame()).raw(s.reference_frame(0)).b;
   EXPECT_READ_ERROR(
       b, "offset " + std::to_string(b.size()) +
-             ": trace not closed (2 complete steps; capture interrupted?) — read with --recover");
+             ": trace not closed (2 complete steps; capture interrupted?) — read with recover");
+  try {  // the option's field, which a front end names in its words (the command line: --recover)
+    read_trace_bytes(b, "t");
+  } catch (const InputError& e) {
+    const auto flag = [](const std::string& f) { return "--" + f; };
+    EXPECT_TRUE(e.render(flag).ends_with("— read with --recover")) << e.what();
+  }
   ReadOptions recover;
   recover.recover = true;
   EXPECT_EQ(read_trace_bytes(b, "t", recover).steps.size(), 2u);
@@ -851,7 +857,7 @@ TEST(TraceReader, RecoversTheCompleteStepsAfterTruncationAtEveryOffset) {
     ASSERT_NO_THROW(back = read_trace_bytes(prefix, "cut", recover)) << "prefix " << n;
     ASSERT_EQ(back.steps.size(), complete) << "prefix " << n;
     for (std::size_t s = 0; s < complete; ++s) EXPECT_EQ(back.steps[s], trace.steps[s]);
-    EXPECT_NE(read_error(prefix).find("read with --recover"), std::string::npos) << n;
+    EXPECT_NE(read_error(prefix).find("read with recover"), std::string::npos) << n;
   }
   EXPECT_EQ(read_trace_bytes(bytes, "whole", recover), trace);
 }
@@ -919,7 +925,7 @@ TEST(TraceReader, RejectsEachCommittedBrokenTrace) {
       {"bad_reference.tgt", "reference to a non-existent step"},
       {"truncated.tgt", "truncated frame"},
       {"interrupted.tgt",
-       "trace not closed (2 complete steps; capture interrupted?) — read with --recover"},
+       "trace not closed (2 complete steps; capture interrupted?) — read with recover"},
   };
   for (const auto& [file, substring] : cases) {
     const fs::path p = data_dir() / file;

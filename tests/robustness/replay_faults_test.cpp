@@ -355,8 +355,8 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         ex->run_step(g, &a, w);
       },
       ::testing::ExitedWithCode(1),
-      "replay stopped making progress \\(--timeout\\): thread .* runs or last ran task .*; a task "
-      "body does not return, ending the process");
+      "replay stopped making progress \\(watchdog timeout\\): thread .* runs or last ran task "
+      ".*; a task body does not return, ending the process");
 }
 
 // A workload whose body of one task sleeps, once, long enough for every thread to stall

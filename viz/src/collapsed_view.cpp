@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// The aggregated picture of a step (--collapse object, kind, processor or loop): one node per
+// The aggregated picture of a step (Collapse::kObject, kKind, kProcessor or kLoop): one node per
 // group of tasks, edges summed between groups.
 #include <algorithm>
 #include <map>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The picture model of a step: task nodes with synchronisation (signal, wait, reducer) made
-// explicit for an assignment, or aggregates for --collapse.
+// explicit for an assignment, or aggregates (ViewOptions::collapse).
 #include "tgraph/viz/graph_view.hpp"
 
 #include <algorithm>

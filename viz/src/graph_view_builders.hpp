@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The two builders of a step's picture (graph_view.cpp chooses): the task view with its
-// synchronisation nodes (task_view.cpp) and the aggregated view of --collapse
+// synchronisation nodes (task_view.cpp) and the aggregated view (ViewOptions::collapse)
 // (collapsed_view.cpp).
 #pragma once
 

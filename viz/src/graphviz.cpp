@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/file_util.hpp"
 #include "tgraph/viz/palette.hpp"
 
 namespace tgraph::viz {
@@ -328,7 +329,17 @@ GraphFormat graph_format_of(const std::string& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (GraphFormat f : {GraphFormat::kDot, GraphFormat::kSvg, GraphFormat::kPng, GraphFormat::kPdf})
     if (to_string(f) == ext) return f;
-  throw UsageError("-o " + path + ": expected a .dot, .svg, .png or .pdf file name");
+  throw UsageError("", "{output} " + path + ": expected a .dot, .svg, .png or .pdf file name",
+                   kNamesFields);
+}
+
+std::string draw_step(const Trace& trace, const std::string& trace_name, std::size_t step,
+                      const TraceAssignment* assignment, const ViewOptions& options,
+                      const std::string& output) {
+  const GraphFormat format = graph_format_of(output);
+  const GraphView v = trace_step_view(trace, trace_name, step, assignment, options);
+  write_file_atomic(output, render_graph(v, format));
+  return v.collapse != Collapse::kNone && v.hidden_deps > 0 ? hidden_deps_note(v) : "";
 }
 
 std::string to_dot(const GraphView& view) {

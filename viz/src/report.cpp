@@ -199,9 +199,9 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
         "; vermillion edges cross processors; thick black: the critical path; " +
         hidden_deps_note(view) +
         ". Hover a node or an edge for its text (edge labels: data, bytes per step, "
-        "crossings). Same picture with edge labels drawn: tgraph viz " +
-        trace_name + " --step " + std::to_string(step) + " --collapse object --critical-path" +
-        (assignment ? " --assign A.tga" : "") + " -o g.svg";
+        "crossings). Same picture with edge labels drawn: step " + std::to_string(step) +
+        " of " + trace_name + " collapsed by object, with the critical path" +
+        (assignment ? " and the assignment" : "") + ", drawn on its own as SVG";
   }
   return c;
 }
@@ -222,7 +222,7 @@ void add_compare_json(ReportContent& c, std::string_view text, const std::string
   const json j = json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object() || !j.contains("rows") || !j["rows"].is_array())
     throw InputError(name, std::nullopt,
-                     "not a comparison (expected tgraph compare --json output with \"rows\")");
+                     "not a comparison (expected a comparison's JSON with \"rows\")");
   std::size_t i = 0;
   try {
     for (const json& r : j["rows"]) {
@@ -258,8 +258,7 @@ void add_replay_json(ReportContent& c, std::string_view text, const std::string&
   }
   if (j.is_discarded() || !j.is_object() || !j.contains("policy") || !j.contains("speedup"))
     throw InputError(name, std::nullopt,
-                     "expected a replay timeline (tgraph replay --timeline) or a measurement "
-                     "(tgraph replay --json)");
+                     "expected a replay timeline or a replay's measurement (its JSON report)");
   try {
     MethodRow row;
     const std::string policy = j.at("policy").get<std::string>();
@@ -290,6 +289,18 @@ ReportContent report_from_files(const Trace& trace, const std::string& trace_nam
   if (!compare_path.empty()) add_compare_json(c, read_file_text(compare_path), compare_path);
   for (const std::string& r : replay_paths) add_replay_json(c, read_file_text(r), r);
   return c;
+}
+
+void write_report(const Trace& trace, const std::string& trace_name,
+                  const TraceAssignment* assignment, std::size_t step,
+                  const std::string& compare_path, const std::vector<std::string>& replay_paths,
+                  const StepQuotient& quotient, const std::string& output) {
+  ReportContent c =
+      report_from_files(trace, trace_name, assignment, step, compare_path, replay_paths);
+  if (assignment && !c.graph_svg.empty())
+    set_quotient(c, quotient(trace.steps[c.graph_step], assignment->steps[c.graph_step]),
+                 assignment->method);
+  write_file_atomic(output, report_html(c));
 }
 
 std::string report_html(const ReportContent& c) {

@@ -225,7 +225,7 @@ json timeline_spec(const Timeline& t, std::string* caption) {
   if (shown < t.tasks.size())
     *caption += " Steps 0 to " + std::to_string(last_step) + " shown (" + with_commas(shown) +
                 " of " + with_commas(t.tasks.size()) +
-                " task instances); `tgraph timeline --steps` draws any range.";
+                " task instances); the timeline drawn on its own shows any range of steps.";
   json kind_range = json::array();
   for (std::uint32_t i = 0; i < kKindColours; ++i) kind_range.push_back(kind_colour(i));
   const json x = {{"field", "start"}, {"type", "quantitative"}, {"title", "time (ms)"}};

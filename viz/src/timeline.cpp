@@ -262,7 +262,21 @@ TimelineFormat timeline_format_of(const std::string& path) {
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   for (TimelineFormat f : {TimelineFormat::kSvg, TimelineFormat::kPng})
     if (to_string(f) == ext) return f;
-  throw UsageError("-o " + path + ": expected a .svg or .png file name");
+  throw UsageError("", "{output} " + path + ": expected a .svg or .png file name", kNamesFields);
+}
+
+void draw_timeline(const std::string& input, const std::string& steps,
+                   const std::string& output) {
+  const TimelineFormat format = timeline_format_of(output);
+  Timeline t = read_timeline(input);
+  if (!steps.empty()) {
+    const auto r = parse_step_range(steps);
+    if (!r)
+      throw UsageError("", "{steps} " + steps + ": expected a:b, a: or a (steps, a <= b)",
+                       kNamesFields);
+    t = select_steps(t, r->first, r->second);
+  }
+  write_file_atomic(output, render_timeline(t, format, timeline_title(t, input)));
 }
 
 std::string render_timeline(const Timeline& t, TimelineFormat format, const std::string& title) {

@@ -50,7 +50,7 @@ struct DemoResult {
 DemoResult run_demo(const DemoOptions& options,
                     const std::function<void(const std::string&)>& say = {});
 
-/// `tgraph demo --json`: one JSON object (scene, steps, threads, trace, report, cost_model,
+/// The demo as one JSON object (scene, steps, threads, trace, report, cost_model,
 /// rows).
 std::string demo_json(const DemoResult& result);
 /// `tgraph demo`'s table, as printed on stdout: the cost model of its predictions, then the

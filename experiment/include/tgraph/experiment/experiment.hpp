@@ -15,6 +15,7 @@
 #include "tgraph/experiment/machine.hpp"
 #include "tgraph/experiment/progress.hpp"
 #include "tgraph/experiment/results.hpp"
+#include "tgraph/experiment/settings.hpp"
 #include "tgraph/experiment/threads.hpp"
 
 namespace tgraph::experiment {
@@ -36,8 +37,7 @@ std::vector<std::string> experiment_names();
 /// Every experiment run_named runs: the paper's four, then "metg" and "scaling".
 std::vector<std::string> all_experiment_names();
 
-/// What to run (the flags of `tgraph experiment`); empty or unset fields take the
-/// experiment's defaults (plan_experiment).
+/// What to run; empty or unset fields take the experiment's defaults (plan_experiment).
 struct ExperimentOptions {
   ExperimentName name = ExperimentName::kIndependent;
   std::vector<std::uint32_t> threads;   ///< thread counts (thread_counts); empty: default
@@ -48,6 +48,8 @@ struct ExperimentOptions {
   std::vector<std::string> methods;     ///< strategies and baselines; empty: the experiment's
   std::vector<int> subobjects;          ///< domain: sub-object counts (squares); empty: default
   std::optional<bool> replay;           ///< synthetic replays too; unset: the experiment's default
+  /// How the results files write the run that reproduces this one (empty: plain_words).
+  InvocationWords words;
 };
 
 /// A scene with its build options.
@@ -73,13 +75,17 @@ struct ExperimentPlan {
   ThreadPlan threads;
   std::string out_dir;
   std::vector<std::string> notes;  ///< what the plan left out and why
+  InvocationWords words;           ///< ExperimentOptions::words
   /// Whether `method` at `threads` is replayed: when replays are on, at more than one thread
   /// (one thread replays the sequential order), and not for starpu (its replay costs 4 to 7
   /// times the sequential one; docs/results.md has it).
   bool replays(const std::string& method, std::uint32_t threads) const;
   /// Runs reported on the progress line (live runs, replays, per-step runs).
   std::size_t runs() const;
-  /// `tgraph experiment ...` reproducing this plan.
+  /// The settings that reproduce this plan (every one resolved: threads, steps, repeat,
+  /// methods, domain's subobjects, replay, out).
+  Invocation invocation() const;
+  /// words_of(words, invocation()): the results files' "command".
   std::string command() const;
 };
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `tgraph experiment metg`: Task Bench's minimum effective task granularity (Slaughter et al.,
+// The METG experiment: Task Bench's minimum effective task granularity (Slaughter et al.,
 // SC'20) for every replay policy, on synthetic graphs of Task Bench's dependence patterns and
 // on bars64's own step, at every thread count of the machine.
 #pragma once
@@ -12,6 +12,7 @@
 
 #include "tgraph/experiment/machine.hpp"
 #include "tgraph/experiment/progress.hpp"
+#include "tgraph/experiment/settings.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
 namespace tgraph::experiment {
@@ -34,7 +35,7 @@ std::string_view to_string(MetgShape shape);
 StepGraph metg_graph(MetgShape shape, std::uint32_t width, std::uint32_t steps,
                      std::uint64_t task_ns);
 
-/// What to run (the flags of `tgraph experiment metg`).
+/// What to run.
 struct MetgOptions {
   bool quick = false;    ///< coarse duration grid, one timed pass, small graphs
   std::string out;                     ///< results folder; "": tgraph-experiment-metg
@@ -42,6 +43,8 @@ struct MetgOptions {
   /// The replay policies swept (the other experiments' methods); empty: sequential and every
   /// parallel policy built.
   std::vector<std::string> methods;
+  /// How results.json writes the run that reproduces this one (empty: plain_words).
+  InvocationWords words;
 };
 
 /// One timed point: a policy on a shape at a thread count and a task duration.
@@ -87,6 +90,9 @@ struct MetgResult {
   /// Why some (policy, threads) were not run (StarPU above its build's CPU workers).
   std::vector<std::string> skipped;
   std::vector<std::string> files;
+  /// The settings that reproduce this run (quick, threads and methods when given, out).
+  Invocation invocation() const;
+  /// words_of(options.words, invocation()): results.json's "command".
   std::string command() const;
 };
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `tgraph experiment scaling`: live runs (measure::run_live, as `tgraph run` makes them) of
+// The scaling experiment: live runs (measure::run_live, as a scene's live run makes them) of
 // bars64, falling64, torso and cloth256-s64 for the partition strategies and every baseline
 // at each thread count, with where each run's time goes: speed-up, the main thread's serial
 // share, inflation of the task bodies, the threads' waiting share, parks, repartitions.
@@ -12,10 +12,11 @@
 
 #include "tgraph/experiment/machine.hpp"
 #include "tgraph/experiment/progress.hpp"
+#include "tgraph/experiment/settings.hpp"
 
 namespace tgraph::experiment {
 
-/// What to run (the flags of `tgraph experiment scaling`).
+/// What to run.
 struct ScalingOptions {
   bool quick = false;                   ///< few steps, threads 1,2, a smoke run
   std::string out;                      ///< results folder; "": tgraph-experiment-scaling
@@ -23,6 +24,8 @@ struct ScalingOptions {
   std::vector<std::string> methods;     ///< strategies and baselines; empty: all
   std::optional<std::uint32_t> steps;   ///< steps of every scene; unset: each scene's own
   std::optional<std::uint32_t> repeat;  ///< timed passes per run (medians); unset: 1
+  /// How results.json writes the run that reproduces this one (empty: plain_words).
+  InvocationWords words;
 };
 
 /// A scene of the sweep with its step count.
@@ -48,15 +51,19 @@ struct ScalingPlan {
   bool quick = false;
   std::string out_dir;
   std::vector<std::string> notes;  ///< what the plan left out or warns about, and why
+  InvocationWords words;           ///< ScalingOptions::words
   /// Live runs: one per scene, method and thread count, plus one reference run per scene.
   std::size_t runs() const;
-  /// `tgraph experiment scaling ...` reproducing this plan.
+  /// The settings that reproduce this plan (quick, threads, methods, steps when every scene
+  /// has the same count, repeat, out).
+  Invocation invocation() const;
+  /// words_of(words, invocation()): results.json's "command".
   std::string command() const;
 };
 
 /// Resolves `options` on a machine with `cores` cores. Defaults: bars64 (20 steps), falling64
 /// (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier, omp-tasks and
-/// starpu (when built); scaling_thread_list(cores); one pass. --quick: 2, 3, 3 and 1 steps,
+/// starpu (when built); scaling_thread_list(cores); one pass. quick: 2, 3, 3 and 1 steps,
 /// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
 /// field (an unknown method, sequential or partition as a method, starpu in a build without
 /// it, a thread count, steps or repeat of 0).

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 namespace tgraph::experiment {
@@ -15,6 +16,11 @@ inline constexpr std::uint32_t kMaxThreads = 1024;
 /// `threads` ascending, without duplicates; tgraph::OptionError on `threads` for a count of 0
 /// or above kMaxThreads.
 std::vector<std::uint32_t> thread_counts(std::vector<std::uint32_t> threads);
+
+/// The counts of a list such as "1-4,8,16" (counts and ranges, each 1 to kMaxThreads), in
+/// its order (thread_counts sorts them). A UsageError naming the field `threads` for anything
+/// else: an empty item, a range that goes down, a count out of range.
+std::vector<std::uint32_t> parse_thread_list(std::string_view text);
 
 /// The default list: every count from 1 to `cores`, then the powers of two above `cores`
 /// up to `max_threads` (2 cores, 64: 1, 2, 4, 8, 16, 32, 64).

@@ -10,6 +10,7 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/graph/trace.hpp"
 
 namespace tgraph {
 
@@ -78,6 +79,11 @@ StepDiff diff_steps(const StepGraph& before, const StepGraph& after);
 /// (an assignment of `before`) and `a_after` (of `after`). The assignments must fit.
 void add_processor_changes(StepDiff& d, const StepGraph& before, const Assignment& a_before,
                            const StepGraph& after, const Assignment& a_after);
+
+/// Steps `a` and `b` of `trace` diffed (step_at, naming the field `steps` and `trace_name`),
+/// with the processor changes of `assignment` (it fits `trace`) when it is not null.
+StepDiff diff_trace_steps(const Trace& trace, const std::string& trace_name, std::size_t a,
+                          std::size_t b, const TraceAssignment* assignment);
 
 /// One line: "+3/-4 tasks, +12/-9 edges, contacts +mattress|box, groups merged:
 /// {box} + {mattress, ...}" ("no structural change" when there is none).

@@ -19,5 +19,7 @@ std::string read_file_text(const std::string& path);
 /// so that a process killed while it writes leaves no temporary file either (elsewhere a
 /// named temporary file from the start). Throws tgraph::Error.
 void write_file_atomic(const std::string& path, std::string_view content);
+/// write_file_atomic, or `content` on standard output when `path` is empty or "-".
+void write_output(const std::string& path, std::string_view content);
 
 }  // namespace tgraph

@@ -27,9 +27,12 @@ StgGraph parse_stg(std::string_view text, const std::string& name, std::uint64_t
 StgGraph read_stg(const std::string& path, std::uint64_t unit_ns = 1000,
                   std::uint64_t edge_bytes = 8);
 
-/// `tgraph import`'s report on `g` read from `input` and written to `output`: one JSON object
-/// (input, output, tasks, edges, unit_ns, cp_length) or a text line and "wrote ...".
+/// The report on `g` read from `input` and written to `output`: one JSON object (input,
+/// output, tasks, edges, unit_ns, cp_length) or a text line and "wrote ...".
 std::string stg_import_report(const StgGraph& g, const std::string& input,
                               const std::string& output, std::uint64_t unit_ns, bool json);
+/// The STG file `input` (read_stg) written as the trace `output`: its stg_import_report.
+std::string import_stg(const std::string& input, const std::string& output,
+                       std::uint64_t unit_ns, std::uint64_t edge_bytes, bool json);
 
 }  // namespace tgraph

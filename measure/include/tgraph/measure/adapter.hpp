@@ -34,7 +34,7 @@ namespace tgraph::measure {
 ///   o.exec.threads = 2;
 ///   o.check = true;
 ///   LiveResult r = run_engine_live(make, choose_method("owner"), o);
-///   std::puts(to_json(r, "my engine", "owner").c_str());  // as `tgraph run --json`
+///   std::puts(to_json(r, "my engine", "owner").c_str());  // as a scene's live run reports
 struct EngineCallbacks {
   /// Declares the engine's kinds, objects and data (each with its storage) on `rec`; called
   /// once, before the first step. The ids it hands out are the ones `step` uses.
@@ -69,7 +69,7 @@ std::unique_ptr<LiveEngine> make_live_engine(EngineCallbacks callbacks);
 LiveResult run_engine_live(const CallbacksFactory& make, const MethodChoice& method,
                            LiveOptions options);
 
-/// `tgraph run --json`'s object for an outside engine (to_json(r, engine, method) of
+/// A live run's JSON object for an outside engine (to_json(r, engine, method) of
 /// report.hpp: `engine` under the key "scene") with `extra` numeric keys added, such as an
 /// engine's own check of its result.
 std::string to_json(const LiveResult& r, const std::string& engine, const std::string& method,

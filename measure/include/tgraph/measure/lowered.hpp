@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
-// The graph the partition executors run, as a trace the simulators take, and `tgraph
-// simulate [--lower]` on it.
+// The graph the partition executors run, as a trace the simulators take, and a simulation of a
+// trace file's steps, lowered or not (simulate_command).
 #pragma once
+
+#include <string>
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/partition/simulation.hpp"
+#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::measure {
 
@@ -26,10 +29,29 @@ struct LoweredTrace {
 /// time; steps beyond the assignment's are dropped.
 LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment);
 
-/// `tgraph simulate`: partition::simulate_trace of `trace` under `assignment`, lowered first
-/// when `lower` (then Prediction::lowered is set).
+/// partition::simulate_trace of `trace` under `assignment`, lowered first when `lower` (then
+/// Prediction::lowered is set).
 partition::Prediction simulate(const Trace& trace, const TraceAssignment& assignment,
                                partition::SimulationEngine engine,
                                const partition::SimulatedPlatform& platform, bool lower);
+
+/// What a simulation of a trace file predicts and how it reports.
+struct SimulateCommand {
+  std::string trace;       ///< the .tgt file
+  std::string assignment;  ///< the .tga file
+  partition::SimulationEngine engine = partition::SimulationEngine::builtin;
+  std::string platform;  ///< a SimGrid platform file (simgrid engine only), or empty
+  std::string cluster;   ///< an N x C cluster as "NxC" (partition::parse_cluster), or empty
+  partition::IntraNodeTransfer intra_node = partition::IntraNodeTransfer::reader;
+  partition::NamedOptions model;  ///< the cost model (model, calibration)
+  bool lower = false;             ///< simulate the lowered graph (simulate)
+  partition::SerialWork serial;   ///< the main thread's work per step (builtin engine only)
+  bool json = false;              ///< report as one JSON line (else text)
+};
+
+/// Reads the files, simulates every step (simulate) and returns the report, ready to print:
+/// prediction_json and a newline, or prediction_text. OptionError for a platform file with
+/// the builtin engine or serial work with another; InputError for the files.
+std::string simulate_command(const SimulateCommand& command);
 
 }  // namespace tgraph::measure

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -30,14 +31,17 @@ void write_assignment(const std::string& path, const TraceAssignment& a,
 TraceAssignment read_assignment(const std::string& path,
                                 std::vector<std::uint64_t>* hashes = nullptr);
 
-/// Writes the assignment of `trace`'s steps with their structural hashes (what `tgraph
-/// partition -o` writes), so that load_assignment can tell a file made for another trace.
+/// Writes the assignment of `trace`'s steps with their structural hashes (what partition_file
+/// writes), so that load_assignment can tell a file made for another trace.
 void write_assignment(const std::string& path, const TraceAssignment& a, const Trace& trace);
 /// Reads the .tga file `path` and checks that it fits `trace` (named `trace_name` in
 /// errors): check_fits (step and task counts, processors, orders) and, where the file stored
 /// one, each step's structural hash. Throws InputError naming `path`.
 TraceAssignment load_assignment(const std::string& path, const Trace& trace,
                                 const std::string& trace_name);
+/// load_assignment, or nullopt when `path` is empty (no assignment given).
+std::optional<TraceAssignment> load_assignment_if(const std::string& path, const Trace& trace,
+                                                  const std::string& trace_name);
 
 /// What load_or_partition computed, when it partitioned (TracePartition's notes).
 struct PartitionNotes {

@@ -33,9 +33,9 @@ PartitionSummary summarize(const std::vector<Stats>& stats);
 TracePartition partition_file(const std::string& trace_path, const std::string& method,
                               std::uint32_t k, const Options& options, const std::string& output);
 
-/// The JSON of `tgraph partition`: method, k, the summary, `output` and one object per step.
+/// The JSON of a trace's partition: method, k, the summary, `output` and one object per step.
 std::string partition_json(const TracePartition& tp, const std::string& output);
-/// `tgraph partition`'s text: method, K, time, edgecut, moves (sticky: reused, fallback,
+/// A trace's partition as text: method, K, time, edgecut, moves (sticky: reused, fallback,
 /// rebalanced steps), and the file written when `output` is not empty.
 std::string partition_text(const TracePartition& tp, const std::string& output);
 
@@ -88,14 +88,21 @@ Comparison compare(const Trace& trace, const std::vector<std::string>& methods,
                    const std::vector<std::uint32_t>& ks, const Options& options = {},
                    const std::vector<double>& sticky_migration_costs = {});
 
+/// compare of the trace file `trace` with the same arguments, its comparison_csv written to
+/// `csv` unless empty: comparison_json and a newline when `json`, else comparison_table.
+std::string compare_file(const std::string& trace, const std::vector<std::string>& methods,
+                         const std::vector<std::uint32_t>& ks, const Options& options,
+                         const std::vector<double>& sticky_migration_costs,
+                         const std::string& csv, bool json);
+
 /// The row's name in tables: the method, or "sticky@COST" for a sweep row.
 std::string row_label(const CompareRow& row);
 
-/// The JSON of `tgraph compare`: {"trace", "model", "rows": [...], "sticky_moves": [...]}.
+/// The comparison's JSON: {"trace", "model", "rows": [...], "sticky_moves": [...]}.
 std::string comparison_json(const Comparison& c, const std::string& trace_name);
-/// The CSV of `tgraph compare`: one header line, one line per row.
+/// The comparison's CSV: one header line, one line per row.
 std::string comparison_csv(const Comparison& c);
-/// `tgraph compare`'s text table, followed by sticky's step kinds and moves per K and the
+/// The comparison's text table, followed by sticky's step kinds and moves per K and the
 /// Pareto points of each K.
 std::string comparison_table(const Comparison& c);
 

@@ -82,8 +82,8 @@ struct CostModel {
 /// Default calibration file: $XDG_CONFIG_HOME/tgraph/calibration.json, else
 /// ~/.config/tgraph/calibration.json.
 std::string default_calibration_path();
-/// Reads a calibration file written by `tgraph calibrate`; throws InputError naming the
-/// file for unreadable or malformed content.
+/// Reads a calibration file (save_calibration's); throws InputError naming the file for
+/// unreadable or malformed content.
 CostModel load_calibration(const std::string& path);
 /// Parses a calibration file's text (at most 1 MiB, JSON nested at most 64 deep); `name`
 /// names it in errors.
@@ -93,8 +93,8 @@ CostModel parse_calibration(std::string_view text, const std::string& name);
 CostModel select_cost_model(const std::string& model, const std::string& calibration);
 
 /// The main thread's serial work per step that a live run measured: per_step[].record_ns +
-/// partition_ns + prepare_ns of the JSON output of `tgraph run` (recording, the wait for
-/// partitioning, plan preparation). Throws InputError naming the file.
+/// partition_ns + prepare_ns of a live run's JSON report (measure's to_json of a scene run:
+/// recording, the wait for partitioning, plan preparation). Throws InputError naming the file.
 std::vector<std::uint64_t> load_serial_work(const std::string& path);
 /// The serial work of each of a trace's `steps` steps: `serial_ns` for every step when
 /// given, else the first `steps` of load_serial_work(live) (an OptionError of the field
@@ -102,7 +102,16 @@ std::vector<std::uint64_t> load_serial_work(const std::string& path);
 std::vector<std::uint64_t> serial_work(const std::string& live,
                                        std::optional<std::uint64_t> serial_ns, std::size_t steps);
 
-/// What `tgraph calibrate` measured.
+/// The main thread's serial work per step that a simulation charges instead of the trace's
+/// host time: a live run's measure (`live`) or the same for every step (`serial_ns`).
+struct SerialWork {
+  std::string live;                        ///< a live run's JSON report (load_serial_work)
+  std::optional<std::uint64_t> serial_ns;  ///< ns before every step's tasks
+  /// serial_work(live, serial_ns, steps): per step of a `steps`-step trace; empty for neither.
+  std::vector<std::uint64_t> per_step(std::size_t steps) const;
+};
+
+/// What measure_calibration measured.
 struct Calibration {
   double sync_latency_ns = 0;   ///< median one-way handoff by spinning on an atomic
   double per_byte_ns = 0;       ///< extra cost per byte of reading data written on the other core
@@ -149,7 +158,9 @@ std::string calibration_json(const Calibration& c);
 /// Writes calibration_json(c) to `path` atomically (default_calibration_path() when empty),
 /// creating its folder; returns the path written.
 std::string save_calibration(const Calibration& c, const std::string& path = "");
-/// `tgraph calibrate`'s report of a saved calibration: one JSON object, or two lines.
+/// The report of a saved calibration: one JSON object, or two lines.
 std::string calibration_report(const Calibration& c, const std::string& path, bool json);
+/// measure_calibration(options), saved to `path` (save_calibration): its report.
+std::string calibrate_file(const CalibrateOptions& options, const std::string& path, bool json);
 
 }  // namespace tgraph::partition

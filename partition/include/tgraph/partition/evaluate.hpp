@@ -58,11 +58,17 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
                 const std::string& a_name = "<assignment>",
                 const std::vector<std::uint64_t>* serial_ns = nullptr);
 
-/// The JSON of `tgraph evaluate`: the totals' keys, method, k, model, steps, imbalance_max,
+/// The evaluation of the assignment file `assignment` of the trace file `trace` under `model`,
+/// charging `serial`'s work per step (none: the trace's host time): report_json and a newline
+/// when `json`, else report_text. InputError for the files, OptionError for `serial`.
+std::string evaluate_files(const std::string& trace, const std::string& assignment,
+                           const CostModel& model, const SerialWork& serial, bool json);
+
+/// The JSON of an evaluation: the totals' keys, method, k, model, steps, imbalance_max,
 /// cyclic_steps, predicted_speedup_with_partitioning and (when `per_step`) one object per step.
 std::string report_json(const Report& report, bool per_step = true);
 
-/// `tgraph evaluate`'s text: method, k, cut, synchronisation, balance, migrations, predicted
+/// An evaluation's text: method, k, cut, synchronisation, balance, migrations, predicted
 /// makespan and the quotient graph, five lines.
 std::string report_text(const Report& report);
 

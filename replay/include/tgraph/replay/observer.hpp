@@ -130,7 +130,7 @@ class TimelineObserver : public Observer {
   /// What was recorded so far: every task instance (its kind named from the step it ran in),
   /// step by step, sorted by start time within a step, and every blocking wait.
   /// timeline_json() writes it; viz draws it and converts it to Chrome / Perfetto trace
-  /// events (`tgraph replay --timeline`, `--chrome`).
+  /// events (what a replay writes when asked for its timeline).
   const Timeline& timeline() const { return timeline_; }
   /// Keeps at most this many steps (older steps are not recorded); default unlimited.
   void set_max_steps(std::uint32_t n) { max_steps_ = n; }

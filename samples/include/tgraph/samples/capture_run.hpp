@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Driving the engine for `tgraph capture`: a scene stepped N times through a Recorder, every
-// step streamed to a .tgt trace, with per-step figures; and the trace header of a scene.
+// Driving the engine for a capture: a scene stepped N times through a Recorder, every step
+// streamed to a .tgt trace, with per-step figures; and the trace header of a scene.
 #pragma once
 
 #include <cstdint>
@@ -10,12 +10,13 @@
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::samples {
 
-/// What to capture (the flags of `tgraph capture`).
+/// What to capture (the capture verb binds its flags to these fields).
 struct CaptureOptions {
   std::string scene;           ///< built-in scene name or scene file
   std::optional<int> steps;    ///< default: the scene's
@@ -25,7 +26,8 @@ struct CaptureOptions {
   bool progress = false;       ///< a progress line on stderr
   /// Timed passes of every task body, median kept (Recorder::set_cost_passes; 1: one run).
   std::uint32_t cost_passes = 1;
-  /// Called with each of the scene's warnings (unstable dt...) before the first step.
+  /// Called with each of the scene's warnings (unstable dt...) before the first step; a
+  /// warning names the options' fields as `{field}` (name_fields writes them in one's words).
   std::function<void(const std::string&)> warn;
 };
 
@@ -48,10 +50,11 @@ struct CaptureRun {
 };
 
 /// The work of a capture failed (a diverging simulation, a failed write, API misuse): the
-/// message says what and where the complete steps before it are (exit status 1).
-class CaptureFailure : public std::runtime_error {
+/// message says what and where the complete steps before it are, readable with
+/// ReadOptions::recover, which it names as the field `{recover}` (exit status 1).
+class CaptureFailure : public ErrorWithFields {
  public:
-  using std::runtime_error::runtime_error;
+  using ErrorWithFields::ErrorWithFields;
 };
 
 /// Runs the capture. Bad options or scene: tgraph::Error; failure of the run: CaptureFailure
@@ -60,9 +63,9 @@ class CaptureFailure : public std::runtime_error {
 ///   CaptureRun r = capture_scene({.scene = "bars64", .steps = 20, .output = "b.tgt"});
 CaptureRun capture_scene(const CaptureOptions& options);
 
-/// The JSON of `tgraph capture`: one object.
+/// The JSON of a capture: one object.
 std::string capture_json(const CaptureRun& run, const CaptureOptions& options);
-/// `tgraph capture`'s line.
+/// A capture's one-line text report.
 std::string capture_text(const CaptureRun& run, const CaptureOptions& options);
 
 /// Header of a trace captured from `scene` (engine, integrator, dt, seed, this machine).

@@ -27,7 +27,7 @@ enum class Collapse : std::uint8_t {
 };
 /// "none", "object", "kind", "processor" or "loop".
 std::string_view to_string(Collapse c);
-/// Parses a --collapse value; throws UsageError naming the flag otherwise.
+/// Inverse of to_string; an OptionError of the field `collapse` for another name.
 Collapse parse_collapse(std::string_view s);
 
 /// What a node stands for.
@@ -36,8 +36,8 @@ enum class NodeKind : std::uint8_t {
   kSignal = 1,   ///< a writer's signal to other processors
   kWait = 2,     ///< a processor waiting for a datum written elsewhere
   kReducer = 3,  ///< sums the per-processor temporaries of a CW group that spans processors
-  kGroup = 4,    ///< an aggregate (--collapse)
-  kDatum = 5     ///< a datum joining many sources to many targets (--collapse)
+  kGroup = 4,    ///< an aggregate (ViewOptions::collapse)
+  kDatum = 5     ///< a datum joining many sources to many targets (collapsed views)
 };
 /// "task", "signal", "wait", "reducer", "group" or "datum".
 std::string_view to_string(NodeKind k);

@@ -14,7 +14,8 @@ namespace tgraph::viz {
 enum class GraphFormat : std::uint8_t { kDot = 0, kSvg = 1, kPng = 2, kPdf = 3 };
 /// "dot", "svg", "png" or "pdf".
 std::string_view to_string(GraphFormat f);
-/// Format from a file name's extension; throws UsageError naming the file otherwise.
+/// Format from a file name's extension; throws UsageError naming the file (the field
+/// `output`) otherwise.
 GraphFormat graph_format_of(const std::string& path);
 
 /// The picture as DOT text, without layout (what golden tests compare).
@@ -23,5 +24,12 @@ std::string to_dot(const GraphView& view);
 /// thread-safe: calls are serialised by a lock. Throws std::runtime_error when Graphviz
 /// fails (for instance a missing cairo plugin for png and pdf).
 std::string render_graph(const GraphView& view, GraphFormat format);
+
+/// Step `step` of `trace` (named `trace_name`; trace_step_view) drawn into `output` in the
+/// format of its extension (graph_format_of), atomically. Returns hidden_deps_note when a
+/// collapsed view leaves dependencies out, else "".
+std::string draw_step(const Trace& trace, const std::string& trace_name, std::size_t step,
+                      const TraceAssignment* assignment, const ViewOptions& options,
+                      const std::string& output);
 
 }  // namespace tgraph::viz

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -76,20 +77,31 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
 /// of step `c.graph_step`), beside the step graph; `method` names the assignment.
 void set_quotient(ReportContent& c, const QuotientGraph& q, const std::string& method);
 
-/// Adds the rows (and per-step series) of `tgraph compare --json` text; throws InputError
-/// naming `name` when the text is not such a comparison.
+/// Adds the rows (and per-step series) of a comparison's JSON text (partition's
+/// comparison_json); throws InputError naming `name` when the text is not such a comparison.
 void add_compare_json(ReportContent& c, std::string_view json, const std::string& name);
-/// Adds a `--replay` file: a timeline (tgraph replay --timeline; the first one is drawn) or
-/// a measurement (tgraph replay --json, one measured row). Throws InputError otherwise.
+/// Adds a replay file: a timeline (timeline_json; the first one is drawn) or a measurement
+/// (a replay's JSON report, one measured row). Throws InputError otherwise.
 void add_replay_json(ReportContent& c, std::string_view json, const std::string& name);
 
-/// `tgraph report`: report_content of step `step` (step 0 when the trace has no such step),
+/// A report of files: report_content of step `step` (step 0 when the trace has no such step),
 /// coloured by that step of `assignment` (nullptr: none), then the comparison file
 /// `compare_path` (empty: none) and each replay file (add_compare_json, add_replay_json).
 ReportContent report_from_files(const Trace& trace, const std::string& trace_name,
                                 const TraceAssignment* assignment, std::size_t step,
                                 const std::string& compare_path,
                                 const std::vector<std::string>& replay_paths);
+
+/// A step's quotient graph under its assignment, from a front end (partition::step_quotient,
+/// whose signal counts come from the partition module's simulator, which viz does not link).
+using StepQuotient = std::function<QuotientGraph(const StepGraph&, const Assignment&)>;
+
+/// report_from_files, with `quotient` of the step graph's assignment beside the step graph
+/// (set_quotient) when both are drawn, written to `output` as report_html, atomically.
+void write_report(const Trace& trace, const std::string& trace_name,
+                  const TraceAssignment* assignment, std::size_t step,
+                  const std::string& compare_path, const std::vector<std::string>& replay_paths,
+                  const StepQuotient& quotient, const std::string& output);
 
 /// The page. Charts are Vega-Lite specifications rendered as SVG by the inlined libraries; a
 /// chart that fails to render shows its error in place and on the console.

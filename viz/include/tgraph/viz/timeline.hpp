@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Replay timelines (tgraph::Timeline, `tgraph replay --timeline R.json`): drawing them as a
-// Gantt chart with cairo (SVG, PNG), and converting them to Chrome / Perfetto trace events.
+// Replay timelines (tgraph::Timeline, which replay's TimelineObserver records): drawing them as
+// a Gantt chart with cairo (SVG, PNG), and converting them to Chrome / Perfetto trace events.
 #pragma once
 
 #include <cstdint>
@@ -24,16 +24,22 @@ std::optional<std::pair<std::uint32_t, std::uint32_t>> parse_step_range(std::str
 enum class TimelineFormat : std::uint8_t { kSvg = 0, kPng = 1 };
 /// "svg" or "png".
 std::string_view to_string(TimelineFormat f);
-/// Format from a file name's extension; throws UsageError naming the file otherwise.
+/// Format from a file name's extension; throws UsageError naming the file (the field
+/// `output`) otherwise.
 TimelineFormat timeline_format_of(const std::string& path);
 
 /// The Gantt chart: one row per thread, tasks coloured by kind (legend of the kinds ranked
 /// by time), waits hatched grey, step boundaries as solid lines, the start of each loop
 /// iteration as dotted lines, axis in ms. `title` is drawn above the chart.
 std::string render_timeline(const Timeline& t, TimelineFormat format, const std::string& title);
-/// `tgraph timeline`'s title for `t` read from `path`: "<file name>: T threads, N task
-/// instances, W blocking waits".
+/// The chart's title for `t` read from `path`: "<file name>: T threads, N task instances, W
+/// blocking waits".
 std::string timeline_title(const Timeline& t, const std::string& path);
+/// The timeline file `input` (read_timeline), its steps `steps` ("a:b", "a:", ":b" or "a";
+/// empty: all), drawn with its timeline_title into `output` in the format of its extension,
+/// atomically. UsageError naming the field `steps` for a malformed range; select_steps'
+/// OptionError for a range without tasks.
+void draw_timeline(const std::string& input, const std::string& steps, const std::string& output);
 
 /// A cross-thread dependency in a timeline: `to` (a wait) was released when `from` (a task
 /// instance on another thread) ended.
