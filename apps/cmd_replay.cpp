@@ -39,12 +39,9 @@ void add_exec_flags(CLI::App* cmd, tr::ExecOptions& exec, bool& json) {
   };
   cmd->add_option_function<std::string>("--barrier-rule", rule, "omp-for, level or operation");
   cmd->add_option_function<std::string>("--openmp-runtime", tr::use_openmp_runtime, "gnu or llvm");
-  auto scope = [&exec](const std::string& s) {
-    exec.reduce_scope = s == "per-thread" ? tr::ReduceScope::kPerThread : tr::ReduceScope::kPerWriter;
-  };
-  cmd->add_option_function<std::string>("--reduce-scope", scope,
-                                        "Dynamic policies' CW temporaries: per-writer or per-thread")
-      ->check(CLI::IsMember({"per-writer", "per-thread"}));
+  add_enum(cmd, "--reduce-scope", exec.reduce_scope,
+           {tr::ReduceScope::kPerWriter, tr::ReduceScope::kPerThread},
+           "Dynamic policies' CW temporaries: per-writer or per-thread");
   cmd->add_option("--omp-wait", exec.omp_tasks.wait_depend, "omp-tasks: all or depend")
       ->transform(CLI::CheckedTransformer(Words{{"all", false}, {"depend", true}}));
   cmd->add_option("--starpu-sched", exec.starpu.sched, "StarPU's scheduler (default lws)");
