@@ -131,6 +131,9 @@ void add_partition_verbs(CLI::App& app) {
                   "Output file (default " + tp::default_calibration_path() + ")");
   cmd->add_option("--rounds", cal->rounds, "Ping-pong round trips (default 20000)")
       ->check(CLI::Range(500, 10000000));
+  cmd->add_option("--samples", cal->samples,
+                  "Times each figure is measured, interleaved; medians kept (default 15)")
+      ->check(CLI::Range(1, 1000));
   cmd->callback([a, cal] { std::cout << tp::calibrate_file(*cal, a->output, a->json); });
 }
 

@@ -312,6 +312,12 @@ std::vector<std::size_t> thread_counts(std::size_t n) {
 
 }  // namespace
 
+Spread spread_of(std::vector<double> v) {
+  if (v.empty()) return {};
+  std::sort(v.begin(), v.end());
+  return {v.front(), v[v.size() / 2], v.back()};
+}
+
 Calibration measure_calibration(const CalibrateOptions& options) {
   const auto start = Clock::now();
   const std::vector<int> cpus = allowed_cpus();
@@ -323,25 +329,56 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   c.cpu_b = cpus[1];
   c.rounds = std::max(options.rounds, 500);
   c.buffer_bytes = options.buffer_bytes;
-  c.sync_latency_ns = measure_latency(c.cpu_a, c.cpu_b, c.rounds);
-  c.per_byte_ns = measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1));
   c.park_rounds = std::max(options.park_rounds, 20);
-  c.park_wake_ns = measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds);
-  // Inflation: in each round one thread alone, then K at once (the same body, one round
-  // each), so that a machine whose speed drifts moves both alike; the median of the rounds'
-  // ratios. A pass over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
   c.inflation_bytes = options.inflation_bytes;
+  c.samples = std::max(options.samples, 1);
+  // Every measurement is taken `samples` times, the samples interleaved (a sample of each,
+  // then the next), so that a machine whose speed drifts (a shared VM whose vCPUs the
+  // hypervisor moves) spreads each measurement alike; each value is the samples' median and
+  // its spread (min, median, max) is reported beside it.
+  const std::vector<std::size_t> ks = thread_counts(cpus.size());
+  std::vector<double> latency, per_byte, park;
+  std::vector<std::vector<double>> inflation(ks.size()), reduction(ks.size());
   const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
-  for (std::size_t k : thread_counts(cpus.size())) {
-    std::vector<double> ratio;
-    for (int r = 0; k > 1 && r < rounds; ++r) {
-      const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
-      ratio.push_back(busy_pass_ns(cpus, k, c.inflation_bytes, 1, passes) / alone);
+  for (int sample = 0; sample < c.samples; ++sample) {
+    latency.push_back(measure_latency(c.cpu_a, c.cpu_b, c.rounds));
+    per_byte.push_back(
+        measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1)));
+    park.push_back(measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds));
+    // Inflation: in each round one thread alone, then K at once (the same body, one round
+    // each), so that a drift moves both alike; the median of the rounds' ratios. A pass
+    // over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
+    for (std::size_t i = 0; i < ks.size(); ++i) {
+      if (ks[i] < 2) continue;
+      std::vector<double> ratio;
+      for (int r = 0; r < rounds; ++r) {
+        const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
+        ratio.push_back(busy_pass_ns(cpus, ks[i], c.inflation_bytes, 1, passes) / alone);
+      }
+      inflation[i].push_back(median(ratio));
+      reduction[i].push_back(
+          reduction_round_ns(cpus, ks[i], std::max(options.reduction_rounds, 100)));
     }
-    c.inflation.push_back({static_cast<std::uint32_t>(k), k == 1 ? 1.0 : median(ratio)});
-    if (k >= 2)
-      c.reduction.push_back({static_cast<std::uint32_t>(k),
-                             reduction_round_ns(cpus, k, std::max(options.reduction_rounds, 100))});
+  }
+  c.latency_spread = spread_of(latency);
+  c.per_byte_spread = spread_of(per_byte);
+  c.park_wake_spread = spread_of(park);
+  c.sync_latency_ns = c.latency_spread.median;
+  c.per_byte_ns = c.per_byte_spread.median;
+  c.park_wake_ns = c.park_wake_spread.median;
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    const auto k = static_cast<std::uint32_t>(ks[i]);
+    if (k < 2) {
+      c.inflation.push_back({1, 1.0});
+      continue;
+    }
+    const Spread in = spread_of(inflation[i]), re = spread_of(reduction[i]);
+    c.inflation_spread.push_back({k, in.min, in.median, in.max});
+    c.reduction_spread.push_back({k, re.min, re.median, re.max});
+    // K copies of the body cannot each run faster than one alone on the same cores: a median
+    // below 1 is the machine's noise (its spread says how much), and the factor is 1.
+    c.inflation.push_back({k, std::max(1.0, c.inflation_spread.back().median)});
+    c.reduction.push_back({k, c.reduction_spread.back().median});
   }
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return c;

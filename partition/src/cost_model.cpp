@@ -211,6 +211,23 @@ std::string calibration_json(const Calibration& c) {
   j["inflation"] = curve_json(c.inflation, "factor");
   j["inflation_bytes"] = c.inflation_bytes;
   j["reduction"] = curve_json(c.reduction, "ns");
+  // How far the samples spread: each value above is their median (the inflation's floored
+  // at 1); a model built on a figure whose spread is wide predicts no better than that.
+  auto spread = [](const Spread& s) {
+    return nlohmann::json{{"min", s.min}, {"median", s.median}, {"max", s.max}};
+  };
+  auto curve_spread = [](const std::vector<CurveSpread>& v) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const CurveSpread& p : v)
+      out.push_back({{"threads", p.threads}, {"min", p.min}, {"median", p.median}, {"max", p.max}});
+    return out;
+  };
+  j["samples"] = c.samples;
+  j["spread"] = {{"spin_handoff_ns", spread(c.latency_spread)},
+                 {"park_wake_ns", spread(c.park_wake_spread)},
+                 {"per_byte_ns", spread(c.per_byte_spread)},
+                 {"inflation", curve_spread(c.inflation_spread)},
+                 {"reduction", curve_spread(c.reduction_spread)}};
   j["cpus"] = {c.cpu_a, c.cpu_b};
   j["rounds"] = c.rounds;
   j["park_rounds"] = c.park_rounds;
@@ -251,6 +268,22 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   };
   curve_text("inflation (threads: factor):", c.inflation, " %u: %.3f");
   curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
+  // The spread of each figure over the samples, so that a reader sees how far to trust it.
+  auto range = [&](const char* what, const Spread& s, const char* fmt) {
+    char a[64], b[64];
+    std::snprintf(a, sizeof a, fmt, s.min);
+    std::snprintf(b, sizeof b, fmt, s.max);
+    return std::string(what) + " " + a + "-" + b;
+  };
+  out += "spread over " + std::to_string(c.samples) + " samples: " +
+         range("spinning", c.latency_spread, "%.1f") + " ns, " +
+         range("parked", c.park_wake_spread, "%.0f") + " ns, " +
+         range("transfer", c.per_byte_spread, "%.4f") + " ns/byte";
+  for (const CurveSpread& p : c.inflation_spread) {
+    std::snprintf(line, sizeof line, ", inflation at %u %.3f-%.3f", p.threads, p.min, p.max);
+    out += line;
+  }
+  out += "\n";
   std::snprintf(line, sizeof line, "measured in %.1f s\n", c.seconds);
   return out + line + "wrote " + path + "\n";
 }

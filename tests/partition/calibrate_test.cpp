@@ -4,6 +4,8 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include <nlohmann/json.hpp>
+
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -38,6 +40,52 @@ TEST(Calibration, OnOneCpuFailsAsTheWorkNotAsBadInput) {
   EXPECT_FALSE(input_error);
   EXPECT_TRUE(runtime_error);
   EXPECT_EQ(what, "calibrate: needs two CPUs, this process may use 1");
+}
+
+TEST(Spread, IsTheSamplesMinMedianAndMax) {
+  EXPECT_EQ(spread_of({3.0, 1.0, 2.0}), (Spread{1.0, 2.0, 3.0}));
+  EXPECT_EQ(spread_of({5.0, 1.0, 4.0, 2.0}), (Spread{1.0, 4.0, 5.0}));  // the upper median
+  EXPECT_EQ(spread_of({}), Spread{});
+}
+
+// Each figure is the median of its samples, reported with their spread; the inflation is
+// the measured median floored at 1; the file reads back with the same values.
+TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
+  CalibrateOptions o;
+  o.rounds = 500;
+  o.park_rounds = 20;
+  o.inflation_rounds = 1;
+  o.inflation_bytes = 1 << 16;
+  o.reduction_rounds = 100;
+  o.samples = 3;
+  const Calibration c = measure_calibration(o);
+  EXPECT_EQ(c.samples, 3);
+  for (const auto& [spread, value] : {std::pair{c.latency_spread, c.sync_latency_ns},
+                                      std::pair{c.park_wake_spread, c.park_wake_ns},
+                                      std::pair{c.per_byte_spread, c.per_byte_ns}}) {
+    EXPECT_EQ(spread.median, value);
+    EXPECT_LE(spread.min, spread.median);
+    EXPECT_LE(spread.median, spread.max);
+  }
+  EXPECT_GT(c.park_wake_spread.min, 0.0);
+  ASSERT_GE(c.inflation.size(), 2u);
+  ASSERT_EQ(c.inflation_spread.size(), c.inflation.size() - 1);  // K = 1 has no samples
+  ASSERT_EQ(c.reduction_spread.size(), c.reduction.size());
+  for (std::size_t i = 0; i < c.inflation_spread.size(); ++i) {
+    const CurveSpread& s = c.inflation_spread[i];
+    EXPECT_EQ(s.threads, c.inflation[i + 1].threads);
+    EXPECT_EQ(c.inflation[i + 1].value, std::max(1.0, s.median));
+    EXPECT_LE(s.min, s.median);
+    EXPECT_LE(s.median, s.max);
+    EXPECT_EQ(c.reduction[i].value, c.reduction_spread[i].median);
+  }
+  const nlohmann::json j = nlohmann::json::parse(calibration_json(c));
+  EXPECT_EQ(j["samples"], 3);
+  EXPECT_EQ(j["spread"]["park_wake_ns"]["median"].get<double>(), c.park_wake_ns);
+  EXPECT_EQ(j["spread"]["inflation"][0]["threads"], c.inflation_spread[0].threads);
+  const CostModel m = parse_calibration(calibration_json(c), "cal.json");
+  EXPECT_EQ(m.park_wake_ns, c.park_wake_ns);
+  EXPECT_EQ(m.inflation, c.inflation);
 }
 
 }  // namespace

@@ -111,6 +111,20 @@ struct SerialWork {
   std::vector<std::uint64_t> per_step(std::size_t steps) const;
 };
 
+/// How one measurement of measure_calibration spread over its samples.
+struct Spread {
+  double min = 0, median = 0, max = 0;
+  friend bool operator==(const Spread&, const Spread&) = default;
+};
+/// The same, for one point of a curve against the number of threads.
+struct CurveSpread {
+  std::uint32_t threads = 1;
+  double min = 0, median = 0, max = 0;
+  friend bool operator==(const CurveSpread&, const CurveSpread&) = default;
+};
+/// The spread (min, median, max) of `samples`; all zero for none.
+Spread spread_of(std::vector<double> samples);
+
 /// What measure_calibration measured.
 struct Calibration {
   double sync_latency_ns = 0;   ///< median one-way handoff by spinning on an atomic
@@ -132,6 +146,14 @@ struct Calibration {
   /// last sums the partials and publishes; every thread reads the result): median ns per
   /// round, for the same K as `inflation` (K >= 2).
   std::vector<ThreadsPoint> reduction;
+  /// Samples of every measurement (interleaved); each value above is their median, but the
+  /// inflation, which is at least 1 (a median below 1 is noise: K copies cannot each run
+  /// faster than one alone).
+  int samples = 0;
+  Spread latency_spread, per_byte_spread, park_wake_spread;  ///< over the samples
+  /// Over the samples, per K >= 2: the inflation as measured (before the floor at 1), the
+  /// reduction's ns.
+  std::vector<CurveSpread> inflation_spread, reduction_spread;
   double seconds = 0;  ///< wall time of the whole measurement
 };
 
@@ -147,6 +169,9 @@ struct CalibrateOptions {
   std::size_t inflation_bytes = std::size_t{2} << 20;
   int inflation_rounds = 7;           ///< rounds per thread count (median taken)
   int reduction_rounds = 2000;        ///< reductions per thread count
+  /// Times every measurement above is taken, interleaved; the medians are kept and the
+  /// spread reported (a VM's figures move by several times from one sample to the next).
+  int samples = 15;
 };
 
 /// Measures this machine with two threads pinned to two different CPUs; throws
