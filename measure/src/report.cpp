@@ -296,7 +296,10 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
          {"replay_wall_ns", r.replay_ns},
          {"predicted_ns", pred ? nlohmann::json(r.predicted_ns) : nlohmann::json(nullptr)},
          {"host_ns", r.host_ns},
-         {"serial_ns", r.serial_ns}});
+         {"serial_ns", r.serial_ns},
+         {"replay_sequential_ns", r.replay_sequential_ns},
+         {"predicted_sequential_ns",
+          pred ? nlohmann::json(r.predicted_sequential_ns) : nlohmann::json(nullptr)}});
   nlohmann::json j = {
       {"scene", o.scene},
       {"policy", std::string(to_string(v.choice.policy))},
@@ -306,14 +309,18 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
       {"rounds", rounds},
       {"live_wall_ns", v.live_ns},
       {"engine_wall_ns", v.engine_ns},
-      {"live_speedup",
-       v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns) : 0.0},
+      {"live_speedup", v.live_speedup},
       {"replay_wall_ns", v.replay_ns},
-      {"replay_over_live", v.replay_over_live}};
+      {"replay_over_live", v.replay_over_live},
+      {"replay_speedup", v.replay_speedup},
+      {"replay_speedup_over_live", v.replay_speedup_over_live}};
   j["predicted_ns"] = pred ? nlohmann::json(v.predicted_ns) : nlohmann::json(nullptr);
   j["predicted_over_live"] = pred ? nlohmann::json(v.predicted_over_live) : nlohmann::json(nullptr);
   j["predicted_over_replay"] =
       pred ? nlohmann::json(v.predicted_over_replay) : nlohmann::json(nullptr);
+  j["predicted_speedup"] = pred ? nlohmann::json(v.predicted_speedup) : nlohmann::json(nullptr);
+  j["predicted_speedup_over_live"] =
+      pred ? nlohmann::json(v.predicted_speedup_over_live) : nlohmann::json(nullptr);
   j["model"] = v.model;
   j["model_terms"] = v.model_terms;
   j["rounds_with_live_assignments"] = v.rounds_with_live_assignments;
@@ -333,16 +340,19 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
       line, sizeof line,
       "  live run        %10.3f ms   (uninstrumented engine %.3f ms, speed-up %.2f)\n",
       static_cast<double>(v.live_ns) / 1e6, static_cast<double>(v.engine_ns) / 1e6,
-      v.live_ns > 0 ? static_cast<double>(v.engine_ns) / static_cast<double>(v.live_ns) : 0.0);
+      v.live_speedup);
   out += line;
-  std::snprintf(line, sizeof line, "  replay          %10.3f ms   replay / live %.3f\n",
-                static_cast<double>(v.replay_ns) / 1e6, v.replay_over_live);
+  std::snprintf(line, sizeof line,
+                "  replay          %10.3f ms   replay / live %.3f; speed-up %.2f, / live's %.3f\n",
+                static_cast<double>(v.replay_ns) / 1e6, v.replay_over_live, v.replay_speedup,
+                v.replay_speedup_over_live);
   out += line;
   if (v.predicted_ns != 0) {
     std::snprintf(line, sizeof line,
-                  "  simulator       %10.3f ms   simulator / live %.3f, simulator / replay %.3f\n",
+                  "  simulator       %10.3f ms   simulator / live %.3f, simulator / replay %.3f; "
+                  "speed-up %.2f, / live's %.3f\n",
                   static_cast<double>(v.predicted_ns) / 1e6, v.predicted_over_live,
-                  v.predicted_over_replay);
+                  v.predicted_over_replay, v.predicted_speedup, v.predicted_speedup_over_live);
     out += line;
     std::string terms;
     for (const std::string& t : v.model_terms) terms += (terms.empty() ? "" : ", ") + t;

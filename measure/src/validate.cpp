@@ -92,14 +92,23 @@ Validation validate(const ValidateOptions& o) {
     ro.exec.threads = v.threads;
     ro.repeat = 1;
     ro.observe = false;
-    ro.sequential_baseline = false;
-    r.replay_ns = replay_trace(trace, assignment ? &*assignment : nullptr, ro).wall_ns;
+    ro.sequential_baseline = v.choice.policy != replay::Policy::kSequential;
+    const ReplayResult replayed = replay_trace(trace, assignment ? &*assignment : nullptr, ro);
+    r.replay_ns = replayed.wall_ns;
+    r.replay_sequential_ns = ro.sequential_baseline ? replayed.sequential_wall_ns : replayed.wall_ns;
 
     // 3. The simulator's makespan of the same partition (partition policy only).
-    if (assignment)
+    if (assignment) {
       for (std::uint64_t ns : partition::predicted_makespans(trace, *assignment, model,
                                                              o.live_serial ? &serial : nullptr))
         r.predicted_ns += ns;
+      TraceAssignment one{"single", 1, {}, {}};
+      for (const StepGraph& g : trace.steps)
+        one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
+      for (std::uint64_t ns : partition::predicted_makespans(trace, one, model,
+                                                             o.live_serial ? &serial : nullptr))
+        r.predicted_sequential_ns += ns;
+    }
     if (round == 0) {
       bool host = false;
       for (const StepGraph& g : trace.steps) host = host || g.host_ns > 0;
@@ -108,7 +117,7 @@ Validation validate(const ValidateOptions& o) {
     v.rounds.push_back(r);
   }
 
-  std::vector<double> live, engine, rep, pred, rl, pl, pr;
+  std::vector<double> live, engine, rep, pred, rl, pl, pr, live_su, rep_su, pred_su, rsl, psl;
   for (const ValidationRound& r : v.rounds) {
     const double l = static_cast<double>(r.live_ns), x = static_cast<double>(r.replay_ns),
                  p = static_cast<double>(r.predicted_ns);
@@ -119,6 +128,20 @@ Validation validate(const ValidateOptions& o) {
     rl.push_back(x / l);
     pl.push_back(p / l);
     pr.push_back(p / x);
+    live_su.push_back(static_cast<double>(r.engine_ns) / l);
+    rep_su.push_back(static_cast<double>(r.replay_sequential_ns) / x);
+    rsl.push_back(rep_su.back() / live_su.back());
+    if (partition) {
+      pred_su.push_back(static_cast<double>(r.predicted_sequential_ns) / p);
+      psl.push_back(pred_su.back() / live_su.back());
+    }
+  }
+  v.live_speedup = median(live_su);
+  v.replay_speedup = median(rep_su);
+  v.replay_speedup_over_live = median(rsl);
+  if (partition) {
+    v.predicted_speedup = median(pred_su);
+    v.predicted_speedup_over_live = median(psl);
   }
   v.live_ns = static_cast<std::int64_t>(median(live));
   v.engine_ns = static_cast<std::int64_t>(median(engine));

@@ -37,7 +37,8 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   const ValidateOptions o = falling("metis", 2, 3);
   const Validation v = validate(o);
   ASSERT_EQ(v.rounds.size(), 3u);
-  std::vector<double> live, replay_over_live, predicted_over_live;
+  std::vector<double> live, replay_over_live, predicted_over_live, predicted_speedup_over_live,
+      replay_speedup_over_live;
   for (const ValidationRound& r : v.rounds) {
     EXPECT_GT(r.live_ns, 0);
     EXPECT_GT(r.engine_ns, 0);
@@ -51,7 +52,20 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
     replay_over_live.push_back(static_cast<double>(r.replay_ns) / static_cast<double>(r.live_ns));
     predicted_over_live.push_back(static_cast<double>(r.predicted_ns) /
                                   static_cast<double>(r.live_ns));
+    // Each model's speed-up is over its own sequential time of the same round: the
+    // simulator's on one processor is the capture's work plus the same serial work, at
+    // least its makespan on two; the replay's is a sequential pass.
+    EXPECT_GE(r.predicted_sequential_ns, r.predicted_ns);
+    EXPECT_GT(r.replay_sequential_ns, 0);
+    const double live_speedup = static_cast<double>(r.engine_ns) / static_cast<double>(r.live_ns);
+    predicted_speedup_over_live.push_back(static_cast<double>(r.predicted_sequential_ns) /
+                                          static_cast<double>(r.predicted_ns) / live_speedup);
+    replay_speedup_over_live.push_back(static_cast<double>(r.replay_sequential_ns) /
+                                       static_cast<double>(r.replay_ns) / live_speedup);
   }
+  EXPECT_DOUBLE_EQ(v.predicted_speedup_over_live, median(predicted_speedup_over_live));
+  EXPECT_DOUBLE_EQ(v.replay_speedup_over_live, median(replay_speedup_over_live));
+  EXPECT_GE(v.predicted_speedup, 1.0);
   EXPECT_EQ(v.live_ns, static_cast<std::int64_t>(median(live)));
   EXPECT_DOUBLE_EQ(v.replay_over_live, median(replay_over_live));
   EXPECT_DOUBLE_EQ(v.predicted_over_live, median(predicted_over_live));
@@ -62,6 +76,11 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   EXPECT_EQ(j.at("method"), "metis");
   EXPECT_EQ(j.at("threads"), 2);
   EXPECT_DOUBLE_EQ(j.at("replay_over_live").get<double>(), v.replay_over_live);
+  EXPECT_DOUBLE_EQ(j.at("predicted_speedup_over_live").get<double>(),
+                   v.predicted_speedup_over_live);
+  EXPECT_DOUBLE_EQ(j.at("replay_speedup").get<double>(), v.replay_speedup);
+  EXPECT_EQ(j.at("rounds")[2].at("predicted_sequential_ns").get<std::uint64_t>(),
+            v.rounds[2].predicted_sequential_ns);
   // The capture records the live run's steps, so every round replays and simulates the
   // assignments the live run used.
   EXPECT_EQ(v.rounds_with_live_assignments, 3u);
@@ -76,6 +95,8 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
   const auto j = nlohmann::json::parse(to_json(v, o));
   EXPECT_TRUE(j.at("predicted_ns").is_null());
   EXPECT_TRUE(j.at("predicted_over_live").is_null());
+  EXPECT_TRUE(j.at("predicted_speedup_over_live").is_null());
+  EXPECT_GT(j.at("replay_speedup_over_live").get<double>(), 0.0);
   EXPECT_GT(j.at("replay_over_live").get<double>(), 0.0);
   EXPECT_EQ(v.rounds_with_live_assignments, 0u);
 }

@@ -36,6 +36,11 @@ struct ValidationRound {
   std::uint64_t predicted_ns = 0;  ///< simulator on this round's capture (0: no partition)
   std::uint64_t host_ns = 0;       ///< the capture's host time (outside the graph)
   std::uint64_t serial_ns = 0;     ///< the live run's serial work the prediction charged
+  /// Sequential pass of the same replay, same round (its speed-up's denominator).
+  std::int64_t replay_sequential_ns = 0;
+  /// The simulator on one processor (the capture's costs and the same serial work, no
+  /// synchronisation): the predicted speed-up's denominator (0: no partition).
+  std::uint64_t predicted_sequential_ns = 0;
 };
 
 /// The three figures of one validation: medians over the rounds, and the medians of each
@@ -47,6 +52,15 @@ struct Validation {
   std::int64_t live_ns = 0, engine_ns = 0, replay_ns = 0;
   std::uint64_t predicted_ns = 0;  ///< simulator, partition policy only (0: none)
   double replay_over_live = 0, predicted_over_live = 0, predicted_over_replay = 0;
+  /// Speed-ups, each over its own sequential pass of the same round (live: the
+  /// uninstrumented engine; replay: the sequential replay; simulator: one processor), and
+  /// the medians of each round's predicted or replayed speed-up / live speed-up. Unlike the
+  /// times' ratios these do not move when the machine's pace drifts between the capture,
+  /// whose costs the two models use, and the live run (a shared VM's does by 10-20 % within
+  /// seconds: predicted / live at 1 thread, where the model is the costs' sum, spread
+  /// 0.82-1.01 over three rounds on bars64).
+  double live_speedup = 0, replay_speedup = 0, predicted_speedup = 0;
+  double replay_speedup_over_live = 0, predicted_speedup_over_live = 0;
   std::string model;                     ///< the cost model's source
   std::vector<std::string> model_terms;  ///< what the prediction charged
   /// Partition policy: the rounds whose replay and prediction ran the assignments the live
