@@ -345,21 +345,17 @@ Calibration measure_calibration(const CalibrateOptions& options) {
     per_byte.push_back(
         measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1)));
     park.push_back(measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds));
-    // Inflation: rounds of one thread alone, then K at once (the same body); the fastest
-    // round of K over the fastest alone. Another tenant's work (a shared VM) only ever slows
-    // a round, by up to twice on this project's 2-vCPU VM: the fastest rounds are the two
-    // bodies' own, and their ratio is the slow-down the cores' sharing causes (the median
-    // ratio spread 0.93-2.06 over one calibration's samples there). A pass over 2 MiB takes
-    // 0.1-0.5 ms: 20 passes keep a round within tens of ms.
+    // Inflation: in each round one thread alone, then K at once (the same body, one round
+    // each), so that a drift moves both alike; the median of the rounds' ratios. A pass
+    // over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
     for (std::size_t i = 0; i < ks.size(); ++i) {
       if (ks[i] < 2) continue;
-      std::vector<double> alone, together;
+      std::vector<double> ratio;
       for (int r = 0; r < rounds; ++r) {
-        alone.push_back(busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes));
-        together.push_back(busy_pass_ns(cpus, ks[i], c.inflation_bytes, 1, passes));
+        const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
+        ratio.push_back(busy_pass_ns(cpus, ks[i], c.inflation_bytes, 1, passes) / alone);
       }
-      inflation[i].push_back(*std::min_element(together.begin(), together.end()) /
-                             *std::min_element(alone.begin(), alone.end()));
+      inflation[i].push_back(median(ratio));
       reduction[i].push_back(
           reduction_round_ns(cpus, ks[i], std::max(options.reduction_rounds, 100)));
     }

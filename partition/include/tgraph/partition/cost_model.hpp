@@ -137,9 +137,9 @@ struct Calibration {
   double park_wake_ns = 0;
   int park_rounds = 0;  ///< parked hand-offs measured
   /// Slow-down of a memory-touching body run by K pinned threads at once against one
-  /// thread alone (per sample, over rounds of one thread alone then K at once: the fastest
-  /// round's mean time per pass of the K threads / the fastest alone; the samples' median,
-  /// at least 1), K = 1, 2, 4, ... and the CPUs this process may use.
+  /// thread alone (per sample, the median over rounds, each one thread alone then K at once,
+  /// of the K threads' mean time per pass / alone's; the samples' median, at least 1),
+  /// K = 1, 2, 4, ... and the CPUs this process may use.
   std::vector<ThreadsPoint> inflation;
   std::size_t inflation_bytes = 0;  ///< each body's working set
   /// Combine of one partial sum per thread (K threads, each arriving at a counter; the
@@ -167,7 +167,7 @@ struct CalibrateOptions {
   /// written), an engine object's vectors several times over: beyond a core's private L2
   /// on current x86, so that the copies share the last-level cache and memory.
   std::size_t inflation_bytes = std::size_t{2} << 20;
-  int inflation_rounds = 7;           ///< rounds per thread count and sample (fastest taken)
+  int inflation_rounds = 7;           ///< rounds per thread count and sample (median taken)
   int reduction_rounds = 2000;        ///< reductions per thread count
   /// Times every measurement above is taken, interleaved; the medians are kept and the
   /// spread reported (a VM's figures move by several times from one sample to the next).
