@@ -372,13 +372,12 @@ Calibration measure_calibration(const CalibrateOptions& options) {
       c.inflation.push_back({1, 1.0});
       continue;
     }
-    const Spread in = spread_of(inflation[i]), re = spread_of(reduction[i]);
-    c.inflation_spread.push_back({k, in.min, in.median, in.max});
-    c.reduction_spread.push_back({k, re.min, re.median, re.max});
+    c.inflation_spread.push_back({k, spread_of(inflation[i])});
+    c.reduction_spread.push_back({k, spread_of(reduction[i])});
     // K copies of the body cannot each run faster than one alone on the same cores: a median
     // below 1 is the machine's noise (its spread says how much), and the factor is 1.
-    c.inflation.push_back({k, std::max(1.0, c.inflation_spread.back().median)});
-    c.reduction.push_back({k, c.reduction_spread.back().median});
+    c.inflation.push_back({k, std::max(1.0, c.inflation_spread.back().spread.median)});
+    c.reduction.push_back({k, c.reduction_spread.back().spread.median});
   }
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return c;

@@ -216,10 +216,12 @@ std::string calibration_json(const Calibration& c) {
   auto spread = [](const Spread& s) {
     return nlohmann::json{{"min", s.min}, {"median", s.median}, {"max", s.max}};
   };
-  auto curve_spread = [](const std::vector<CurveSpread>& v) {
+  auto curve_spread = [&spread](const std::vector<CurveSpread>& v) {
     nlohmann::json out = nlohmann::json::array();
-    for (const CurveSpread& p : v)
-      out.push_back({{"threads", p.threads}, {"min", p.min}, {"median", p.median}, {"max", p.max}});
+    for (const CurveSpread& p : v) {
+      out.push_back(spread(p.spread));
+      out.back()["threads"] = p.threads;
+    }
     return out;
   };
   j["samples"] = c.samples;
@@ -280,7 +282,8 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
          range("parked", c.park_wake_spread, "%.0f") + " ns, " +
          range("transfer", c.per_byte_spread, "%.4f") + " ns/byte";
   for (const CurveSpread& p : c.inflation_spread) {
-    std::snprintf(line, sizeof line, ", inflation at %u %.3f-%.3f", p.threads, p.min, p.max);
+    std::snprintf(line, sizeof line, ", inflation at %u %.3f-%.3f", p.threads, p.spread.min,
+                  p.spread.max);
     out += line;
   }
   out += "\n";

@@ -72,12 +72,12 @@ TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
   ASSERT_EQ(c.inflation_spread.size(), c.inflation.size() - 1);  // K = 1 has no samples
   ASSERT_EQ(c.reduction_spread.size(), c.reduction.size());
   for (std::size_t i = 0; i < c.inflation_spread.size(); ++i) {
-    const CurveSpread& s = c.inflation_spread[i];
-    EXPECT_EQ(s.threads, c.inflation[i + 1].threads);
+    const Spread& s = c.inflation_spread[i].spread;
+    EXPECT_EQ(c.inflation_spread[i].threads, c.inflation[i + 1].threads);
     EXPECT_EQ(c.inflation[i + 1].value, std::max(1.0, s.median));
     EXPECT_LE(s.min, s.median);
     EXPECT_LE(s.median, s.max);
-    EXPECT_EQ(c.reduction[i].value, c.reduction_spread[i].median);
+    EXPECT_EQ(c.reduction[i].value, c.reduction_spread[i].spread.median);
   }
   const nlohmann::json j = nlohmann::json::parse(calibration_json(c));
   EXPECT_EQ(j["samples"], 3);

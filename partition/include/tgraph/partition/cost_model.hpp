@@ -116,10 +116,10 @@ struct Spread {
   double min = 0, median = 0, max = 0;
   friend bool operator==(const Spread&, const Spread&) = default;
 };
-/// The same, for one point of a curve against the number of threads.
+/// The spread of one point of a curve against the number of threads.
 struct CurveSpread {
   std::uint32_t threads = 1;
-  double min = 0, median = 0, max = 0;
+  Spread spread;
   friend bool operator==(const CurveSpread&, const CurveSpread&) = default;
 };
 /// The spread (min, median, max) of `samples`; all zero for none.
