@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // `tgraph partition | evaluate | compare | import | calibrate`: flags, one call into
-// tgraph::partition (or libgraph's STG reader), and its report.
+// tgraph::partition (or libgraph's STG reader; measure's calibration, which adds the
+// executor's time per task), and its report.
 #include <iostream>
 
 #include "commands.hpp"
 #include "tgraph/graph/stg.hpp"
+#include "tgraph/measure/calibrate.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
@@ -134,7 +136,7 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("--samples", cal->samples,
                   "Times each figure is measured, interleaved; medians kept (default 15)")
       ->check(CLI::Range(1, 1000));
-  cmd->callback([a, cal] { std::cout << tp::calibrate_file(*cal, a->output, a->json); });
+  cmd->callback([a, cal] { std::cout << measure::calibrate_file(*cal, a->output, a->json); });
 }
 
 }  // namespace tgraph::app

@@ -25,17 +25,31 @@ CostModel CostModel::ideal() {
   return m;
 }
 
-double CostModel::inflation_at(double busy) const {
-  if (inflation.empty() || busy <= 1.0) return 1.0;
-  // Below the first point: from (1, 1) to it; between points: linear; beyond: the last.
-  double x0 = 1.0, y0 = 1.0;
-  for (const ThreadsPoint& p : inflation) {
+namespace {
+
+// A curve's value at `x` processors: from (1, `at_one`) to its first point, linear between
+// points, beyond the last the last.
+double curve_at(const std::vector<ThreadsPoint>& curve, double x, double at_one) {
+  double x0 = 1.0, y0 = at_one;
+  for (const ThreadsPoint& p : curve) {
     const double x1 = p.threads, y1 = p.value;
-    if (busy <= x1) return x1 <= x0 ? y1 : y0 + (y1 - y0) * (busy - x0) / (x1 - x0);
+    if (x <= x1) return x1 <= x0 ? y1 : y0 + (y1 - y0) * (x - x0) / (x1 - x0);
     x0 = x1;
     y0 = y1;
   }
   return y0;
+}
+
+}  // namespace
+
+double CostModel::inflation_at(double busy) const {
+  if (inflation.empty() || busy <= 1.0) return 1.0;
+  return curve_at(inflation, busy, 1.0);
+}
+
+double CostModel::executor_overhead_at(std::uint32_t k) const {
+  if (executor_overhead.empty() || k <= 1) return 0.0;
+  return curve_at(executor_overhead, k, 0.0);
 }
 
 // Defaults: the middle of the 70-150 ns a cross-core spin handoff takes on current x86
@@ -156,6 +170,8 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   if (j.contains("spin_budget_ns")) m.spin_budget_ns = number("spin_budget_ns");
   if (j.contains("inflation")) m.inflation = curve("inflation", "factor", 0.001);
   if (j.contains("reduction")) m.reduction = curve("reduction", "ns", 0.0);
+  if (j.contains("executor_overhead"))
+    m.executor_overhead = curve("executor_overhead", "ns", 0.0);
   // Inter-node fields are optional: files written before they existed keep their meaning.
   if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
   if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
@@ -211,6 +227,8 @@ std::string calibration_json(const Calibration& c) {
   j["inflation"] = curve_json(c.inflation, "factor");
   j["inflation_bytes"] = c.inflation_bytes;
   j["reduction"] = curve_json(c.reduction, "ns");
+  if (!c.executor_overhead.empty())
+    j["executor_overhead"] = curve_json(c.executor_overhead, "ns");
   // How far the samples spread: each value above is their median (the inflation's floored
   // at 1); a model built on a figure whose spread is wide predicts no better than that.
   auto spread = [](const Spread& s) {
@@ -230,6 +248,8 @@ std::string calibration_json(const Calibration& c) {
                  {"per_byte_ns", spread(c.per_byte_spread)},
                  {"inflation", curve_spread(c.inflation_spread)},
                  {"reduction", curve_spread(c.reduction_spread)}};
+  if (!c.executor_overhead_spread.empty())
+    j["spread"]["executor_overhead"] = curve_spread(c.executor_overhead_spread);
   j["cpus"] = {c.cpu_a, c.cpu_b};
   j["rounds"] = c.rounds;
   j["park_rounds"] = c.park_rounds;
@@ -270,6 +290,8 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   };
   curve_text("inflation (threads: factor):", c.inflation, " %u: %.3f");
   curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
+  if (!c.executor_overhead.empty())
+    curve_text("executor's time per task (threads: ns):", c.executor_overhead, " %u: %.1f");
   // The spread of each figure over the samples, so that a reader sees how far to trust it.
   auto range = [&](const char* what, const Spread& s, const char* fmt) {
     char a[64], b[64];
@@ -283,6 +305,11 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
          range("transfer", c.per_byte_spread, "%.4f") + " ns/byte";
   for (const CurveSpread& p : c.inflation_spread) {
     std::snprintf(line, sizeof line, ", inflation at %u %.3f-%.3f", p.threads, p.spread.min,
+                  p.spread.max);
+    out += line;
+  }
+  for (const CurveSpread& p : c.executor_overhead_spread) {
+    std::snprintf(line, sizeof line, ", executor at %u %.1f-%.1f ns", p.threads, p.spread.min,
                   p.spread.max);
     out += line;
   }

@@ -32,7 +32,7 @@ class Simulator {
             const std::vector<double>* inflation)
       : g_(g), a_(a), k_(a.k), latency_(to_ns(m.sync_latency_ns)),
         per_byte_(m.per_byte_ns),
-        overhead_(to_ns(m.task_overhead_ns)),
+        overhead_(to_ns(m.task_overhead_ns + m.executor_overhead_at(a.k))),
         wake_(to_ns(m.park_wake_ns)),
         budget_(to_ns(m.spin_budget_ns)),
         inflation_(inflation) {
@@ -254,7 +254,8 @@ class Simulator {
   const std::uint32_t k_;
   const std::uint64_t latency_;
   const double per_byte_;
-  const std::uint64_t overhead_;  // CostModel::task_overhead_ns, per instance
+  // CostModel::task_overhead_ns and the executor's time at a.k processors, per instance
+  const std::uint64_t overhead_;
   const std::uint64_t wake_;      // CostModel::park_wake_ns (0: term off)
   const std::uint64_t budget_;    // CostModel::spin_budget_ns
   const std::vector<double>* inflation_;  // per instance, or nullptr
@@ -339,6 +340,7 @@ std::vector<std::string> model_terms(const CostModel& model, bool serial_given, 
   std::vector<std::string> terms = {"sync_latency", "per_byte"};
   if (model.source == "ideal") terms.clear();
   if (model.task_overhead_ns > 0) terms.push_back("task_overhead");
+  if (!model.executor_overhead.empty()) terms.push_back("executor_overhead");
   if (model.park_wake_ns > 0) terms.push_back("park_wake");
   if (!model.inflation.empty()) terms.push_back("inflation");
   if (serial_given) {

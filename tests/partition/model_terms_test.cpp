@@ -101,6 +101,30 @@ TEST(ModelTerms, InflationCurveInterpolatesAndHoldsItsLastPoint) {
   EXPECT_DOUBLE_EQ(m.inflation_at(1.5), 1.25);
 }
 
+TEST(ModelTerms, TheExecutorsTimePerTaskIsChargedAtItsProcessorCountOnly) {
+  CostModel m = model(10);
+  m.executor_overhead = {{2, 40}, {4, 100}};
+  // Two processors: each instance takes its cost plus 40 ns.
+  const Schedule two = simulate(two_independent(), assign(2, {0, 1}), m);
+  EXPECT_EQ(two.end_ns, (std::vector<std::uint64_t>{1040, 1040}));
+  // The same tasks on one processor of a 2-processor assignment: still that executor.
+  EXPECT_EQ(simulate(two_independent(), assign(2, {0, 0}), m).makespan_ns, 2080u);
+  // One processor: the sequential engine, no executor.
+  EXPECT_EQ(simulate(two_independent(), assign(1, {0, 0}), m).makespan_ns, 2000u);
+  // Four: 100 ns each, on top of the runtime's own task_overhead_ns.
+  m.task_overhead_ns = 5;
+  EXPECT_EQ(simulate(two_independent(), assign(4, {0, 1}), m).makespan_ns, 1105u);
+  // The curve: 0 at one thread, linear from there to its first point and between points,
+  // its last beyond it.
+  EXPECT_DOUBLE_EQ(m.executor_overhead_at(1), 0.0);
+  EXPECT_DOUBLE_EQ(m.executor_overhead_at(3), 70.0);
+  EXPECT_DOUBLE_EQ(m.executor_overhead_at(16), 100.0);
+  m.executor_overhead = {{4, 90}};
+  EXPECT_DOUBLE_EQ(m.executor_overhead_at(2), 30.0);
+  m.executor_overhead.clear();
+  EXPECT_DOUBLE_EQ(m.executor_overhead_at(8), 0.0);
+}
+
 TEST(ModelTerms, GivenSerialWorkRunsBeforeTheTasksAndWakesTheOthers) {
   CostModel m = model(10);
   m.spin_budget_ns = 200;
@@ -126,9 +150,11 @@ TEST(ModelTerms, NamesTheTermsAPredictionCharges) {
   m.park_wake_ns = 5000;
   m.inflation = {{1, 1.0}, {2, 1.1}};
   m.task_overhead_ns = 3;
+  m.executor_overhead = {{2, 150}};
   EXPECT_EQ(model_terms(m, true, true),
-            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead", "park_wake",
-                                      "inflation", "serial_main_thread"}));
+            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead",
+                                      "executor_overhead", "park_wake", "inflation",
+                                      "serial_main_thread"}));
   EXPECT_EQ(model_terms(CostModel::ideal(), false, true), (std::vector<std::string>{"host_time"}));
 }
 
@@ -151,24 +177,36 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
   c.park_wake_ns = 6500;
   c.inflation = {{1, 1.0}, {2, 1.08}};
   c.reduction = {{2, 180}};
+  c.executor_overhead = {{2, 150.5}};
+  c.executor_overhead_spread = {{2, {120, 150.5, 230}}};
   const std::string text = calibration_json(c);
   const nlohmann::json j = nlohmann::json::parse(text);
   EXPECT_DOUBLE_EQ(j.at("spin_handoff_ns").get<double>(), 70);
   EXPECT_DOUBLE_EQ(j.at("park_wake_ns").get<double>(), 6500);
   EXPECT_DOUBLE_EQ(j.at("inflation").at(1).at("factor").get<double>(), 1.08);
   EXPECT_EQ(j.at("inflation").at(1).at("threads").get<int>(), 2);
+  EXPECT_DOUBLE_EQ(j.at("executor_overhead").at(0).at("ns").get<double>(), 150.5);
+  EXPECT_DOUBLE_EQ(j.at("spread").at("executor_overhead").at(0).at("max").get<double>(), 230);
   const CostModel m = parse_calibration(text, "new");
   EXPECT_DOUBLE_EQ(m.sync_latency_ns, 70);
   EXPECT_DOUBLE_EQ(m.park_wake_ns, 6500);
   EXPECT_EQ(m.inflation, c.inflation);
   EXPECT_EQ(m.reduction, c.reduction);
+  EXPECT_EQ(m.executor_overhead, c.executor_overhead);
+  // Without it (partition's own measurement, an older file): no key, no term.
+  c.executor_overhead.clear();
+  c.executor_overhead_spread.clear();
+  EXPECT_FALSE(nlohmann::json::parse(calibration_json(c)).contains("executor_overhead"));
+  EXPECT_TRUE(parse_calibration(calibration_json(c), "old").executor_overhead.empty());
 }
 
-TEST(CalibrationFile, RejectsAnInflationListThatIsNotOne) {
+TEST(CalibrationFile, RejectsACurveThatIsNotOne) {
   for (const char* bad : {R"("inflation": 3)", R"("inflation": [{"threads": 2}])",
                           R"("inflation": [{"threads": 2, "factor": 1.1}, {"threads": 1, "factor": 1}])",
                           R"("inflation": [{"threads": 0, "factor": 1}])",
-                          R"("inflation": [{"threads": 2, "factor": -1}])"}) {
+                          R"("inflation": [{"threads": 2, "factor": -1}])",
+                          R"("executor_overhead": [{"threads": 2, "factor": 1}])",
+                          R"("executor_overhead": [{"threads": 2, "ns": -5}])"}) {
     const std::string text =
         std::string(R"({"sync_latency_ns": 80, "per_byte_ns": 0.04, )") + bad + "}";
     try {
@@ -176,7 +214,8 @@ TEST(CalibrationFile, RejectsAnInflationListThatIsNotOne) {
       ADD_FAILURE() << "accepted " << text;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find("cal.json"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find("\"inflation\""), std::string::npos) << e.what();
+      const std::string key = std::string(bad).substr(0, std::string(bad).find(':'));
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
     }
   }
 }

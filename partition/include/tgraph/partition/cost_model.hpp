@@ -69,9 +69,19 @@ struct CostModel {
   /// A cross-processor reduction's hand-off against the processors taking part (`reduction`
   /// of `tgraph calibrate`, ns; measured, reported, not charged by the simulator).
   std::vector<ThreadsPoint> reduction;
+  /// The partition executor's own time per task instance against its number of threads
+  /// (`executor_overhead` of `tgraph calibrate`, ns: a step of independent tasks on K
+  /// threads against the same bodies run by the sequential executor), charged by the
+  /// built-in simulator to every instance of a K-processor assignment on top of
+  /// task_overhead_ns; sorted by threads, empty: term off. None at one processor (the
+  /// sequential engine has no executor), linear between points, beyond the last the last.
+  std::vector<ThreadsPoint> executor_overhead;
 
   /// The inflation factor at `busy` processors busy at once (1 when the curve is empty).
   double inflation_at(double busy) const;
+  /// The executor's time per task instance at `k` processors (0 at k <= 1 or when the curve
+  /// is empty).
+  double executor_overhead_at(std::uint32_t k) const;
 
   /// Zero synchronisation and transfer cost: pure precedence and load.
   static CostModel ideal();
@@ -146,6 +156,11 @@ struct Calibration {
   /// last sums the partials and publishes; every thread reads the result): median ns per
   /// round, for the same K as `inflation` (K >= 2).
   std::vector<ThreadsPoint> reduction;
+  /// The partition executor's own time per task instance at K threads (ns; K = 2, 4, ...
+  /// and the CPUs this process may use): measure_calibration leaves it empty, measure's
+  /// calibrate_file (`tgraph calibrate`, which can run the executor) fills it.
+  std::vector<ThreadsPoint> executor_overhead;
+  std::vector<CurveSpread> executor_overhead_spread;  ///< over its samples, per K
   /// Samples of every measurement (interleaved); each value above is their median, but the
   /// inflation, which is at least 1 (a median below 1 is noise: K copies cannot each run
   /// faster than one alone).

@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// The partition executor's time per task that `tgraph calibrate` adds to partition's
+// measurements: one sample per step, the median per K in the file, read back by the model.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/measure/calibrate.hpp"
+
+namespace tgraph::measure {
+namespace {
+
+TEST(ExecutorOverhead, IsOneSamplePerStepOfTheExecutorsTimeBeyondItsBodies) {
+  ExecutorOverheadOptions o;
+  o.tasks_per_thread = 500;
+  o.cost_ns = 2000;
+  o.samples = 5;
+  o.repeat = 1;
+  const std::vector<double> s = executor_overhead_samples(2, o);
+  ASSERT_EQ(s.size(), 5u);
+  // Per task, not per step or per thread: a step's 500 tasks of 2 us take 1 ms per thread,
+  // and what the executor adds to each is a fraction of the body (a wrong divisor would be
+  // 500 or 1000 times off). A sample below 0 is the noise of the machine; by a whole body
+  // it would be a wrong baseline.
+  std::vector<double> sorted = s;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  EXPECT_TRUE(std::isfinite(median));
+  EXPECT_GT(median, -2000.0);
+  EXPECT_LT(median, 2000.0);
+  EXPECT_THROW(executor_overhead_samples(1, o), OptionError);
+  o.tasks_per_thread = 0;
+  EXPECT_THROW(executor_overhead_samples(2, o), OptionError);
+}
+
+TEST(ExecutorOverhead, CalibrationAddsItsCurveBesideTheInflations) {
+  partition::CalibrateOptions o;
+  o.rounds = 500;
+  o.park_rounds = 20;
+  o.inflation_rounds = 1;
+  o.inflation_bytes = 1 << 16;
+  o.reduction_rounds = 100;
+  o.samples = 3;
+  const partition::Calibration c = calibrate_machine(o);
+  // The same K as the inflation's but its K = 1 (no executor there).
+  ASSERT_EQ(c.executor_overhead.size(), c.inflation.size() - 1);
+  ASSERT_EQ(c.executor_overhead_spread.size(), c.executor_overhead.size());
+  for (std::size_t i = 0; i < c.executor_overhead.size(); ++i) {
+    const partition::Spread& s = c.executor_overhead_spread[i].spread;
+    EXPECT_EQ(c.executor_overhead[i].threads, c.inflation[i + 1].threads);
+    EXPECT_EQ(c.executor_overhead_spread[i].threads, c.inflation[i + 1].threads);
+    EXPECT_EQ(c.executor_overhead[i].value, std::max(0.0, s.median));
+    EXPECT_LE(s.min, s.median);
+    EXPECT_LE(s.median, s.max);
+  }
+  const partition::CostModel m =
+      partition::parse_calibration(partition::calibration_json(c), "cal.json");
+  EXPECT_EQ(m.executor_overhead, c.executor_overhead);
+  EXPECT_EQ(m.executor_overhead_at(c.executor_overhead[0].threads), c.executor_overhead[0].value);
+  EXPECT_EQ(nlohmann::json::parse(partition::calibration_report(c, "cal.json", true))
+                .at("executor_overhead")
+                .size(),
+            c.executor_overhead.size());
+}
+
+}  // namespace
+}  // namespace tgraph::measure
