@@ -222,11 +222,25 @@ std::uint64_t body_pass(std::uint64_t* w, std::size_t words, std::uint64_t seed)
   return s;
 }
 
+// One pass of the compute body: a dependent chain of 2^17 integer multiply-adds in a
+// register, no memory traffic: what a body's arithmetic feels of the other busy cores (the
+// lower clock of many busy cores, a core's other hardware thread).
+std::uint64_t compute_pass(std::uint64_t seed) {
+  std::uint64_t x = seed | 1;
+  for (int i = 0; i < (1 << 17); ++i) {
+    x = x * 6364136223846793005ull + 1442695040888963407ull;
+    asm volatile("" : "+r"(x));  // one step at a time: no closed form, no vectors
+  }
+  return x;
+}
+
+enum class Body { kMemory, kCompute };
+
 // Mean time per thread of `passes` passes of the body, each of `k` pinned threads on its
-// own working set of `bytes` (allocated and first touched by that thread), all started
-// together; median over `rounds`.
+// own working set of `bytes` (allocated and first touched by that thread; the compute body
+// touches none of it), all started together; median over `rounds`.
 double busy_pass_ns(const std::vector<int>& cpus, std::size_t k, std::size_t bytes, int rounds,
-                    int passes) {
+                    int passes, Body body = Body::kMemory) {
   const std::size_t words = std::max<std::size_t>(bytes / 8, 4096);
   SpinBarrier barrier(k);
   std::vector<std::vector<double>> times(k);
@@ -239,7 +253,8 @@ double busy_pass_ns(const std::vector<int>& cpus, std::size_t k, std::size_t byt
       for (int r = -1; r < rounds; ++r) {  // round -1 warms the caches, unmeasured
         barrier.arrive_and_wait();
         const auto t0 = Clock::now();
-        for (int p = 0; p < passes; ++p) s += body_pass(w.data(), words, s);
+        for (int p = 0; p < passes; ++p)
+          s += body == Body::kMemory ? body_pass(w.data(), words, s) : compute_pass(s);
         const auto t1 = Clock::now();
         if (r >= 0) times[t].push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
       }
@@ -337,8 +352,10 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   // hypervisor moves) spreads each measurement alike; each value is the samples' median and
   // its spread (min, median, max) is reported beside it.
   const std::vector<std::size_t> ks = thread_counts(cpus.size());
-  std::vector<double> latency, per_byte, park;
-  std::vector<std::vector<double>> inflation(ks.size()), reduction(ks.size());
+  std::vector<double> latency, per_byte, park, pass_per_byte;
+  std::vector<std::vector<double>> inflation(ks.size()), compute(ks.size()), reduction(ks.size());
+  // Bytes one pass of the memory body touches (each word once: read, or read and written).
+  const double pass_bytes = static_cast<double>(std::max<std::size_t>(c.inflation_bytes / 8, 4096) * 8);
   const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
   for (int sample = 0; sample < c.samples; ++sample) {
     latency.push_back(measure_latency(c.cpu_a, c.cpu_b, c.rounds));
@@ -346,20 +363,32 @@ Calibration measure_calibration(const CalibrateOptions& options) {
         measure_per_byte(c.cpu_a, c.cpu_b, options.buffer_bytes, std::max(options.repeats, 1)));
     park.push_back(measure_park_wake(c.cpu_a, c.cpu_b, c.park_rounds));
     // Inflation: in each round one thread alone, then K at once (the same body, one round
-    // each), so that a drift moves both alike; the median of the rounds' ratios. A pass
-    // over 2 MiB takes 0.1-0.5 ms: 20 passes keep a round within tens of ms.
+    // each), so that a drift moves both alike; the median of the rounds' ratios; for the
+    // memory body and for the compute body. A pass over 2 MiB takes 0.1-0.5 ms, one of the
+    // compute body about 0.1 ms: 20 passes keep a round within tens of ms.
+    std::vector<double> alone_per_byte;
     for (std::size_t i = 0; i < ks.size(); ++i) {
       if (ks[i] < 2) continue;
-      std::vector<double> ratio;
+      std::vector<double> ratio, compute_ratio;
       for (int r = 0; r < rounds; ++r) {
         const double alone = busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes);
+        alone_per_byte.push_back(alone / pass_bytes);
         ratio.push_back(busy_pass_ns(cpus, ks[i], c.inflation_bytes, 1, passes) / alone);
+        const double alone_compute =
+            busy_pass_ns(cpus, 1, c.inflation_bytes, 1, passes, Body::kCompute);
+        compute_ratio.push_back(
+            busy_pass_ns(cpus, ks[i], c.inflation_bytes, 1, passes, Body::kCompute) /
+            alone_compute);
       }
       inflation[i].push_back(median(ratio));
+      compute[i].push_back(median(compute_ratio));
       reduction[i].push_back(
           reduction_round_ns(cpus, ks[i], std::max(options.reduction_rounds, 100)));
     }
+    if (!alone_per_byte.empty()) pass_per_byte.push_back(median(alone_per_byte));
   }
+  c.inflation_pass_spread = spread_of(pass_per_byte);
+  c.inflation_ns_per_byte = c.inflation_pass_spread.median;
   c.latency_spread = spread_of(latency);
   c.per_byte_spread = spread_of(per_byte);
   c.park_wake_spread = spread_of(park);
@@ -370,6 +399,7 @@ Calibration measure_calibration(const CalibrateOptions& options) {
     const auto k = static_cast<std::uint32_t>(ks[i]);
     if (k < 2) {
       c.inflation.push_back({1, 1.0});
+      c.compute_inflation.push_back({1, 1.0});
       continue;
     }
     c.inflation_spread.push_back({k, spread_of(inflation[i])});
@@ -377,6 +407,9 @@ Calibration measure_calibration(const CalibrateOptions& options) {
     // K copies of the body cannot each run faster than one alone on the same cores: a median
     // below 1 is the machine's noise (its spread says how much), and the factor is 1.
     c.inflation.push_back({k, std::max(1.0, c.inflation_spread.back().spread.median)});
+    c.compute_inflation_spread.push_back({k, spread_of(compute[i])});
+    c.compute_inflation.push_back(
+        {k, std::max(1.0, c.compute_inflation_spread.back().spread.median)});
     c.reduction.push_back({k, c.reduction_spread.back().spread.median});
   }
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();

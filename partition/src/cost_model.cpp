@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "tgraph/partition/cost_model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -45,6 +46,18 @@ double curve_at(const std::vector<ThreadsPoint>& curve, double x, double at_one)
 double CostModel::inflation_at(double busy) const {
   if (inflation.empty() || busy <= 1.0) return 1.0;
   return curve_at(inflation, busy, 1.0);
+}
+
+double CostModel::compute_inflation_at(double busy) const {
+  if (compute_inflation.empty() || busy <= 1.0) return 1.0;
+  return curve_at(compute_inflation, busy, 1.0);
+}
+
+double CostModel::task_inflation(double busy, double cost_ns, double bytes) const {
+  if (inflation_ns_per_byte <= 0 || cost_ns <= 0) return inflation_at(busy);
+  const double memory = std::min(cost_ns, bytes * inflation_ns_per_byte);
+  return (memory * inflation_at(busy) + (cost_ns - memory) * compute_inflation_at(busy)) /
+         cost_ns;
 }
 
 double CostModel::executor_overhead_at(std::uint32_t k) const {
@@ -169,6 +182,9 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   if (j.contains("park_wake_ns")) m.park_wake_ns = number("park_wake_ns");
   if (j.contains("spin_budget_ns")) m.spin_budget_ns = number("spin_budget_ns");
   if (j.contains("inflation")) m.inflation = curve("inflation", "factor", 0.001);
+  if (j.contains("compute_inflation"))
+    m.compute_inflation = curve("compute_inflation", "factor", 0.001);
+  if (j.contains("inflation_ns_per_byte")) m.inflation_ns_per_byte = number("inflation_ns_per_byte");
   if (j.contains("reduction")) m.reduction = curve("reduction", "ns", 0.0);
   if (j.contains("executor_overhead"))
     m.executor_overhead = curve("executor_overhead", "ns", 0.0);
@@ -226,6 +242,10 @@ std::string calibration_json(const Calibration& c) {
   j["per_byte_ns"] = c.per_byte_ns;
   j["inflation"] = curve_json(c.inflation, "factor");
   j["inflation_bytes"] = c.inflation_bytes;
+  if (!c.compute_inflation.empty()) {
+    j["compute_inflation"] = curve_json(c.compute_inflation, "factor");
+    j["inflation_ns_per_byte"] = c.inflation_ns_per_byte;
+  }
   j["reduction"] = curve_json(c.reduction, "ns");
   if (!c.executor_overhead.empty())
     j["executor_overhead"] = curve_json(c.executor_overhead, "ns");
@@ -247,6 +267,8 @@ std::string calibration_json(const Calibration& c) {
                  {"park_wake_ns", spread(c.park_wake_spread)},
                  {"per_byte_ns", spread(c.per_byte_spread)},
                  {"inflation", curve_spread(c.inflation_spread)},
+                 {"compute_inflation", curve_spread(c.compute_inflation_spread)},
+                 {"inflation_ns_per_byte", spread(c.inflation_pass_spread)},
                  {"reduction", curve_spread(c.reduction_spread)}};
   if (!c.executor_overhead_spread.empty())
     j["spread"]["executor_overhead"] = curve_spread(c.executor_overhead_spread);
@@ -289,6 +311,11 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
     out += "\n";
   };
   curve_text("inflation (threads: factor):", c.inflation, " %u: %.3f");
+  if (!c.compute_inflation.empty()) {
+    curve_text("compute inflation (threads: factor):", c.compute_inflation, " %u: %.3f");
+    std::snprintf(line, sizeof line, "memory body alone: %.4f ns/byte\n", c.inflation_ns_per_byte);
+    out += line;
+  }
   curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
   if (!c.executor_overhead.empty())
     curve_text("executor's time per task (threads: ns):", c.executor_overhead, " %u: %.1f");
@@ -306,6 +333,11 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   for (const CurveSpread& p : c.inflation_spread) {
     std::snprintf(line, sizeof line, ", inflation at %u %.3f-%.3f", p.threads, p.spread.min,
                   p.spread.max);
+    out += line;
+  }
+  for (const CurveSpread& p : c.compute_inflation_spread) {
+    std::snprintf(line, sizeof line, ", compute inflation at %u %.3f-%.3f", p.threads,
+                  p.spread.min, p.spread.max);
     out += line;
   }
   for (const CurveSpread& p : c.executor_overhead_spread) {

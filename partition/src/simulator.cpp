@@ -316,11 +316,21 @@ Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& mode
   check_assignment(g, a);
   const std::uint64_t serial = serial_ns.value_or(g.host_ns);
   Schedule s = Simulator(g, a, model, serial, nullptr).run();
-  if (model.inflation.empty() || a.k < 2) return s;
+  if ((model.inflation.empty() && model.compute_inflation.empty()) || a.k < 2) return s;
   // The bodies' slow-down: each instance's cost scaled by the inflation at the number of
-  // instances that ran at once during it in the schedule without inflation.
+  // instances that ran at once during it in the schedule without inflation (its memory
+  // share, the bytes of the data it accesses, by the memory body's curve; the rest by the
+  // compute body's).
   std::vector<double> factor = mean_busy(s);
-  for (double& f : factor) f = model.inflation_at(f);
+  for (TaskId t = 0; t < g.tasks.size(); ++t) {
+    const Task& task = g.tasks[t];
+    double bytes = 0;
+    for (std::uint32_t i = 0; i < task.access_count; ++i)
+      bytes += static_cast<double>(g.data[g.accesses[task.access_begin + i].datum].bytes);
+    const auto cost = static_cast<double>(task.cost_ns);
+    for (std::uint64_t i = s.first_instance[t]; i < s.first_instance[t + 1]; ++i)
+      factor[i] = model.task_inflation(factor[i], cost, bytes);
+  }
   return Simulator(g, a, model, serial, &factor).run();
 }
 
@@ -343,6 +353,9 @@ std::vector<std::string> model_terms(const CostModel& model, bool serial_given, 
   if (!model.executor_overhead.empty()) terms.push_back("executor_overhead");
   if (model.park_wake_ns > 0) terms.push_back("park_wake");
   if (!model.inflation.empty()) terms.push_back("inflation");
+  // The compute body's curve, and the memory share that splits a task between the two.
+  if (!model.compute_inflation.empty()) terms.push_back("compute_inflation");
+  if (model.inflation_ns_per_byte > 0 && !model.inflation.empty()) terms.push_back("memory_share");
   if (serial_given) {
     terms.push_back("serial_main_thread");
   } else if (host_time) {

@@ -79,6 +79,15 @@ TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
     EXPECT_LE(s.median, s.max);
     EXPECT_EQ(c.reduction[i].value, c.reduction_spread[i].spread.median);
   }
+  // The compute body's curve at the same K, floored at 1 as the memory body's; the memory
+  // body's time per byte alone is the median of its samples.
+  ASSERT_EQ(c.compute_inflation.size(), c.inflation.size());
+  ASSERT_EQ(c.compute_inflation_spread.size(), c.inflation_spread.size());
+  for (std::size_t i = 0; i < c.compute_inflation_spread.size(); ++i)
+    EXPECT_EQ(c.compute_inflation[i + 1].value,
+              std::max(1.0, c.compute_inflation_spread[i].spread.median));
+  EXPECT_GT(c.inflation_ns_per_byte, 0.0);
+  EXPECT_EQ(c.inflation_ns_per_byte, c.inflation_pass_spread.median);
   const nlohmann::json j = nlohmann::json::parse(calibration_json(c));
   EXPECT_EQ(j["samples"], 3);
   EXPECT_EQ(j["spread"]["park_wake_ns"]["median"].get<double>(), c.park_wake_ns);
@@ -86,6 +95,8 @@ TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
   const CostModel m = parse_calibration(calibration_json(c), "cal.json");
   EXPECT_EQ(m.park_wake_ns, c.park_wake_ns);
   EXPECT_EQ(m.inflation, c.inflation);
+  EXPECT_EQ(m.compute_inflation, c.compute_inflation);
+  EXPECT_EQ(m.inflation_ns_per_byte, c.inflation_ns_per_byte);
 }
 
 }  // namespace

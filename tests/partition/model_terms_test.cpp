@@ -76,6 +76,43 @@ TEST(ModelTerms, InflationTwoAtTwoBusyProcessorsDoublesABody) {
   EXPECT_EQ(simulate(two_independent(), assign(2, {0, 1}), m).makespan_ns, 1000u);
 }
 
+// Two tasks of cost 1000 on disjoint data of 1000 bytes each.
+StepGraph two_independent_of_1000_bytes() {
+  Builder b;
+  const DatumId x = b.datum("x", 1000), y = b.datum("y", 1000);
+  b.task({{x, M::W}}, 1000);
+  b.task({{y, M::W}}, 1000);
+  return b.done();
+}
+
+TEST(ModelTerms, InflationScalesATasksMemoryShareByTheMemoryCurveAndTheRestByTheComputeCurve) {
+  CostModel m = model(0);
+  m.inflation = {{1, 1.0}, {2, 2.0}};
+  m.compute_inflation = {{1, 1.0}, {2, 1.0}};
+  // 1000 bytes at 0.5 ns/byte: half of each 1000 ns body is memory, doubled; the other
+  // half computes at full speed: 500 x 2 + 500 = 1500.
+  m.inflation_ns_per_byte = 0.5;
+  EXPECT_EQ(simulate(two_independent_of_1000_bytes(), assign(2, {0, 1}), m).end_ns,
+            (std::vector<std::uint64_t>{1500, 1500}));
+  EXPECT_DOUBLE_EQ(m.task_inflation(2, 1000, 1000), 1.5);
+  // At 2 ns/byte the memory pass would outlast the body: all of it is memory, doubled.
+  m.inflation_ns_per_byte = 2.0;
+  EXPECT_EQ(simulate(two_independent_of_1000_bytes(), assign(2, {0, 1}), m).makespan_ns, 2000u);
+  // A compute curve alone: the rest slowed by 1.2, the memory share not at all.
+  m.inflation.clear();
+  m.compute_inflation = {{2, 1.2}};
+  m.inflation_ns_per_byte = 0.5;
+  EXPECT_EQ(simulate(two_independent_of_1000_bytes(), assign(2, {0, 1}), m).makespan_ns, 1100u);
+  // Without a time per byte (an older file), the memory curve scales the whole body.
+  m.inflation = {{1, 1.0}, {2, 2.0}};
+  m.inflation_ns_per_byte = 0;
+  EXPECT_EQ(simulate(two_independent_of_1000_bytes(), assign(2, {0, 1}), m).makespan_ns, 2000u);
+  EXPECT_DOUBLE_EQ(m.task_inflation(2, 1000, 1000), 2.0);
+  // One busy processor at a time: no slow-down from either curve.
+  m.inflation_ns_per_byte = 0.5;
+  EXPECT_EQ(simulate(two_independent_of_1000_bytes(), assign(2, {0, 0}), m).makespan_ns, 2000u);
+}
+
 TEST(ModelTerms, InflationScalesABodyByTheMeanBusyCountDuringIt) {
   // t0 (1000) on p0 beside t1 (500) on p1: t1 always has two busy, t0 half its time.
   Builder b;
@@ -155,6 +192,12 @@ TEST(ModelTerms, NamesTheTermsAPredictionCharges) {
             (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead",
                                       "executor_overhead", "park_wake", "inflation",
                                       "serial_main_thread"}));
+  m.compute_inflation = {{1, 1.0}, {2, 1.01}};
+  m.inflation_ns_per_byte = 0.05;
+  EXPECT_EQ(model_terms(m, false, false),
+            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead",
+                                      "executor_overhead", "park_wake", "inflation",
+                                      "compute_inflation", "memory_share"}));
   EXPECT_EQ(model_terms(CostModel::ideal(), false, true), (std::vector<std::string>{"host_time"}));
 }
 
@@ -179,6 +222,8 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
   c.reduction = {{2, 180}};
   c.executor_overhead = {{2, 150.5}};
   c.executor_overhead_spread = {{2, {120, 150.5, 230}}};
+  c.compute_inflation = {{1, 1.0}, {2, 1.01}};
+  c.inflation_ns_per_byte = 0.045;
   const std::string text = calibration_json(c);
   const nlohmann::json j = nlohmann::json::parse(text);
   EXPECT_DOUBLE_EQ(j.at("spin_handoff_ns").get<double>(), 70);
@@ -193,6 +238,8 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
   EXPECT_EQ(m.inflation, c.inflation);
   EXPECT_EQ(m.reduction, c.reduction);
   EXPECT_EQ(m.executor_overhead, c.executor_overhead);
+  EXPECT_EQ(m.compute_inflation, c.compute_inflation);
+  EXPECT_DOUBLE_EQ(m.inflation_ns_per_byte, 0.045);
   // Without it (partition's own measurement, an older file): no key, no term.
   c.executor_overhead.clear();
   c.executor_overhead_spread.clear();

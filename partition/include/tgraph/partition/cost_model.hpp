@@ -65,7 +65,17 @@ struct CostModel {
   /// The bodies' slow-down against the number of busy processors (`inflation` of `tgraph
   /// calibrate`: K copies of a memory-touching body at once against one), sorted by threads;
   /// empty: term off. Between points linear, below the first 1, beyond the last the last.
+  /// With inflation_ns_per_byte it scales a task's memory share only (below).
   std::vector<ThreadsPoint> inflation;
+  /// The same for a body that only computes (`compute_inflation`: K copies of a register
+  /// multiply-add chain against one: a lower clock when many cores are busy, a core's other
+  /// hardware thread), which scales the rest of a task's cost; empty: 1.
+  std::vector<ThreadsPoint> compute_inflation;
+  /// Time per byte of the memory-touching body alone (`inflation_ns_per_byte`): a task's
+  /// memory share is min(its cost, the bytes of the data it accesses x this), inflated by
+  /// `inflation`, the rest by `compute_inflation`. 0 (files without it): the whole cost is
+  /// scaled by `inflation`, as a memory-bound body.
+  double inflation_ns_per_byte = 0.0;
   /// A cross-processor reduction's hand-off against the processors taking part (`reduction`
   /// of `tgraph calibrate`, ns; measured, reported, not charged by the simulator).
   std::vector<ThreadsPoint> reduction;
@@ -79,6 +89,12 @@ struct CostModel {
 
   /// The inflation factor at `busy` processors busy at once (1 when the curve is empty).
   double inflation_at(double busy) const;
+  /// compute_inflation's factor at `busy` processors busy at once (1 when it is empty).
+  double compute_inflation_at(double busy) const;
+  /// The factor a task of `cost_ns` accessing `bytes` bytes is scaled by at `busy`
+  /// processors busy at once: memory share x inflation_at + the rest x compute_inflation_at,
+  /// over the cost (inflation_at alone without inflation_ns_per_byte).
+  double task_inflation(double busy, double cost_ns, double bytes) const;
   /// The executor's time per task instance at `k` processors (0 at k <= 1 or when the curve
   /// is empty).
   double executor_overhead_at(std::uint32_t k) const;
@@ -152,6 +168,11 @@ struct Calibration {
   /// K = 1, 2, 4, ... and the CPUs this process may use.
   std::vector<ThreadsPoint> inflation;
   std::size_t inflation_bytes = 0;  ///< each body's working set
+  /// The same for K copies of a body that only computes (a register multiply-add chain).
+  std::vector<ThreadsPoint> compute_inflation;
+  /// The memory body's time per byte touched when it runs alone (the median over samples of
+  /// each sample's median over its rounds): what sizes a task's memory share.
+  double inflation_ns_per_byte = 0;
   /// Combine of one partial sum per thread (K threads, each arriving at a counter; the
   /// last sums the partials and publishes; every thread reads the result): median ns per
   /// round, for the same K as `inflation` (K >= 2).
@@ -169,6 +190,8 @@ struct Calibration {
   /// Over the samples, per K >= 2: the inflation as measured (before the floor at 1), the
   /// reduction's ns.
   std::vector<CurveSpread> inflation_spread, reduction_spread;
+  std::vector<CurveSpread> compute_inflation_spread;  ///< before the floor at 1
+  Spread inflation_pass_spread;  ///< of inflation_ns_per_byte
   double seconds = 0;  ///< wall time of the whole measurement
 };
 
