@@ -227,6 +227,22 @@ StepGraph generate_step(const GenerateOptions& o, std::uint32_t step) {
   return g;
 }
 
+ChainsStep chains_step(std::uint32_t chains, std::uint32_t per_chain, std::uint64_t cost_ns) {
+  ChainsStep c;
+  StepGraph& g = c.graph;
+  const KindId kind = g.intern_kind("calibrate");
+  for (std::uint32_t p = 0; p < chains; ++p)
+    g.data.push_back({"chain " + std::to_string(p), kNoObject, 64});
+  c.assignment.k = chains;
+  for (std::uint32_t i = 0; i < per_chain * chains; ++i) {
+    const Access acc[] = {{static_cast<DatumId>(i % chains), AccessMode::RW}};
+    g.add_task(kind, kNoObject, acc, cost_ns, i);
+    c.assignment.proc.push_back(i % chains);
+  }
+  g.derive_edges();
+  return c;
+}
+
 Trace generate_trace(const GenerateOptions& o, std::uint32_t steps) {
   Trace trace;
   trace.header.scene = "generated-" + std::string(to_string(o.pattern));

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/generate.hpp"
 #include "tgraph/measure/replay_trace.hpp"
 
 namespace tgraph::measure {
@@ -17,27 +18,16 @@ std::vector<double> executor_overhead_samples(std::uint32_t threads,
   if (threads < 2) throw OptionError("threads", "must be at least 2");
   if (options.tasks_per_thread == 0 || options.samples == 0 || options.repeat == 0)
     throw OptionError("tasks_per_thread", "tasks, samples and passes must be at least 1");
-  StepGraph g;
-  const KindId kind = g.intern_kind("calibrate");
-  for (std::uint32_t p = 0; p < threads; ++p)
-    g.data.push_back({"chain " + std::to_string(p), kNoObject, 64});
-  Assignment a;
-  a.k = threads;
   // Round robin, as a step's tasks of many objects interleave: thread p runs every
   // threads-th task, each after the previous one of its chain (an edge on its own thread).
-  for (std::uint32_t i = 0; i < options.tasks_per_thread * threads; ++i) {
-    const Access acc[] = {{static_cast<DatumId>(i % threads), AccessMode::RW}};
-    g.add_task(kind, kNoObject, acc, options.cost_ns, i);
-    a.proc.push_back(i % threads);
-  }
-  g.derive_edges();
+  const ChainsStep chains = chains_step(threads, options.tasks_per_thread, options.cost_ns);
   // Step 0 warms up (threads started, buffers first touched); each later step is a sample.
   Trace trace;
   trace.header.scene = "executor overhead";
   TraceAssignment as{"round robin", threads, {}, {}};
   for (std::uint32_t s = 0; s <= options.samples; ++s) {
-    trace.steps.push_back(g);
-    as.steps.push_back(a);
+    trace.steps.push_back(chains.graph);
+    as.steps.push_back(chains.assignment);
   }
   ReplayOptions ro;
   ro.policy = replay::Policy::kPartition;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/generate.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/mpi/replay.hpp"
 #include "tgraph/partition/cost_model.hpp"
@@ -93,20 +94,8 @@ MpiLink measure_mpi_link(int rounds, std::uint64_t message_bytes, int repeats) {
 double measure_task_overhead(std::uint32_t tasks, std::uint64_t cost_ns, int steps) {
   const World w = world(false);
   if (tasks == 0 || steps < 2) throw UsageError("calibrate: bad task count or steps");
-  const auto ranks = static_cast<std::uint32_t>(w.size);
-  StepGraph g;
-  const KindId kind = g.intern_kind("calibrate");
-  for (std::uint32_t r = 0; r < ranks; ++r)
-    g.data.push_back({"chain " + std::to_string(r), kNoObject, 64});
-  Assignment a;
-  a.k = ranks;
-  for (std::uint32_t i = 0; i < tasks * ranks; ++i) {
-    const Access acc[] = {{static_cast<DatumId>(i % ranks), AccessMode::RW}};
-    g.add_task(kind, kNoObject, acc, cost_ns, i);
-    a.proc.push_back(i % ranks);
-  }
-  g.derive_edges();
-  const double wall = median_step_ns(g, a, steps);
+  const ChainsStep chains = chains_step(static_cast<std::uint32_t>(w.size), tasks, cost_ns);
+  const double wall = median_step_ns(chains.graph, chains.assignment, steps);
   if (w.rank != 0) return 0;
   return std::max(0.0, (wall - static_cast<double>(tasks) * static_cast<double>(cost_ns)) / tasks);
 }

@@ -350,9 +350,4 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   return out + line + "wrote " + path + "\n";
 }
 
-std::string calibrate_file(const CalibrateOptions& options, const std::string& path, bool json) {
-  const Calibration c = measure_calibration(options);  // runtime_error: a failure of the work
-  return calibration_report(c, save_calibration(c, path), json);
-}
-
 }  // namespace tgraph::partition

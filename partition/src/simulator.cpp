@@ -323,11 +323,9 @@ Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& mode
   // compute body's).
   std::vector<double> factor = mean_busy(s);
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
-    const Task& task = g.tasks[t];
     double bytes = 0;
-    for (std::uint32_t i = 0; i < task.access_count; ++i)
-      bytes += static_cast<double>(g.data[g.accesses[task.access_begin + i].datum].bytes);
-    const auto cost = static_cast<double>(task.cost_ns);
+    for (const Access& acc : g.accesses_of(t)) bytes += static_cast<double>(g.data[acc.datum].bytes);
+    const auto cost = static_cast<double>(g.tasks[t].cost_ns);
     for (std::uint64_t i = s.first_instance[t]; i < s.first_instance[t + 1]; ++i)
       factor[i] = model.task_inflation(factor[i], cost, bytes);
   }

@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/graph/trace.hpp"
 
@@ -51,6 +52,17 @@ StepGraph generate_step(const GenerateOptions& options, std::uint32_t step = 0);
 ///   Trace t = generate_trace({.tasks = 1'000'000, .pattern = Pattern::kRandom}, 1);
 ///   write_trace("random.tgt", t);
 Trace generate_trace(const GenerateOptions& options, std::uint32_t steps);
+
+/// A step of `chains` independent chains and the assignment of chain p to processor p:
+/// `chains` x `per_chain` tasks of `cost_ns` each in round robin (task i rewrites datum
+/// i mod chains, "chain <p>" of 64 bytes, after the chain's previous task), edges derived.
+/// What a runtime's own time per task is measured on (`tgraph calibrate`, `tgraph-mpi
+/// calibrate`): every wait is on the task's own processor.
+struct ChainsStep {
+  StepGraph graph;
+  Assignment assignment;
+};
+ChainsStep chains_step(std::uint32_t chains, std::uint32_t per_chain, std::uint64_t cost_ns);
 
 /// What generate_file() wrote: the first step's sizes (every step has them).
 struct GeneratedFile {

@@ -223,7 +223,5 @@ std::string calibration_json(const Calibration& c);
 std::string save_calibration(const Calibration& c, const std::string& path = "");
 /// The report of a saved calibration: one JSON object, or two lines.
 std::string calibration_report(const Calibration& c, const std::string& path, bool json);
-/// measure_calibration(options), saved to `path` (save_calibration): its report.
-std::string calibrate_file(const CalibrateOptions& options, const std::string& path, bool json);
 
 }  // namespace tgraph::partition
