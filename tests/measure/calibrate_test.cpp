@@ -7,6 +7,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "../quick_calibration.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/measure/calibrate.hpp"
 
@@ -39,14 +40,7 @@ TEST(ExecutorOverhead, IsOneSamplePerStepOfTheExecutorsTimeBeyondItsBodies) {
 }
 
 TEST(ExecutorOverhead, CalibrationAddsItsCurveBesideTheInflations) {
-  partition::CalibrateOptions o;
-  o.rounds = 500;
-  o.park_rounds = 20;
-  o.inflation_rounds = 1;
-  o.inflation_bytes = 1 << 16;
-  o.reduction_rounds = 100;
-  o.samples = 3;
-  const partition::Calibration c = calibrate_machine(o);
+  const partition::Calibration c = calibrate_machine(tgraph::testing::quick_calibration());
   // The same K as the inflation's but its K = 1 (no executor there).
   ASSERT_EQ(c.executor_overhead.size(), c.inflation.size() - 1);
   ASSERT_EQ(c.executor_overhead_spread.size(), c.executor_overhead.size());

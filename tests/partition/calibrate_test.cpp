@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 
+#include "../quick_calibration.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/partition/cost_model.hpp"
 
@@ -51,14 +52,7 @@ TEST(Spread, IsTheSamplesMinMedianAndMax) {
 // Each figure is the median of its samples, reported with their spread; the inflation is
 // the measured median floored at 1; the file reads back with the same values.
 TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
-  CalibrateOptions o;
-  o.rounds = 500;
-  o.park_rounds = 20;
-  o.inflation_rounds = 1;
-  o.inflation_bytes = 1 << 16;
-  o.reduction_rounds = 100;
-  o.samples = 3;
-  const Calibration c = measure_calibration(o);
+  const Calibration c = measure_calibration(tgraph::testing::quick_calibration());
   EXPECT_EQ(c.samples, 3);
   for (const auto& [spread, value] : {std::pair{c.latency_spread, c.sync_latency_ns},
                                       std::pair{c.park_wake_spread, c.park_wake_ns},

@@ -1,0 +1,22 @@
+// SPDX-License-Identifier: MIT
+// The smallest calibration the tests run for real: every measurement taken, few rounds.
+#pragma once
+
+#include "tgraph/partition/cost_model.hpp"
+
+namespace tgraph::testing {
+
+/// 3 samples of 500 spinning and 20 parked hand-offs, 1 inflation round over 64 KiB and 100
+/// reductions: well under a second on 2 cores.
+inline partition::CalibrateOptions quick_calibration() {
+  partition::CalibrateOptions o;
+  o.rounds = 500;
+  o.park_rounds = 20;
+  o.inflation_rounds = 1;
+  o.inflation_bytes = 1 << 16;
+  o.reduction_rounds = 100;
+  o.samples = 3;
+  return o;
+}
+
+}  // namespace tgraph::testing
