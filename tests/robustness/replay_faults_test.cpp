@@ -360,7 +360,9 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         ExecOptions o;
         o.threads = 2;
         o.pin = false;
-        o.partition.timeout_ms = 200;
+        // 1 s, not 200 ms: under ASan beside another test the second thread once ran no
+        // task within 200 ms, and the watchdog then named a stall, not the hanging body.
+        o.partition.timeout_ms = 1000;
         o.partition.timeout_exits = true;
         auto ex = make_executor(Policy::kPartition, o);
         HangingWorkload w(stuck);
