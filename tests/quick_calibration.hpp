@@ -6,8 +6,8 @@
 
 namespace tgraph::testing {
 
-/// 3 samples of 500 spinning and 20 parked hand-offs, 1 inflation round over 64 KiB and 100
-/// reductions: well under a second on 2 cores.
+/// 3 samples of 500 spinning and 20 parked hand-offs, 1 inflation round over 64 KiB, 100
+/// reductions and 20 ms of looking for interruptions: well under a second on 2 cores.
 inline partition::CalibrateOptions quick_calibration() {
   partition::CalibrateOptions o;
   o.rounds = 500;
@@ -15,6 +15,7 @@ inline partition::CalibrateOptions quick_calibration() {
   o.inflation_rounds = 1;
   o.inflation_bytes = 1 << 16;
   o.reduction_rounds = 100;
+  o.interruption_ms = 20;
   o.samples = 3;
   return o;
 }

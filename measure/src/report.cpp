@@ -299,7 +299,17 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
          {"serial_ns", r.serial_ns},
          {"replay_sequential_ns", r.replay_sequential_ns},
          {"predicted_sequential_ns",
-          pred ? nlohmann::json(r.predicted_sequential_ns) : nlohmann::json(nullptr)}});
+          pred ? nlohmann::json(r.predicted_sequential_ns) : nlohmann::json(nullptr)},
+         {"live_body_ns", pred ? nlohmann::json(r.live_body_ns) : nlohmann::json(nullptr)},
+         {"live_wait_ns", pred ? nlohmann::json(r.live_wait_ns) : nlohmann::json(nullptr)},
+         {"live_idle_ns", pred ? nlohmann::json(r.live_idle_ns) : nlohmann::json(nullptr)},
+         {"predicted_body_ns", pred ? nlohmann::json(r.predicted_body_ns) : nlohmann::json(nullptr)},
+         {"predicted_wait_ns", pred ? nlohmann::json(r.predicted_wait_ns) : nlohmann::json(nullptr)},
+         {"predicted_overhead_ns",
+          pred ? nlohmann::json(r.predicted_overhead_ns) : nlohmann::json(nullptr)},
+         {"live_inflation", pred ? nlohmann::json(r.live_inflation) : nlohmann::json(nullptr)},
+         {"predicted_inflation",
+          pred ? nlohmann::json(r.predicted_inflation) : nlohmann::json(nullptr)}});
   nlohmann::json j = {
       {"scene", o.scene},
       {"policy", std::string(to_string(v.choice.policy))},
@@ -321,6 +331,20 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
   j["predicted_speedup"] = pred ? nlohmann::json(v.predicted_speedup) : nlohmann::json(nullptr);
   j["predicted_speedup_over_live"] =
       pred ? nlohmann::json(v.predicted_speedup_over_live) : nlohmann::json(nullptr);
+  // Where the prediction departs from the live run: the bodies' time, the waits, and the
+  // bodies' slow-down (over all kinds and per kind).
+  const auto or_null = [pred](double x) { return pred && x > 0 ? nlohmann::json(x) : nlohmann::json(nullptr); };
+  j["body_predicted_over_live"] = or_null(v.body_predicted_over_live);
+  j["wait_predicted_over_live"] = or_null(v.wait_predicted_over_live);
+  j["live_inflation"] = or_null(v.live_inflation);
+  j["predicted_inflation"] = or_null(v.predicted_inflation);
+  nlohmann::json kinds = nlohmann::json::array();
+  for (const KindInflation& k : v.kinds)
+    kinds.push_back({{"kind", k.kind},
+                     {"instances", k.instances},
+                     {"live_inflation", or_null(k.live)},
+                     {"predicted_inflation", or_null(k.predicted)}});
+  j["kinds"] = kinds;
   j["model"] = v.model;
   j["model_terms"] = v.model_terms;
   j["rounds_with_live_assignments"] = v.rounds_with_live_assignments;
@@ -359,6 +383,12 @@ std::string to_text(const Validation& v, const ValidateOptions& o) {
     out += "  model " + v.model + ": " + terms + "\n";
     std::snprintf(line, sizeof line, "  assignments     the live run's in %u of %zu rounds\n",
                   v.rounds_with_live_assignments, v.rounds.size());
+    out += line;
+    std::snprintf(line, sizeof line,
+                  "  where           simulator / live: bodies' time %.3f, waits %.3f; bodies' "
+                  "slow-down live %.3f, simulator %.3f\n",
+                  v.body_predicted_over_live, v.wait_predicted_over_live, v.live_inflation,
+                  v.predicted_inflation);
     out += line;
   }
   return out;

@@ -3,6 +3,7 @@
 #include "tgraph/measure/validate.hpp"
 
 #include <algorithm>
+#include <map>
 #include <optional>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include "tgraph/measure/replay_trace.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulator.hpp"
+#include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/thread_binding.hpp"
 #include "tgraph/partition/strategy.hpp"
 
@@ -53,7 +55,9 @@ Validation validate(const ValidateOptions& o) {
     lo.exec.threads = v.threads;
     lo.steps = o.steps;
     lo.repeat = 1;
-    lo.observe = false;
+    // The partition policy's observed passes (the policy's, then the sequential one's)
+    // time every body: where the threads' time went, beside the simulated schedule's.
+    lo.observe = partition;
     lo.keep_assignments = partition;
     const std::string scene = o.scene;
     const samples::SceneOptions so = o.scene_options;
@@ -66,6 +70,11 @@ Validation validate(const ValidateOptions& o) {
     for (const LiveStepMeasure& m : live.steps) {
       serial.push_back(static_cast<std::uint64_t>(m.record_ns + m.partition_ns + m.prepare_ns));
       r.serial_ns += serial.back();
+      for (const replay::StatsObserver::Thread& t : m.threads) {
+        r.live_body_ns += t.busy_ns;
+        r.live_wait_ns += t.wait_ns;
+        r.live_idle_ns += t.idle_ns;
+      }
     }
     // The simulated threads wait as the live run's did: spinning this long, then parked. The
     // partition executor spins on up to kLongSpinNs while the thread it waits for runs, where
@@ -99,9 +108,51 @@ Validation validate(const ValidateOptions& o) {
 
     // 3. The simulator's makespan of the same partition (partition policy only).
     if (assignment) {
-      for (std::uint64_t ns : partition::predicted_makespans(trace, *assignment, model,
-                                                             o.live_serial ? &serial : nullptr))
-        r.predicted_ns += ns;
+      std::map<std::string, std::pair<double, double>> by_kind;  // inflated, capture's cost
+      for (std::size_t s = 0; s < trace.steps.size() && s < assignment->steps.size(); ++s) {
+        const StepGraph& g = trace.steps[s];
+        std::optional<std::uint64_t> serial_s;
+        if (o.live_serial && s < serial.size()) serial_s = serial[s];
+        const partition::Schedule sched =
+            partition::simulate(g, assignment->steps[s], model, serial_s);
+        r.predicted_ns += sched.makespan_ns;
+        const std::uint64_t before = serial_s.value_or(g.host_ns);
+        std::uint64_t body = 0, busy = 0;
+        for (ProcId p = 0; p < sched.body_ns.size(); ++p) {
+          body += sched.body_ns[p];
+          busy += sched.busy_ns[p];
+        }
+        r.predicted_body_ns += body;
+        r.predicted_overhead_ns += busy - body;
+        const std::uint64_t phase =
+            sched.makespan_ns > before ? (sched.makespan_ns - before) * v.threads : 0;
+        r.predicted_wait_ns += phase > busy ? phase - busy : 0;
+        for (TaskId t = 0; t < g.tasks.size(); ++t)
+          by_kind[g.kind_name(t)].second +=
+              static_cast<double>(g.tasks[t].cost_ns) *
+              static_cast<double>(sched.first_instance[t + 1] - sched.first_instance[t]);
+        for (std::size_t k = 0; k < g.kinds.size() && k < sched.kind_body_ns.size(); ++k)
+          by_kind[g.kinds[k]].first += static_cast<double>(sched.kind_body_ns[k]);
+      }
+      // Each kind's two slow-downs, and both over all kinds weighted by sequential time.
+      double live_par = 0, live_seq = 0, pred_inflated = 0, pred_cost = 0;
+      for (const KindTime& k : live.kinds) {
+        KindInflation ki{k.kind, k.instances, 0, 0};
+        if (k.sequential_mean_ns > 0) ki.live = k.mean_ns / k.sequential_mean_ns;
+        const auto it = by_kind.find(k.kind);
+        if (it != by_kind.end() && it->second.second > 0)
+          ki.predicted = it->second.first / it->second.second;
+        if (ki.live > 0 && ki.predicted > 0) {
+          const double n = static_cast<double>(k.instances);
+          live_par += k.mean_ns * n;
+          live_seq += k.sequential_mean_ns * n;
+          pred_inflated += it->second.first;
+          pred_cost += it->second.second;
+        }
+        r.kinds.push_back(std::move(ki));
+      }
+      if (live_seq > 0) r.live_inflation = live_par / live_seq;
+      if (pred_cost > 0) r.predicted_inflation = pred_inflated / pred_cost;
       TraceAssignment one{"single", 1, {}, {}};
       for (const StepGraph& g : trace.steps)
         one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
@@ -134,6 +185,37 @@ Validation validate(const ValidateOptions& o) {
     if (partition) {
       pred_su.push_back(static_cast<double>(r.predicted_sequential_ns) / p);
       psl.push_back(pred_su.back() / live_su.back());
+    }
+  }
+  if (partition && !v.rounds.empty()) {
+    std::vector<double> body, wait, li, pi;
+    for (const ValidationRound& r : v.rounds) {
+      if (r.live_body_ns > 0)
+        body.push_back(static_cast<double>(r.predicted_body_ns) /
+                       static_cast<double>(r.live_body_ns));
+      if (r.live_wait_ns > 0)
+        wait.push_back(static_cast<double>(r.predicted_wait_ns) /
+                       static_cast<double>(r.live_wait_ns));
+      if (r.live_inflation > 0) li.push_back(r.live_inflation);
+      if (r.predicted_inflation > 0) pi.push_back(r.predicted_inflation);
+    }
+    if (!body.empty()) v.body_predicted_over_live = median(body);
+    if (!wait.empty()) v.wait_predicted_over_live = median(wait);
+    if (!li.empty()) v.live_inflation = median(li);
+    if (!pi.empty()) v.predicted_inflation = median(pi);
+    // Per kind (the first round's), the medians of its two slow-downs over the rounds.
+    for (const KindInflation& k : v.rounds.front().kinds) {
+      KindInflation m = k;
+      std::vector<double> l, p;
+      for (const ValidationRound& r : v.rounds)
+        for (const KindInflation& x : r.kinds)
+          if (x.kind == k.kind) {
+            if (x.live > 0) l.push_back(x.live);
+            if (x.predicted > 0) p.push_back(x.predicted);
+          }
+      m.live = l.empty() ? 0 : median(l);
+      m.predicted = p.empty() ? 0 : median(p);
+      v.kinds.push_back(std::move(m));
     }
   }
   v.live_speedup = median(live_su);

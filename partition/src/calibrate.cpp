@@ -317,6 +317,53 @@ double reduction_round_ns(const std::vector<int>& cpus, std::size_t k, int round
   return median(per_block);
 }
 
+// `k` pinned threads, started together, each reading the clock in a loop for `ns`: per
+// thread, the gaps between two readings of at least kInterruptionGapNs (appended to
+// gaps[t]) and the loop's length (added to span[t]).
+void interruption_gaps(const std::vector<int>& cpus, std::size_t k, double ns,
+                       std::vector<std::vector<double>>& gaps, std::vector<double>& span) {
+  SpinBarrier barrier(k);
+  std::vector<std::vector<double>> found(k);
+  std::vector<double> length(k, 0);
+  std::vector<std::thread> threads;
+  const auto duration = std::chrono::duration_cast<Clock::duration>(
+      std::chrono::duration<double, std::nano>(ns));
+  for (std::size_t t = 0; t < k; ++t) {
+    threads.emplace_back([&, t] {
+      std::vector<double> mine;
+      barrier.arrive_and_wait();
+      const auto t0 = Clock::now(), end = t0 + duration;
+      auto last = t0;
+      for (;;) {
+        const auto now = Clock::now();
+        const double gap = std::chrono::duration<double, std::nano>(now - last).count();
+        if (gap >= kInterruptionGapNs) mine.push_back(gap);
+        last = now;
+        if (now >= end) break;
+      }
+      length[t] = std::chrono::duration<double, std::nano>(last - t0).count();
+      found[t] = std::move(mine);
+    });
+    pin(threads.back(), cpus[t]);
+  }
+  for (std::thread& t : threads) t.join();
+  for (std::size_t t = 0; t < k; ++t) {
+    gaps[t].insert(gaps[t].end(), found[t].begin(), found[t].end());
+    span[t] += length[t];
+  }
+}
+
+// Up to 32 quantiles of `v` (all of it when shorter), at the middles of 32 equal shares.
+std::vector<double> quantiles(std::vector<double> v) {
+  constexpr std::size_t kQ = 32;
+  std::sort(v.begin(), v.end());
+  if (v.size() <= kQ) return v;
+  std::vector<double> out;
+  for (std::size_t j = 0; j < kQ; ++j)
+    out.push_back(v[std::min(v.size() - 1, (2 * j + 1) * v.size() / (2 * kQ))]);
+  return out;
+}
+
 // 1, 2, 4, ... below n, and n.
 std::vector<std::size_t> thread_counts(std::size_t n) {
   std::vector<std::size_t> out;
@@ -354,6 +401,13 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   const std::vector<std::size_t> ks = thread_counts(cpus.size());
   std::vector<double> latency, per_byte, park, pass_per_byte;
   std::vector<std::vector<double>> inflation(ks.size()), compute(ks.size()), reduction(ks.size());
+  // Interruptions: per thread count, per thread, the gaps and the loop's time.
+  std::vector<std::vector<std::vector<double>>> gaps(ks.size());
+  std::vector<std::vector<double>> spans(ks.size());
+  for (std::size_t i = 0; i < ks.size(); ++i) {
+    gaps[i].resize(ks[i]);
+    spans[i].assign(ks[i], 0.0);
+  }
   // Bytes one pass of the memory body touches (each word once: read, or read and written).
   const double pass_bytes = static_cast<double>(std::max<std::size_t>(c.inflation_bytes / 8, 4096) * 8);
   const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
@@ -368,6 +422,8 @@ Calibration measure_calibration(const CalibrateOptions& options) {
     // compute body about 0.1 ms: 20 passes keep a round within tens of ms.
     std::vector<double> alone_per_byte;
     for (std::size_t i = 0; i < ks.size(); ++i) {
+      if (options.interruption_ms > 0)
+        interruption_gaps(cpus, ks[i], options.interruption_ms * 1e6, gaps[i], spans[i]);
       if (ks[i] < 2) continue;
       std::vector<double> ratio, compute_ratio;
       for (int r = 0; r < rounds; ++r) {
@@ -395,6 +451,19 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   c.sync_latency_ns = c.latency_spread.median;
   c.per_byte_ns = c.per_byte_spread.median;
   c.park_wake_ns = c.park_wake_spread.median;
+  const std::size_t measured = options.interruption_ms > 0 ? ks.size() : 0;
+  for (std::size_t i = 0; i < measured; ++i) {
+    InterruptionsPoint point{static_cast<std::uint32_t>(ks[i]), {}};
+    for (std::size_t t = 0; t < ks[i]; ++t) {
+      double lost = 0;
+      for (double g : gaps[i][t]) lost += g;
+      ThreadInterruptions ti;
+      ti.lost = spans[i][t] > 0 ? std::min(0.5, lost / spans[i][t]) : 0.0;
+      ti.lengths_ns = quantiles(gaps[i][t]);
+      point.cpus.push_back(std::move(ti));
+    }
+    c.interruptions.push_back(std::move(point));
+  }
   for (std::size_t i = 0; i < ks.size(); ++i) {
     const auto k = static_cast<std::uint32_t>(ks[i]);
     if (k < 2) {

@@ -60,6 +60,16 @@ double CostModel::task_inflation(double busy, double cost_ns, double bytes) cons
          cost_ns;
 }
 
+const ThreadInterruptions* CostModel::interruptions_at(std::uint32_t k, std::uint32_t p) const {
+  if (interruptions.empty()) return nullptr;
+  const InterruptionsPoint* at = &interruptions.front();
+  for (const InterruptionsPoint& q : interruptions)
+    if (q.threads <= k) at = &q;
+  if (at->cpus.empty()) return nullptr;
+  const ThreadInterruptions& t = at->cpus[p % at->cpus.size()];
+  return t.lost > 0 && !t.lengths_ns.empty() ? &t : nullptr;
+}
+
 double CostModel::executor_overhead_at(std::uint32_t k) const {
   if (executor_overhead.empty() || k <= 1) return 0.0;
   return curve_at(executor_overhead, k, 0.0);
@@ -188,6 +198,40 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   if (j.contains("reduction")) m.reduction = curve("reduction", "ns", 0.0);
   if (j.contains("executor_overhead"))
     m.executor_overhead = curve("executor_overhead", "ns", 0.0);
+  if (j.contains("interruptions")) {
+    const std::string what =
+        "expected \"interruptions\" as a list of {\"threads\": K, \"cpus\": [{\"lost\": "
+        "share in [0, 0.5], \"lengths_ns\": [ns in [0, 1e9], ...]}, ...]} with K rising from 1";
+    const nlohmann::json& list = j["interruptions"];
+    if (!list.is_array() || list.size() > 1024) throw InputError(name, std::nullopt, what);
+    for (const nlohmann::json& e : list) {
+      const auto bad = [&] { return InputError(name, std::nullopt, what + ", found " + e.dump()); };
+      if (!e.is_object() || !e.contains("threads") || !e["threads"].is_number_integer() ||
+          !e.contains("cpus") || !e["cpus"].is_array() || e["cpus"].size() > 65536)
+        throw bad();
+      const auto k = e["threads"].get<std::int64_t>();
+      if (k < 1 || k > 65536 ||
+          (!m.interruptions.empty() && static_cast<std::uint32_t>(k) <= m.interruptions.back().threads))
+        throw bad();
+      InterruptionsPoint point{static_cast<std::uint32_t>(k), {}};
+      for (const nlohmann::json& c : e["cpus"]) {
+        if (!c.is_object() || !c.contains("lost") || !c["lost"].is_number() ||
+            !c.contains("lengths_ns") || !c["lengths_ns"].is_array() || c["lengths_ns"].size() > 1024)
+          throw bad();
+        ThreadInterruptions t;
+        t.lost = c["lost"].get<double>();
+        if (!std::isfinite(t.lost) || t.lost < 0 || t.lost > 0.5) throw bad();
+        for (const nlohmann::json& x : c["lengths_ns"]) {
+          if (!x.is_number()) throw bad();
+          const double v = x.get<double>();
+          if (!std::isfinite(v) || v < 0 || v > 1e9) throw bad();
+          t.lengths_ns.push_back(v);
+        }
+        point.cpus.push_back(std::move(t));
+      }
+      m.interruptions.push_back(std::move(point));
+    }
+  }
   // Inter-node fields are optional: files written before they existed keep their meaning.
   if (j.contains("mpi_latency_ns")) m.mpi_latency_ns = number("mpi_latency_ns");
   if (j.contains("mpi_per_byte_ns")) m.mpi_per_byte_ns = number("mpi_per_byte_ns");
@@ -249,6 +293,15 @@ std::string calibration_json(const Calibration& c) {
   j["reduction"] = curve_json(c.reduction, "ns");
   if (!c.executor_overhead.empty())
     j["executor_overhead"] = curve_json(c.executor_overhead, "ns");
+  if (!c.interruptions.empty()) {
+    j["interruptions"] = nlohmann::json::array();
+    for (const InterruptionsPoint& p : c.interruptions) {
+      nlohmann::json cpus = nlohmann::json::array();
+      for (const ThreadInterruptions& t : p.cpus)
+        cpus.push_back({{"lost", t.lost}, {"lengths_ns", t.lengths_ns}});
+      j["interruptions"].push_back({{"threads", p.threads}, {"cpus", cpus}});
+    }
+  }
   // How far the samples spread: each value above is their median (the inflation's floored
   // at 1); a model built on a figure whose spread is wide predicts no better than that.
   auto spread = [](const Spread& s) {
@@ -319,6 +372,18 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   curve_text("reduction (threads: ns):", c.reduction, " %u: %.0f");
   if (!c.executor_overhead.empty())
     curve_text("executor's time per task (threads: ns):", c.executor_overhead, " %u: %.1f");
+  if (!c.interruptions.empty()) {
+    out += "time lost to interruptions (threads: % per thread):";
+    for (const InterruptionsPoint& p : c.interruptions) {
+      std::snprintf(line, sizeof line, " %u:", p.threads);
+      out += line;
+      for (std::size_t i = 0; i < p.cpus.size(); ++i) {
+        std::snprintf(line, sizeof line, "%s%.2f", i == 0 ? " " : "/", 100.0 * p.cpus[i].lost);
+        out += line;
+      }
+    }
+    out += "\n";
+  }
   // The spread of each figure over the samples, so that a reader sees how far to trust it.
   auto range = [&](const char* what, const Spread& s, const char* fmt) {
     char a[64], b[64];

@@ -49,7 +49,24 @@ class Simulator {
     // is longer than they spin they have parked and start a wake-up later.
     for (ProcId p = 0; p < k_; ++p)
       state_[p].time = serial_ns + (p != 0 && wake_ > 0 && serial_ns > budget_ ? wake_ : 0);
+    // Each processor's interruptions, seeded by the processor and the step's size.
+    pauses_.resize(k_);
+    for (ProcId p = 0; p < k_; ++p) {
+      const ThreadInterruptions* of = m.interruptions_at(k_, p);
+      if (of == nullptr) continue;
+      double mean = 0;
+      for (double l : of->lengths_ns) mean += l;
+      mean /= static_cast<double>(of->lengths_ns.size());
+      if (mean < 1.0) continue;
+      Pauses& ps = pauses_[p];
+      ps.of = of;
+      ps.mean_gap = mean * (1.0 - of->lost) / of->lost;
+      ps.rng = 0x9e3779b97f4a7c15ull * (p + 1) ^ (total << 17);
+      next_gap(ps);
+    }
     s_.busy_ns.assign(k_, 0);
+    s_.body_ns.assign(k_, 0);
+    s_.kind_body_ns.assign(g.kinds.size(), 0);
     s_.finish_ns.assign(k_, 0);
     s_.waits_between.assign(static_cast<std::size_t>(k_) * k_, 0);
   }
@@ -191,18 +208,69 @@ class Simulator {
       *memo = Memo{i, group, group_remote_end};
     }
     ready = woken(st.time, ready, remote_end);
+    std::uint64_t start = ready;
     const std::uint64_t inst = s_.first_instance[t] + i;
     const double cost = static_cast<double>(g_.tasks[t].cost_ns) *
                         (inflation_ != nullptr ? (*inflation_)[inst] : 1.0);
     const std::uint64_t duration =
         to_ns(cost) + overhead_ +
         static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * per_byte_));
-    s_.start_ns[inst] = ready;
-    s_.end_ns[inst] = ready + duration;
-    st.time = ready + duration;
-    s_.busy_ns[p] += duration;
+    std::uint64_t end = start + duration;
+    if (pauses_[p].of != nullptr) std::tie(start, end) = interrupted(pauses_[p], ready, duration);
+    s_.start_ns[inst] = start;
+    s_.end_ns[inst] = end;
+    st.time = end;
+    s_.busy_ns[p] += end - start;
+    s_.body_ns[p] += to_ns(cost);
+    if (g_.tasks[t].kind < s_.kind_body_ns.size()) s_.kind_body_ns[g_.tasks[t].kind] += to_ns(cost);
     s_.transfer_bytes += bytes;
     return true;
+  }
+
+  // A processor's interruptions, in time order: the next gap is [start, end).
+  struct Pauses {
+    const ThreadInterruptions* of = nullptr;  // nullptr: none
+    double mean_gap = 0;  // mean time from one gap's end to the next's start
+    std::uint64_t rng = 0;
+    std::uint64_t start = 0, end = 0;
+  };
+
+  static std::uint64_t next_random(std::uint64_t& state) {  // splitmix64
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+
+  // Draws the gap after the current one: exponentially spaced (mean_gap), its length one of
+  // the measured ones at random; the processor loses `lost` of its time on average.
+  static void next_gap(Pauses& ps) {
+    const double u = static_cast<double>(next_random(ps.rng) >> 11) * 0x1.0p-53;  // [0, 1)
+    const double spacing = -std::log1p(-u) * ps.mean_gap;
+    const std::vector<double>& lengths = ps.of->lengths_ns;
+    const double length = lengths[next_random(ps.rng) % lengths.size()];
+    ps.start = ps.end + std::max<std::uint64_t>(1, to_ns(spacing));
+    ps.end = ps.start + to_ns(length);
+  }
+
+  // [start, end) of a body of `duration` ns ready at `ready` on a processor interrupted by
+  // `ps`: gaps over before it is ready cost nothing (the processor was waiting); one under
+  // way delays its start; those that begin while it runs lengthen it.
+  static std::pair<std::uint64_t, std::uint64_t> interrupted(Pauses& ps, std::uint64_t ready,
+                                                             std::uint64_t duration) {
+    while (ps.end <= ready) next_gap(ps);
+    std::uint64_t start = ready;
+    if (ps.start <= start) {
+      start = ps.end;
+      next_gap(ps);
+    }
+    std::uint64_t t = start, left = duration;
+    while (ps.start < t + left) {
+      left -= ps.start - t;
+      t = ps.end;
+      next_gap(ps);
+    }
+    return {start, t + left};
   }
 
   // Runs processor p as far as it can; returns whether it moved.
@@ -267,6 +335,7 @@ class Simulator {
   std::vector<std::vector<Item>> items_;
   std::vector<State> state_;
   detail::VersionSet waits_, signals_;
+  std::vector<Pauses> pauses_;  // by processor
 };
 
 
@@ -350,6 +419,7 @@ std::vector<std::string> model_terms(const CostModel& model, bool serial_given, 
   if (model.task_overhead_ns > 0) terms.push_back("task_overhead");
   if (!model.executor_overhead.empty()) terms.push_back("executor_overhead");
   if (model.park_wake_ns > 0) terms.push_back("park_wake");
+  if (!model.interruptions.empty()) terms.push_back("interruptions");
   if (!model.inflation.empty()) terms.push_back("inflation");
   // The compute body's curve, and the memory share that splits a task between the two.
   if (!model.compute_inflation.empty()) terms.push_back("compute_inflation");

@@ -81,6 +81,31 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   EXPECT_DOUBLE_EQ(j.at("replay_speedup").get<double>(), v.replay_speedup);
   EXPECT_EQ(j.at("rounds")[2].at("predicted_sequential_ns").get<std::uint64_t>(),
             v.rounds[2].predicted_sequential_ns);
+  // Where the time went: the live observed pass's bodies and waits beside the simulated
+  // schedule's, and each kind's slow-down in both.
+  std::vector<double> body_ratio;
+  for (const ValidationRound& r : v.rounds) {
+    EXPECT_GT(r.live_body_ns, 0);
+    EXPECT_GE(r.live_wait_ns, 0);
+    EXPECT_GT(r.predicted_body_ns, 0u);
+    // The simulated bodies, overheads and waits fill the two processors' task phases.
+    EXPECT_LE(r.predicted_body_ns + r.predicted_overhead_ns + r.predicted_wait_ns,
+              2 * r.predicted_ns);
+    body_ratio.push_back(static_cast<double>(r.predicted_body_ns) /
+                         static_cast<double>(r.live_body_ns));
+  }
+  EXPECT_DOUBLE_EQ(v.body_predicted_over_live, median(body_ratio));
+  ASSERT_FALSE(v.kinds.empty());
+  const auto compared = std::count_if(v.kinds.begin(), v.kinds.end(), [](const KindInflation& k) {
+    return k.live > 0 && k.predicted > 0;
+  });
+  EXPECT_GT(compared, 0);
+  EXPECT_GT(v.live_inflation, 0.0);
+  EXPECT_GT(v.predicted_inflation, 0.0);
+  EXPECT_DOUBLE_EQ(j.at("body_predicted_over_live").get<double>(), v.body_predicted_over_live);
+  EXPECT_EQ(j.at("kinds").size(), v.kinds.size());
+  EXPECT_EQ(j.at("kinds")[0].at("kind"), v.kinds[0].kind);
+  EXPECT_EQ(j.at("rounds")[0].at("live_body_ns").get<std::int64_t>(), v.rounds[0].live_body_ns);
   // The capture records the live run's steps, so every round replays and simulates the
   // assignments the live run used.
   EXPECT_EQ(v.rounds_with_live_assignments, 3u);
@@ -96,6 +121,8 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
   EXPECT_TRUE(j.at("predicted_ns").is_null());
   EXPECT_TRUE(j.at("predicted_over_live").is_null());
   EXPECT_TRUE(j.at("predicted_speedup_over_live").is_null());
+  EXPECT_TRUE(j.at("body_predicted_over_live").is_null());
+  EXPECT_TRUE(j.at("kinds").empty());
   EXPECT_GT(j.at("replay_speedup_over_live").get<double>(), 0.0);
   EXPECT_GT(j.at("replay_over_live").get<double>(), 0.0);
   EXPECT_EQ(v.rounds_with_live_assignments, 0u);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // measure_calibration (`tgraph calibrate`): what it reports when the machine cannot be measured.
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <pthread.h>
 #include <sched.h>
 
@@ -91,6 +93,22 @@ TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
   EXPECT_EQ(m.inflation, c.inflation);
   EXPECT_EQ(m.compute_inflation, c.compute_inflation);
   EXPECT_EQ(m.inflation_ns_per_byte, c.inflation_ns_per_byte);
+  // Interruptions at every K of the inflation (K = 1 included), one entry per thread: the
+  // share lost in [0, 0.5], at most 32 sorted gap lengths, each at least the threshold.
+  ASSERT_EQ(c.interruptions.size(), c.inflation.size());
+  for (std::size_t i = 0; i < c.interruptions.size(); ++i) {
+    EXPECT_EQ(c.interruptions[i].threads, c.inflation[i].threads);
+    ASSERT_EQ(c.interruptions[i].cpus.size(), c.interruptions[i].threads);
+    for (const ThreadInterruptions& t : c.interruptions[i].cpus) {
+      EXPECT_GE(t.lost, 0.0);
+      EXPECT_LE(t.lost, 0.5);
+      EXPECT_LE(t.lengths_ns.size(), 32u);
+      EXPECT_TRUE(std::is_sorted(t.lengths_ns.begin(), t.lengths_ns.end()));
+      for (double l : t.lengths_ns) EXPECT_GE(l, kInterruptionGapNs);
+      EXPECT_EQ(t.lost > 0, !t.lengths_ns.empty());
+    }
+  }
+  EXPECT_EQ(m.interruptions, c.interruptions);
 }
 
 }  // namespace

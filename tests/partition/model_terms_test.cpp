@@ -162,6 +162,78 @@ TEST(ModelTerms, TheExecutorsTimePerTaskIsChargedAtItsProcessorCountOnly) {
   EXPECT_DOUBLE_EQ(m.executor_overhead_at(8), 0.0);
 }
 
+// One task of `cost` ns.
+StepGraph one_task(std::uint64_t cost) {
+  Builder b;
+  const DatumId x = b.datum("x", 8);
+  b.task({{x, M::W}}, cost);
+  return b.done();
+}
+
+TEST(ModelTerms, InterruptionsTakeTheirShareOfAProcessorsTimeInGapsOfTheMeasuredLengths) {
+  CostModel m = model(10);
+  // One thread busy: 5 % of its time lost in gaps of 50 us.
+  m.interruptions = {{1, {{0.05, {50'000}}}}};
+  // A 1 s body is lengthened by whole gaps, about lost / (1 - lost) of it: 52.6 ms (the
+  // count of gaps is random, seeded: about 1,050 of them, within a tenth of that).
+  const Schedule s = simulate(one_task(1'000'000'000), assign(1, {0}), m);
+  const std::uint64_t added = s.makespan_ns - 1'000'000'000;
+  EXPECT_EQ(added % 50'000, 0u);
+  EXPECT_NEAR(static_cast<double>(added), 1e9 * 0.05 / 0.95, 1e9 * 0.05 / 0.95 / 10);
+  // The same graph, the same schedule.
+  EXPECT_EQ(simulate(one_task(1'000'000'000), assign(1, {0}), m).makespan_ns, s.makespan_ns);
+  // The gaps fall on the processor's time, not on a task: 1000 tasks of 1 ms lose as much.
+  Builder b;
+  const DatumId x = b.datum("x", 8);
+  for (int i = 0; i < 1000; ++i) b.task({{x, M::RW}}, 1'000'000);
+  const Schedule chain = simulate(b.done(), assign(1, std::vector<ProcId>(1000, 0)), m);
+  EXPECT_EQ((chain.makespan_ns - 1'000'000'000) % 50'000, 0u);
+  EXPECT_NEAR(static_cast<double>(chain.makespan_ns - 1'000'000'000), 1e9 * 0.05 / 0.95,
+              1e9 * 0.05 / 0.95 / 10);
+  // No lost time, or no lengths: no gaps.
+  m.interruptions = {{1, {{0.0, {50'000}}}}};
+  EXPECT_EQ(simulate(one_task(1'000'000'000), assign(1, {0}), m).makespan_ns, 1'000'000'000u);
+  m.interruptions = {{1, {{0.05, {}}}}};
+  EXPECT_EQ(simulate(one_task(1'000'000'000), assign(1, {0}), m).makespan_ns, 1'000'000'000u);
+}
+
+TEST(ModelTerms, AnInterruptedProcessorStallsTheOneThatWaitsForIt) {
+  CostModel m = model(10);
+  // At two busy threads only the second CPU is interrupted.
+  m.interruptions = {{1, {{0.0, {}}}}, {2, {{0.0, {}}, {0.1, {20'000, 40'000}}}}};
+  // A 100 ms producer on p1 and its consumer on p0: the consumer starts when the
+  // interrupted producer ends (its gaps of 20 or 40 us included), plus the latency.
+  Builder b;
+  const DatumId x = b.datum("x", 8);
+  b.task({{x, M::W}}, 100'000'000);
+  b.task({{x, M::R}}, 100);
+  const Schedule s = simulate(b.done(), assign(2, {1, 0}), m);
+  const std::uint64_t added = s.end_ns[0] - 100'000'000;
+  EXPECT_EQ(added % 20'000, 0u);
+  EXPECT_NEAR(static_cast<double>(added), 1e8 * 0.1 / 0.9, 1e8 * 0.1 / 0.9 / 5);
+  EXPECT_EQ(s.start_ns[1], s.end_ns[0] + 10);
+  EXPECT_EQ(s.busy_ns[1], 100'000'000 + added);
+  // Its body time is still the task's cost: the gaps are neither body nor waiting.
+  EXPECT_EQ(s.body_ns[1], 100'000'000u);
+  // The other way round, the producer runs uninterrupted on p0.
+  EXPECT_EQ(simulate(b.done(), assign(2, {0, 1}), m).end_ns[0], 100'000'000u);
+}
+
+TEST(ModelTerms, InterruptionsAtKBusyProcessorsComeFromTheMostThreadsMeasuredUpToK) {
+  CostModel m;
+  EXPECT_EQ(m.interruptions_at(2, 0), nullptr);
+  m.interruptions = {{1, {{0.01, {6000}}}}, {2, {{0.02, {7000}}, {0.03, {8000}}}},
+                     {4, {{0.04, {9000}}, {0.0, {9000}}}}};
+  EXPECT_DOUBLE_EQ(m.interruptions_at(1, 0)->lost, 0.01);
+  EXPECT_DOUBLE_EQ(m.interruptions_at(2, 1)->lost, 0.03);
+  // Three threads: the two-thread point, its CPUs in turn.
+  EXPECT_DOUBLE_EQ(m.interruptions_at(3, 2)->lost, 0.02);
+  EXPECT_DOUBLE_EQ(m.interruptions_at(16, 0)->lost, 0.04);
+  EXPECT_EQ(m.interruptions_at(16, 1), nullptr);  // nothing lost there
+  m.interruptions = {{2, {{0.02, {7000}}}}};
+  EXPECT_DOUBLE_EQ(m.interruptions_at(1, 0)->lost, 0.02);  // below the first: the first
+}
+
 TEST(ModelTerms, GivenSerialWorkRunsBeforeTheTasksAndWakesTheOthers) {
   CostModel m = model(10);
   m.spin_budget_ns = 200;
@@ -199,6 +271,10 @@ TEST(ModelTerms, NamesTheTermsAPredictionCharges) {
                                       "executor_overhead", "park_wake", "inflation",
                                       "compute_inflation", "memory_share"}));
   EXPECT_EQ(model_terms(CostModel::ideal(), false, true), (std::vector<std::string>{"host_time"}));
+  m = model(10);
+  m.interruptions = {{1, {{0.02, {7000}}}}};
+  EXPECT_EQ(model_terms(m, false, false),
+            (std::vector<std::string>{"sync_latency", "per_byte", "interruptions"}));
 }
 
 TEST(CalibrationFile, OlderFileWithoutTheNewKeysPredictsAsBefore) {
@@ -224,6 +300,7 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
   c.executor_overhead_spread = {{2, {120, 150.5, 230}}};
   c.compute_inflation = {{1, 1.0}, {2, 1.01}};
   c.inflation_ns_per_byte = 0.045;
+  c.interruptions = {{1, {{0.03, {5200, 48000}}}}, {2, {{0.025, {5100}}, {0.04, {6000, 90000}}}}};
   const std::string text = calibration_json(c);
   const nlohmann::json j = nlohmann::json::parse(text);
   EXPECT_DOUBLE_EQ(j.at("spin_handoff_ns").get<double>(), 70);
@@ -240,6 +317,8 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
   EXPECT_EQ(m.executor_overhead, c.executor_overhead);
   EXPECT_EQ(m.compute_inflation, c.compute_inflation);
   EXPECT_DOUBLE_EQ(m.inflation_ns_per_byte, 0.045);
+  EXPECT_DOUBLE_EQ(j.at("interruptions").at(1).at("cpus").at(1).at("lost").get<double>(), 0.04);
+  EXPECT_EQ(m.interruptions, c.interruptions);
   // Without it (partition's own measurement, an older file): no key, no term.
   c.executor_overhead.clear();
   c.executor_overhead_spread.clear();
@@ -253,7 +332,11 @@ TEST(CalibrationFile, RejectsACurveThatIsNotOne) {
                           R"("inflation": [{"threads": 0, "factor": 1}])",
                           R"("inflation": [{"threads": 2, "factor": -1}])",
                           R"("executor_overhead": [{"threads": 2, "factor": 1}])",
-                          R"("executor_overhead": [{"threads": 2, "ns": -5}])"}) {
+                          R"("executor_overhead": [{"threads": 2, "ns": -5}])",
+                          R"("interruptions": [{"threads": 1}])",
+                          R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.7, "lengths_ns": []}]}])",
+                          R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.1, "lengths_ns": [-1]}]}])",
+                          R"("interruptions": [{"threads": 2, "cpus": []}, {"threads": 2, "cpus": []}])"}) {
     const std::string text =
         std::string(R"({"sync_latency_ns": 80, "per_byte_ns": 0.04, )") + bad + "}";
     try {

@@ -27,6 +27,16 @@ struct ValidateOptions {
   bool live_serial = true;
 };
 
+/// One task kind's slow-down in parallel: the live run's (its observed pass's mean duration
+/// over the observed sequential pass's) beside the simulator's (the kind's simulated body
+/// time, inflated, over the capture's costs).
+struct KindInflation {
+  std::string kind;
+  std::uint64_t instances = 0;  ///< the live observed pass's
+  double live = 0;              ///< 0: no sequential mean to compare with
+  double predicted = 0;         ///< 0: the capture has no instance of the kind
+};
+
 /// One round of a validation: the three measured back to back, so that a machine whose
 /// speed drifts (a shared VM) moves all three alike and their ratios stay comparable.
 struct ValidationRound {
@@ -41,6 +51,18 @@ struct ValidationRound {
   /// The simulator on one processor (the capture's costs and the same serial work, no
   /// synchronisation): the predicted speed-up's denominator (0: no partition).
   std::uint64_t predicted_sequential_ns = 0;
+  /// Where the threads' time went in the steps' task phase, summed over the steps and the
+  /// threads or processors (partition policy only; 0 otherwise). Live, from the observed
+  /// pass (every body timed): time in bodies, in blocked waits, and the rest (idle: the
+  /// executor's and the observers' own time between bodies). Predicted: the simulated
+  /// instances' costs (inflated); the processors' time waiting (the task phase less their
+  /// busy time); the executor's time per task and the transfers.
+  std::int64_t live_body_ns = 0, live_wait_ns = 0, live_idle_ns = 0;
+  std::uint64_t predicted_body_ns = 0, predicted_wait_ns = 0, predicted_overhead_ns = 0;
+  /// The bodies' slow-down over all kinds, weighted by their sequential time: live (the
+  /// observed passes) and predicted (the simulator's inflation); 0: not measured.
+  double live_inflation = 0, predicted_inflation = 0;
+  std::vector<KindInflation> kinds;  ///< by kind (partition policy only)
 };
 
 /// The three figures of one validation: medians over the rounds, and the medians of each
@@ -67,6 +89,13 @@ struct Validation {
   /// run used, step by step (carried-over steps included); the others (a capture whose
   /// steps do not match the live run's) ran the strategy's offline partition of the capture.
   std::uint32_t rounds_with_live_assignments = 0;
+  /// Partition policy: the medians over the rounds of each round's predicted / live time in
+  /// bodies and in waits, of its live and predicted inflation, and per kind of the two
+  /// slow-downs (the first round's kinds): which part of the prediction departs from the
+  /// live run (0 and empty for the other policies).
+  double body_predicted_over_live = 0, wait_predicted_over_live = 0;
+  double live_inflation = 0, predicted_inflation = 0;
+  std::vector<KindInflation> kinds;
 };
 
 /// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a

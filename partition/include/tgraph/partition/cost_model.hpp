@@ -18,6 +18,25 @@ struct ThreadsPoint {
   friend bool operator==(const ThreadsPoint&, const ThreadsPoint&) = default;
 };
 
+/// What takes a busy thread's core from it (interrupts, other processes, a VM's hypervisor)
+/// on one CPU while K threads are busy: the share of wall time lost in gaps of at least
+/// kInterruptionGapNs, and the gaps' lengths.
+struct ThreadInterruptions {
+  double lost = 0;                 ///< share of wall time lost, in [0, 0.5]
+  std::vector<double> lengths_ns;  ///< quantiles of the gaps' lengths (empty: none seen)
+  friend bool operator==(const ThreadInterruptions&, const ThreadInterruptions&) = default;
+};
+/// The interruptions measured with `threads` threads busy at once, thread p on the p-th CPU.
+struct InterruptionsPoint {
+  std::uint32_t threads = 1;
+  std::vector<ThreadInterruptions> cpus;
+  friend bool operator==(const InterruptionsPoint&, const InterruptionsPoint&) = default;
+};
+/// The shortest gap between two clock readings of a spinning thread that counts as an
+/// interruption: shorter ones (a timer tick's handler) slow every task alike and are in
+/// the captured costs; longer ones are what the capture's outlier trim leaves out.
+inline constexpr double kInterruptionGapNs = 5'000.0;
+
 /// The executor's default spin before a waiting thread parks (replay::kDefaultSpinNs, which
 /// partition cannot see: the modules are siblings; measure passes the executor's own).
 inline constexpr double kDefaultSpinBudgetNs = 50'000.0;
@@ -86,7 +105,17 @@ struct CostModel {
   /// task_overhead_ns; sorted by threads, empty: term off. None at one processor (the
   /// sequential engine has no executor), linear between points, beyond the last the last.
   std::vector<ThreadsPoint> executor_overhead;
+  /// Interruptions of busy threads against the number of busy threads (`interruptions` of
+  /// `tgraph calibrate`), sorted by threads; empty: term off. The built-in simulator
+  /// interrupts each processor's tasks at random (a seeded stream per processor: the same
+  /// graph gives the same schedule) so that it loses `lost` of its time in gaps drawn from
+  /// `lengths_ns`; a task that starts inside a gap starts at its end.
+  std::vector<InterruptionsPoint> interruptions;
 
+  /// Processor p's interruptions at k busy processors: the point of the most threads at
+  /// most k (else the first), its CPU p modulo its CPUs; nullptr when there are none (no
+  /// curve, or nothing lost).
+  const ThreadInterruptions* interruptions_at(std::uint32_t k, std::uint32_t p) const;
   /// The inflation factor at `busy` processors busy at once (1 when the curve is empty).
   double inflation_at(double busy) const;
   /// compute_inflation's factor at `busy` processors busy at once (1 when it is empty).
@@ -182,6 +211,10 @@ struct Calibration {
   /// calibrate_file (`tgraph calibrate`, which can run the executor) fills it.
   std::vector<ThreadsPoint> executor_overhead;
   std::vector<CurveSpread> executor_overhead_spread;  ///< over its samples, per K
+  /// K = 1, 2, 4, ... pinned threads each reading the clock in a loop, all at once: per
+  /// thread the share of time lost in gaps of at least kInterruptionGapNs and 32 quantiles
+  /// of their lengths, pooled over the samples.
+  std::vector<InterruptionsPoint> interruptions;
   /// Samples of every measurement (interleaved); each value above is their median, but the
   /// inflation, which is at least 1 (a median below 1 is noise: K copies cannot each run
   /// faster than one alone).
@@ -207,6 +240,7 @@ struct CalibrateOptions {
   std::size_t inflation_bytes = std::size_t{2} << 20;
   int inflation_rounds = 7;           ///< rounds per thread count and sample (median taken)
   int reduction_rounds = 2000;        ///< reductions per thread count
+  double interruption_ms = 60;        ///< per thread count and sample: the clock loop's length
   /// Times every measurement above is taken, interleaved; the medians are kept and the
   /// spread reported (a VM's figures move by several times from one sample to the next).
   int samples = 15;

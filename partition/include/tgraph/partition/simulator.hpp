@@ -19,6 +19,11 @@ namespace tgraph::partition {
 struct Schedule {
   std::uint64_t makespan_ns = 0;
   std::vector<std::uint64_t> busy_ns;     ///< per processor: task cost + transfer time
+  /// Per processor: the bodies' time alone (each instance's cost, inflated when the model
+  /// inflates it), without the per-task overheads and transfers that busy_ns adds.
+  std::vector<std::uint64_t> body_ns;
+  /// The same summed by task kind (indexed by KindId of the step's kinds).
+  std::vector<std::uint64_t> kind_body_ns;
   std::vector<std::uint64_t> finish_ns;   ///< per processor: end of its last task
   std::uint64_t signals = 0;     ///< datum versions (and loop decisions) sent to other processors
   std::uint64_t waits = 0;       ///< (version, receiving processor) pairs
