@@ -132,11 +132,15 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
     const std::vector<std::uint32_t> level_phases =
         task_phases(g, level, options.phases, levels_used);
     if (level_phases != phase) {
+      // The candidates are compared without the machine's random interruptions: one draw
+      // of them is noise, not a difference between the partitions.
+      CostModel model = options.model;
+      model.interruptions.clear();
       const auto predicted = [&](const std::vector<std::uint32_t>& p) {
         Assignment a;
         a.k = k;
         a.proc = p;
-        return simulate(g, a, options.model).makespan_ns;
+        return simulate(g, a, model).makespan_ns;
       };
       std::uint64_t best = predicted(part);
       const Metrics metrics = compute_metrics(g);
