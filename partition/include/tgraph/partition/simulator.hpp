@@ -18,7 +18,9 @@ namespace tgraph::partition {
 /// `first_instance[t] + i` is iteration i of task t (i < g.runs(t)).
 struct Schedule {
   std::uint64_t makespan_ns = 0;
-  std::vector<std::uint64_t> busy_ns;     ///< per processor: task cost + transfer time
+  /// Per processor: its instances' time (cost, per-task overheads, transfers and the
+  /// interruptions that fell inside them).
+  std::vector<std::uint64_t> busy_ns;
   /// Per processor: the bodies' time alone (each instance's cost, inflated when the model
   /// inflates it), without the per-task overheads and transfers that busy_ns adds.
   std::vector<std::uint64_t> body_ns;
@@ -54,6 +56,11 @@ struct Schedule {
 ///   `sync_latency_ns` when the source ran on another processor;
 /// * the first task on a processor that reads a datum version written elsewhere also pays
 ///   `bytes x per_byte_ns`;
+/// * with `model.interruptions`, each processor is interrupted at random (a stream seeded
+///   by the processor and the step's size) by gaps of the measured lengths, so that it
+///   loses the measured share of its time: a gap under way delays a task's start, one
+///   that begins while it runs lengthens it, one that ends while the processor waits
+///   costs nothing;
 /// * a loop body is run by every processor holding some of its tasks (loop control
 ///   replicated, paper section 3.3): iteration i+1 starts, and the loop is left, only once
 ///   the break task of iteration i is known (plus latency if it ran elsewhere);
@@ -71,7 +78,8 @@ std::vector<std::uint64_t> predicted_makespans(
 
 /// The terms a prediction with `model` charges (`model_terms` in the JSON of `tgraph evaluate`
 /// and `tgraph simulate`): "sync_latency", "per_byte" (not with the ideal model),
-/// "task_overhead", "park_wake", "inflation" when the model has them, then
+/// "task_overhead", "executor_overhead", "park_wake", "interruptions", "inflation",
+/// "compute_inflation", "memory_share" when the model has them, then
 /// "serial_main_thread" when the serial work per step was given, else "host_time" when
 /// the trace has host time.
 std::vector<std::string> model_terms(const CostModel& model, bool serial_given, bool host_time);
