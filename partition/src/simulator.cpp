@@ -221,7 +221,8 @@ class Simulator {
     s_.end_ns[inst] = end;
     st.time = end;
     s_.busy_ns[p] += end - start;
-    s_.body_ns[p] += to_ns(cost);
+    // The body's time as a live run's clock sees it: its cost and the gaps inside it.
+    s_.body_ns[p] += to_ns(cost) + (end - start - duration);
     if (g_.tasks[t].kind < s_.kind_body_ns.size()) s_.kind_body_ns[g_.tasks[t].kind] += to_ns(cost);
     s_.transfer_bytes += bytes;
     return true;

@@ -213,8 +213,10 @@ TEST(ModelTerms, AnInterruptedProcessorStallsTheOneThatWaitsForIt) {
   EXPECT_NEAR(static_cast<double>(added), 1e8 * 0.1 / 0.9, 1e8 * 0.1 / 0.9 / 5);
   EXPECT_EQ(s.start_ns[1], s.end_ns[0] + 10);
   EXPECT_EQ(s.busy_ns[1], 100'000'000 + added);
-  // Its body time is still the task's cost: the gaps are neither body nor waiting.
-  EXPECT_EQ(s.body_ns[1], 100'000'000u);
+  // A clock around the body sees the gaps inside it; its kind's cost is the task's alone.
+  EXPECT_EQ(s.body_ns[1], 100'000'000 + added);
+  EXPECT_EQ(s.kind_body_ns[0], 100'000'000u + 100u);
+  EXPECT_EQ(s.body_ns[0], 100u);
   // The other way round, the producer runs uninterrupted on p0.
   EXPECT_EQ(simulate(b.done(), assign(2, {0, 1}), m).end_ns[0], 100'000'000u);
 }

@@ -55,8 +55,9 @@ struct ValidationRound {
   /// threads or processors (partition policy only; 0 otherwise). Live, from the observed
   /// pass (every body timed): time in bodies, in blocked waits, and the rest (idle: the
   /// executor's and the observers' own time between bodies). Predicted: the simulated
-  /// instances' costs (inflated); the processors' time waiting (the task phase less their
-  /// busy time); the executor's time per task and the transfers.
+  /// instances' costs (inflated) and the interruptions inside them (a live body's clock
+  /// sees those); the processors' time waiting (the task phase less their busy time); the
+  /// executor's time per task and the transfers.
   std::int64_t live_body_ns = 0, live_wait_ns = 0, live_idle_ns = 0;
   std::uint64_t predicted_body_ns = 0, predicted_wait_ns = 0, predicted_overhead_ns = 0;
   /// The bodies' slow-down over all kinds, weighted by their sequential time: live (the

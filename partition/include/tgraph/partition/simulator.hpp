@@ -21,10 +21,12 @@ struct Schedule {
   /// Per processor: its instances' time (cost, per-task overheads, transfers and the
   /// interruptions that fell inside them).
   std::vector<std::uint64_t> busy_ns;
-  /// Per processor: the bodies' time alone (each instance's cost, inflated when the model
-  /// inflates it), without the per-task overheads and transfers that busy_ns adds.
+  /// Per processor: the bodies' time as a live run's clock around each body sees it (each
+  /// instance's cost, inflated when the model inflates it, and the interruptions inside
+  /// it), without the per-task overheads and transfers that busy_ns adds.
   std::vector<std::uint64_t> body_ns;
-  /// The same summed by task kind (indexed by KindId of the step's kinds).
+  /// The instances' costs alone (inflated), summed by task kind (indexed by KindId of the
+  /// step's kinds).
   std::vector<std::uint64_t> kind_body_ns;
   std::vector<std::uint64_t> finish_ns;   ///< per processor: end of its last task
   std::uint64_t signals = 0;     ///< datum versions (and loop decisions) sent to other processors
