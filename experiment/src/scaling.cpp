@@ -20,11 +20,15 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/fixed.hpp"
+#include "tgraph/measure/capture.hpp"
 #include "tgraph/measure/engine.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
+#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/policy.hpp"
+#include "tgraph/replay/thread_binding.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/series_chart.hpp"
 
@@ -82,6 +86,7 @@ meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std:
   o.repeat = p.repeat;
   o.baseline = false;
   o.observe = true;
+  o.keep_assignments = m.policy == tr::Policy::kPartition;
   std::optional<tp::StepPartitioner> part;
   if (m.policy == tr::Policy::kPartition) {
     tp::Options po;
@@ -121,6 +126,36 @@ ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::u
   if (thread_time > 0) rec.wait_share = std::max(0.0, thread_time - busy) / thread_time;
   rec.parks_per_step = static_cast<double>(r.parks) / std::max<double>(s.steps, 1);
   return rec;
+}
+
+// The simulator's speed-up of live run `r` (partition policy) on `capture`, the same steps:
+// its assignments when they fit the capture's steps, else the strategy's partition of the
+// capture; its serial work per step; its spin budget (validate's prediction). Over the
+// simulated uninstrumented engine: one processor, the capture's host time as serial work
+// (the live speed-up's reference has no recording, partitioning or plans either).
+double predicted_speedup(const Trace& capture, const std::string& method, std::uint32_t k,
+                         const meas::LiveResult& r, tp::CostModel model) {
+  bool fits = r.assignments.size() == capture.steps.size();
+  for (std::size_t st = 0; fits && st < capture.steps.size(); ++st)
+    fits = validate(capture.steps[st], r.assignments[st], k).empty();
+  const TraceAssignment a = fits ? TraceAssignment{method, k, r.assignments, {}}
+                                 : tp::partition_trace(capture, method, k).assignment;
+  std::vector<std::uint64_t> serial;
+  for (const meas::LiveStepMeasure& st : r.steps)
+    serial.push_back(static_cast<std::uint64_t>(st.record_ns + st.partition_ns + st.prepare_ns));
+  // The partition executor spins on up to kLongSpinNs where every thread has a core.
+  model.spin_budget_ns = static_cast<double>(tr::kDefaultSpinNs);
+  if (k <= tr::hardware_pus())
+    model.spin_budget_ns = std::max(model.spin_budget_ns, static_cast<double>(tr::kLongSpinNs));
+  TraceAssignment one{"single", 1, {}, {}};
+  for (const StepGraph& g : capture.steps)
+    one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
+  double parallel = 0, sequential = 0;
+  for (std::uint64_t ns : tp::predicted_makespans(capture, a, model, &serial))
+    parallel += static_cast<double>(ns);
+  for (std::uint64_t ns : tp::predicted_makespans(capture, one, model, nullptr))
+    sequential += static_cast<double>(ns);
+  return parallel > 0 ? sequential / parallel : 0.0;
 }
 
 ScalingMiss miss_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
@@ -164,12 +199,14 @@ viz::SeriesChart speedup_chart(const ScalingResult& res, const std::string& scen
 std::string results_csv(const ScalingResult& res) {
   std::ostringstream csv;
   csv << "scene,policy,method,threads,speedup,serial_share,inflation,wait_share,parks_per_step,"
-         "partitioned_steps,steps,wall_ns,sequential_wall_ns\n";
+         "partitioned_steps,predicted_speedup,predicted_over_live,steps,wall_ns,"
+         "sequential_wall_ns\n";
   csv << std::setprecision(6);
   for (const ScalingRecord& r : res.records)
     csv << r.scene << ',' << r.policy << ',' << r.method << ',' << r.threads << ',' << r.speedup
         << ',' << r.serial_share << ',' << r.inflation << ',' << r.wait_share << ','
-        << r.parks_per_step << ',' << r.partitioned_steps << ',' << r.steps << ',' << r.wall_ns
+        << r.parks_per_step << ',' << r.partitioned_steps << ',' << r.predicted_speedup << ','
+        << r.predicted_over_live << ',' << r.steps << ',' << r.wall_ns
         << ',' << r.sequential_wall_ns << '\n';
   return csv.str();
 }
@@ -280,6 +317,9 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
                 " methods, " + std::to_string(p.threads.size()) + " thread counts; " +
                 std::to_string(p.runs()) + " runs");
   for (const std::string& n : p.notes) progress.note(n);
+  // The partition runs' predictions: the default calibration file when there is one.
+  const tp::CostModel model = tp::select_cost_model("calibrated", "");
+  progress.note("predictions: cost model " + model.source);
 
   for (const ScalingScene& s : p.scenes) {
     const std::string label = s.label();
@@ -299,6 +339,8 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
       continue;
     }
     res.references.push_back(ref);
+    // The capture the partition runs' predictions simulate (taken once per scene).
+    std::optional<Trace> capture;
     // Every method at one thread count before the next count: drift of the machine over the
     // sweep falls on thread counts alike, not on one method.
     for (std::uint32_t k : p.threads)
@@ -307,12 +349,22 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
         progress.begin(run);
         try {
           const meas::LiveResult r = live_run(s, method, k, p);
-          const ScalingRecord rec = record_of(s, method, k, r, ref);
+          ScalingRecord rec = record_of(s, method, k, r, ref);
+          const meas::MethodChoice m = meas::choose_method(method);
+          if (m.policy == tr::Policy::kPartition) {
+            if (!capture) capture = meas::capture_trace(s.scene, s.steps, scene_options(s));
+            rec.predicted_speedup = predicted_speedup(*capture, m.method, k, r, model);
+            if (rec.speedup > 0) rec.predicted_over_live = rec.predicted_speedup / rec.speedup;
+          }
           progress.end(run + ": speed-up " + fixed(rec.speedup, 2) + ", serial " +
                        fixed(rec.serial_share, 3) + ", inflation " + fixed(rec.inflation, 2) +
                        ", wait " + fixed(rec.wait_share, 2) + ", parks/step " +
                        fixed(rec.parks_per_step, 1) + ", partitioned " +
-                       std::to_string(rec.partitioned_steps) + "/" + std::to_string(s.steps));
+                       std::to_string(rec.partitioned_steps) + "/" + std::to_string(s.steps) +
+                       (rec.predicted_speedup > 0
+                            ? ", predicted " + fixed(rec.predicted_speedup, 2) + " (x" +
+                                  fixed(rec.predicted_over_live, 2) + ")"
+                            : std::string()));
           res.records.push_back(rec);
         } catch (const UsageError& e) {
           // The policy refuses this configuration (StarPU above its CPU workers): not a failure.
@@ -348,7 +400,13 @@ std::string scaling_json(const ScalingResult& res, int indent) {
        "threads' time outside task bodies (waiting, parked, searching, idle) / (threads x "
        "executor wall time), observed pass"},
       {"parks_per_step", "parks (futex waits) of all threads / steps, first timed pass"},
-      {"partitioned_steps", "steps at which the partitioner was called, first timed pass"}};
+      {"partitioned_steps", "steps at which the partitioner was called, first timed pass"},
+      {"predicted_speedup",
+       "partition policy: the built-in simulator's makespan of a capture of the same steps "
+       "with the live run's assignments and serial work per step (default calibration), "
+       "against its one-processor makespan with the capture's host time (the uninstrumented "
+       "engine); null for the baselines"},
+      {"predicted_over_live", "predicted_speedup / speedup; null for the baselines"}};
   j["machine"] = res.machine.summary();
   j["cores"] = res.plan.cores;
   j["date"] = res.date;
@@ -374,7 +432,13 @@ std::string scaling_json(const ScalingResult& res, int indent) {
                             {"inflation", r.inflation},
                             {"wait_share", r.wait_share},
                             {"parks_per_step", r.parks_per_step},
-                            {"partitioned_steps", r.partitioned_steps}});
+                            {"partitioned_steps", r.partitioned_steps},
+                            {"predicted_speedup", r.predicted_speedup > 0
+                                                      ? nlohmann::json(r.predicted_speedup)
+                                                      : nlohmann::json(nullptr)},
+                            {"predicted_over_live", r.predicted_over_live > 0
+                                                        ? nlohmann::json(r.predicted_over_live)
+                                                        : nlohmann::json(nullptr)}});
   for (const auto& [key, list] : {std::pair{"skipped", &res.skipped}, std::pair{"failed", &res.failed}}) {
     j[key] = nlohmann::json::array();
     for (const ScalingMiss& m : *list)
@@ -397,13 +461,18 @@ std::string scaling_text(const ScalingResult& res) {
   s << std::left << std::setw(14) << "scene" << std::setw(11) << "method" << std::right
     << std::setw(4) << "K" << std::setw(9) << "speed-up" << std::setw(8) << "serial"
     << std::setw(10) << "inflation" << std::setw(7) << "wait" << std::setw(12) << "parks/step"
-    << std::setw(13) << "partitioned" << "\n";
+    << std::setw(13) << "partitioned" << std::setw(11) << "predicted" << std::setw(11)
+    << "pred/live" << "\n";
   for (const ScalingRecord& r : res.records)
     s << std::left << std::setw(14) << r.scene << std::setw(11) << r.method << std::right
       << std::setw(4) << r.threads << std::setw(9) << fixed(r.speedup, 2) << std::setw(8)
       << fixed(r.serial_share, 3) << std::setw(10) << fixed(r.inflation, 2) << std::setw(7)
       << fixed(r.wait_share, 2) << std::setw(12) << fixed(r.parks_per_step, 1) << std::setw(13)
-      << (std::to_string(r.partitioned_steps) + "/" + std::to_string(r.steps)) << "\n";
+      << (std::to_string(r.partitioned_steps) + "/" + std::to_string(r.steps)) << std::setw(11)
+      << (r.predicted_speedup > 0 ? fixed(r.predicted_speedup, 2) : std::string("-"))
+      << std::setw(11)
+      << (r.predicted_over_live > 0 ? fixed(r.predicted_over_live, 2) : std::string("-"))
+      << "\n";
   for (const ScalingMiss& m : res.skipped)
     s << "skipped " << m.scene << " " << m.method << " K=" << m.threads << ": " << m.reason << "\n";
   for (const ScalingMiss& m : res.failed)

@@ -15,7 +15,8 @@ from experiment_check import check, problems, run_quick_json  # noqa: E402
 
 tgraph = sys.argv[1]
 KEYS = {"scene", "policy", "method", "threads", "speedup", "serial_share", "inflation",
-        "wait_share", "parks_per_step", "partitioned_steps"}
+        "wait_share", "parks_per_step", "partitioned_steps", "predicted_speedup",
+        "predicted_over_live"}
 SCENES = {"bars64": 2, "falling64": 3, "torso": 3, "cloth256-s64": 1}  # --quick's steps
 BASELINES = {"worksteal", "barrier", "omp-tasks", "starpu"}
 
@@ -58,8 +59,18 @@ with tempfile.TemporaryDirectory() as tmp:
               0 <= r["partitioned_steps"] <= (steps or 0), f"partitioned_steps of {r}")
         if baseline:
             check(r["partitioned_steps"] == 0, f"a baseline partitioned: {r}")
+            check(r["predicted_speedup"] is None and r["predicted_over_live"] is None,
+                  f"a baseline with a prediction: {r}")
         else:
             check(r["partitioned_steps"] >= 1, f"the first step was not partitioned: {r}")
+            # The simulator's speed-up of the same steps, beside the live one: about the thread
+            # count at most (one processor's makespan with the engine's host time over K's with
+            # the live run's serial work), and the ratio is the two's.
+            p = r["predicted_speedup"]
+            check(p is not None and 0 < p <= 1.1 * r["threads"], f"predicted_speedup of {r}")
+            if p is not None:
+                check(abs(r["predicted_over_live"] - p / r["speedup"]) < 1e-9 * p / r["speedup"],
+                      f"predicted_over_live of {r}")
     skipped = {(s["scene"], s["method"], s["threads"]) for s in j["skipped"]}
     for scene in SCENES:
         for m in methods:

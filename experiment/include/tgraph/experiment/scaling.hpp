@@ -83,7 +83,14 @@ ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
 ///   (only the partition executor reports its waits apart, so the share counts them all);
 /// - parks_per_step: the threads' parks (futex waits) per step, first timed pass;
 /// - partitioned_steps: steps at which the partitioner was called, first timed pass (0 for
-///   the baselines).
+///   the baselines);
+/// - predicted_speedup, predicted_over_live (partition policy): the built-in simulator's
+///   makespan of a capture of the same steps with the assignments the live run used (its
+///   first timed pass; the strategy's partition of the capture when the capture's steps
+///   differ) and the live run's serial work per step, under the default calibration (or
+///   the defaults), against its one-processor makespan with the capture's own host time
+///   (the uninstrumented engine, the live speed-up's reference); and that over the live
+///   speed-up.
 struct ScalingRecord {
   std::string scene;   ///< ScalingScene::label()
   std::string policy;  ///< replay::Policy name
@@ -95,6 +102,12 @@ struct ScalingRecord {
   double wait_share = 0;
   double parks_per_step = 0;
   std::uint32_t partitioned_steps = 0;
+  /// Partition policy: the built-in simulator's speed-up of the same steps (a capture of
+  /// the scene, the assignments the live run used, its serial work per step, the default
+  /// calibration; over one processor with the capture's host time), and that over the live
+  /// speed-up; 0 for the baselines.
+  double predicted_speedup = 0;
+  double predicted_over_live = 0;
   // Beside the record (results.csv, the text table), not in results.json's `scaling`:
   std::uint32_t steps = 0;
   std::int64_t wall_ns = 0;             ///< median pass
