@@ -24,11 +24,12 @@
 #include "tgraph/measure/engine.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
+#include "tgraph/measure/validate.hpp"
 #include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
+#include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/policy.hpp"
-#include "tgraph/replay/thread_binding.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/series_chart.hpp"
 
@@ -135,25 +136,14 @@ ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::u
 // (the live speed-up's reference has no recording, partitioning or plans either).
 double predicted_speedup(const Trace& capture, const std::string& method, std::uint32_t k,
                          const meas::LiveResult& r, tp::CostModel model) {
-  bool fits = r.assignments.size() == capture.steps.size();
-  for (std::size_t st = 0; fits && st < capture.steps.size(); ++st)
-    fits = validate(capture.steps[st], r.assignments[st], k).empty();
-  const TraceAssignment a = fits ? TraceAssignment{method, k, r.assignments, {}}
-                                 : tp::partition_trace(capture, method, k).assignment;
-  std::vector<std::uint64_t> serial;
-  for (const meas::LiveStepMeasure& st : r.steps)
-    serial.push_back(static_cast<std::uint64_t>(st.record_ns + st.partition_ns + st.prepare_ns));
-  // The partition executor spins on up to kLongSpinNs where every thread has a core.
-  model.spin_budget_ns = static_cast<double>(tr::kDefaultSpinNs);
-  if (k <= tr::hardware_pus())
-    model.spin_budget_ns = std::max(model.spin_budget_ns, static_cast<double>(tr::kLongSpinNs));
-  TraceAssignment one{"single", 1, {}, {}};
-  for (const StepGraph& g : capture.steps)
-    one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
+  const TraceAssignment a = meas::live_assignment(capture, r.assignments, method, k, nullptr);
+  const std::vector<std::uint64_t> serial = meas::live_serial_work(r);
+  model.spin_budget_ns = meas::live_spin_budget_ns(k, tr::kDefaultSpinNs);
   double parallel = 0, sequential = 0;
   for (std::uint64_t ns : tp::predicted_makespans(capture, a, model, &serial))
     parallel += static_cast<double>(ns);
-  for (std::uint64_t ns : tp::predicted_makespans(capture, one, model, nullptr))
+  for (std::uint64_t ns : tp::predicted_makespans(capture, meas::one_processor(capture), model,
+                                                  nullptr))
     sequential += static_cast<double>(ns);
   return parallel > 0 ? sequential / parallel : 0.0;
 }

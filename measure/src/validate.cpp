@@ -22,17 +22,35 @@ namespace tgraph::measure {
 
 namespace tr = tgraph::replay;
 
-namespace {
-
-/// Whether `ran` (a live run's assignments) assigns every step of `trace`, task for task.
-bool live_ran(const Trace& trace, const std::vector<Assignment>& ran, std::uint32_t k) {
-  if (ran.size() != trace.steps.size()) return false;
-  for (std::size_t s = 0; s < ran.size(); ++s)
-    if (!validate(trace.steps[s], ran[s], k).empty()) return false;
-  return true;
+std::vector<std::uint64_t> live_serial_work(const LiveResult& r) {
+  std::vector<std::uint64_t> serial;
+  for (const LiveStepMeasure& m : r.steps)
+    serial.push_back(static_cast<std::uint64_t>(m.record_ns + m.partition_ns + m.prepare_ns));
+  return serial;
 }
 
-}  // namespace
+TraceAssignment live_assignment(const Trace& capture, const std::vector<Assignment>& ran,
+                                const std::string& method, std::uint32_t k, bool* live) {
+  bool fits = ran.size() == capture.steps.size();
+  for (std::size_t s = 0; fits && s < ran.size(); ++s)
+    fits = validate(capture.steps[s], ran[s], k).empty();
+  if (live != nullptr) *live = fits;
+  if (fits) return TraceAssignment{method, k, ran, {}};
+  return partition::partition_trace(capture, method, k).assignment;
+}
+
+TraceAssignment one_processor(const Trace& trace) {
+  TraceAssignment one{"single", 1, {}, {}};
+  for (const StepGraph& g : trace.steps)
+    one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
+  return one;
+}
+
+double live_spin_budget_ns(std::uint32_t k, std::int64_t spin_ns) {
+  double budget = static_cast<double>(spin_ns);
+  if (k <= tr::hardware_pus()) budget = std::max(budget, static_cast<double>(tr::kLongSpinNs));
+  return budget;
+}
 
 Validation validate(const ValidateOptions& o) {
   Validation v;
@@ -66,10 +84,9 @@ Validation validate(const ValidateOptions& o) {
     r.live_ns = live.wall_ns;
     r.engine_ns = live.baseline_wall_ns;
     // The main thread's work between the steps' tasks, as this live run measured it.
-    std::vector<std::uint64_t> serial;
+    const std::vector<std::uint64_t> serial = live_serial_work(live);
+    for (std::uint64_t ns : serial) r.serial_ns += ns;
     for (const LiveStepMeasure& m : live.steps) {
-      serial.push_back(static_cast<std::uint64_t>(m.record_ns + m.partition_ns + m.prepare_ns));
-      r.serial_ns += serial.back();
       for (const replay::StatsObserver::Thread& t : m.threads) {
         r.live_body_ns += t.busy_ns;
         r.live_wait_ns += t.wait_ns;
@@ -79,9 +96,8 @@ Validation validate(const ValidateOptions& o) {
     // The simulated threads wait as the live run's did: spinning this long, then parked. The
     // partition executor spins on up to kLongSpinNs while the thread it waits for runs, where
     // every thread has a core of its own.
-    model.spin_budget_ns = static_cast<double>(lo.exec.spin_ns);
-    if (partition && lo.exec.threads <= tr::hardware_pus())
-      model.spin_budget_ns = std::max(model.spin_budget_ns, static_cast<double>(tr::kLongSpinNs));
+    model.spin_budget_ns = partition ? live_spin_budget_ns(lo.exec.threads, lo.exec.spin_ns)
+                                     : static_cast<double>(lo.exec.spin_ns);
 
     // 2. A capture of the same steps, replayed with synthetic bodies under the same policy.
     const Trace trace = capture_trace(o.scene, o.steps, o.scene_options);
@@ -90,11 +106,10 @@ Validation validate(const ValidateOptions& o) {
     // the carried-over ones of changed structures included, when the capture recorded the
     // same steps (the scenes are deterministic); else the strategy's partition of the capture.
     std::optional<TraceAssignment> assignment;
-    if (partition && live_ran(trace, live.assignments, v.threads)) {
-      assignment = TraceAssignment{v.choice.method, v.threads, live.assignments, {}};
-      ++v.rounds_with_live_assignments;
-    } else if (partition) {
-      assignment = partition::partition_trace(trace, v.choice.method, v.threads).assignment;
+    if (partition) {
+      bool ran = false;
+      assignment = live_assignment(trace, live.assignments, v.choice.method, v.threads, &ran);
+      if (ran) ++v.rounds_with_live_assignments;
     }
     ReplayOptions ro;
     ro.policy = v.choice.policy;
@@ -153,10 +168,7 @@ Validation validate(const ValidateOptions& o) {
       }
       if (live_seq > 0) r.live_inflation = live_par / live_seq;
       if (pred_cost > 0) r.predicted_inflation = pred_inflated / pred_cost;
-      TraceAssignment one{"single", 1, {}, {}};
-      for (const StepGraph& g : trace.steps)
-        one.steps.push_back(Assignment{1, std::vector<ProcId>(g.tasks.size(), 0), {}});
-      for (std::uint64_t ns : partition::predicted_makespans(trace, one, model,
+      for (std::uint64_t ns : partition::predicted_makespans(trace, one_processor(trace), model,
                                                              o.live_serial ? &serial : nullptr))
         r.predicted_sequential_ns += ns;
     }

@@ -7,6 +7,9 @@
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/trace.hpp"
+#include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
 #include "tgraph/samples/scene.hpp"
 
@@ -98,6 +101,21 @@ struct Validation {
   double live_inflation = 0, predicted_inflation = 0;
   std::vector<KindInflation> kinds;
 };
+
+// The pieces of a live run's prediction (`validate`'s, `experiment scaling`'s).
+
+/// The main thread's serial work of each step of live run `r` (record + partition + prepare).
+std::vector<std::uint64_t> live_serial_work(const LiveResult& r);
+/// The assignments a prediction of `capture` simulates for a partition run of `method` on
+/// `k` threads: the live run's (`ran`, one per step) when they assign every step of the
+/// capture task for task (`*live` true), else the strategy's partition of the capture.
+TraceAssignment live_assignment(const Trace& capture, const std::vector<Assignment>& ran,
+                                const std::string& method, std::uint32_t k, bool* live);
+/// Every task of every step of `trace` on one processor.
+TraceAssignment one_processor(const Trace& trace);
+/// How long the partition executor's waits spin before parking on `k` threads with its
+/// ExecOptions::spin_ns: up to replay::kLongSpinNs where every thread has a core of its own.
+double live_spin_budget_ns(std::uint32_t k, std::int64_t spin_ns);
 
 /// Runs `repeat` rounds of: the live run (one pass, against the uninstrumented engine), a
 /// capture of the same steps, its replay under the same policy (one pass) and the
