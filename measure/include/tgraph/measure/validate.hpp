@@ -9,11 +9,12 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::measure {
+
+struct LiveResult;  // tgraph/measure/live.hpp
 
 /// What to validate.
 struct ValidateOptions {
