@@ -111,8 +111,8 @@ ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::u
   const double sequential = static_cast<double>(ref.sequential_wall_ns);
   if (r.wall_ns > 0) rec.speedup = sequential / static_cast<double>(r.wall_ns);
   double serial = 0, busy = 0, thread_time = 0;
+  for (std::uint64_t ns : meas::live_serial_work(r)) serial += static_cast<double>(ns);
   for (const meas::LiveStepMeasure& st : r.steps) {
-    serial += static_cast<double>(st.record_ns + st.partition_ns + st.prepare_ns);
     rec.partitioned_steps += st.partitioned ? 1 : 0;
     for (const tr::StatsObserver::Thread& t : st.threads) {
       busy += static_cast<double>(t.busy_ns);
