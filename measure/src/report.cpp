@@ -343,7 +343,10 @@ std::string to_json(const Validation& v, const ValidateOptions& o) {
     kinds.push_back({{"kind", k.kind},
                      {"instances", k.instances},
                      {"live_inflation", or_null(k.live)},
-                     {"predicted_inflation", or_null(k.predicted)}});
+                     {"predicted_inflation", or_null(k.predicted)},
+                     {"live_mean_ns", or_null(k.live_mean_ns)},
+                     {"sequential_mean_ns", or_null(k.sequential_mean_ns)},
+                     {"captured_mean_ns", or_null(k.captured_mean_ns)}});
   j["kinds"] = kinds;
   j["model"] = v.model;
   j["model_terms"] = v.model_terms;

@@ -124,6 +124,7 @@ Validation validate(const ValidateOptions& o) {
     // 3. The simulator's makespan of the same partition (partition policy only).
     if (assignment) {
       std::map<std::string, std::pair<double, double>> by_kind;  // inflated, capture's cost
+      std::map<std::string, double> kind_instances;              // the capture's instances
       for (std::size_t s = 0; s < trace.steps.size() && s < assignment->steps.size(); ++s) {
         const StepGraph& g = trace.steps[s];
         std::optional<std::uint64_t> serial_s;
@@ -142,10 +143,12 @@ Validation validate(const ValidateOptions& o) {
         const std::uint64_t phase =
             sched.makespan_ns > before ? (sched.makespan_ns - before) * v.threads : 0;
         r.predicted_wait_ns += phase > busy ? phase - busy : 0;
-        for (TaskId t = 0; t < g.tasks.size(); ++t)
-          by_kind[g.kind_name(t)].second +=
-              static_cast<double>(g.tasks[t].cost_ns) *
+        for (TaskId t = 0; t < g.tasks.size(); ++t) {
+          const double n =
               static_cast<double>(sched.first_instance[t + 1] - sched.first_instance[t]);
+          by_kind[g.kind_name(t)].second += static_cast<double>(g.tasks[t].cost_ns) * n;
+          kind_instances[g.kind_name(t)] += n;
+        }
         for (std::size_t k = 0; k < g.kinds.size() && k < sched.kind_body_ns.size(); ++k)
           by_kind[g.kinds[k]].first += static_cast<double>(sched.kind_body_ns[k]);
       }
@@ -153,10 +156,16 @@ Validation validate(const ValidateOptions& o) {
       double live_par = 0, live_seq = 0, pred_inflated = 0, pred_cost = 0;
       for (const KindTime& k : live.kinds) {
         KindInflation ki{k.kind, k.instances, 0, 0};
+        ki.live_mean_ns = k.mean_ns;
+        ki.sequential_mean_ns = k.sequential_mean_ns;
         if (k.sequential_mean_ns > 0) ki.live = k.mean_ns / k.sequential_mean_ns;
         const auto it = by_kind.find(k.kind);
-        if (it != by_kind.end() && it->second.second > 0)
+        if (it != by_kind.end() && it->second.second > 0) {
           ki.predicted = it->second.first / it->second.second;
+          const auto n = kind_instances.find(k.kind);
+          if (n != kind_instances.end() && n->second > 0)
+            ki.captured_mean_ns = it->second.second / n->second;
+        }
         if (ki.live > 0 && ki.predicted > 0) {
           const double n = static_cast<double>(k.instances);
           live_par += k.mean_ns * n;
@@ -218,15 +227,21 @@ Validation validate(const ValidateOptions& o) {
     // Per kind (the first round's), the medians of its two slow-downs over the rounds.
     for (const KindInflation& k : v.rounds.front().kinds) {
       KindInflation m = k;
-      std::vector<double> l, p;
+      std::vector<double> l, p, lm, sm, cm;
       for (const ValidationRound& r : v.rounds)
         for (const KindInflation& x : r.kinds)
           if (x.kind == k.kind) {
             if (x.live > 0) l.push_back(x.live);
             if (x.predicted > 0) p.push_back(x.predicted);
+            if (x.live_mean_ns > 0) lm.push_back(x.live_mean_ns);
+            if (x.sequential_mean_ns > 0) sm.push_back(x.sequential_mean_ns);
+            if (x.captured_mean_ns > 0) cm.push_back(x.captured_mean_ns);
           }
       m.live = l.empty() ? 0 : median(l);
       m.predicted = p.empty() ? 0 : median(p);
+      m.live_mean_ns = lm.empty() ? 0 : median(lm);
+      m.sequential_mean_ns = sm.empty() ? 0 : median(sm);
+      m.captured_mean_ns = cm.empty() ? 0 : median(cm);
       v.kinds.push_back(std::move(m));
     }
   }

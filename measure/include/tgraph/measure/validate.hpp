@@ -39,6 +39,9 @@ struct KindInflation {
   std::uint64_t instances = 0;  ///< the live observed pass's
   double live = 0;              ///< 0: no sequential mean to compare with
   double predicted = 0;         ///< 0: the capture has no instance of the kind
+  double live_mean_ns = 0;        ///< an instance's mean time in the policy's observed pass
+  double sequential_mean_ns = 0;  ///< the same in the sequential observed pass
+  double captured_mean_ns = 0;    ///< the capture's cost per instance (0: no instance)
 };
 
 /// One round of a validation: the three measured back to back, so that a machine whose
