@@ -177,8 +177,11 @@ Validation validate(const ValidateOptions& o) {
       }
       if (live_seq > 0) r.live_inflation = live_par / live_seq;
       if (pred_cost > 0) r.predicted_inflation = pred_inflated / pred_cost;
-      for (std::uint64_t ns : partition::predicted_makespans(trace, one_processor(trace), model,
-                                                             o.live_serial ? &serial : nullptr))
+      // The live speed-up's reference is the uninstrumented engine, which neither records
+      // nor partitions: the simulated one is one processor with the capture's host time
+      // (the engine's own work outside the tasks), not the live run's serial work.
+      for (std::uint64_t ns :
+           partition::predicted_makespans(trace, one_processor(trace), model, nullptr))
         r.predicted_sequential_ns += ns;
     }
     if (round == 0) {

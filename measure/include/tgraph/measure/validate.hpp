@@ -55,8 +55,9 @@ struct ValidationRound {
   std::uint64_t serial_ns = 0;     ///< the live run's serial work the prediction charged
   /// Sequential pass of the same replay, same round (its speed-up's denominator).
   std::int64_t replay_sequential_ns = 0;
-  /// The simulator on one processor (the capture's costs and the same serial work, no
-  /// synchronisation): the predicted speed-up's denominator (0: no partition).
+  /// The simulator on one processor (the capture's costs and host time, no synchronisation:
+  /// the simulated uninstrumented engine, as `engine_ns` is the live speed-up's): the
+  /// predicted speed-up's denominator (0: no partition).
   std::uint64_t predicted_sequential_ns = 0;
   /// Where the threads' time went in the steps' task phase, summed over the steps and the
   /// threads or processors (partition policy only; 0 otherwise). Live, from the observed
