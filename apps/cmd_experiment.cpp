@@ -36,6 +36,9 @@ void add_experiment(CLI::App& app) {
   cmd->add_flag_function(
       "--replay,!--no-replay", [o](std::int64_t n) { o->replay = n > 0; },
       "Also replay the captured trace with synthetic bodies (default, except for domain), or not");
+  cmd->add_option("--calibration", o->calibration,
+                  "Calibration file of the predictions (tgraph calibrate --out; default: the "
+                  "default calibration file when there is one)");
   cmd->add_flag("--json", a->json, "Print results.json on stdout");
   o->words = experiment::words_with("tgraph experiment", flag_of);  // the command to rerun it
   cmd->callback([o, a] {

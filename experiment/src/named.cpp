@@ -20,13 +20,16 @@ NamedRun run_named(std::string_view name, const ExperimentOptions& o, Progress& 
   if (!o.subobjects.empty())
     throw OptionError("subobjects", "applies to the domain experiment only");
   if (name == "metg") {
+    if (!o.calibration.empty())
+      throw OptionError("calibration", "metg predicts nothing: it measures each policy");
     const MetgResult r = run_metg({o.quick, o.out, o.threads, o.methods, o.words}, progress);
     return {metg_text(r), metg_json(r), 0};
   }
   if (name == "scaling") {
     if (o.replay) throw OptionError("replay", "the scaling experiment makes live runs only");
-    const ScalingResult r =
-        run_scaling({o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words}, progress);
+    const ScalingResult r = run_scaling(
+        {o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words, o.calibration},
+        progress);
     return {scaling_text(r), scaling_json(r), r.failed.size()};
   }
   throw UsageError("unknown experiment '" + std::string(name) + "' (expected " +

@@ -6,6 +6,7 @@
 #include "common.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/partition/cost_model.hpp"
 
 namespace tgraph::experiment {
 namespace {
@@ -95,6 +96,7 @@ Invocation ExperimentPlan::invocation() const {
     if (!subs.empty()) inv.settings.push_back({"subobjects", join(subs)});
   }
   inv.settings.push_back({"replay", std::nullopt, replay});
+  if (!calibration.empty()) inv.settings.push_back({"calibration", calibration});
   inv.settings.push_back({"out", out_dir});
   return inv;
 }
@@ -107,6 +109,9 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
   p.cores = std::max(cores, 1u);
   p.out_dir = o.out.empty() ? "tgraph-experiment-" + std::string(to_string(o.name)) : o.out;
   p.words = o.words;
+  // Read now: a bad file stops the experiment before its first run.
+  if (!o.calibration.empty()) (void)partition::select_cost_model("calibrated", o.calibration);
+  p.calibration = o.calibration;
   const std::vector<std::uint32_t> ks =
       o.threads.empty() ? default_thread_list(p.cores) : thread_counts(o.threads);
   p.threads = split_threads(ks, p.cores);

@@ -208,8 +208,9 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
                 std::to_string(p.threads.predicted.size()) + " more; " + std::to_string(p.runs()) +
                 " runs");
   for (const std::string& n : p.notes) progress.note(n);
-  // The default calibration file when `tgraph calibrate` wrote one, else the defaults.
-  const tp::CostModel model = tp::select_cost_model("calibrated", "");
+  // --calibration, else the default calibration file when `tgraph calibrate` wrote one,
+  // else the defaults.
+  const tp::CostModel model = tp::select_cost_model("calibrated", p.calibration);
   res.cost_model = model.source == tp::CostModel::defaults().source ? "defaults" : model.source;
 
   for (const SceneVariant& v : p.scenes) {

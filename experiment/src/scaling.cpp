@@ -249,6 +249,7 @@ Invocation ScalingPlan::invocation() const {
       scenes.size() > 1)
     inv.settings.push_back({"steps", std::to_string(scenes.front().steps)});
   inv.settings.push_back({"repeat", std::to_string(repeat)});
+  if (!calibration.empty()) inv.settings.push_back({"calibration", calibration});
   inv.settings.push_back({"out", out_dir});
   return inv;
 }
@@ -261,6 +262,9 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
   p.quick = o.quick;
   p.out_dir = o.out.empty() ? "tgraph-experiment-scaling" : o.out;
   p.words = o.words;
+  // Read now, so that a bad file stops the sweep before its first run, not after hours.
+  if (!o.calibration.empty()) (void)tp::select_cost_model("calibrated", o.calibration);
+  p.calibration = o.calibration;
   if (o.steps && *o.steps == 0) throw OptionError("steps", "must be at least 1");
   if (o.repeat && *o.repeat == 0) throw OptionError("repeat", "must be at least 1");
   if (!o.threads.empty())
@@ -307,8 +311,9 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
                 " methods, " + std::to_string(p.threads.size()) + " thread counts; " +
                 std::to_string(p.runs()) + " runs");
   for (const std::string& n : p.notes) progress.note(n);
-  // The partition runs' predictions: the default calibration file when there is one.
-  const tp::CostModel model = tp::select_cost_model("calibrated", "");
+  // The partition runs' predictions: --calibration, else the default calibration file when
+  // there is one.
+  const tp::CostModel model = tp::select_cost_model("calibrated", p.calibration);
   progress.note("predictions: cost model " + model.source);
 
   for (const ScalingScene& s : p.scenes) {

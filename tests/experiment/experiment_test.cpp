@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -138,6 +139,36 @@ TEST(Plan, FlagsOverrideTheDefaults) {
   EXPECT_EQ(plan_experiment(o, 2).command(),
             "tgraph experiment medical --threads 1,2,3,8 --steps 7 --repeat 5 --methods "
             "owner,worksteal --no-replay --out out");
+}
+
+// --calibration: read when the experiment is planned (a bad file stops it before its first
+// run, naming the file) and written into the command that reproduces it.
+TEST(Plan, ACalibrationFileIsReadBeforeAnyRunAndWrittenInTheCommand) {
+  const std::string dir = ::testing::TempDir();
+  const std::string good = dir + "tgraph_plan_cal.json", bad = dir + "tgraph_plan_bad.json";
+  std::ofstream(good) << R"({"sync_latency_ns": 80, "per_byte_ns": 0.02})";
+  std::ofstream(bad) << R"({"sync_latency_ns": 80})";
+  ExperimentOptions o;
+  o.name = ExperimentName::kMedical;
+  o.threads = {1, 2};
+  o.steps = 7;
+  o.repeat = 5;
+  o.methods = {"owner"};
+  o.replay = false;
+  o.out = "out";
+  o.calibration = good;
+  EXPECT_EQ(plan_experiment(o, 2).command(),
+            "medical threads=1,2 steps=7 repeat=5 methods=owner replay=off calibration=" + good +
+                " out=out");
+  for (const std::string& file : {bad, dir + "tgraph_no_such_calibration.json"}) {
+    o.calibration = file;
+    try {
+      plan_experiment(o, 2);
+      ADD_FAILURE() << "planned with " << file;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(Plan, DomainHasEveryClothAndSubObjectCount) {

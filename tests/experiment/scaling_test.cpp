@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -87,6 +88,35 @@ TEST(ScalingPlan, RejectsBadOptionsNamingTheField) {
   o = {};
   o.repeat = 0;
   EXPECT_EQ(error(), "repeat: must be at least 1");
+}
+
+// --calibration: read when the sweep is planned (a bad file stops it before its first run,
+// naming the file) and written into the command that reproduces it.
+TEST(ScalingPlan, ACalibrationFileIsReadBeforeAnyRunAndWrittenInTheCommand) {
+  const std::string dir = ::testing::TempDir();
+  const std::string good = dir + "tgraph_scaling_cal.json", bad = dir + "tgraph_scaling_bad.json";
+  std::ofstream(good) << R"({"sync_latency_ns": 80, "per_byte_ns": 0.02})";
+  std::ofstream(bad) << R"({"sync_latency_ns": "fast", "per_byte_ns": 0.02})";
+  ScalingOptions o;
+  o.threads = {1, 2};
+  o.methods = {"owner"};
+  o.steps = 3;
+  o.repeat = 1;
+  o.out = "d";
+  o.calibration = good;
+  const ScalingPlan p = plan_scaling(o, 2);
+  EXPECT_EQ(p.calibration, good);
+  EXPECT_EQ(p.command(),
+            "scaling threads=1,2 methods=owner steps=3 repeat=1 calibration=" + good + " out=d");
+  for (const std::string& file : {bad, dir + "tgraph_no_such_calibration.json"}) {
+    o.calibration = file;
+    try {
+      plan_scaling(o, 2);
+      ADD_FAILURE() << "planned with " << file;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

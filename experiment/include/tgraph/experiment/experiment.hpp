@@ -50,6 +50,9 @@ struct ExperimentOptions {
   std::optional<bool> replay;           ///< synthetic replays too; unset: the experiment's default
   /// How the results files write the run that reproduces this one (empty: plain_words).
   InvocationWords words;
+  /// Calibration file of the predictions (`tgraph calibrate --out`); empty: the default
+  /// calibration file when there is one, else the defaults. Not for metg (no prediction).
+  std::string calibration;
 };
 
 /// A scene with its build options.
@@ -76,6 +79,7 @@ struct ExperimentPlan {
   std::string out_dir;
   std::vector<std::string> notes;  ///< what the plan left out and why
   InvocationWords words;           ///< ExperimentOptions::words
+  std::string calibration;         ///< ExperimentOptions::calibration (checked readable)
   /// Whether `method` at `threads` is replayed: when replays are on, at more than one thread
   /// (one thread replays the sequential order), and not for starpu (its replay costs 4 to 7
   /// times the sequential one; docs/results.md has it).

@@ -26,6 +26,9 @@ struct ScalingOptions {
   std::optional<std::uint32_t> repeat;  ///< timed passes per run (medians); unset: 1
   /// How results.json writes the run that reproduces this one (empty: plain_words).
   InvocationWords words;
+  /// Calibration file of the partition runs' predictions; empty: the default calibration
+  /// file when there is one, else the defaults.
+  std::string calibration;
 };
 
 /// A scene of the sweep with its step count.
@@ -52,6 +55,7 @@ struct ScalingPlan {
   std::string out_dir;
   std::vector<std::string> notes;  ///< what the plan left out or warns about, and why
   InvocationWords words;           ///< ScalingOptions::words
+  std::string calibration;         ///< ScalingOptions::calibration (checked readable)
   /// Live runs: one per scene, method and thread count, plus one reference run per scene.
   std::size_t runs() const;
   /// The settings that reproduce this plan (quick, threads, methods, steps when every scene
