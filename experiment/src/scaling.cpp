@@ -398,7 +398,8 @@ std::string scaling_json(const ScalingResult& res, int indent) {
       {"partitioned_steps", "steps at which the partitioner was called, first timed pass"},
       {"predicted_speedup",
        "partition policy: the built-in simulator's makespan of a capture of the same steps "
-       "with the live run's assignments and serial work per step (default calibration), "
+       "with the live run's assignments and serial work per step (--calibration, else the "
+       "default calibration), "
        "against its one-processor makespan with the capture's host time (the uninstrumented "
        "engine); null for the baselines"},
       {"predicted_over_live", "predicted_speedup / speedup; null for the baselines"}};

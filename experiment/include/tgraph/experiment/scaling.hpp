@@ -91,8 +91,8 @@ ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
 /// - predicted_speedup, predicted_over_live (partition policy): the built-in simulator's
 ///   makespan of a capture of the same steps with the assignments the live run used (its
 ///   first timed pass; the strategy's partition of the capture when the capture's steps
-///   differ) and the live run's serial work per step, under the default calibration (or
-///   the defaults), against its one-processor makespan with the capture's own host time
+///   differ) and the live run's serial work per step, under ScalingOptions::calibration (else
+///   the default calibration, else the defaults), against its one-processor makespan with the capture's own host time
 ///   (the uninstrumented engine, the live speed-up's reference); and that over the live
 ///   speed-up.
 struct ScalingRecord {
