@@ -53,9 +53,11 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
     predicted_over_live.push_back(static_cast<double>(r.predicted_ns) /
                                   static_cast<double>(r.live_ns));
     // Each model's speed-up is over its own sequential time of the same round: the
-    // simulator's on one processor is the capture's work plus the same serial work, at
-    // least its makespan on two; the replay's is a sequential pass.
-    EXPECT_GE(r.predicted_sequential_ns, r.predicted_ns);
+    // simulator's on one processor is the simulated uninstrumented engine, the capture's
+    // work and its host time (not the live run's recording and partitioning, which the
+    // two-processor prediction charges: with metis on falling it can be the longer); the
+    // replay's is a sequential pass.
+    EXPECT_GT(r.predicted_sequential_ns, r.host_ns);
     EXPECT_GT(r.replay_sequential_ns, 0);
     const double live_speedup = static_cast<double>(r.engine_ns) / static_cast<double>(r.live_ns);
     predicted_speedup_over_live.push_back(static_cast<double>(r.predicted_sequential_ns) /
