@@ -20,4 +20,15 @@ std::string option_error(Call&& call) {
   return "accepted";
 }
 
+/// The same for the InputError that `call()` throws (a file it read: "cal.json: ...").
+template <class Call>
+std::string input_error(Call&& call) {
+  try {
+    call();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 }  // namespace tgraph::test

@@ -110,12 +110,8 @@ TEST(ScalingPlan, ACalibrationFileIsReadBeforeAnyRunAndWrittenInTheCommand) {
             "scaling threads=1,2 methods=owner steps=3 repeat=1 calibration=" + good + " out=d");
   for (const std::string& file : {bad, dir + "tgraph_no_such_calibration.json"}) {
     o.calibration = file;
-    try {
-      plan_scaling(o, 2);
-      ADD_FAILURE() << "planned with " << file;
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
-    }
+    const std::string error = test::input_error([&o] { plan_scaling(o, 2); });
+    EXPECT_NE(error.find(file), std::string::npos) << error;
   }
 }
 
