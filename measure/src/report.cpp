@@ -89,6 +89,7 @@ std::string to_json(const ReplayResult& r) {
              {{"spin_iterations_per_ns", r.calibration.spin_iterations_per_ns},
               {"touch_ns_per_byte_in_cache", r.calibration.touch_ns_per_byte},
               {"touch_ns_per_byte", r.touch_ns_per_byte},
+              {"spin_offset_ns", r.spin_offset_ns},
               {"working_set_bytes", r.working_set_bytes}}},
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);

@@ -202,6 +202,7 @@ void SyntheticWorkload::run(const TaskRun& r) {
     const auto w = static_cast<std::uint64_t>(static_cast<double>(b.words) * fraction + 0.5);
     return std::clamp<std::uint64_t>(w, 1, b.words);
   };
+  const std::int64_t t0 = timing_ ? now_ns() : 0;
   std::uint64_t bytes = 0;
   for (std::size_t i = 0; i < na; ++i) {
     if (!reads(orig[i].mode)) continue;
@@ -222,7 +223,19 @@ void SyntheticWorkload::run(const TaskRun& r) {
     write_pass(orig[i].mode, b->w.get(), words, acc);
     bytes += words * 8;
   }
-  if (options_.spin) spin_ns(cost - static_cast<double>(bytes) * touch_ns_per_byte_, acc);
+  if (options_.spin)
+    spin_ns(cost - static_cast<double>(bytes) * touch_ns_per_byte_ - spin_offset_ns_, acc);
+  if (timing_) {
+    ++timed_.tasks;
+    timed_.body_ns += static_cast<double>(now_ns() - t0);
+    timed_.cost_ns += cost;
+    timed_.bytes += static_cast<double>(bytes);
+  }
+}
+
+void SyntheticWorkload::time_bodies(bool on) {
+  timing_ = on;
+  if (on) timed_ = {};
 }
 
 void SyntheticWorkload::spin_ns(double ns, std::uint64_t seed) {

@@ -77,5 +77,37 @@ TEST(SyntheticPass, TheGivenRateDecidesTheWordsNotTheProcessCalibration) {
   EXPECT_EQ(changed(*run_one(acc, 100, 0.02), 1), 208u);  // 100 / 480 of 1000, rounded
 }
 
+TEST(SyntheticPass, TimedBodiesSumTheirTimeCostAndBytes) {
+  // Two tasks of 1000 and 3000 ns recorded, spins off: their bodies are their data passes
+  // (8000 bytes read + 8000 read and written each, at 0.01 ns a byte all of it fits); the
+  // sums start again at time_bodies(true) and stop at time_bodies(false).
+  StepGraph g;
+  g.intern_kind("k");
+  g.data.push_back({"d0", kNoObject, kWords * 8});
+  g.data.push_back({"d1", kNoObject, kWords * 8});
+  const std::vector<Access> acc = {{0, AccessMode::R}, {1, AccessMode::RW}};
+  g.add_task(0, kNoObject, acc, 1000);
+  g.add_task(0, kNoObject, acc, 3000);
+  g.derive_edges();
+  SyntheticOptions o;
+  o.fraction_ns_per_byte = 0.01;
+  o.spin = false;
+  SyntheticWorkload w(o);
+  w.set_step(g);
+  const auto ex = make_executor(Policy::kSequential, {});
+  w.time_bodies(true);
+  ex->run_step(g, nullptr, w);
+  EXPECT_EQ(w.timed().tasks, 2u);
+  EXPECT_EQ(w.timed().cost_ns, 4000.0);
+  EXPECT_EQ(w.timed().bytes, 2.0 * 3 * kWords * 8);
+  EXPECT_GT(w.timed().body_ns, 0.0);
+  w.time_bodies(true);
+  EXPECT_EQ(w.timed().tasks, 0u);
+  EXPECT_EQ(w.timed().bytes, 0.0);
+  w.time_bodies(false);
+  ex->run_step(g, nullptr, w);
+  EXPECT_EQ(w.timed().tasks, 0u);
+}
+
 }  // namespace
 }  // namespace tgraph::replay

@@ -68,7 +68,8 @@ struct ReplayResult {
   /// filled by the caller, "warnings" in the JSON.
   std::vector<std::string> warnings;
   replay::SyntheticCalibration calibration;  ///< the synthetic bodies' speed on this machine
-  double touch_ns_per_byte = 0;         ///< memory pass cost at the trace's working set
+  double touch_ns_per_byte = 0;         ///< the bodies' data passes in place (ns per byte)
+  double spin_offset_ns = 0;            ///< taken off each body's spin (measured in place)
   std::uint64_t working_set_bytes = 0;  ///< bytes of the first replayed step's data
   std::uint64_t signals() const;
   std::uint64_t waits() const;

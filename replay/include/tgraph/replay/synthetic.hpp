@@ -42,8 +42,9 @@ struct SyntheticOptions {
 /// RW: combine, CW: add), with values derived from what it read, so that the final buffer
 /// contents depend on the order the dataflow graph prescribes (and CW sums are exact
 /// integers: any reduction order gives the same bits). It then spins for its recorded cost
-/// minus the calibrated time the memory pass takes in cache: running away from its data
-/// costs the real cache misses on top. Buffers are allocated and first touched by the
+/// minus the time the memory pass takes at the rate in use (calibrate_touch's stream, or
+/// set_touch_ns_per_byte: what the passes took where the sequential program ran them):
+/// running away from its data costs the real cache misses on top. Buffers are allocated and first touched by the
 /// thread that first uses them in the plan (Workload::first_touch).
 ///
 ///   SyntheticWorkload w;
@@ -78,6 +79,24 @@ class SyntheticWorkload : public Workload {
   double calibrate_touch(std::uint64_t bytes);
   /// Touch cost per byte in use.
   double touch_ns_per_byte() const { return touch_ns_per_byte_; }
+  /// Uses `ns_per_byte` from now on to size the spin after each data pass (what
+  /// calibrate_touch sets; measure_touch's rate of the tasks' own passes, for instance).
+  void set_touch_ns_per_byte(double ns_per_byte) { touch_ns_per_byte_ = ns_per_byte; }
+  /// Spin after the data pass (SyntheticOptions::spin) from now on, or not.
+  void set_spin(bool on) { options_.spin = on; }
+  /// Taken off every task's spin from now on (ns; negative: added): what a body costs over
+  /// its pass and its spin (the calls, the loop's start), measured where it runs.
+  void set_spin_offset_ns(double ns) { spin_offset_ns_ = ns; }
+  /// What the bodies run while time_bodies(true) took, summed.
+  struct BodyTimes {
+    std::uint64_t tasks = 0;
+    double body_ns = 0;   ///< each body's wall time: its data pass and its spin
+    double cost_ns = 0;   ///< their recorded costs (x cost_scale)
+    double bytes = 0;     ///< the bytes their data passes touched
+  };
+  /// While on, each task body is timed and summed (BodyTimes); on again starts new sums.
+  void time_bodies(bool on);
+  const BodyTimes& timed() const { return timed_; }
   /// Runs step `g`'s host time (StepGraph::host_ns: the engine's serial work outside the
   /// graph, before the step's tasks) on the calling thread as a calibrated spin, scaled like
   /// the task costs; returns the wall time it took (ns).
@@ -91,6 +110,9 @@ class SyntheticWorkload : public Workload {
   std::vector<std::uint64_t> want_words_;         // by exec datum
   std::vector<bool> is_temp_;                     // by exec datum
   double touch_ns_per_byte_ = 0;
+  double spin_offset_ns_ = 0;
+  bool timing_ = false;
+  BodyTimes timed_;
   // Busy loop for `ns` nanoseconds at the calibrated rate (nothing when ns <= 0).
   static void spin_ns(double ns, std::uint64_t seed);
 };
