@@ -63,16 +63,16 @@ LiveResult live(const std::string& scene, Policy policy, const std::string& meth
                   policy == Policy::kPartition ? &p : nullptr, o);
 }
 
-struct Case {
+struct FallingCase {
   Policy policy;
   const char* method;
   std::uint32_t threads;
 };
 
-class FallingLive : public ::testing::TestWithParam<Case> {};
+class FallingLive : public ::testing::TestWithParam<FallingCase> {};
 
 TEST_P(FallingLive, MatchesTheSameReductionOrderBitForBitThroughContactChanges) {
-  const Case c = GetParam();
+  const FallingCase c = GetParam();
   const LiveResult r = live("falling", c.policy, c.method, c.threads, kFallingSteps);
   EXPECT_EQ(r.cw, CwMode::kReduce);
   EXPECT_EQ(r.check, Check::kIdentical) << (r.difference ? r.difference->datum : "");
@@ -86,9 +86,9 @@ TEST_P(FallingLive, MatchesTheSameReductionOrderBitForBitThroughContactChanges) 
 
 INSTANTIATE_TEST_SUITE_P(
     Policies, FallingLive,
-    ::testing::Values(Case{Policy::kPartition, "owner", 2}, Case{Policy::kPartition, "owner", 3},
-                      Case{Policy::kPartition, "sticky", 2}, Case{Policy::kPartition, "sticky", 3},
-                      Case{Policy::kWorksteal, "", 2}, Case{Policy::kWorksteal, "", 3}),
+    ::testing::Values(FallingCase{Policy::kPartition, "owner", 2}, FallingCase{Policy::kPartition, "owner", 3},
+                      FallingCase{Policy::kPartition, "sticky", 2}, FallingCase{Policy::kPartition, "sticky", 3},
+                      FallingCase{Policy::kWorksteal, "", 2}, FallingCase{Policy::kWorksteal, "", 3}),
     [](const auto& p) {
       return std::string(to_string(p.param.policy)) + p.param.method +
              std::to_string(p.param.threads);

@@ -132,7 +132,7 @@ TEST(Validate, ABaselinePolicyHasNoPrediction) {
 
 TEST(Validate, RefusesZeroThreadsStepsOrRoundsNamingTheField) {
   ValidateOptions o = falling("owner", 1, 1);
-  const auto error = [&o] { return test::option_error([&o] { validate(o); }); };
+  const auto error = [&o] { return tgraph::test::option_error([&o] { validate(o); }); };
   o.threads = 0;
   EXPECT_EQ(error(), "threads: must be at least 1");
   o.threads = 1;
