@@ -86,9 +86,12 @@ TEST_P(FallingLive, MatchesTheSameReductionOrderBitForBitThroughContactChanges) 
 
 INSTANTIATE_TEST_SUITE_P(
     Policies, FallingLive,
-    ::testing::Values(FallingCase{Policy::kPartition, "owner", 2}, FallingCase{Policy::kPartition, "owner", 3},
-                      FallingCase{Policy::kPartition, "sticky", 2}, FallingCase{Policy::kPartition, "sticky", 3},
-                      FallingCase{Policy::kWorksteal, "", 2}, FallingCase{Policy::kWorksteal, "", 3}),
+    ::testing::Values(FallingCase{Policy::kPartition, "owner", 2},
+                      FallingCase{Policy::kPartition, "owner", 3},
+                      FallingCase{Policy::kPartition, "sticky", 2},
+                      FallingCase{Policy::kPartition, "sticky", 3},
+                      FallingCase{Policy::kWorksteal, "", 2},
+                      FallingCase{Policy::kWorksteal, "", 3}),
     [](const auto& p) {
       return std::string(to_string(p.param.policy)) + p.param.method +
              std::to_string(p.param.threads);

@@ -43,9 +43,10 @@ struct SyntheticOptions {
 /// contents depend on the order the dataflow graph prescribes (and CW sums are exact
 /// integers: any reduction order gives the same bits). It then spins for its recorded cost
 /// minus the time the memory pass takes at the rate in use (calibrate_touch's stream, or
-/// set_touch_ns_per_byte: what the passes took where the sequential program ran them):
-/// running away from its data costs the real cache misses on top. Buffers are allocated and first touched by the
-/// thread that first uses them in the plan (Workload::first_touch).
+/// set_touch_ns_per_byte: what the passes took where the sequential program ran them) and
+/// the spin offset: running away from its data costs the real cache misses on top. Buffers
+/// are allocated and first touched by the thread that first uses them in the plan
+/// (Workload::first_touch).
 ///
 ///   SyntheticWorkload w;
 ///   w.set_step(trace.steps[s]);       // costs and loop iterations of that step
@@ -80,7 +81,8 @@ class SyntheticWorkload : public Workload {
   /// Touch cost per byte in use.
   double touch_ns_per_byte() const { return touch_ns_per_byte_; }
   /// Uses `ns_per_byte` from now on to size the spin after each data pass (what
-  /// calibrate_touch sets; measure_touch's rate of the tasks' own passes, for instance).
+  /// calibrate_touch sets; the rate of the bodies' own passes timed with time_bodies, as
+  /// measure::replay_trace does).
   void set_touch_ns_per_byte(double ns_per_byte) { touch_ns_per_byte_ = ns_per_byte; }
   /// Spin after the data pass (SyntheticOptions::spin) from now on, or not.
   void set_spin(bool on) { options_.spin = on; }
