@@ -38,7 +38,7 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
   const Validation v = validate(o);
   ASSERT_EQ(v.rounds.size(), 3u);
   std::vector<double> live, replay_over_live, predicted_over_live, predicted_speedup_over_live,
-      replay_speedup_over_live;
+      replay_speedup_over_live, predicted_speedup;
   for (const ValidationRound& r : v.rounds) {
     EXPECT_GT(r.live_ns, 0);
     EXPECT_GT(r.engine_ns, 0);
@@ -60,14 +60,17 @@ TEST(Validate, ReportsTheMediansOfItsRoundsAndOfEachRoundsRatios) {
     EXPECT_GT(r.predicted_sequential_ns, r.host_ns);
     EXPECT_GT(r.replay_sequential_ns, 0);
     const double live_speedup = static_cast<double>(r.engine_ns) / static_cast<double>(r.live_ns);
-    predicted_speedup_over_live.push_back(static_cast<double>(r.predicted_sequential_ns) /
-                                          static_cast<double>(r.predicted_ns) / live_speedup);
+    predicted_speedup.push_back(static_cast<double>(r.predicted_sequential_ns) /
+                                static_cast<double>(r.predicted_ns));
+    predicted_speedup_over_live.push_back(predicted_speedup.back() / live_speedup);
     replay_speedup_over_live.push_back(static_cast<double>(r.replay_sequential_ns) /
                                        static_cast<double>(r.replay_ns) / live_speedup);
   }
   EXPECT_DOUBLE_EQ(v.predicted_speedup_over_live, median(predicted_speedup_over_live));
   EXPECT_DOUBLE_EQ(v.replay_speedup_over_live, median(replay_speedup_over_live));
-  EXPECT_GE(v.predicted_speedup, 1.0);
+  // Not at least 1: the two-processor prediction charges the live run's waited partitioning
+  // (metis on falling's 2 steps: a run under load predicted 0.72).
+  EXPECT_DOUBLE_EQ(v.predicted_speedup, median(predicted_speedup));
   EXPECT_EQ(v.live_ns, static_cast<std::int64_t>(median(live)));
   EXPECT_DOUBLE_EQ(v.replay_over_live, median(replay_over_live));
   EXPECT_DOUBLE_EQ(v.predicted_over_live, median(predicted_over_live));
