@@ -8,27 +8,28 @@
 
 namespace tgraph::test {
 
-/// The what() of the OptionError that `call()` throws ("threads: must be at least 1"), or
-/// "accepted" when it returns; any other exception passes through (and fails the test).
-template <class Call>
-std::string option_error(Call&& call) {
+/// The what() of the `Error` that `call()` throws, or "accepted" when it returns; any other
+/// exception passes through (and fails the test).
+template <class Error, class Call>
+std::string error_of(Call&& call) {
   try {
     call();
-  } catch (const OptionError& e) {
+  } catch (const Error& e) {
     return e.what();
   }
   return "accepted";
 }
 
-/// The same for the InputError that `call()` throws (a file it read: "cal.json: ...").
+/// The OptionError's ("threads: must be at least 1").
+template <class Call>
+std::string option_error(Call&& call) {
+  return error_of<OptionError>(call);
+}
+
+/// The InputError's (a file it read: "cal.json: ...").
 template <class Call>
 std::string input_error(Call&& call) {
-  try {
-    call();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "accepted";
+  return error_of<InputError>(call);
 }
 
 }  // namespace tgraph::test

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // Standard Task Graph Set import: critical paths, dummy tasks, round trip, malformed files.
+#include "../option_error.hpp"
 #include "../stg_files.hpp"
 #include "tgraph/graph/stg.hpp"
 
@@ -57,12 +58,7 @@ TEST(Stg, SurvivesATraceFileRoundTrip) {
 
 TEST(Stg, RejectsMalformedFilesWithTheOffset) {
   auto message = [](const std::string& text) {
-    try {
-      parse_stg(text, "g.stg");
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("accepted");
+    return test::input_error([&] { parse_stg(text, "g.stg"); });
   };
   EXPECT_NE(message("").find("g.stg: offset 0: truncated: expected the task count"),
             std::string::npos);
