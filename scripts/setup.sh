@@ -10,7 +10,8 @@ TGRAPH_PACKAGES=(cmake g++ ninja-build pkg-config python3
   libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libhwloc-dev libcli11-dev nlohmann-json3-dev
   libstarpu-dev zlib1g-dev clang libclang-rt-14-dev libomp-14-dev libcairo2-dev
   python3-dev python3-pybind11 pybind11-dev python3-pytest libsimgrid-dev
-  liblapacke-dev liblapack-dev libblas-dev libopenmpi-dev openmpi-bin libptscotch-dev)
+  liblapacke-dev liblapack-dev libblas-dev libopenmpi-dev openmpi-bin libptscotch-dev
+  libode-dev)
 
 tgraph_install_packages() {
   local missing=()
