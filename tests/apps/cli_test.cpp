@@ -15,23 +15,14 @@
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/version.hpp"
 #include "../scratch_dir.hpp"
+#include "cli_run.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using Result = tgraph::test::CliResult;
+using tgraph::test::slurp;
 
 class Cli : public ::testing::Test {
  protected:
@@ -40,17 +31,7 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Result run(const std::string& args) {
-    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string cmd = std::string("cd '") + dir_.string() + "' && '" + TGRAPH_BIN + "' " + args + " >'" +
-                            out.string() + "' 2>'" + err.string() + "'";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
+  Result run(const std::string& args) { return tgraph::test::run_tgraph(dir_, args); }
   // Runs `tgraph ARGS` expecting exit 0 and parses its standard output as JSON; null when the
   // run failed (the failure recorded), so that a caller's non-const j["key"] fails its checks.
   nlohmann::json run_json(const std::string& args) {
@@ -506,8 +487,9 @@ TEST_F(Cli, SimulateJsonIsOneParsableObjectAndBadPlatformsExit2) {
   for (const char* bad : {"--cluster 4", "--cluster 0x4", "--cluster 1x3"}) {
     const Result r = run(std::string("simulate f.tgt f.tga --engine simgrid ") + bad);
     EXPECT_EQ(r.code, 2) << bad;
-    if (std::string(bad) != "--cluster 1x3")  // that one is well formed but too small
+    if (std::string(bad) != "--cluster 1x3") {  // that one is well formed but too small
       EXPECT_EQ(r.err.rfind("tgraph: --cluster: expected ", 0), 0u) << r.err;
+    }
     EXPECT_TRUE(one_line(r.err)) << bad << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << bad;
   }
