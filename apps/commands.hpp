@@ -69,14 +69,14 @@ void add_strategy_flags(CLI::App* cmd, partition::NamedOptions& n);
 using AddVerbs = void(CLI::App& app);
 AddVerbs add_info, add_export, add_diff, add_capture, add_generate, add_demo, add_experiment,
     add_partition_verbs, add_replay_verbs, add_validate, add_viz_verbs, add_timeline, add_report,
-    add_simulate, add_platform;
+    add_simulate, add_platform, add_explain;
 
 /// Every verb, in the order `tgraph --help` lists them (main() and the command-line fuzz
 /// target register the same set).
 inline void add_all_verbs(CLI::App& app) {
   for (AddVerbs* add : {add_demo, add_experiment, add_capture, add_generate, add_info, add_export,
                         add_diff, add_partition_verbs, add_simulate, add_platform, add_replay_verbs,
-                        add_validate, add_viz_verbs})
+                        add_validate, add_viz_verbs, add_explain})
     add(app);
 }
 

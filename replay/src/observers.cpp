@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Built-in observers: per-thread stats, locality, timeline (a tgraph::Timeline; viz draws it).
+#include <time.h>
+
 #include <algorithm>
 #include <optional>
 
@@ -114,6 +116,35 @@ namespace {
 // A timeline's task: empty for kNoTask (a reducer's origin, a wait on no task).
 std::optional<TaskId> known(TaskId t) { return t == kNoTask ? std::nullopt : std::optional(t); }
 
+// The calling thread's CPU time in ns.
+std::int64_t thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+// The executed graph as a timeline records it.
+TimelineGraph timeline_graph(const ExecGraph& exec) {
+  const StepGraph& g = exec.graph;
+  TimelineGraph out;
+  out.kinds = g.kinds;
+  out.data.reserve(g.data.size());
+  for (const Datum& d : g.data) out.data.push_back(d.name);
+  out.task_kind.reserve(g.tasks.size());
+  out.task_loop.reserve(g.tasks.size());
+  for (const Task& t : g.tasks) {
+    out.task_kind.push_back(t.kind);
+    out.task_loop.push_back(t.loop);
+  }
+  out.origin = exec.origin;
+  for (const Loop& l : g.loops) out.loops.emplace_back(l.first, l.last);
+  out.edges = g.edges;
+  out.carried_edges = g.carried_edges;
+  for (Edge& e : out.edges) e.kind = EdgeKind::RAW;
+  for (Edge& e : out.carried_edges) e.kind = EdgeKind::RAW;
+  return out;
+}
+
 }  // namespace
 
 void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t threads,
@@ -129,13 +160,16 @@ void TimelineObserver::on_step_begin(const ExecGraph& exec, std::uint32_t thread
 
 void TimelineObserver::on_begin(std::uint32_t thread, TaskId, std::uint32_t, std::int64_t t_ns) {
   open_[thread * 8] = t_ns;
+  if (cpu_time_ && recording_) open_[thread * 8 + 1] = thread_cpu_ns();
 }
 
 void TimelineObserver::on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
                               std::int64_t t_ns) {
   if (!recording_) return;
-  per_thread_[thread].push_back(
-      {task, iteration, open_[thread * 8] - step_begin_, t_ns - step_begin_});
+  const std::int64_t cpu = cpu_time_ ? thread_cpu_ns() - open_[thread * 8 + 1] : -1;
+  const std::int64_t start = open_[thread * 8] - step_begin_, end = t_ns - step_begin_;
+  // The CPU clock's reads sit just inside the body's wall span: never more than it.
+  per_thread_[thread].push_back({task, iteration, start, end, cpu < 0 ? -1 : std::min(cpu, end - start)});
 }
 
 void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t0, std::int64_t t1,
@@ -145,7 +179,7 @@ void TimelineObserver::on_wait(std::uint32_t thread, TaskId task, std::int64_t t
       {timeline_.steps, thread, known(task), t0 - step_begin_, t1 - step_begin_, parked});
 }
 
-void TimelineObserver::on_step_end(std::int64_t) {
+void TimelineObserver::on_step_end(std::int64_t t_ns) {
   if (recording_) {
     const std::uint32_t step = timeline_.steps;
     const std::size_t first = timeline_.tasks.size();
@@ -153,7 +187,7 @@ void TimelineObserver::on_step_end(std::int64_t) {
       for (const Instance& i : per_thread_[th]) {
         timeline_.tasks.push_back({step, th, i.task, known(exec_->origin[i.task]),
                                    exec_->graph.kind_name(i.task), i.iteration, i.start_ns,
-                                   i.end_ns});
+                                   i.end_ns, i.cpu_ns});
       }
       per_thread_[th].clear();
     }
@@ -165,8 +199,50 @@ void TimelineObserver::on_step_end(std::int64_t) {
       timeline_.waits.insert(timeline_.waits.end(), v.begin(), v.end());
       v.clear();
     }
+    // The executed graph, shared with the last step of the same one (the newest first).
+    TimelineGraph graph = timeline_graph(*exec_);
+    std::uint32_t index = static_cast<std::uint32_t>(timeline_.graphs.size());
+    for (std::uint32_t i = index; i-- > 0;)
+      if (timeline_.graphs[i] == graph) {
+        index = i;
+        break;
+      }
+    if (index == timeline_.graphs.size()) timeline_.graphs.push_back(std::move(graph));
+    TimelineStep info;
+    info.step = step;
+    info.graph = index;
+    info.wall_ns = t_ns - step_begin_;
+    const StepGraph& g = exec_->graph;
+    for (const Loop& l : g.loops) info.iterations.push_back(l.iterations);
+    info.cost_ns.reserve(g.tasks.size());
+    for (TaskId t = 0; t < g.tasks.size(); ++t)
+      info.cost_ns.push_back(exec_->origin[t] == kNoTask
+                                 ? 0
+                                 : static_cast<std::int64_t>(g.tasks[t].cost_ns));
+    timeline_.step_info.push_back(std::move(info));
   }
   ++timeline_.steps;
+}
+
+void TimelineObserver::set_serial(std::int64_t record_ns, std::int64_t partition_ns,
+                                  std::int64_t prepare_ns, std::int64_t host_ns) {
+  if (timeline_.step_info.empty() || timeline_.step_info.back().step + 1 != timeline_.steps)
+    return;
+  TimelineStep& s = timeline_.step_info.back();
+  s.record_ns = record_ns;
+  s.partition_ns = partition_ns;
+  s.prepare_ns = prepare_ns;
+  s.host_ns = host_ns;
+}
+
+void TimelineObserver::set_sequential_costs(const std::vector<std::int64_t>& cost_by_origin) {
+  if (timeline_.step_info.empty() || timeline_.step_info.back().step + 1 != timeline_.steps)
+    return;
+  TimelineStep& s = timeline_.step_info.back();
+  const TimelineGraph& g = timeline_.graphs[s.graph];
+  for (TaskId t = 0; t < g.origin.size(); ++t)
+    if (g.origin[t] != kNoTask && g.origin[t] < cost_by_origin.size())
+      s.cost_ns[t] = cost_by_origin[g.origin[t]];
 }
 
 }  // namespace tgraph::replay

@@ -8,6 +8,7 @@
 #include <tuple>
 #include <vector>
 
+#include "../scratch_dir.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
@@ -72,6 +73,72 @@ TEST(Timeline, CountsStepsFromTheEventsWhenTheFileDoesNotSay) {
   EXPECT_EQ(t.tasks[0].kind, "task");
   EXPECT_FALSE(t.waits[0].task.has_value());
   EXPECT_EQ(t.step_offsets(), (std::vector<std::int64_t>{0, 7}));
+}
+
+// A timeline with its step's graph, written in columns, gzip-compressed and read back.
+Timeline with_graph() {
+  Timeline t = parse_timeline(kTimeline, "t.json");
+  TimelineGraph g;
+  g.kinds = {"a", "b", "c", "reduce"};
+  g.data = {"x", "y"};
+  g.task_kind = {0, 1, 2, 3};
+  g.origin = {0, 1, 2, kNoTask};
+  g.task_loop = {kNoLoop, kNoLoop, 0, kNoLoop};
+  g.loops = {{2, 3}};
+  g.edges = {{0, 1, 0, EdgeKind::RAW}, {1, 3, 1, EdgeKind::RAW}};
+  g.carried_edges = {{2, 2, 1, EdgeKind::RAW}};
+  t.graphs = {g};
+  TimelineStep s;
+  s.step = 0;
+  s.wall_ns = 2100;
+  s.record_ns = 5;
+  s.partition_ns = 6;
+  s.prepare_ns = 7;
+  s.host_ns = 3;
+  s.iterations = {2};
+  s.cost_ns = {900, 800, 400, 0};
+  t.step_info = {s};
+  t.tasks[0].cpu_ns = 950;
+  return t;
+}
+
+TEST(Timeline, KeepsGraphsStepInfoAndCpuTimeThroughGzip) {
+  const Timeline t = with_graph();
+  const std::string path = (test::scratch_dir("timeline_gzip") / "r.json").string();
+  write_timeline(path, t);
+  const std::string bytes = read_file_text(path);
+  ASSERT_GE(bytes.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[0]), 0x1f);  // gzip
+  const Timeline back = read_timeline(path);
+  ASSERT_EQ(back.tasks.size(), t.tasks.size());
+  for (std::size_t i = 0; i < t.tasks.size(); ++i) {
+    EXPECT_EQ(back.tasks[i].start_ns, t.tasks[i].start_ns) << i;
+    EXPECT_EQ(back.tasks[i].end_ns, t.tasks[i].end_ns) << i;
+    EXPECT_EQ(back.tasks[i].cpu_ns, t.tasks[i].cpu_ns) << i;
+    EXPECT_EQ(back.tasks[i].kind, t.tasks[i].kind) << i;
+  }
+  ASSERT_EQ(back.graphs.size(), 1u);
+  EXPECT_EQ(back.graphs[0], t.graphs[0]);
+  ASSERT_EQ(back.step_info.size(), 1u);
+  const TimelineStep& s = back.step_info[0];
+  EXPECT_EQ(s.serial_ns(), 18);
+  EXPECT_EQ(s.host_ns, 3);
+  EXPECT_EQ(s.cost_ns, (std::vector<std::int64_t>{900, 800, 400, 0}));
+  EXPECT_EQ(back.info(0), &back.step_info[0]);
+  EXPECT_EQ(back.info(1), nullptr);
+}
+
+TEST(Timeline, RejectsGraphIndicesOutOfRange) {
+  Timeline t = with_graph();
+  t.graphs[0].edges.push_back({3, 1, 0, EdgeKind::RAW});  // backwards
+  EXPECT_THROW(parse_timeline(timeline_json(t), "bad.json"), InputError);
+  t = with_graph();
+  t.tasks[0].task = 9;  // not a task of step 0's graph
+  EXPECT_THROW(parse_timeline(timeline_json(t), "bad.json"), InputError);
+  t = with_graph();
+  t.step_info[0].cost_ns.pop_back();  // a cost per task
+  EXPECT_THROW(parse_timeline(timeline_json(t), "bad.json"), InputError);
+  EXPECT_THROW(parse_timeline(std::string("\x1f\x8b garbage"), "bad.gz"), InputError);
 }
 
 }  // namespace

@@ -115,7 +115,10 @@ class LocalityObserver : public Observer {
   std::uint64_t migrated_ = 0;
 };
 
-/// Records every task instance (thread, start, end) and every blocking wait.
+/// Records every task instance (thread, start, end, the thread's CPU time in the body) and
+/// every blocking wait, and per step the executed graph (interned: steps of one structure
+/// share it), each task's cost, the loops' iterations and the execution's wall time: what
+/// tgraph::explain needs to find the critical path and attribute the lost time.
 class TimelineObserver : public Observer {
  public:
   void on_step_begin(const ExecGraph& exec, std::uint32_t threads, std::int64_t t_ns) override;
@@ -134,6 +137,18 @@ class TimelineObserver : public Observer {
   const Timeline& timeline() const { return timeline_; }
   /// Keeps at most this many steps (older steps are not recorded); default unlimited.
   void set_max_steps(std::uint32_t n) { max_steps_ = n; }
+  /// Also reads each thread's CPU time around every body (CLOCK_THREAD_CPUTIME_ID, a system
+  /// call of some 100 ns on each side: TimelineTask::cpu_ns); default on.
+  void set_cpu_time(bool on) { cpu_time_ = on; }
+  /// The serial phases of the calling thread before the last recorded step's execution
+  /// (record, partitioning waited, preparation) and the part of them the sequential program
+  /// runs too (host work): TimelineStep's fields, which the executor cannot see.
+  void set_serial(std::int64_t record_ns, std::int64_t partition_ns, std::int64_t prepare_ns,
+                  std::int64_t host_ns = 0);
+  /// The sequential cost of one execution of each task of the step graph (by original
+  /// task) for the last recorded step, replacing the executed graph's costs (a live run's
+  /// costs measured in its sequential pass).
+  void set_sequential_costs(const std::vector<std::int64_t>& cost_by_origin);
 
  private:
   // What a thread records in its callbacks (no string: the kind is named at step end).
@@ -141,11 +156,13 @@ class TimelineObserver : public Observer {
     TaskId task = 0;
     std::uint32_t iteration = 0;
     std::int64_t start_ns = 0, end_ns = 0;
+    std::int64_t cpu_ns = -1;
   };
   std::vector<std::vector<Instance>> per_thread_;
   std::vector<std::vector<TimelineWait>> waits_per_thread_;
-  std::vector<std::int64_t> open_;  // start of the running task, per thread (8 apart)
+  std::vector<std::int64_t> open_;  // start and CPU time of the running task, per thread (8 apart)
   Timeline timeline_;
+  bool cpu_time_ = true;
   const ExecGraph* exec_ = nullptr;
   std::int64_t step_begin_ = 0;
   std::uint32_t max_steps_ = 0xffffffffu;

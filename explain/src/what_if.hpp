@@ -1,0 +1,22 @@
+// SPDX-License-Identifier: MIT
+// Virtual speed-ups (Coz, SOSP'15) on the executed schedule of a step.
+#pragma once
+
+#include <vector>
+
+#include "step_view.hpp"
+#include "tgraph/explain/explain.hpp"
+
+namespace tgraph::explain::detail {
+
+/// The step's predicted time under each change (each task kind 10 % and 50 % faster, each
+/// cause free), by re-running its executed schedule: every thread's order, the time between
+/// its bodies and each hand-off's latency as measured; the largest gain first.
+std::vector<WhatIf> what_ifs(const StepView& v, const StepExplanation& s);
+
+/// The makespan (serial phases + execution) of the step re-run with bodies of kind `kind`
+/// `fraction` shorter (0.5: half as long); the executed schedule otherwise as measured.
+std::int64_t predict_kind_faster(const StepView& v, std::int64_t serial_ns, KindId kind,
+                                 double fraction);
+
+}  // namespace tgraph::explain::detail
