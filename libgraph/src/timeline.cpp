@@ -57,7 +57,9 @@ std::vector<std::int64_t> Timeline::step_offsets() const {
 
 namespace {
 
-// The earlier format: one object per event.
+void read_graphs(const json& j, Timeline& t, std::int64_t events);
+
+// One object per event (timeline_json).
 Timeline parse_objects(const json& j, const std::string& name) {
   Timeline t;
   std::size_t index = 0;
@@ -103,6 +105,11 @@ Timeline parse_objects(const json& j, const std::string& name) {
       ev.kind = e.contains("kind") && e["kind"].is_string() ? e["kind"].get<std::string>() : "task";
       ev.iteration = e.contains("iteration") ? get_u32(e, "iteration") : 0;
       std::tie(ev.start_ns, ev.end_ns) = span_of(e);
+      if (e.contains("cpu_ns")) {
+        ev.cpu_ns = get_i64(e, "cpu_ns");
+        if (ev.cpu_ns < -1 || ev.cpu_ns > ev.end_ns - ev.start_ns)
+          throw json::other_error::create(501, "cpu_ns out of range", &e);
+      }
       t.tasks.push_back(std::move(ev));
       ++index;
     }
@@ -122,11 +129,15 @@ Timeline parse_objects(const json& j, const std::string& name) {
         ++index;
       }
     }
+    what = "graphs";
+    index = 0;
+    read_graphs(j, t, static_cast<std::int64_t>(events));
   } catch (const json::exception& e) {
     std::string why = e.what();
     if (const auto p = why.find("] "); p != std::string::npos) why = why.substr(p + 2);
     throw InputError(name, std::nullopt,
-                     std::string(what) + "[" + std::to_string(index) + "]: " + why);
+                     std::string(what) + (what[0] == 'g' ? "" : "[" + std::to_string(index) + "]") +
+                         ": " + why);
   }
   return t;
 }
@@ -279,7 +290,50 @@ TimelineGraph graph_of(const json& g) {
   return out;
 }
 
-// The columnar format (timeline_json).
+// The executed graphs and step information (both formats): "graphs" and "step_info".
+void read_graphs(const json& j, Timeline& t, std::int64_t events) {
+  if (j.contains("graphs")) {
+    if (!j["graphs"].is_array()) throw json::type_error::create(302, "\"graphs\" must be an array", &j);
+    for (const json& g : j["graphs"]) t.graphs.push_back(graph_of(g));
+  }
+  if (j.contains("step_info")) {
+    if (!j["step_info"].is_array())
+      throw json::type_error::create(302, "\"step_info\" must be an array", &j);
+    for (const json& e : j["step_info"]) {
+      TimelineStep s;
+      s.step = get_u32(e, "step");
+      if (static_cast<std::int64_t>(s.step) >= std::max<std::int64_t>(events, 1) ||
+          (!t.step_info.empty() && s.step <= t.step_info.back().step))
+        throw json::other_error::create(501, "step_info: steps must increase, below the events",
+                                        &e);
+      s.graph = get_u32(e, "graph");
+      if (s.graph >= t.graphs.size())
+        throw json::other_error::create(501, "step_info: \"graph\" out of range", &e);
+      const TimelineGraph& g = t.graphs[s.graph];
+      for (const char* key : {"wall_ns", "record_ns", "partition_ns", "prepare_ns", "host_ns"}) {
+        const std::int64_t v = get_i64(e, key);
+        if (v < 0 || v > kMaxNs) throw json::other_error::create(501, std::string(key) + " out of range", &e);
+      }
+      s.wall_ns = get_i64(e, "wall_ns");
+      s.record_ns = get_i64(e, "record_ns");
+      s.partition_ns = get_i64(e, "partition_ns");
+      s.prepare_ns = get_i64(e, "prepare_ns");
+      s.host_ns = get_i64(e, "host_ns");
+      for (const std::int64_t i : column(e, "iterations", g.loops.size(), 0, 1 << 24))
+        s.iterations.push_back(static_cast<std::uint32_t>(i));
+      s.cost_ns = column(e, "cost_ns", g.task_kind.size(), 0, kMaxNs / 65536);
+      t.step_info.push_back(std::move(s));
+    }
+    // An instance of a step with a graph names one of its tasks.
+    for (std::size_t i = 0; i < t.tasks.size(); ++i)
+      if (const TimelineStep* s = t.info(t.tasks[i].step);
+          s && t.tasks[i].task >= t.graphs[s->graph].task_kind.size())
+        throw json::other_error::create(
+            501, "tasks[" + std::to_string(i) + "]: task out of range of its step's graph", &j);
+  }
+}
+
+// The columnar format (compact_timeline_json).
 Timeline parse_columns(const json& j) {
   Timeline t;
   t.threads = j.contains("threads") ? get_u32(j, "threads") : 0;
@@ -339,45 +393,7 @@ Timeline parse_columns(const json& j) {
       w.parked = parked[i] != 0;
     }
   }
-  if (j.contains("graphs")) {
-    if (!j["graphs"].is_array()) throw json::type_error::create(302, "\"graphs\" must be an array", &j);
-    for (const json& g : j["graphs"]) t.graphs.push_back(graph_of(g));
-  }
-  if (j.contains("step_info")) {
-    if (!j["step_info"].is_array())
-      throw json::type_error::create(302, "\"step_info\" must be an array", &j);
-    for (const json& e : j["step_info"]) {
-      TimelineStep s;
-      s.step = get_u32(e, "step");
-      if (static_cast<std::int64_t>(s.step) >= std::max<std::int64_t>(events, 1) ||
-          (!t.step_info.empty() && s.step <= t.step_info.back().step))
-        throw json::other_error::create(501, "step_info: steps must increase, below the events",
-                                        &e);
-      s.graph = get_u32(e, "graph");
-      if (s.graph >= t.graphs.size())
-        throw json::other_error::create(501, "step_info: \"graph\" out of range", &e);
-      const TimelineGraph& g = t.graphs[s.graph];
-      for (const char* key : {"wall_ns", "record_ns", "partition_ns", "prepare_ns", "host_ns"}) {
-        const std::int64_t v = get_i64(e, key);
-        if (v < 0 || v > kMaxNs) throw json::other_error::create(501, std::string(key) + " out of range", &e);
-      }
-      s.wall_ns = get_i64(e, "wall_ns");
-      s.record_ns = get_i64(e, "record_ns");
-      s.partition_ns = get_i64(e, "partition_ns");
-      s.prepare_ns = get_i64(e, "prepare_ns");
-      s.host_ns = get_i64(e, "host_ns");
-      for (const std::int64_t i : column(e, "iterations", g.loops.size(), 0, 1 << 24))
-        s.iterations.push_back(static_cast<std::uint32_t>(i));
-      s.cost_ns = column(e, "cost_ns", g.task_kind.size(), 0, kMaxNs / 65536);
-      t.step_info.push_back(std::move(s));
-    }
-    // An instance of a step with a graph names one of its tasks.
-    for (std::size_t i = 0; i < t.tasks.size(); ++i)
-      if (const TimelineStep* s = t.info(t.tasks[i].step);
-          s && t.tasks[i].task >= t.graphs[s->graph].task_kind.size())
-        throw json::other_error::create(
-            501, "tasks[" + std::to_string(i) + "]: task out of range of its step's graph", &j);
-  }
+  read_graphs(j, t, events);
   return t;
 }
 
@@ -443,7 +459,36 @@ const TimelineStep* Timeline::info(std::uint32_t step) const {
   return it != step_info.end() && it->step == step ? &*it : nullptr;
 }
 
+// The executed graphs and step information as the two formats write them.
+json graphs_json(const Timeline& t);
+json step_info_json(const Timeline& t);
+
 std::string timeline_json(const Timeline& t) {
+  json tasks = json::array(), waits = json::array();
+  const auto optional_json = [](const std::optional<TaskId>& v) { return v ? json(*v) : json(nullptr); };
+  for (const TimelineTask& e : t.tasks) {
+    json o = {{"step", e.step},         {"thread", e.thread},   {"task", e.task},
+              {"origin", optional_json(e.origin)}, {"kind", e.kind},
+              {"iteration", e.iteration}, {"start_ns", e.start_ns}, {"end_ns", e.end_ns}};
+    if (e.cpu_ns >= 0) o["cpu_ns"] = e.cpu_ns;
+    tasks.push_back(std::move(o));
+  }
+  for (const TimelineWait& w : t.waits)
+    waits.push_back({{"step", w.step},
+                     {"thread", w.thread},
+                     {"task", optional_json(w.task)},
+                     {"start_ns", w.start_ns},
+                     {"end_ns", w.end_ns},
+                     {"parked", w.parked}});
+  json j = {{"threads", t.threads}, {"steps", t.steps}, {"tasks", tasks}, {"waits", waits}};
+  if (!t.graphs.empty()) {
+    j["graphs"] = graphs_json(t);
+    j["step_info"] = step_info_json(t);
+  }
+  return j.dump();
+}
+
+std::string compact_timeline_json(const Timeline& t) {
   // Kinds interned; instances in step order (stable), each start the difference from the
   // previous instance of its step.
   std::vector<std::string> kinds;
@@ -490,6 +535,26 @@ std::string timeline_json(const Timeline& t) {
     wduration.push_back(w.end_ns - w.start_ns);
     parked.push_back(w.parked ? 1 : 0);
   }
+  const json graphs = graphs_json(t), info = step_info_json(t);
+  return json{{"format", "tgraph-timeline"},
+              {"version", 2},
+              {"threads", t.threads},
+              {"steps", t.steps},
+              {"kinds", kinds},
+              {"tasks", tasks},
+              {"waits",
+               {{"step", wstep},
+                {"thread", wthread},
+                {"task", wtask},
+                {"start_ns", wstart},
+                {"duration_ns", wduration},
+                {"parked", parked}}},
+              {"graphs", graphs},
+              {"step_info", info}}
+      .dump();
+}
+
+json graphs_json(const Timeline& t) {
   json graphs = json::array();
   for (const TimelineGraph& g : t.graphs) {
     json first = json::array(), last = json::array(), origins = json::array();
@@ -508,6 +573,10 @@ std::string timeline_json(const Timeline& t) {
                       {"edges", edges_json(g.edges)},
                       {"carried_edges", edges_json(g.carried_edges)}});
   }
+  return graphs;
+}
+
+json step_info_json(const Timeline& t) {
   json info = json::array();
   for (const TimelineStep& s : t.step_info)
     info.push_back({{"step", s.step},
@@ -519,22 +588,7 @@ std::string timeline_json(const Timeline& t) {
                     {"host_ns", s.host_ns},
                     {"iterations", s.iterations},
                     {"cost_ns", s.cost_ns}});
-  return json{{"format", "tgraph-timeline"},
-              {"version", 2},
-              {"threads", t.threads},
-              {"steps", t.steps},
-              {"kinds", kinds},
-              {"tasks", tasks},
-              {"waits",
-               {{"step", wstep},
-                {"thread", wthread},
-                {"task", wtask},
-                {"start_ns", wstart},
-                {"duration_ns", wduration},
-                {"parked", parked}}},
-              {"graphs", graphs},
-              {"step_info", info}}
-      .dump();
+  return info;
 }
 
 Timeline parse_timeline(std::string_view text, const std::string& name) {
@@ -572,7 +626,7 @@ Timeline read_timeline(const std::string& path) {
 }
 
 void write_timeline(const std::string& path, const Timeline& t) {
-  write_file_atomic(path, gzip(timeline_json(t)));
+  write_file_atomic(path, gzip(compact_timeline_json(t)));
 }
 
 }  // namespace tgraph

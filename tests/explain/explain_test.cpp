@@ -313,7 +313,7 @@ TEST(Explain, WritesTheJsonShapeChecksRead) {
   EXPECT_TRUE(s["what_if"][0].contains("gain"));
   EXPECT_GE(s["what_if"][0]["gain"].get<std::int64_t>(), s["what_if"].back()["gain"].get<std::int64_t>());
   // The timeline itself, through its file format and back, explains the same.
-  const Timeline back = parse_timeline(timeline_json(b.t), "back.json");
+  const Timeline back = parse_timeline(compact_timeline_json(b.t), "back.json");
   EXPECT_EQ(explanation_json(explain_timeline(back, "back.json")),
             explanation_json(explain_timeline(b.t, "t.json")));
 }

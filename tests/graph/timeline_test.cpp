@@ -126,6 +126,12 @@ TEST(Timeline, KeepsGraphsStepInfoAndCpuTimeThroughGzip) {
   EXPECT_EQ(s.cost_ns, (std::vector<std::int64_t>{900, 800, 400, 0}));
   EXPECT_EQ(back.info(0), &back.step_info[0]);
   EXPECT_EQ(back.info(1), nullptr);
+  // The format of one object per event carries the same.
+  const Timeline objects = parse_timeline(timeline_json(t), "objects.json");
+  EXPECT_EQ(objects.graphs, back.graphs);
+  EXPECT_EQ(objects.step_info[0].cost_ns, s.cost_ns);
+  EXPECT_EQ(objects.tasks[0].cpu_ns, 950);
+  EXPECT_EQ(compact_timeline_json(objects), compact_timeline_json(back));
 }
 
 TEST(Timeline, RejectsGraphIndicesOutOfRange) {
@@ -138,6 +144,7 @@ TEST(Timeline, RejectsGraphIndicesOutOfRange) {
   t = with_graph();
   t.step_info[0].cost_ns.pop_back();  // a cost per task
   EXPECT_THROW(parse_timeline(timeline_json(t), "bad.json"), InputError);
+  EXPECT_THROW(parse_timeline(compact_timeline_json(t), "bad.json"), InputError);
   EXPECT_THROW(parse_timeline(std::string("\x1f\x8b garbage"), "bad.gz"), InputError);
 }
 

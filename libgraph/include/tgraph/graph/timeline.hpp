@@ -98,20 +98,24 @@ struct Timeline {
   std::vector<std::int64_t> step_offsets() const;
 };
 
-/// The timeline as JSON, in columns (docs/trace-format.md, "Timelines"): {"format":
-/// "tgraph-timeline", "version": 2, "threads", "steps", "kinds" (the kind names once),
-/// "tasks": {step, thread, task, origin, kind, iteration, start_ns, duration_ns[, cpu_ns]}
-/// (arrays, one entry per instance; start_ns as the difference from the previous instance
-/// of the same step; origin -1 for none), "waits": {step, thread, task, start_ns,
-/// duration_ns, parked}, "graphs" and "step_info"}.
+/// The timeline as JSON, one object per event: {"threads", "steps", "tasks": [{step, thread,
+/// task, origin, kind, iteration, start_ns, end_ns[, cpu_ns]}], "waits": [{step, thread,
+/// task, start_ns, end_ns, parked}]} (origin and a wait's task null when empty), and when
+/// recorded "graphs" and "step_info" as compact_timeline_json writes them.
 std::string timeline_json(const Timeline& t);
-/// Parses timeline_json text, gzip-compressed or not, or the earlier format (an array of
-/// objects per event); throws InputError naming `name` and what is wrong (not JSON, missing
+/// The same in columns (docs/trace-format.md, "Timelines"), what write_timeline writes:
+/// {"format": "tgraph-timeline", "version": 2, "threads", "steps", "kinds" (the kind names
+/// once), "tasks": {step, thread, task, origin, kind, iteration, start_ns, duration_ns[,
+/// cpu_ns]} (arrays, one entry per instance; start_ns as the difference from the previous
+/// instance of the same step; origin -1 for none), "waits": {step, thread, task, start_ns,
+/// duration_ns, parked}, "graphs", "step_info"}.
+std::string compact_timeline_json(const Timeline& t);
+/// Parses timeline_json or compact_timeline_json text, gzip-compressed or not; throws InputError naming `name` and what is wrong (not JSON, missing
 /// field, thread out of range, end before start, times that overflow, an index out of range).
 Timeline parse_timeline(std::string_view json, const std::string& name);
 /// parse_timeline of the file at `path` (InputError naming it when unreadable or malformed).
 Timeline read_timeline(const std::string& path);
-/// Writes timeline_json(t) to `path`, gzip-compressed (what read_timeline reads back; zcat
+/// Writes compact_timeline_json(t) to `path`, gzip-compressed (what read_timeline reads back; zcat
 /// shows the JSON), all or nothing (write_file_atomic).
 void write_timeline(const std::string& path, const Timeline& t);
 
