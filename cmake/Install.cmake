@@ -35,11 +35,12 @@ set(_tgraph_debian_PkgConfig::STARPUMPI "libstarpu-dev")
 set(_tgraph_debian_PkgConfig::GRAPHVIZ "libgraphviz-dev")
 set(_tgraph_debian_PkgConfig::CAIRO "libcairo2-dev")
 set(_tgraph_debian_PkgConfig::SIMGRID "libsimgrid-dev")
+set(_tgraph_debian_PkgConfig::ODE "libode-dev")
 
 # The modules, as library targets tgraph_<module> in folder <folder>, in dependency order.
 set(_tgraph_modules "")
 foreach(pair graph:libgraph capture:capture partition:partition replay:replay viz:viz
-             samples:samples measure:measure mpi:mpi experiment:experiment)
+             samples:samples measure:measure ode:ode mpi:mpi experiment:experiment)
   string(REPLACE ":" ";" pair "${pair}")
   list(GET pair 0 module)
   list(GET pair 1 folder)

@@ -32,6 +32,10 @@ if(TGRAPH_REQUIRE_ALL)
     _tgraph_require(tgraph_mpi INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_PTSCOTCH=1
                     "PT-Scotch (scotch/ptscotch.h, libptscotch, libptscotcherr, Debian libptscotch-dev)")
   endif()
+  # tgraph::ode (ode/CMakeLists.txt), when the samples and the measure module are built.
+  if(TARGET tgraph_measure AND NOT TARGET tgraph_ode)
+    list(APPEND _tgraph_missing "ODE (pkg-config ode, Debian libode-dev)")
+  endif()
   # The browser test of the HTML report (tests/viz) is the only user of Chromium.
   if(TGRAPH_BUILD_TESTS AND NOT TGRAPH_CHROMIUM)
     list(APPEND _tgraph_missing "Chromium (chromium or chromium-browser on PATH, Debian chromium)")

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: MIT
+// An ODE scene run live under a method at K threads, timed pass by pass against ODE
+// self-threaded in the same run (`tgraph run --scene ode-*`), and captured into a trace
+// (`tgraph capture --scene ode-*`).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "tgraph/ode/attach.hpp"
+#include "tgraph/ode/method.hpp"
+
+namespace tgraph::ode {
+
+/// What `tgraph run --scene ode-*` does.
+struct RunOptions {
+  std::string scene;                   ///< ode-piles, ode-heap, ode-chains
+  std::optional<std::uint32_t> steps;  ///< default: the scene's
+  Method method;
+  std::uint32_t threads = 2;
+  std::uint32_t repeat = 1;  ///< timed passes of each, interleaved (medians)
+  bool check = false;        ///< compare the final state with ODE self-threaded's
+  Stepper stepper = Stepper::kQuickStep;
+  double watchdog_s = 60.0;
+  std::uint32_t repartition_interval = 10;
+  partition::Options strategy;
+  bool json = false;
+};
+
+/// One step's medians over the timed passes.
+struct RunStep {
+  std::int64_t wall_ns = 0;   ///< collision + world step (+ partitioning)
+  std::int64_t world_ns = 0;  ///< the world step alone
+  std::int64_t collide_ns = 0;
+  std::int64_t partition_ns = 0;
+  std::int64_t sequential_wall_ns = 0;  ///< ODE self-threaded, same step
+  std::int64_t sequential_world_ns = 0;
+};
+
+/// A run's outcome.
+struct RunResult {
+  RunOptions options;
+  std::uint32_t steps = 0;
+  std::vector<RunStep> per_step;
+  std::int64_t wall_ns = 0, world_ns = 0, collide_ns = 0, partition_ns = 0;  ///< median pass
+  std::int64_t sequential_wall_ns = 0, sequential_world_ns = 0, sequential_collide_ns = 0;
+  std::vector<std::int64_t> pass_wall_ns, sequential_pass_wall_ns;
+  double speedup = 0;        ///< sequential_wall_ns / wall_ns: the whole step as the user sees it
+  double world_speedup = 0;  ///< sequential_world_ns / world_ns
+  AttachStats stats;         ///< the first timed pass (ODE self-threaded's for sequential)
+  /// The check: "identical" (bit for bit), "within-tolerance" or "differs"; empty: none.
+  std::string check;
+  double max_abs_diff = 0;  ///< largest difference of a body position (m)
+  double max_rel_diff = 0;  ///< largest relative difference of a state number
+  /// The tolerance of "within-tolerance" (m): how far ODE self-threaded's own final positions
+  /// move with another seed of its random constraint reordering (the same algorithm, another
+  /// equally valid order of its sweeps).
+  double tolerance = 0;
+};
+
+/// Runs the scene: `repeat` timed passes under the method, each beside a pass of ODE
+/// self-threaded, one warm-up pass of each before; the check from the first passes.
+/// InputError for an unknown scene, OptionError for bad options.
+RunResult run_scene(const RunOptions& options);
+
+/// The run as one JSON object (the keys of `tgraph run --json`, docs/ode.md).
+std::string to_json(const RunResult& r);
+/// The run as text.
+std::string to_text(const RunResult& r);
+
+/// What `tgraph capture --scene ode-*` does.
+struct CaptureOptions {
+  std::string scene;
+  std::optional<std::uint32_t> steps;
+  std::uint32_t threads = 2;  ///< ODE posts as many instances of a stage as it has threads
+  Stepper stepper = Stepper::kQuickStep;
+  std::string output;  ///< .tgt
+};
+
+/// What a capture did.
+struct CaptureReport {
+  std::uint32_t steps = 0;
+  std::uint64_t tasks = 0, edges = 0, bytes = 0;
+  std::int64_t recorded_ns = 0;    ///< the recorded pass's steps (recording on)
+  std::int64_t unrecorded_ns = 0;  ///< the same steps, recording off, same run
+  double overhead = 0;             ///< recorded / unrecorded - 1
+};
+
+/// Runs the scene once without and once with recording (worksteal at `threads`) and writes
+/// the recorded steps to `output`: one task per segment of ODE's calls (docs/ode.md).
+CaptureReport capture_scene(const CaptureOptions& options);
+
+}  // namespace tgraph::ode

@@ -1,0 +1,106 @@
+// SPDX-License-Identifier: MIT
+#include "recording.hpp"
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+namespace tgraph::ode::detail {
+
+StepGraph build_step_graph(const StepLog& log) {
+  StepGraph g;
+  g.host_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(log.host_ns, 0));
+  std::unordered_map<std::uint32_t, const CallRecord*> calls;
+  for (const CallRecord& c : log.calls) calls.emplace(c.id, &c);
+  std::vector<const SegmentRecord*> order;
+  order.reserve(log.segments.size());
+  for (const SegmentRecord& s : log.segments)
+    if (calls.count(s.call)) order.push_back(&s);
+  std::sort(order.begin(), order.end(),
+            [](const SegmentRecord* a, const SegmentRecord* b) { return a->seq < b->seq; });
+
+  auto label = [&](const CallRecord& c) {
+    return std::string(c.name) + " [" + std::to_string(c.instance) + "] #" +
+           std::to_string(c.occurrence);
+  };
+  // Data by relation: (kind, a, b) -> id.
+  std::map<std::tuple<std::uint32_t, std::uint64_t, std::uint64_t>, DatumId> data;
+  auto datum = [&](std::uint32_t kind, std::uint64_t a, std::uint64_t b, auto&& name) -> DatumId {
+    auto [it, fresh] = data.emplace(std::tuple{kind, a, b}, static_cast<DatumId>(g.data.size()));
+    if (fresh) g.data.push_back(Datum{name(), kNoObject, 0});
+    return it->second;
+  };
+  // Which calls are released by someone in this log, which waits are signalled.
+  std::unordered_map<std::uint32_t, bool> released;
+  std::unordered_map<std::uint64_t, bool> signalled;
+  for (const AccessRecord& a : log.accesses) {
+    if (a.kind == AccessRecord::kRelease) released[a.a] = true;
+    if (a.kind == AccessRecord::kSignal) signalled[(std::uint64_t{a.a} << 32) | a.b] = true;
+  }
+  // A wait's uses this step, numbered from 0 (its generation counts from its allocation).
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> use;
+  for (const AccessRecord& a : log.accesses)
+    if (a.kind != AccessRecord::kRelease) use.emplace(std::pair{a.a, a.b}, 0);
+  {
+    std::uint32_t last = CallRecord::kNone, n = 0;
+    for (auto& [k, v] : use) {
+      n = k.first == last ? n + 1 : 0;
+      last = k.first;
+      v = n;
+    }
+  }
+  auto wait_name = [&](const AccessRecord& a) {
+    return "wait " + std::to_string(a.a) + " use " + std::to_string(use.at({a.a, a.b}));
+  };
+  std::vector<Access> acc;
+  for (const SegmentRecord* s : order) {
+    const CallRecord& c = *calls.at(s->call);
+    acc.clear();
+    if (s->seg > 0) {
+      acc.push_back({datum(0, s->call, s->seg - 1,
+                           [&] { return label(c) + " part " + std::to_string(s->seg - 1); }),
+                     AccessMode::R});
+    } else {
+      if (c.poster_call != CallRecord::kNone && calls.count(c.poster_call))
+        acc.push_back({datum(0, c.poster_call, c.poster_seg,
+                             [&] {
+                               return label(*calls.at(c.poster_call)) + " part " +
+                                      std::to_string(c.poster_seg);
+                             }),
+                       AccessMode::R});
+      if (released.count(c.id))
+        acc.push_back({datum(1, c.id, 0, [&] { return label(c) + " released"; }), AccessMode::R});
+    }
+    for (std::uint32_t i = 0; i < s->access_count; ++i) {
+      const AccessRecord& a = log.accesses[s->access_begin + i];
+      switch (a.kind) {
+        case AccessRecord::kRelease:
+          if (calls.count(a.a))
+            acc.push_back({datum(1, a.a, 0, [&] { return label(*calls.at(a.a)) + " released"; }),
+                           AccessMode::CW});
+          break;
+        case AccessRecord::kSignal:
+          acc.push_back({datum(2, a.a, a.b, [&] { return wait_name(a); }), AccessMode::CW});
+          break;
+        case AccessRecord::kWaitRead:
+          if (signalled.count((std::uint64_t{a.a} << 32) | a.b))
+            acc.push_back({datum(2, a.a, a.b, [&] { return wait_name(a); }), AccessMode::R});
+          break;
+      }
+    }
+    if (!s->last)
+      acc.push_back(
+          {datum(0, s->call, s->seg, [&] { return label(c) + " part " + std::to_string(s->seg); }),
+           AccessMode::W});
+    const KindId kind = g.intern_kind(c.name);
+    const auto cost =
+        static_cast<std::uint64_t>(std::max<std::int64_t>(s->end_ns - s->start_ns, 1));
+    g.add_task(kind, kNoObject, acc, cost, segment_key(c.key, s->seg));
+  }
+  g.derive_edges();
+  return g;
+}
+
+}  // namespace tgraph::ode::detail

@@ -1,0 +1,243 @@
+// SPDX-License-Identifier: MIT
+#include "tgraph/ode/run.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/measure/passes.hpp"
+#include "tgraph/ode/scenes.hpp"
+
+namespace tgraph::ode {
+namespace {
+
+struct Pass {
+  std::vector<StepTime> steps;
+  std::vector<std::int64_t> partition_ns;
+  std::vector<double> state;
+  std::vector<double> positions;
+  AttachStats stats;
+};
+
+std::vector<double> positions_of(const std::vector<double>& state) {
+  std::vector<double> p;
+  for (std::size_t b = 0; b + 13 <= state.size(); b += 13)
+    p.insert(p.end(), &state[b], &state[b] + 3);
+  return p;
+}
+
+// One pass of `steps` steps on a fresh scene: attached under `method` (or not at all for
+// ODE self-threaded, the reference).
+Pass run_pass(const RunOptions& o, std::uint32_t steps, bool reference, unsigned long seed) {
+  auto scene = Scene::make(o.scene, o.stepper, seed);
+  Pass p;
+  p.steps.reserve(steps);
+  if (reference) {
+    for (std::uint32_t i = 0; i < steps; ++i) p.steps.push_back(scene->step(nullptr));
+    p.partition_ns.assign(steps, 0);
+  } else {
+    AttachOptions a;
+    a.method = o.method;
+    a.threads = o.threads;
+    a.watchdog_s = o.watchdog_s;
+    a.repartition_interval = o.repartition_interval;
+    a.strategy = o.strategy;
+    Attachment attach(scene->world(), a);
+    std::int64_t partitioned = 0;
+    for (std::uint32_t i = 0; i < steps; ++i) {
+      p.steps.push_back(scene->step(&attach));
+      const std::int64_t now = attach.stats().partition_ns;
+      p.partition_ns.push_back(now - partitioned);
+      p.steps.back().world_ns -= now - partitioned;  // the world step alone
+      partitioned = now;
+    }
+    p.stats = attach.stats();
+  }
+  p.state = scene->state();
+  p.positions = positions_of(p.state);
+  return p;
+}
+
+double max_abs(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+
+}  // namespace
+
+RunResult run_scene(const RunOptions& options) {
+  if (!is_scene(options.scene))
+    throw InputError(options.scene, std::nullopt,
+                     "unknown ODE scene (ode-piles, ode-heap, ode-chains)");
+  if (options.threads == 0) throw OptionError("threads", "must be at least 1");
+  if (options.repeat == 0) throw OptionError("repeat", "must be at least 1");
+  if (options.steps && *options.steps == 0) throw OptionError("steps", "must be at least 1");
+  dInitODE2(0);
+  struct Close {
+    ~Close() { dCloseODE(); }
+  } close;
+  RunResult r;
+  r.options = options;
+  r.steps = options.steps.value_or(Scene::make(options.scene, options.stepper)->default_steps());
+  const bool self = options.method.policy == Policy::kSequential;
+  // Warm-up: caches, the threads' first wake-ups, ODE's step memory.
+  const std::uint32_t warm = std::min<std::uint32_t>(r.steps, 20);
+  run_pass(options, warm, true, 0);
+  if (!self) run_pass(options, warm, false, 0);
+
+  measure::PassTimes wall(r.steps), world(r.steps), collide(r.steps), part(r.steps);
+  measure::PassTimes seq_wall(r.steps), seq_world(r.steps), seq_collide(r.steps);
+  Pass first, first_reference;
+  for (std::uint32_t pass = 0; pass < options.repeat; ++pass) {
+    Pass ref = run_pass(options, r.steps, true, 0);
+    Pass run = self ? ref : run_pass(options, r.steps, false, 0);
+    for (std::uint32_t s = 0; s < r.steps; ++s) {
+      seq_wall.add(s, ref.steps[s].collide_ns + ref.steps[s].world_ns);
+      seq_world.add(s, ref.steps[s].world_ns);
+      seq_collide.add(s, ref.steps[s].collide_ns);
+      wall.add(s, run.steps[s].collide_ns + run.steps[s].world_ns + run.partition_ns[s]);
+      world.add(s, run.steps[s].world_ns);
+      collide.add(s, run.steps[s].collide_ns);
+      part.add(s, run.partition_ns[s]);
+    }
+    for (measure::PassTimes* t :
+         {&wall, &world, &collide, &part, &seq_wall, &seq_world, &seq_collide})
+      t->end_pass();
+    if (pass == 0) {
+      first = std::move(run);
+      first_reference = std::move(ref);
+    }
+  }
+  r.wall_ns = wall.median_total();
+  r.world_ns = world.median_total();
+  r.collide_ns = collide.median_total();
+  r.partition_ns = part.median_total();
+  r.sequential_wall_ns = seq_wall.median_total();
+  r.sequential_world_ns = seq_world.median_total();
+  r.sequential_collide_ns = seq_collide.median_total();
+  r.pass_wall_ns = wall.pass_totals();
+  r.sequential_pass_wall_ns = seq_wall.pass_totals();
+  r.speedup = r.wall_ns > 0
+                  ? static_cast<double>(r.sequential_wall_ns) / static_cast<double>(r.wall_ns)
+                  : 0;
+  r.world_speedup =
+      r.world_ns > 0 ? static_cast<double>(r.sequential_world_ns) / static_cast<double>(r.world_ns)
+                     : 0;
+  r.stats = self ? AttachStats{} : first.stats;
+  for (std::uint32_t s = 0; s < r.steps; ++s) {
+    RunStep st;
+    st.wall_ns = wall.step_median(s);
+    st.world_ns = world.step_median(s);
+    st.collide_ns = collide.step_median(s);
+    st.partition_ns = part.step_median(s);
+    st.sequential_wall_ns = seq_wall.step_median(s);
+    st.sequential_world_ns = seq_world.step_median(s);
+    r.per_step.push_back(st);
+  }
+  if (options.check) {
+    const Pass& a = self ? first_reference : first;
+    const Pass& b = first_reference;
+    if (a.state.size() == b.state.size() &&
+        std::memcmp(a.state.data(), b.state.data(), a.state.size() * sizeof(double)) == 0) {
+      r.check = "identical";
+    } else {
+      r.max_abs_diff = max_abs(a.positions, b.positions);
+      for (std::size_t i = 0; i < a.state.size() && i < b.state.size(); ++i) {
+        const double scale = std::max(std::abs(a.state[i]), std::abs(b.state[i]));
+        if (scale > 0)
+          r.max_rel_diff = std::max(r.max_rel_diff, std::abs(a.state[i] - b.state[i]) / scale);
+      }
+      // The same algorithm with another order of its random constraint reordering.
+      const Pass other = run_pass(options, r.steps, true, 1);
+      r.tolerance = max_abs(other.positions, b.positions);
+      r.check = r.max_abs_diff <= r.tolerance ? "within-tolerance" : "differs";
+    }
+  }
+  return r;
+}
+
+std::string to_json(const RunResult& r) {
+  nlohmann::ordered_json j;
+  const RunOptions& o = r.options;
+  j["scene"] = o.scene;
+  j["stepper"] = std::string(to_string(o.stepper));
+  j["method"] = method_name(o.method);
+  j["policy"] = std::string(to_string(o.method.policy));
+  j["threads"] = o.threads;
+  j["steps"] = r.steps;
+  j["repeat"] = o.repeat;
+  j["wall_ns"] = r.wall_ns;
+  j["sequential_wall_ns"] = r.sequential_wall_ns;
+  j["world_ns"] = r.world_ns;
+  j["sequential_world_ns"] = r.sequential_world_ns;
+  j["speedup"] = r.speedup;
+  j["world_speedup"] = r.world_speedup;
+  if (r.check.empty()) {
+    j["check"] = nullptr;
+  } else {
+    j["check"] = r.check;
+    j["check_reference"] = "plain";
+    if (r.check != "identical") {
+      j["max_abs_diff"] = r.max_abs_diff;
+      j["max_rel_diff"] = r.max_rel_diff;
+      j["tolerance"] = r.tolerance;
+      j["tolerance_basis"] =
+          "ODE self-threaded's final positions with another seed of its random constraint "
+          "reordering";
+    }
+  }
+  j["breakdown"] = {{"collide_ns", r.collide_ns},
+                    {"world_ns", r.world_ns},
+                    {"partition_ns", r.partition_ns},
+                    {"sequential_collide_ns", r.sequential_collide_ns},
+                    {"sequential_world_ns", r.sequential_world_ns}};
+  const double steps = std::max<double>(r.steps, 1);
+  j["calls_per_step"] = static_cast<double>(r.stats.calls) / steps;
+  j["steals_per_step"] = static_cast<double>(r.stats.steals) / steps;
+  j["parks_per_step"] = static_cast<double>(r.stats.parks) / steps;
+  j["ode_messages"] = r.stats.messages;
+  if (r.stats.messages) j["first_ode_message"] = r.stats.first_message;
+  j["pass_wall_ns"] = r.pass_wall_ns;
+  j["sequential_pass_wall_ns"] = r.sequential_pass_wall_ns;
+  nlohmann::ordered_json steps_json = nlohmann::ordered_json::array();
+  for (std::size_t s = 0; s < r.per_step.size(); ++s) {
+    const RunStep& st = r.per_step[s];
+    steps_json.push_back({{"step", s},
+                          {"wall_ns", st.wall_ns},
+                          {"world_ns", st.world_ns},
+                          {"collide_ns", st.collide_ns},
+                          {"partition_ns", st.partition_ns},
+                          {"sequential_wall_ns", st.sequential_wall_ns},
+                          {"sequential_world_ns", st.sequential_world_ns}});
+  }
+  j["per_step"] = std::move(steps_json);
+  return j.dump() + "\n";
+}
+
+std::string to_text(const RunResult& r) {
+  std::ostringstream out;
+  const RunOptions& o = r.options;
+  out << o.scene << " (" << to_string(o.stepper) << "), " << r.steps << " steps, "
+      << method_name(o.method) << " at " << o.threads << " threads, " << o.repeat
+      << " timed pass(es)\n";
+  out << "  whole step: " << static_cast<double>(r.wall_ns) / 1e6 << " ms against "
+      << static_cast<double>(r.sequential_wall_ns) / 1e6 << " ms ODE self-threaded: speed-up "
+      << r.speedup << "\n";
+  out << "  world step: " << static_cast<double>(r.world_ns) / 1e6 << " ms against "
+      << static_cast<double>(r.sequential_world_ns) / 1e6 << " ms: speed-up " << r.world_speedup
+      << "\n";
+  if (!r.check.empty()) {
+    out << "  check: " << r.check;
+    if (r.check != "identical")
+      out << " (largest position difference " << r.max_abs_diff << " m; tolerance " << r.tolerance
+          << " m)";
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace tgraph::ode

@@ -1,0 +1,721 @@
+// SPDX-License-Identifier: MIT
+// ODE's threading interface on tgraph's threads (runtime.hpp). Semantics of the interface as
+// ode/threading.h documents them: a call starts when its dependency count is zero; while it
+// runs it may add dependencies to itself (sub-calls releasing it); it completes when it has
+// returned and those have completed, which writes its summary fault, signals its wait and
+// releases its releasee (whose completion may follow in turn).
+#include "runtime.hpp"
+
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string_view>
+
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#define TGRAPH_ODE_PAUSE() _mm_pause()
+#else
+#define TGRAPH_ODE_PAUSE() ((void)0)
+#endif
+
+namespace tgraph::ode::detail {
+namespace {
+
+std::int64_t now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+/// Test-and-test-and-set lock for the deques and the pool (held for a few instructions).
+class SpinLock {
+ public:
+  void lock() {
+    // acquire: the holder's writes before its unlock (release) are seen.
+    while (flag_.exchange(true, std::memory_order_acquire))
+      while (flag_.load(std::memory_order_relaxed)) TGRAPH_ODE_PAUSE();
+  }
+  void unlock() { flag_.store(false, std::memory_order_release); }
+
+ private:
+  std::atomic<bool> flag_{false};
+};
+
+std::uint64_t fnv1a(std::string_view s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  return h | 1;  // never 0 (0 marks a name slot not ready)
+}
+
+std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
+  h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+  return h;
+}
+
+constexpr std::uint32_t kNoRecord = CallRecord::kNone;
+
+}  // namespace
+
+struct Call {
+  dThreadedCallFunction* function = nullptr;
+  void* context = nullptr;
+  dcallindex_t instance = 0;
+  const char* name = nullptr;
+  // Dependencies before the start; 1 + sub-calls while running. acq_rel on every change: a
+  // releaser's writes (its fault, its results) are seen by whoever takes the count to zero.
+  std::atomic<std::intptr_t> count{0};
+  // Set (relaxed) before the function runs; read after a release's acq_rel decrement, which
+  // the call's own post of that releaser (a deque push, release) precedes.
+  std::atomic<bool> started{false};
+  // Set before the count decrement that releases it (release), read after it (acquire).
+  std::atomic<int> fault{0};
+  Call* releasee = nullptr;
+  Wait* wait = nullptr;
+  int* fault_out = nullptr;
+  Call* prev = nullptr;
+  Call* next = nullptr;
+  std::uint32_t record = kNoRecord;
+  std::uint32_t home = 0;
+};
+
+struct Wait {
+  // release on signal, acquire on the waiter's check: the call's fault and results are seen.
+  std::atomic<std::uint32_t> signalled{0};
+  std::uint32_t id = 0;
+  std::uint32_t generation = 0;  // recording: one datum per use
+};
+
+struct Frame {
+  std::uint32_t call = 0;
+  std::uint32_t seg = 0;
+  std::uint64_t seq = 0;
+  std::int64_t start_ns = 0;
+  std::uint32_t access_begin = 0;
+  bool open = false;
+};
+
+struct alignas(64) Slot {
+  std::uint32_t index = 0;
+  SpinLock lock;
+  Call* head = nullptr;  // newest
+  Call* tail = nullptr;  // oldest
+  // Written under the lock; read without it (relaxed) only to skip an empty deque.
+  std::atomic<std::uint32_t> size{0};
+  // Watchdog: the call running here and how many calls started here (relaxed: a sample).
+  std::atomic<const char*> running{nullptr};
+  std::atomic<dcallindex_t> running_instance{0};
+  std::atomic<std::uint64_t> generation{0};
+  // Counters (relaxed; the slot's own thread writes them, read between steps).
+  std::atomic<std::uint64_t> calls{0}, steals{0}, parks{0};
+  // Recording (the slot's own thread only, between begin_step and end_step).
+  std::vector<Frame> frames;
+  std::vector<SegmentRecord> segments;
+  std::vector<AccessRecord> accesses;
+  std::vector<CallRecord> records;
+  std::uint32_t next_record = 0;
+
+  void push_front(Call* c) {
+    lock.lock();
+    c->prev = nullptr;
+    c->next = head;
+    if (head)
+      head->prev = c;
+    else
+      tail = c;
+    head = c;
+    size.store(size.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    lock.unlock();
+  }
+  Call* pop_front() {
+    if (size.load(std::memory_order_relaxed) == 0) return nullptr;
+    lock.lock();
+    Call* c = head;
+    if (c) {
+      head = c->next;
+      if (head)
+        head->prev = nullptr;
+      else
+        tail = nullptr;
+      size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    }
+    lock.unlock();
+    return c;
+  }
+  Call* pop_back() {
+    if (size.load(std::memory_order_relaxed) == 0) return nullptr;
+    lock.lock();
+    Call* c = tail;
+    if (c) {
+      tail = c->prev;
+      if (tail)
+        tail->next = nullptr;
+      else
+        head = nullptr;
+      size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    }
+    lock.unlock();
+    return c;
+  }
+};
+
+struct Runtime::Pool {
+  SpinLock lock;
+  Call* free = nullptr;
+  std::vector<std::unique_ptr<Call[]>> blocks;
+  std::size_t total = 0;
+  // Under the lock.
+  void grow(std::size_t n) {
+    auto block = std::make_unique<Call[]>(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      block[i].next = free;
+      free = &block[i];
+    }
+    blocks.push_back(std::move(block));
+    total += n;
+  }
+};
+
+struct Runtime::Names {
+  static constexpr std::uint32_t kSize = 256;  // distinct call names (ODE posts ~40)
+  static constexpr std::uint32_t kInstances = 16;
+  std::atomic<const char*> name[kSize] = {};
+  // 0 until the interning thread has hashed the text (release), then the hash (acquire).
+  std::atomic<std::uint64_t> hash[kSize] = {};
+  std::atomic<std::uint32_t> occurrence[kSize][kInstances] = {};
+};
+
+namespace {
+
+thread_local Runtime* tl_runtime = nullptr;
+thread_local std::uint32_t tl_slot = 0;
+
+struct MutexGroup {
+  std::unique_ptr<std::mutex[]> mutexes;
+};
+
+Runtime* rt(dThreadingImplementationID impl) { return reinterpret_cast<Runtime*>(impl); }
+
+}  // namespace
+
+Runtime::Runtime(const RuntimeOptions& options)
+    : threads_(options.threads),
+      placed_(options.placed),
+      spin_ns_(options.spin_ns),
+      watchdog_s_(options.watchdog_s),
+      pool_(std::make_unique<Pool>()),
+      names_(std::make_unique<Names>()) {
+  functions_.struct_size = sizeof(dThreadingFunctionsInfo);
+  functions_.alloc_mutex_group = [](dThreadingImplementationID impl, dmutexindex_t count,
+                                    const char* const*) {
+    return rt(impl)->alloc_mutex_group(count);
+  };
+  functions_.free_mutex_group = [](dThreadingImplementationID impl, dMutexGroupID g) {
+    rt(impl)->free_mutex_group(g);
+  };
+  functions_.lock_group_mutex = [](dThreadingImplementationID impl, dMutexGroupID g,
+                                   dmutexindex_t i) { rt(impl)->lock(g, i); };
+  functions_.unlock_group_mutex = [](dThreadingImplementationID impl, dMutexGroupID g,
+                                     dmutexindex_t i) { rt(impl)->unlock(g, i); };
+  functions_.alloc_call_wait = [](dThreadingImplementationID impl) {
+    return rt(impl)->alloc_wait();
+  };
+  functions_.reset_call_wait = [](dThreadingImplementationID impl, dCallWaitID w) {
+    rt(impl)->reset_wait(w);
+  };
+  functions_.free_call_wait = [](dThreadingImplementationID impl, dCallWaitID w) {
+    rt(impl)->free_wait(w);
+  };
+  functions_.post_call = [](dThreadingImplementationID impl, int* fault, dCallReleaseeID* out,
+                            ddependencycount_t deps, dCallReleaseeID dependent, dCallWaitID wait,
+                            dThreadedCallFunction* fn, void* ctx, dcallindex_t index,
+                            const char* name) {
+    rt(impl)->post(fault, out, deps, dependent, wait, fn, ctx, index, name);
+  };
+  functions_.alter_call_dependencies_count = [](dThreadingImplementationID impl, dCallReleaseeID r,
+                                                ddependencychange_t change) {
+    rt(impl)->alter(r, change);
+  };
+  functions_.wait_call = [](dThreadingImplementationID impl, int* status, dCallWaitID w,
+                            const dThreadedWaitTime* timeout,
+                            const char* name) { rt(impl)->wait(status, w, timeout, name); };
+  functions_.retrieve_thread_count = [](dThreadingImplementationID impl) {
+    return rt(impl)->thread_count();
+  };
+  functions_.preallocate_resources_for_calls = [](dThreadingImplementationID impl,
+                                                  ddependencycount_t n) {
+    return rt(impl)->preallocate(n);
+  };
+
+  // The workers allocate ODE's per-thread data, which needs ODE initialised (counted: paired
+  // with dCloseODE in the destructor).
+  dInitODE2(0);
+  for (std::uint32_t i = 0; i < threads_; ++i) {
+    slots_.push_back(std::make_unique<Slot>());
+    slots_.back()->index = i;
+  }
+  pool_->grow(1024);
+  for (std::uint32_t i = 1; i < threads_; ++i) workers_.emplace_back([this, i] { worker(i); });
+  if (watchdog_s_ > 0) watchdog_thread_ = std::thread([this] { watchdog(); });
+}
+
+Runtime::~Runtime() {
+  stop_.store(true, std::memory_order_release);
+  epoch_.fetch_add(1, std::memory_order_release);
+  epoch_.notify_all();
+  for (std::thread& t : workers_) t.join();
+  if (watchdog_thread_.joinable()) watchdog_thread_.join();
+  dCloseODE();
+}
+
+const dThreadingFunctionsInfo* Runtime::functions() const { return &functions_; }
+dThreadingImplementationID Runtime::id() {
+  return reinterpret_cast<dThreadingImplementationID>(this);
+}
+
+Slot& Runtime::my_slot() { return tl_runtime == this ? *slots_[tl_slot] : *slots_[0]; }
+
+Call* Runtime::allocate_call() {
+  pool_->lock.lock();
+  if (!pool_->free) pool_->grow(pool_->total);  // anticipated by preallocate; rare
+  Call* c = pool_->free;
+  pool_->free = c->next;
+  pool_->lock.unlock();
+  return c;
+}
+
+void Runtime::free_call(Call* c) {
+  pool_->lock.lock();
+  c->next = pool_->free;
+  pool_->free = c;
+  pool_->lock.unlock();
+}
+
+int Runtime::preallocate(ddependencycount_t calls) {
+  pool_->lock.lock();
+  if (pool_->total < calls * 2) pool_->grow(calls * 2 - pool_->total);
+  pool_->lock.unlock();
+  return 1;
+}
+
+dMutexGroupID Runtime::alloc_mutex_group(dmutexindex_t count) {
+  auto* g = new MutexGroup{std::make_unique<std::mutex[]>(count)};
+  return reinterpret_cast<dMutexGroupID>(g);
+}
+void Runtime::free_mutex_group(dMutexGroupID group) { delete reinterpret_cast<MutexGroup*>(group); }
+void Runtime::lock(dMutexGroupID group, dmutexindex_t index) {
+  reinterpret_cast<MutexGroup*>(group)->mutexes[index].lock();
+}
+void Runtime::unlock(dMutexGroupID group, dmutexindex_t index) {
+  reinterpret_cast<MutexGroup*>(group)->mutexes[index].unlock();
+}
+
+dCallWaitID Runtime::alloc_wait() {
+  auto* w = new Wait;
+  w->id = wait_ids_.fetch_add(1, std::memory_order_relaxed);  // a name only
+  return reinterpret_cast<dCallWaitID>(w);
+}
+void Runtime::reset_wait(dCallWaitID wait) {
+  auto* w = reinterpret_cast<Wait*>(wait);
+  w->signalled.store(0, std::memory_order_relaxed);  // before the next post that signals it
+  ++w->generation;
+}
+void Runtime::free_wait(dCallWaitID wait) { delete reinterpret_cast<Wait*>(wait); }
+
+std::uint64_t Runtime::call_key(const char* name, dcallindex_t instance,
+                                std::uint32_t* occurrence) {
+  const char* text = name ? name : "(unnamed call)";
+  std::uint32_t i =
+      static_cast<std::uint32_t>((reinterpret_cast<std::uintptr_t>(text) >> 3) * 2654435761u) %
+      Names::kSize;
+  std::uint64_t h = 0;
+  for (std::uint32_t probe = 0; probe < Names::kSize; ++probe, i = (i + 1) % Names::kSize) {
+    const char* at = names_->name[i].load(std::memory_order_acquire);
+    if (at == nullptr) {
+      // acq_rel: the winner publishes the slot; a loser sees who took it.
+      if (names_->name[i].compare_exchange_strong(at, text, std::memory_order_acq_rel)) {
+        names_->hash[i].store(fnv1a(text), std::memory_order_release);
+        at = text;
+      }
+    }
+    if (at == text) {
+      while ((h = names_->hash[i].load(std::memory_order_acquire)) == 0) TGRAPH_ODE_PAUSE();
+      break;
+    }
+  }
+  std::uint32_t occ = 0;
+  if (h == 0) {
+    h = fnv1a(text);  // table full: keys without occurrences
+  } else {
+    const std::size_t bucket = std::min<dcallindex_t>(instance, Names::kInstances - 1);
+    // relaxed: a count; which post gets which number is the posts' order, timing-dependent
+    // between threads anyway.
+    occ = names_->occurrence[i][bucket].fetch_add(1, std::memory_order_relaxed);
+  }
+  *occurrence = occ;
+  return mix(mix(h, instance), occ);
+}
+
+void Runtime::begin_step(const char* entry) {
+  for (std::uint32_t i = 0; i < Names::kSize; ++i)
+    for (std::uint32_t j = 0; j < Names::kInstances; ++j)
+      names_->occurrence[i][j].store(0, std::memory_order_relaxed);  // threads idle
+  if (!recording()) return;
+  for (auto& s : slots_) {
+    s->segments.clear();
+    s->accesses.clear();
+    s->records.clear();
+    s->frames.clear();
+    s->next_record = 0;
+  }
+  Slot& slot = my_slot();
+  CallRecord r;
+  r.id = (slot.index << 24) | slot.next_record++;
+  r.name = entry;
+  r.key = mix(fnv1a(entry), 0);
+  slot.records.push_back(r);
+  slot.frames.push_back(Frame{});
+  open_segment(slot, r.id, 0);
+}
+
+StepLog Runtime::end_step() {
+  StepLog log;
+  if (!recording()) return log;
+  Slot& slot = my_slot();
+  if (!slot.frames.empty()) {
+    if (slot.frames.back().open) close_segment(slot, true);
+    slot.frames.pop_back();
+  }
+  for (auto& s : slots_) {
+    const auto base = static_cast<std::uint32_t>(log.accesses.size());
+    log.accesses.insert(log.accesses.end(), s->accesses.begin(), s->accesses.end());
+    for (SegmentRecord seg : s->segments) {
+      seg.access_begin += base;
+      log.segments.push_back(seg);
+    }
+    log.calls.insert(log.calls.end(), s->records.begin(), s->records.end());
+  }
+  return log;
+}
+
+void Runtime::set_placement(std::unordered_map<std::uint64_t, std::uint32_t> placement) {
+  placement_ = std::move(placement);
+}
+
+RuntimeCounters Runtime::counters() const {
+  RuntimeCounters c;
+  for (const auto& s : slots_) {
+    c.calls += s->calls.load(std::memory_order_relaxed);
+    c.steals += s->steals.load(std::memory_order_relaxed);
+    c.parks += s->parks.load(std::memory_order_relaxed);
+  }
+  return c;
+}
+
+void Runtime::open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg) {
+  Frame& f = slot.frames.back();
+  f.call = call;
+  f.seg = seg;
+  // relaxed: the modification order of one atomic follows happens-before, so a segment that
+  // must follow another (posted after it, released by it) gets a larger number.
+  f.seq = seq_.fetch_add(1, std::memory_order_relaxed);
+  f.start_ns = now_ns();
+  f.access_begin = static_cast<std::uint32_t>(slot.accesses.size());
+  f.open = true;
+}
+
+void Runtime::close_segment(Slot& slot, bool last) {
+  Frame& f = slot.frames.back();
+  SegmentRecord s;
+  s.seq = f.seq;
+  s.call = f.call;
+  s.seg = f.seg;
+  s.start_ns = f.start_ns;
+  s.end_ns = now_ns();
+  s.access_begin = f.access_begin;
+  s.access_count = static_cast<std::uint32_t>(slot.accesses.size()) - f.access_begin;
+  s.last = last;
+  slot.segments.push_back(s);
+  f.open = false;
+}
+
+void Runtime::split(Slot& slot) {
+  if (slot.frames.empty() || !slot.frames.back().open) return;
+  close_segment(slot, false);
+  const Frame& f = slot.frames.back();
+  open_segment(slot, f.call, f.seg + 1);
+}
+
+void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
+                   ddependencycount_t dependencies, dCallReleaseeID dependent_releasee,
+                   dCallWaitID call_wait, dThreadedCallFunction* function, void* context,
+                   dcallindex_t instance, const char* name) {
+  Slot& slot = my_slot();
+  Call* c = allocate_call();
+  c->function = function;
+  c->context = context;
+  c->instance = instance;
+  c->name = name;
+  c->count.store(static_cast<std::intptr_t>(dependencies), std::memory_order_relaxed);
+  c->started.store(false, std::memory_order_relaxed);
+  c->fault.store(0, std::memory_order_relaxed);
+  c->releasee = reinterpret_cast<Call*>(dependent_releasee);
+  c->wait = reinterpret_cast<Wait*>(call_wait);
+  c->fault_out = out_summary_fault;
+  c->home = slot.index;
+  c->record = kNoRecord;
+  slot.calls.store(slot.calls.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  const bool rec = recording();
+  if (rec || placed_) {
+    std::uint32_t occurrence = 0;
+    const std::uint64_t key = call_key(name, instance, &occurrence);
+    if (placed_) {
+      auto it = placement_.find(segment_key(key, 0));
+      if (it != placement_.end()) c->home = it->second % threads_;
+    }
+    if (rec) {
+      CallRecord r;
+      r.id = (slot.index << 24) | slot.next_record++;
+      r.name = name ? name : "(unnamed call)";
+      r.instance = static_cast<std::uint32_t>(instance);
+      r.occurrence = occurrence;
+      r.key = key;
+      r.released = dependencies > 0;
+      if (!slot.frames.empty() && slot.frames.back().open) {
+        r.poster_call = slot.frames.back().call;
+        r.poster_seg = slot.frames.back().seg;
+        split(slot);  // the part before the post precedes the posted call, the rest does not
+      }
+      slot.records.push_back(r);
+      c->record = r.id;
+    }
+  }
+  if (out_post_releasee) *out_post_releasee = reinterpret_cast<dCallReleaseeID>(c);
+  if (dependencies == 0) make_ready(c, slot);
+}
+
+void Runtime::alter(dCallReleaseeID releasee, ddependencychange_t change) {
+  Call* c = reinterpret_cast<Call*>(releasee);
+  Slot& slot = my_slot();
+  // A decrement of a call not yet started is a release: the segment up to here precedes it.
+  if (change < 0 && recording() && c->record != kNoRecord &&
+      !c->started.load(std::memory_order_relaxed) && !slot.frames.empty() &&
+      slot.frames.back().open) {
+    slot.accesses.push_back({AccessRecord::kRelease, c->record, 0});
+    split(slot);
+  }
+  const std::intptr_t left =
+      c->count.fetch_add(static_cast<std::intptr_t>(change), std::memory_order_acq_rel) + change;
+  if (left == 0 && !c->started.load(std::memory_order_relaxed)) make_ready(c, slot);
+}
+
+void Runtime::make_ready(Call* c, Slot& slot) {
+  Slot& target = placed_ ? *slots_[c->home] : slot;
+  target.push_front(c);
+  wake();
+}
+
+void Runtime::wake() {
+  // seq_cst fence against a parking thread's seq_cst increment of sleepers_: either it sees
+  // the work just published or this thread sees it registered and bumps the epoch.
+  std::atomic_thread_fence(std::memory_order_seq_cst);
+  if (sleepers_.load(std::memory_order_relaxed) != 0) {
+    epoch_.fetch_add(1, std::memory_order_release);
+    epoch_.notify_all();
+  }
+}
+
+bool Runtime::any_work() const {
+  for (const auto& s : slots_)
+    if (s->size.load(std::memory_order_relaxed) != 0) return true;
+  return false;
+}
+
+Call* Runtime::find_work(Slot& slot) {
+  if (Call* c = slot.pop_front()) return c;
+  for (std::uint32_t i = 1; i < threads_; ++i) {
+    Slot& other = *slots_[(slot.index + i) % threads_];
+    if (Call* c = other.pop_back()) {
+      slot.steals.store(slot.steals.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+      return c;
+    }
+  }
+  return nullptr;
+}
+
+void Runtime::run(Call* c, Slot& slot) {
+  c->started.store(true, std::memory_order_relaxed);
+  c->count.store(1, std::memory_order_relaxed);  // the running call itself
+  const char* outer = slot.running.load(std::memory_order_relaxed);
+  slot.running_instance.store(c->instance, std::memory_order_relaxed);
+  slot.running.store(c->name ? c->name : "(unnamed call)", std::memory_order_relaxed);
+  slot.generation.store(slot.generation.load(std::memory_order_relaxed) + 1,
+                        std::memory_order_relaxed);
+  const bool rec = c->record != kNoRecord && recording();
+  if (rec) {
+    slot.frames.push_back(Frame{});
+    open_segment(slot, c->record, 0);
+  }
+  const int ok = c->function(c->context, c->instance, reinterpret_cast<dCallReleaseeID>(c));
+  if (rec) {
+    // The last part of the call precedes what its completion releases: its wait, and its
+    // releasee, or, when that one already runs (this call is its sub-call), what that one's
+    // completion releases in turn.
+    for (Call* x = c;;) {
+      if (x->wait)
+        slot.accesses.push_back({AccessRecord::kSignal, x->wait->id, x->wait->generation});
+      Call* dep = x->releasee;
+      if (!dep) break;
+      if (!dep->started.load(std::memory_order_relaxed)) {
+        if (dep->record != kNoRecord)
+          slot.accesses.push_back({AccessRecord::kRelease, dep->record, 0});
+        break;
+      }
+      x = dep;
+    }
+    close_segment(slot, true);
+    slot.frames.pop_back();
+  }
+  slot.running.store(outer, std::memory_order_relaxed);
+  if (!ok) c->fault.store(1, std::memory_order_relaxed);  // published by the decrement below
+  if (c->count.fetch_sub(1, std::memory_order_acq_rel) == 1) complete(c, slot);
+}
+
+void Runtime::complete(Call* c, Slot& slot) {
+  while (true) {
+    const int fault = c->fault.load(std::memory_order_relaxed);  // after an acq_rel decrement
+    if (c->fault_out) *c->fault_out = fault;
+    Wait* w = c->wait;
+    Call* dep = c->releasee;
+    free_call(c);
+    if (w) signal(w);  // after the fault is written: the waiter may read it at once
+    if (!dep) return;
+    if (fault) dep->fault.store(1, std::memory_order_relaxed);
+    if (dep->count.fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+    if (!dep->started.load(std::memory_order_relaxed)) {
+      make_ready(dep, slot);
+      return;
+    }
+    c = dep;  // it had returned and this was its last sub-call: it completes too
+  }
+}
+
+void Runtime::signal(Wait* w) {
+  w->signalled.store(1, std::memory_order_release);
+  wake();
+}
+
+void Runtime::park(Slot& slot, const std::atomic<std::uint32_t>* done) {
+  const std::uint32_t e = epoch_.load(std::memory_order_acquire);
+  sleepers_.fetch_add(1, std::memory_order_seq_cst);  // see wake()
+  if (!any_work() && !stop_.load(std::memory_order_acquire) &&
+      !(done && done->load(std::memory_order_acquire))) {
+    slot.parks.store(slot.parks.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    epoch_.wait(e, std::memory_order_acquire);
+  }
+  sleepers_.fetch_sub(1, std::memory_order_relaxed);
+}
+
+void Runtime::wait(int* out_wait_status, dCallWaitID call_wait, const dThreadedWaitTime* timeout,
+                   const char*) {
+  auto* w = reinterpret_cast<Wait*>(call_wait);
+  Slot& slot = my_slot();
+  const bool rec = recording() && !slot.frames.empty() && slot.frames.back().open;
+  if (rec) close_segment(slot, false);
+  const char* outer = slot.running.exchange(nullptr, std::memory_order_relaxed);
+  const bool bounded = timeout != nullptr;
+  const std::int64_t deadline =
+      bounded ? now_ns() + static_cast<std::int64_t>(timeout->wait_sec) * 1'000'000'000 +
+                    static_cast<std::int64_t>(timeout->wait_nsec)
+              : 0;
+  int status = 1;
+  while (!w->signalled.load(std::memory_order_acquire)) {
+    if (Call* c = find_work(slot)) {
+      run(c, slot);
+      continue;
+    }
+    const std::int64_t t0 = now_ns();
+    if (bounded && t0 >= deadline) {
+      status = 0;
+      break;
+    }
+    bool found = false;
+    for (std::uint32_t spins = 0; !found; ++spins) {
+      TGRAPH_ODE_PAUSE();
+      found = w->signalled.load(std::memory_order_acquire) != 0 || any_work();
+      if ((spins & 63) == 63 && now_ns() - t0 > spin_ns_) break;
+    }
+    if (found) continue;
+    if (!bounded) {
+      park(slot, &w->signalled);
+    } else {
+      const std::int64_t left = deadline - now_ns();
+      if (left > 0)
+        std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<std::int64_t>(left, 50'000)));
+    }
+  }
+  slot.running.store(outer, std::memory_order_relaxed);
+  if (rec) {
+    const Frame f = slot.frames.back();
+    open_segment(slot, f.call, f.seg + 1);
+    if (status) slot.accesses.push_back({AccessRecord::kWaitRead, w->id, w->generation});
+  }
+  if (out_wait_status) *out_wait_status = status;
+}
+
+void Runtime::worker(std::uint32_t index) {
+  tl_runtime = this;
+  tl_slot = index;
+  dAllocateODEDataForThread(dAllocateMaskAll);
+  Slot& slot = *slots_[index];
+  while (!stop_.load(std::memory_order_acquire)) {
+    if (Call* c = find_work(slot)) {
+      run(c, slot);
+      continue;
+    }
+    const std::int64_t t0 = now_ns();
+    bool found = false;
+    for (std::uint32_t spins = 0; !found; ++spins) {
+      TGRAPH_ODE_PAUSE();
+      found = any_work() || stop_.load(std::memory_order_relaxed);
+      if ((spins & 63) == 63 && now_ns() - t0 > spin_ns_) break;
+    }
+    if (!found) park(slot, nullptr);
+  }
+  dCleanupODEAllDataForThread();
+  tl_runtime = nullptr;
+}
+
+void Runtime::watchdog() {
+  using namespace std::chrono;
+  const auto period = milliseconds(20);
+  std::vector<std::uint64_t> last(threads_, 0);
+  std::vector<double> stuck(threads_, 0.0);
+  while (!stop_.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(period);
+    for (std::uint32_t i = 0; i < threads_; ++i) {
+      Slot& s = *slots_[i];
+      const char* name = s.running.load(std::memory_order_relaxed);
+      const std::uint64_t g = s.generation.load(std::memory_order_relaxed);
+      if (name == nullptr || g != last[i]) {
+        last[i] = g;
+        stuck[i] = 0;
+        continue;
+      }
+      stuck[i] += duration<double>(period).count();
+      if (stuck[i] >= watchdog_s_) {
+        std::fprintf(stderr,
+                     "tgraph: watchdog: ODE call \"%s\" (instance %zu) on thread %u has not "
+                     "returned after %.1f s\n",
+                     name,
+                     static_cast<std::size_t>(s.running_instance.load(std::memory_order_relaxed)),
+                     i, stuck[i]);
+        std::fflush(stderr);
+        std::_Exit(1);
+      }
+    }
+  }
+}
+
+}  // namespace tgraph::ode::detail

@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: MIT
+// A scene's world attached to tgraph's threading: it steps, its calls are recorded as task
+// graphs whose edges are ODE's declared releases, and bad uses are refused by name.
+#include "tgraph/ode/attach.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/metrics.hpp"
+#include "tgraph/ode/scenes.hpp"
+
+namespace tgraph::ode {
+namespace {
+
+class OdeWorld : public ::testing::Test {
+ protected:
+  void SetUp() override { dInitODE2(0); }
+  void TearDown() override { dCloseODE(); }
+};
+
+TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
+  for (const char* method : {"worksteal", "list", "ode", "sequential"}) {
+    auto scene = Scene::make("ode-piles");
+    AttachOptions o;
+    o.method = choose_method(method);
+    o.threads = 2;
+    o.repartition_interval = 3;
+    {
+      Attachment attach(scene->world(), o);
+      for (int i = 0; i < 10; ++i) scene->step(&attach);
+      const AttachStats s = attach.stats();
+      EXPECT_EQ(s.steps, 10u) << method;
+      EXPECT_GT(s.world_ns, 0) << method;
+      EXPECT_GT(s.collide_ns, 0) << method;
+      if (o.method.policy == Policy::kWorksteal || o.method.policy == Policy::kPartition) {
+        EXPECT_GT(s.calls, 10u * 32) << method;  // every island at least one call a step
+      }
+    }
+    for (double v : scene->state()) ASSERT_TRUE(std::isfinite(v)) << method;
+    EXPECT_LT(scene->depth_below_floor(), 0.01) << method;
+  }
+}
+
+TEST_F(OdeWorld, RecordsEachStepAsAGraphOfOdesCallsInTopologicalOrder) {
+  auto scene = Scene::make("ode-piles");
+  AttachOptions o;
+  o.threads = 2;
+  o.record = true;
+  Attachment attach(scene->world(), o);
+  for (int i = 0; i < 3; ++i) scene->step(&attach);
+  const std::vector<StepGraph> steps = attach.take_steps();
+  ASSERT_EQ(steps.size(), 3u);
+  for (const StepGraph& g : steps) {
+    EXPECT_EQ(g.validate(), "");
+    std::set<std::string> kinds(g.kinds.begin(), g.kinds.end());
+    EXPECT_TRUE(kinds.count("dWorldQuickStep"));
+    EXPECT_TRUE(kinds.count("World Islands Stepping Group"));
+    EXPECT_TRUE(kinds.count("Island Stepping Job Start"));
+    EXPECT_TRUE(kinds.count("QuickStepIsland Stage1"));
+    EXPECT_GT(g.host_ns, 0u);  // the collision before the step
+    for (const Edge& e : g.edges) EXPECT_LT(e.from, e.to);
+    // The two island jobs the stepping thread posts run side by side: no path between them.
+    std::vector<TaskId> starts;
+    for (TaskId t = 0; t < g.tasks.size(); ++t)
+      if (g.kind_name(t) == "World Islands Stepping Start") starts.push_back(t);
+    ASSERT_EQ(starts.size(), 4u);  // two calls, each split at its post
+    std::vector<bool> reached(g.tasks.size(), false);
+    reached[starts[0]] = true;
+    for (TaskId t = starts[0]; t < g.tasks.size(); ++t)
+      if (reached[t])
+        for (const Edge& e : g.edges)
+          if (e.from == t) reached[e.to] = true;
+    int unreached = 0;
+    for (TaskId t : starts) unreached += reached[t] ? 0 : 1;
+    EXPECT_EQ(unreached, 2);  // the other call's two parts
+    EXPECT_TRUE(g.carried_edges.empty());
+  }
+  EXPECT_TRUE(attach.take_steps().empty());
+}
+
+TEST_F(OdeWorld, RefusesZeroThreadsAndRecordingUnderOdesOwnStepping) {
+  auto scene = Scene::make("ode-chains");
+  AttachOptions o;
+  o.threads = 0;
+  EXPECT_THROW(Attachment(scene->world(), o), OptionError);
+  o.threads = 2;
+  o.record = true;
+  o.method = choose_method("ode");
+  EXPECT_THROW(Attachment(scene->world(), o), OptionError);
+  o.method = choose_method("sequential");
+  EXPECT_THROW(Attachment(scene->world(), o), OptionError);
+  EXPECT_THROW(Attachment(nullptr, AttachOptions{}), OptionError);
+  EXPECT_THROW(choose_method("no-such-method"), OptionError);
+}
+
+TEST_F(OdeWorld, AWorldNoLongerSteppedThroughTheAttachmentIsNamed) {
+  auto scene = Scene::make("ode-chains");
+  Attachment attach(scene->world(), AttachOptions{});
+  scene->step(&attach);
+  dWorldSetStepThreadingImplementation(scene->world(), nullptr, nullptr);  // someone else's
+  try {
+    scene->step(&attach);
+    FAIL() << "no error";
+  } catch (const UsageError& e) {
+    EXPECT_NE(std::string(e.what()).find("not stepped through this attachment"), std::string::npos);
+  }
+}
+
+TEST_F(OdeWorld, AnOdeErrorIsOneLineAndExit1NotAnAbort) {
+  EXPECT_EXIT(
+      {
+        auto scene = Scene::make("ode-chains");
+        Attachment attach(scene->world(), AttachOptions{});
+        dError(7, "planted error %d", 42);
+      },
+      ::testing::ExitedWithCode(1), "tgraph: ODE error 7: planted error 42");
+  EXPECT_EXIT(
+      {
+        auto scene = Scene::make("ode-chains");
+        Attachment attach(scene->world(), AttachOptions{});
+        dDebug(3, "planted internal error");
+      },
+      ::testing::ExitedWithCode(1),
+      "tgraph: ODE internal error \\(dDebug\\) 3: planted internal error");
+}
+
+TEST_F(OdeWorld, WarningsAreCountedNotPrinted) {
+  auto scene = Scene::make("ode-chains");
+  Attachment attach(scene->world(), AttachOptions{});
+  dMessage(5, "planted warning");
+  const AttachStats s = attach.stats();
+  EXPECT_EQ(s.messages, 1u);
+  EXPECT_NE(s.first_message.find("planted warning"), std::string::npos);
+}
+
+TEST_F(OdeWorld, UnknownSceneIsAnInputError) {
+  EXPECT_THROW(Scene::make("ode-nothing"), InputError);
+  EXPECT_THROW(parse_stepper("euler"), OptionError);
+  EXPECT_EQ(parse_stepper("step"), Stepper::kStep);
+}
+
+}  // namespace
+}  // namespace tgraph::ode

@@ -1,0 +1,203 @@
+// SPDX-License-Identifier: MIT
+// The threading implementation through ODE's own interface (ode/threading.h): dependency
+// counts, releasees, sub-calls a running call adds to itself, waits, faults, mutexes.
+#include "runtime.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace tgraph::ode::detail {
+namespace {
+
+struct Log {
+  std::mutex m;
+  std::vector<int> order;
+  void add(int v) {
+    std::lock_guard<std::mutex> lock(m);
+    order.push_back(v);
+  }
+  int position(int v) {
+    for (std::size_t i = 0; i < order.size(); ++i)
+      if (order[i] == v) return static_cast<int>(i);
+    return -1;
+  }
+};
+
+struct Ctx {
+  Log* log;
+  int id;
+  int result = 1;
+};
+
+int record_call(void* c, dcallindex_t, dCallReleaseeID) {
+  auto* ctx = static_cast<Ctx*>(c);
+  std::this_thread::sleep_for(std::chrono::microseconds(200));
+  ctx->log->add(ctx->id);
+  return ctx->result;
+}
+
+class RuntimeThreads : public ::testing::TestWithParam<std::uint32_t> {
+ protected:
+  RuntimeOptions options() const {
+    RuntimeOptions o;
+    o.threads = GetParam();
+    o.watchdog_s = 0;
+    return o;
+  }
+};
+
+TEST_P(RuntimeThreads, ReleaseeStartsAfterEveryReleaserAndSignalsItsWait) {
+  Runtime rt(options());
+  const dThreadingFunctionsInfo* f = rt.functions();
+  dThreadingImplementationID impl = rt.id();
+  Log log;
+  Ctx a{&log, 1}, b{&log, 2}, c{&log, 3};
+  dCallWaitID w = f->alloc_call_wait(impl);
+  int fault = -1;
+  dCallReleaseeID rc = nullptr;
+  f->post_call(impl, &fault, &rc, 2, nullptr, w, &record_call, &c, 0, "C");
+  f->post_call(impl, nullptr, nullptr, 0, rc, nullptr, &record_call, &a, 0, "A");
+  f->post_call(impl, nullptr, nullptr, 0, rc, nullptr, &record_call, &b, 1, "B");
+  int status = -1;
+  f->wait_call(impl, &status, w, nullptr, "test");
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(fault, 0);
+  ASSERT_EQ(log.order.size(), 3u);
+  EXPECT_EQ(log.position(3), 2);  // C last
+  f->free_call_wait(impl, w);
+}
+
+struct Parent {
+  const dThreadingFunctionsInfo* f;
+  dThreadingImplementationID impl;
+  Log* log;
+  std::vector<Ctx> children;
+};
+
+int parent_call(void* p, dcallindex_t, dCallReleaseeID self) {
+  auto* parent = static_cast<Parent*>(p);
+  // ODE's pattern (quickstep's stages): more dependencies on itself, then sub-calls
+  // releasing it, then its own share of the work.
+  parent->f->alter_call_dependencies_count(
+      parent->impl, self, static_cast<ddependencychange_t>(parent->children.size()));
+  for (Ctx& c : parent->children)
+    parent->f->post_call(parent->impl, nullptr, nullptr, 0, self, nullptr, &record_call, &c, 0,
+                         "child");
+  parent->log->add(0);
+  return 1;
+}
+
+TEST_P(RuntimeThreads, ARunningCallCompletesAfterTheSubCallsItAddsToItself) {
+  Runtime rt(options());
+  Log log;
+  Parent p{rt.functions(), rt.id(), &log, {}};
+  for (int i = 1; i <= 4; ++i) p.children.push_back(Ctx{&log, i});
+  Ctx after{&log, 99};
+  dCallWaitID w = p.f->alloc_call_wait(p.impl);
+  dCallReleaseeID r_after = nullptr;
+  p.f->post_call(p.impl, nullptr, &r_after, 1, nullptr, w, &record_call, &after, 0, "after");
+  p.f->post_call(p.impl, nullptr, nullptr, 0, r_after, nullptr, &parent_call, &p, 0, "parent");
+  p.f->wait_call(p.impl, nullptr, w, nullptr, "test");
+  ASSERT_EQ(log.order.size(), 6u);
+  EXPECT_EQ(log.order.back(), 99);  // after the parent and its four children
+  p.f->free_call_wait(p.impl, w);
+}
+
+TEST_P(RuntimeThreads, AFailedCallFaultsTheSummaryOfWhatItReleases) {
+  Runtime rt(options());
+  const dThreadingFunctionsInfo* f = rt.functions();
+  dThreadingImplementationID impl = rt.id();
+  Log log;
+  Ctx root{&log, 1}, bad{&log, 2, 0};
+  dCallWaitID w = f->alloc_call_wait(impl);
+  int fault = -1;
+  dCallReleaseeID r = nullptr;
+  f->post_call(impl, &fault, &r, 1, nullptr, w, &record_call, &root, 0, "root");
+  f->post_call(impl, nullptr, nullptr, 0, r, nullptr, &record_call, &bad, 0, "bad");
+  f->wait_call(impl, nullptr, w, nullptr, "test");
+  EXPECT_EQ(fault, 1);
+  f->free_call_wait(impl, w);
+}
+
+TEST_P(RuntimeThreads, AnAlteredCountHoldsTheCallUntilItIsTakenBack) {
+  Runtime rt(options());
+  const dThreadingFunctionsInfo* f = rt.functions();
+  dThreadingImplementationID impl = rt.id();
+  Log log;
+  Ctx c{&log, 7};
+  dCallWaitID w = f->alloc_call_wait(impl);
+  dCallReleaseeID r = nullptr;
+  f->post_call(impl, nullptr, &r, 1, nullptr, w, &record_call, &c, 0, "held");
+  f->alter_call_dependencies_count(impl, r, 2);
+  f->alter_call_dependencies_count(impl, r, -2);
+  const dThreadedWaitTime zero{0, 0};
+  int status = -1;
+  f->wait_call(impl, &status, w, &zero, "poll");
+  EXPECT_EQ(status, 0);  // still held by its first dependency
+  const dThreadedWaitTime short_wait{0, 2'000'000};
+  f->wait_call(impl, &status, w, &short_wait, "timed");
+  EXPECT_EQ(status, 0);
+  EXPECT_TRUE(log.order.empty());
+  f->alter_call_dependencies_count(impl, r, -1);
+  f->wait_call(impl, &status, w, nullptr, "test");
+  EXPECT_EQ(status, 1);
+  EXPECT_EQ(log.order, std::vector<int>{7});
+  f->reset_call_wait(impl, w);
+  f->wait_call(impl, &status, w, &zero, "after reset");
+  EXPECT_EQ(status, 0);
+  f->free_call_wait(impl, w);
+}
+
+TEST_P(RuntimeThreads, ManyCallsAllRunOnceAndTheThreadCountIsK) {
+  Runtime rt(options());
+  const dThreadingFunctionsInfo* f = rt.functions();
+  dThreadingImplementationID impl = rt.id();
+  EXPECT_EQ(f->retrieve_thread_count(impl), GetParam());
+  EXPECT_EQ(f->preallocate_resources_for_calls(impl, 5000), 1);
+  std::atomic<int> runs{0};
+  dCallWaitID w = f->alloc_call_wait(impl);
+  dCallReleaseeID r = nullptr;
+  auto count = [](void* c, dcallindex_t, dCallReleaseeID) {
+    static_cast<std::atomic<int>*>(c)->fetch_add(1, std::memory_order_relaxed);
+    return 1;
+  };
+  f->post_call(impl, nullptr, &r, 5000, nullptr, w, +count, &runs, 0, "join");
+  for (int i = 0; i < 5000; ++i)
+    f->post_call(impl, nullptr, nullptr, 0, r, nullptr, +count, &runs, i, "leaf");
+  f->wait_call(impl, nullptr, w, nullptr, "test");
+  EXPECT_EQ(runs.load(), 5001);
+  dMutexGroupID g = f->alloc_mutex_group(impl, 3, nullptr);
+  f->lock_group_mutex(impl, g, 2);
+  f->unlock_group_mutex(impl, g, 2);
+  f->free_mutex_group(impl, g);
+  f->free_call_wait(impl, w);
+}
+
+INSTANTIATE_TEST_SUITE_P(Threads, RuntimeThreads, ::testing::Values(1u, 2u, 3u, 4u, 8u));
+
+int never_returns(void*, dcallindex_t, dCallReleaseeID) {
+  for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+}
+
+TEST(RuntimeWatchdog, NamesTheCallThatNeverReturnsAndExits1) {
+  EXPECT_EXIT(
+      {
+        RuntimeOptions o;
+        o.threads = 2;
+        o.watchdog_s = 0.2;
+        Runtime rt(o);
+        dCallWaitID w = rt.functions()->alloc_call_wait(rt.id());
+        rt.functions()->post_call(rt.id(), nullptr, nullptr, 0, nullptr, w, &never_returns, nullptr,
+                                  3, "Stuck Stage");
+        rt.functions()->wait_call(rt.id(), nullptr, w, nullptr, "test");
+      },
+      ::testing::ExitedWithCode(1), "watchdog: ODE call \"Stuck Stage\" \\(instance 3\\)");
+}
+
+}  // namespace
+}  // namespace tgraph::ode::detail
