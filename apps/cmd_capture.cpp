@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <iostream>
+#include <stdexcept>
 
 #include "commands.hpp"
 #include "option_words.hpp"
@@ -40,6 +41,13 @@ void add_capture(CLI::App& app) {
       ->check(CLI::Range(1u, 1000u));
   cmd->add_flag("--no-capture", o->no_capture,
                 "Run the same steps uninstrumented (Mode::kOff), write nothing");
+  cmd->add_flag("--allow-misuse", o->allow_misuse,
+                "Write steps in which the recorder saw API misuses (an unbalanced loop, a "
+                "changed loop body...) instead of stopping before the first, with a warning");
+  cmd->add_flag("--verify-accesses", o->verify_accesses,
+                "Run every task between checksums of the state and again with its undeclared "
+                "data perturbed; list each write or read it does not declare (exit 1 when any; "
+                "docs/instrumenting.md, \"Finding a wrong declaration\")");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
   cmd->callback([o, a] {
     o->progress = isatty(STDERR_FILENO) != 0;
@@ -49,6 +57,9 @@ void add_capture(CLI::App& app) {
     const samples::CaptureRun r = samples::capture_scene(*o);
     std::cout << (a->json ? samples::capture_json(r, *o) + "\n" : samples::capture_text(r, *o))
               << std::flush;
+    if (!r.access_findings.empty())
+      throw std::runtime_error("capture: " + std::to_string(r.access_findings.size()) +
+                               " wrong access declaration(s) found (listed in the report)");
   });
 }
 

@@ -17,7 +17,119 @@ std::string_view to_string(Mode mode) {
   return "?";
 }
 
+std::string_view to_string(Call call) {
+  switch (call) {
+    case Call::kBeginStep: return "begin_step";
+    case Call::kEndStep: return "end_step";
+    case Call::kTask: return "task";
+    case Call::kBeginLoop: return "begin_loop";
+    case Call::kConditionalBreak: return "conditional_break";
+    case Call::kEndLoop: return "end_loop";
+    case Call::kAccumulator: return "accumulator";
+  }
+  return "?";
+}
+
+std::string to_string(const Misuse& m) {
+  std::string s = std::string(to_string(m.call)) + ": " + m.problem + " (";
+  if (!m.loop.empty()) s += m.loop + ", ";
+  return s + "step " + std::to_string(m.step) + ", after " + std::to_string(m.tasks) + " tasks)";
+}
+
+struct Recorder::Verify {
+  AccessChecker checker;
+  AccessFindings findings;
+  std::vector<AccessChecker::Found> found;  // of the run under check
+};
+
 Recorder::Recorder(Mode mode) : mode_(mode) {}
+Recorder::~Recorder() = default;
+Recorder::Recorder(Recorder&&) noexcept = default;
+Recorder& Recorder::operator=(Recorder&&) noexcept = default;
+
+void Recorder::set_verify_accesses(bool on) {
+  if (!on) {
+    verify_.reset();
+    return;
+  }
+  if (verify_) return;
+  verify_ = std::make_unique<Verify>();
+  for (DatumId d = 0; d < data_.size(); ++d)
+    verify_->checker.set_storage(d, ptrs_[d], data_[d].bytes);
+  verify_->checker.sync();
+}
+
+std::vector<AccessFinding> Recorder::access_findings() const {
+  return verify_ ? verify_->findings.list() : std::vector<AccessFinding>{};
+}
+
+const AccessChecker::Counts* Recorder::access_counts() const {
+  return verify_ ? &verify_->checker.counts() : nullptr;
+}
+
+void Recorder::check_task(KindId kind, ObjectId obj, const Access* acc, std::size_t n, BodyRef body) {
+  Verify& v = *verify_;
+  v.found.clear();
+  // Reads in a loop's first two iterations and every 8th (the same tasks run each time).
+  const bool reads = open_loop_ == kNoLoop || iteration_ < 2 || iteration_ % 8 == 0;
+  v.checker.run({acc, n}, body, reads, v.found);
+  if (v.found.empty()) return;
+  // The task's id in the step: appended now, or matched in a later loop iteration.
+  const TaskId t = open_loop_ != kNoLoop && iteration_ > 0
+                       ? body_first_ + replay_pos_
+                       : static_cast<TaskId>(cur_.tasks.size());
+  std::uint32_t occurrence = 0;
+  for (TaskId u = 0; u < t && u < cur_.tasks.size(); ++u)
+    if (cur_.tasks[u].kind == kind && cur_.tasks[u].object == obj) ++occurrence;
+  const std::string label =
+      task_label(kinds_[kind], obj == kNoObject ? std::string_view() : objects_[obj].name, occurrence);
+  for (const AccessChecker::Found& f : v.found) v.findings.add(finding(label, f, data_));
+}
+
+void Recorder::check_condition(LoopId loop, BodyRef evaluate) {
+  Verify& v = *verify_;
+  v.found.clear();
+  if (loop >= cur_.loops.size()) {
+    evaluate();
+    v.checker.sync();
+    return;
+  }
+  const Access acc{cur_.loops[loop].condition, AccessMode::R};
+  v.checker.run({&acc, 1}, evaluate, false, v.found);
+  for (const AccessChecker::Found& f : v.found)
+    v.findings.add(finding("loop.break of loop " + std::to_string(loop), f, data_));
+}
+
+void Recorder::misuse(Call call, std::string problem, LoopId loop) {
+  ++errors_;
+  if (misuses_.size() == kMaxMisuses) return;
+  Misuse m;
+  m.call = call;
+  m.problem = std::move(problem);
+  if (loop != kNoLoop && loop < cur_.loops.size()) {
+    const DatumId c = cur_.loops[loop].condition;
+    m.loop = "loop " + std::to_string(loop) + " on " +
+             (c < data_.size() ? data_[c].name : "datum " + std::to_string(c));
+  }
+  m.step = steps_begun_ == 0 ? 0 : steps_begun_ - 1;
+  m.tasks = static_cast<std::uint32_t>(cur_.tasks.size());
+  misuses_.push_back(std::move(m));
+}
+
+void Recorder::body_changed(TaskId expected, KindId kind, ObjectId obj) {
+  auto name = [this](KindId k, ObjectId o) {
+    std::string s = k < kinds_.size() ? kinds_[k] : "kind " + std::to_string(k);
+    if (o != kNoObject) s += " of " + (o < objects_.size() ? objects_[o].name : std::to_string(o));
+    return s;
+  };
+  std::string problem = "iteration " + std::to_string(iteration_) + " issued " + name(kind, obj);
+  if (expected + 1 < body_last_)
+    problem += " where the first iteration issued " +
+               name(cur_.tasks[expected].kind, cur_.tasks[expected].object);
+  else
+    problem += " after the first iteration's last task (every iteration must issue the same tasks)";
+  misuse(Call::kTask, std::move(problem), open_loop_);
+}
 
 ObjectId Recorder::object(std::string_view name) {
   const std::string key(name);
@@ -31,12 +143,17 @@ ObjectId Recorder::object(std::string_view name) {
 DatumId Recorder::datum(std::string_view name, ObjectId owner, std::uint64_t bytes, void* ptr) {
   data_.push_back({std::string(name), owner, bytes});
   ptrs_.push_back(ptr);
-  return static_cast<DatumId>(data_.size() - 1);
+  const auto d = static_cast<DatumId>(data_.size() - 1);
+  if (verify_) {
+    verify_->checker.set_storage(d, ptr, bytes);
+    verify_->checker.sync(d);
+  }
+  return d;
 }
 
 void Recorder::accumulator(DatumId d, Accumulator a) {
   if (d >= data_.size()) {
-    ++errors_;
+    misuse(Call::kAccumulator, "datum " + std::to_string(d) + " was not declared");
     return;
   }
   if (accumulators_.size() < data_.size()) accumulators_.resize(data_.size());
@@ -51,9 +168,12 @@ KindId Recorder::kind(std::string_view name) {
 }
 
 void Recorder::begin_step(std::uint64_t host_ns) {
-  if (in_step_) ++errors_;
+  errors_before_step_ = errors_;
+  ++steps_begun_;
+  if (in_step_) misuse(Call::kBeginStep, "the previous step was not ended (missing end_step)");
   in_step_ = true;
   host_ns_ = host_ns;
+  if (verify_) verify_->checker.sync();  // the engine's work between steps
   cur_.tasks.clear();
   cur_.accesses.clear();
   cur_.loops.clear();
@@ -136,7 +256,9 @@ std::uint64_t Recorder::median_ticks() {
 
 LoopId Recorder::begin_loop(DatumId condition, std::uint32_t max_iterations) {
   if (open_loop_ != kNoLoop) {
-    ++errors_;  // nested loops are not supported
+    misuse(Call::kBeginLoop,
+           "a loop is still open (nested loops are not supported, or its end_loop is missing)",
+           open_loop_);
     return open_loop_;
   }
   Loop loop;
@@ -156,7 +278,13 @@ LoopId Recorder::begin_loop(DatumId condition, std::uint32_t max_iterations) {
 
 bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
   if (loop_id != open_loop_ || loop_id == kNoLoop) {
-    ++errors_;
+    if (open_loop_ == kNoLoop && loop_id < cur_.loops.size())
+      misuse(Call::kConditionalBreak, "the loop was closed by end_loop", loop_id);
+    else if (open_loop_ == kNoLoop)
+      misuse(Call::kConditionalBreak, "no loop is open (loop id " + std::to_string(loop_id) + ")");
+    else
+      misuse(Call::kConditionalBreak,
+             "loop id " + std::to_string(loop_id) + " is not the open loop", open_loop_);
     return true;
   }
   Loop& loop = cur_.loops[loop_id];
@@ -169,7 +297,12 @@ bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
     body_last_ = loop.last;
   } else {
     const TaskId t = loop.first + replay_pos_;
-    if (t + 1 != loop.last) ++errors_;  // fewer tasks than in the first iteration
+    if (t + 1 != loop.last)
+      misuse(Call::kConditionalBreak,
+             "iteration " + std::to_string(iteration_) + " issued " + std::to_string(replay_pos_) +
+                 " tasks before the break where the first issued " +
+                 std::to_string(loop.last - 1 - loop.first),
+             loop_id);
     cost_sum_[loop.last - 1] += ns;
     if (ns > cost_max_[loop.last - 1]) cost_max_[loop.last - 1] = ns;
   }
@@ -183,19 +316,26 @@ bool Recorder::record_break(LoopId loop_id, std::uint64_t ns) {
 
 void Recorder::end_loop(LoopId loop) {
   if (loop != open_loop_ || loop == kNoLoop) {
-    ++errors_;
+    if (open_loop_ == kNoLoop && loop < cur_.loops.size())
+      misuse(Call::kEndLoop, "the loop is already closed", loop);
+    else if (open_loop_ == kNoLoop)
+      misuse(Call::kEndLoop, "no loop is open (loop id " + std::to_string(loop) + ")");
+    else
+      misuse(Call::kEndLoop, "loop id " + std::to_string(loop) + " is not the open loop",
+             open_loop_);
     return;
   }
-  if (cur_.loops[loop].iterations == 0) ++errors_;  // no conditional_break was recorded
+  if (cur_.loops[loop].iterations == 0)
+    misuse(Call::kEndLoop, "no conditional_break was called in the loop", loop);
   open_loop_ = kNoLoop;
   time_task_ = true;
 }
 
 StepGraph Recorder::finish_step() {
-  if (!in_step_) ++errors_;
+  if (!in_step_) misuse(Call::kEndStep, "no step was begun (missing begin_step)");
   in_step_ = false;
   if (open_loop_ != kNoLoop) {
-    ++errors_;
+    misuse(Call::kEndStep, "the loop is still open (missing end_loop)", open_loop_);
     open_loop_ = kNoLoop;
   }
   if (mode_ == Mode::kOff) return {};

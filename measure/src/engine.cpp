@@ -5,6 +5,8 @@
 #include <utility>
 
 #include "recorded_step.hpp"
+#include "tgraph/measure/adapter.hpp"
+#include "tgraph/samples/tiled_heat.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::measure {
@@ -45,9 +47,13 @@ class SceneEngine final : public LiveEngine {
 
 LiveStep detail::take_recorded_step(capture::Recorder& rec, const std::string& engine) {
   capture::StepProgram p = rec.end_step_program();
-  if (rec.errors() != 0)
-    throw UsageError(engine + ": the recorder counted " + std::to_string(rec.errors()) +
-                     " API misuses");
+  if (rec.errors() != 0) {
+    // The first misuse names the call, the loop, the step and its task count.
+    const std::vector<capture::Misuse>& m = rec.misuses();
+    std::string what = m.empty() ? "API misuse" : capture::to_string(m[0]);
+    if (rec.errors() > 1) what += " (" + std::to_string(rec.errors()) + " misuses in all)";
+    throw UsageError(engine + ": " + what);
+  }
   LiveStep step;
   step.graph = std::move(p.graph);
   step.bodies = std::move(p.bodies);
@@ -67,6 +73,14 @@ std::vector<StateRegion> detail::recorded_state(const capture::Recorder& rec) {
 
 std::unique_ptr<LiveEngine> make_live_engine(const std::string& scene,
                                              const samples::SceneOptions& options) {
+  if (samples::is_tiled_heat(scene)) {  // the test engine of --verify-accesses
+    auto heat = std::make_shared<samples::TiledHeat>(samples::tiled_heat_options(scene));
+    EngineCallbacks c;
+    c.declare = [heat](capture::Recorder& rec) { heat->declare(rec); };
+    c.step = [heat](capture::Recorder& rec) { heat->step(rec); };
+    c.same_every_step = true;
+    return make_live_engine(std::move(c));
+  }
   return std::make_unique<SceneEngine>(samples::make_scene(scene, options));
 }
 

@@ -45,7 +45,45 @@ void ProgramWorkload::first_touch(DatumId d) {
   temps_[d] = acc->make_zero();  // on the thread that owns the temporary
 }
 
+void ProgramWorkload::checked_run(const TaskRun& r) {
+  const ExecGraph& x = *r.exec;
+  if (r.origin == kNoTask || redirected_[r.task])
+    throw UsageError("live run: verifying accesses needs cumulative writes serialised "
+                     "(CwMode::kSerialize), not lowered to temporaries and reducers");
+  const auto& body = bodies_[r.origin];
+  if (!body) return;
+  const std::span<const Access> acc = x.graph.accesses_of(r.task);
+  const bool reads = r.iteration < 2 || r.iteration % 8 == 0;
+  std::vector<AccessChecker::Found> found;
+  {
+    std::unique_lock<std::mutex> lock = checker_->lock();  // one body at a time
+    auto run = [&body] { body(); };
+    checker_->run(acc, BodyRef(run), reads, found);
+  }
+  for (const AccessChecker::Found& f : found)
+    findings_->add(finding(task_label(x.graph, r.task), f, x.graph.data));
+}
+
+bool ProgramWorkload::checked_stop_after(LoopId loop) {
+  const ExecGraph& x = *exec_;
+  bool stop = false;
+  std::vector<AccessChecker::Found> found;
+  {
+    std::unique_lock<std::mutex> lock = checker_->lock();
+    const Access acc{x.graph.loops[loop].condition, AccessMode::R};
+    auto evaluate = [this, loop, &stop] { stop = conditions_[loop](); };
+    checker_->run({&acc, 1}, BodyRef(evaluate), false, found);
+  }
+  for (const AccessChecker::Found& f : found)
+    findings_->add(finding("loop.break of loop " + std::to_string(loop), f, x.graph.data));
+  return stop;
+}
+
 void ProgramWorkload::run(const TaskRun& r) {
+  if (checker_ != nullptr) [[unlikely]] {
+    checked_run(r);
+    return;
+  }
   const ExecGraph& x = *r.exec;
   if (r.origin == kNoTask) {  // a reducer: target += temps, in the lowering's order
     const Reduction& red = x.reductions[x.reduction[r.task]];
@@ -72,6 +110,10 @@ void ProgramWorkload::run(const TaskRun& r) {
   body();
 }
 
-bool ProgramWorkload::stop_after(LoopId loop, std::uint32_t) { return conditions_[loop](); }
+bool ProgramWorkload::stop_after(LoopId loop, std::uint32_t) {
+  if (checker_ != nullptr) [[unlikely]]
+    return checked_stop_after(loop);
+  return conditions_[loop]();
+}
 
 }  // namespace tgraph::replay

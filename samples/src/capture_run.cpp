@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tgraph/capture/recorder.hpp"
+#include "tgraph/capture/write_step.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/samples/divergence.hpp"
@@ -55,6 +56,9 @@ CaptureRun capture_scene(const CaptureOptions& o) {
   rec.set_derive_edges(false);  // the trace stores no edges; readers derive them
   if (o.cost_passes == 0) throw OptionError("cost_passes", "must be at least 1");
   rec.set_cost_passes(o.cost_passes);
+  if (o.verify_accesses && o.no_capture)
+    throw OptionError("verify_accesses", "needs the capture (not {no_capture})");
+  rec.set_verify_accesses(o.verify_accesses);
   run.cost_passes = o.cost_passes;
   std::unique_ptr<TraceWriter> writer;
   if (!o.no_capture)
@@ -77,6 +81,16 @@ CaptureRun capture_scene(const CaptureOptions& o) {
       stop(e.what());
     }
     StepGraph g = rec.end_step();
+    if (rec.step_errors() != 0 && !o.allow_misuse) {
+      // The graph is not what the engine ran: refuse the step, name the first misuse.
+      const std::string refused = "step " + std::to_string(s) +
+                                  " is not written: write it anyway with {allow_misuse}";
+      const std::string what = "capture: " + capture::step_misuse_line(rec) + "; ";
+      if (!writer) throw CaptureFailure(what, refused, kNamesFields);
+      throw CaptureFailure(what + "the " + std::to_string(writer->steps_written()) +
+                               " complete steps before it are in " + writer->partial_path() + " (",
+                           "read with {recover}); " + refused, kNamesFields);
+    }
     const auto t1 = std::chrono::steady_clock::now();
     const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     run.seconds += ms / 1000.0;
@@ -108,9 +122,12 @@ CaptureRun capture_scene(const CaptureOptions& o) {
     run.file_bytes = writer->bytes_written();
   }
   run.single_pass_runs = rec.single_pass_runs();
-  if (rec.errors() != 0)
-    throw CaptureFailure("capture: the recorder reported " + std::to_string(rec.errors()) +
-                         " API misuse(s)");
+  run.misuses = rec.errors();
+  run.access_findings = rec.access_findings();
+  if (const AccessChecker::Counts* c = rec.access_counts()) run.access_counts = *c;
+  if (run.misuses != 0 && o.warn)
+    o.warn("the recorder counted " + std::to_string(run.misuses) +
+           " API misuse(s), written anyway; the first: " + capture::to_string(rec.misuses()[0]));
   return run;
 }
 
@@ -132,6 +149,19 @@ std::string capture_json(const CaptureRun& r, const CaptureOptions& o) {
   j["groups"] = r.groups;
   j["cost_passes"] = r.cost_passes;
   j["single_pass_runs"] = r.single_pass_runs;
+  j["misuses"] = r.misuses;
+  if (o.verify_accesses) {
+    nlohmann::json f = nlohmann::json::array();
+    for (const AccessFinding& a : r.access_findings)
+      f.push_back({{"task", a.task},
+                   {"datum", a.datum},
+                   {"found", std::string(to_string(a.found))},
+                   {"declared", a.declared}});
+    j["access_findings"] = f;
+    j["access_check"] = {{"runs", r.access_counts.runs},
+                         {"reruns", r.access_counts.reruns},
+                         {"reads_unchecked", r.access_counts.reads_unchecked}};
+  }
   return j.dump();
 }
 
@@ -146,6 +176,17 @@ std::string capture_text(const CaptureRun& r, const CaptureOptions& o) {
                   static_cast<unsigned long long>(r.tasks),
                   static_cast<unsigned long long>(r.file_bytes));
     out += line + o.output + "\n";
+  }
+  if (o.verify_accesses) {
+    std::snprintf(line, sizeof line,
+                  "verify-accesses: %llu task runs checked, %llu reruns, %llu not checked for "
+                  "reads (they write data without storage): %zu finding(s)\n",
+                  static_cast<unsigned long long>(r.access_counts.runs),
+                  static_cast<unsigned long long>(r.access_counts.reruns),
+                  static_cast<unsigned long long>(r.access_counts.reads_unchecked),
+                  r.access_findings.size());
+    out += line;
+    for (const AccessFinding& a : r.access_findings) out += "  " + to_string(a) + "\n";
   }
   return out;
 }

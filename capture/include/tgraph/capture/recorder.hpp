@@ -14,6 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "tgraph/graph/access_check.hpp"
 #include "tgraph/graph/cumulative.hpp"
 #include "tgraph/graph/incremental.hpp"
 #include "tgraph/graph/step_graph.hpp"
@@ -46,6 +47,34 @@ enum class Mode : std::uint8_t {
 
 /// "off", "capture" or "deferred".
 std::string_view to_string(Mode mode);
+
+/// The API call in which the recorder saw a misuse.
+enum class Call : std::uint8_t {
+  kBeginStep = 0,
+  kEndStep = 1,
+  kTask = 2,  ///< task() or a Scope
+  kBeginLoop = 3,
+  kConditionalBreak = 4,
+  kEndLoop = 5,
+  kAccumulator = 6,
+};
+
+/// "begin_step", "end_step", "task", "begin_loop", "conditional_break", "end_loop",
+/// "accumulator".
+std::string_view to_string(Call call);
+
+/// One misuse of the API, as the recorder saw it (Recorder::misuses).
+struct Misuse {
+  Call call = Call::kTask;
+  std::string problem;      ///< what was wrong ("the loop was closed by end_loop")
+  std::string loop;         ///< the loop concerned, by its condition datum; empty: none
+  std::uint64_t step = 0;   ///< the step (0-based: begin_step calls before it)
+  std::uint32_t tasks = 0;  ///< tasks that step had recorded when it happened
+};
+
+/// "conditional_break: the loop was closed by end_loop (loop 0 on solver.converged, step 3,
+/// after 12 tasks)".
+std::string to_string(const Misuse& m);
 
 /// A step recorded in deferred mode: the graph plus the bodies to run.
 ///
@@ -104,6 +133,9 @@ class Recorder {
   static constexpr std::uint32_t kTimeEvery = 4;
 
   explicit Recorder(Mode mode = Mode::kCapture);
+  ~Recorder();
+  Recorder(Recorder&&) noexcept;
+  Recorder& operator=(Recorder&&) noexcept;
 
   /// Current mode.
   Mode mode() const { return mode_; }
@@ -193,7 +225,7 @@ class Recorder {
         : rec_(rec), kind_(kind), obj_(obj) {
       for (const Access& a : acc) {
         if (n_ == kMaxAccesses) {
-          ++rec_.errors_;
+          rec_.misuse(Call::kTask, "a Scope takes at most 16 accesses; the others were dropped");
           break;
         }
         acc_[n_++] = a;
@@ -230,15 +262,45 @@ class Recorder {
       return true;
     }
     const std::uint64_t t0 = detail::ticks();
-    const bool stop = pred();
+    bool stop = false;
+    if (verify_ && mode_ == Mode::kCapture) [[unlikely]] {
+      auto evaluate = [&stop, &pred] { stop = pred(); };
+      check_condition(loop, BodyRef(evaluate));
+    } else {
+      stop = pred();
+    }
     return record_break(loop, detail::ticks() - t0) || stop;
   }
   /// Closes the loop.
   void end_loop(LoopId loop);
 
+  /// Access verification (capture mode; `tgraph capture --verify-accesses`): every task body
+  /// runs between checksums of the data with storage, and again from the same state with
+  /// the data it does not declare perturbed (tgraph::AccessChecker: what it sees and what it
+  /// cannot), so that a body writing a datum it declares R (or not at all), or reading one
+  /// it does not declare, is found; break conditions are checked for writes. Costs several
+  /// passes over the state per task (recorded costs then mean nothing); off by default,
+  /// and then one untaken branch per task.
+  void set_verify_accesses(bool on);
+  /// Whether accesses are verified.
+  bool verify_accesses() const { return verify_ != nullptr; }
+  /// The wrong declarations found since verification was turned on, deduplicated by task,
+  /// datum and what was found, in the order seen.
+  std::vector<AccessFinding> access_findings() const;
+  /// What verification ran (runs, reruns, runs whose reads were not checked); null when off.
+  const AccessChecker::Counts* access_counts() const;
+
   /// Number of API misuses seen (task count changing between iterations, unbalanced
   /// loops...); the hot path never throws, it counts and end_step() reports.
   std::uint64_t errors() const { return errors_; }
+  /// The misuses themselves, in the order seen: which call, what, the loop, the step and
+  /// its task count (the first kMaxMisuses kept; errors() counts them all).
+  const std::vector<Misuse>& misuses() const { return misuses_; }
+  /// Misuses counted since the last begin_step() (after end_step(): the step's own). A
+  /// trace writer refuses a step with misuses: its graph is not what the engine ran.
+  std::uint64_t step_errors() const { return errors_ - errors_before_step_; }
+  /// Misuses kept in misuses().
+  static constexpr std::size_t kMaxMisuses = 64;
 
  private:
   template <class F>
@@ -248,6 +310,12 @@ class Recorder {
         body();
         return;
       case Mode::kCapture: {
+        if (verify_) [[unlikely]] {
+          const std::uint64_t t0 = detail::ticks();
+          check_task(kind, obj, acc, n, BodyRef(body));
+          record(kind, obj, acc, n, detail::ticks() - t0);
+          return;
+        }
         if (!time_task_) {  // an untimed loop iteration (see kTimeEvery)
           body();
           record(kind, obj, acc, n, 0);
@@ -277,7 +345,7 @@ class Recorder {
         if (ticks > cost_max_[t]) cost_max_[t] = ticks;
         ++replay_pos_;
       } else {
-        ++errors_;  // the body changed between iterations
+        body_changed(t, kind, obj);
       }
       return false;
     }
@@ -309,6 +377,15 @@ class Recorder {
   std::uint64_t median_ticks();
   // Returns true when the loop has reached its maximum iteration count.
   bool record_break(LoopId loop, std::uint64_t ticks);
+  // Runs a task body under the access checker; its findings named by the task's key.
+  void check_task(KindId kind, ObjectId obj, const Access* acc, std::size_t n, BodyRef body);
+  // Evaluates a loop's break condition under the checker (writes only).
+  void check_condition(LoopId loop, BodyRef evaluate);
+  // Counts a misuse and keeps its description (the first kMaxMisuses); `loop` names the
+  // loop concerned (kNoLoop: none).
+  void misuse(Call call, std::string problem, LoopId loop = kNoLoop);
+  // A loop iteration after the first issued a task other than the first iteration's.
+  void body_changed(TaskId expected, KindId kind, ObjectId obj);
   // FNV-1a of a name, cached per object / kind id for stable keys.
   std::uint64_t name_hash(std::vector<std::uint64_t>& cache, std::size_t id, std::string_view name);
   StepGraph finish_step();
@@ -342,6 +419,11 @@ class Recorder {
   bool time_task_ = true;                   // time the tasks of the current iteration
   std::vector<std::uint32_t> loop_timed_;   // per loop: timed iterations so far
   std::uint64_t errors_ = 0;
+  std::uint64_t errors_before_step_ = 0;  // errors_ at the last begin_step
+  std::uint64_t steps_begun_ = 0;
+  std::vector<Misuse> misuses_;
+  struct Verify;                    // the checker and its findings (set_verify_accesses)
+  std::unique_ptr<Verify> verify_;
   std::uint32_t cost_passes_ = 1;           // timed passes per body (capture mode)
   std::uint64_t single_pass_runs_ = 0;      // runs timed once: unrestorable written data
   std::vector<unsigned char> saved_;        // written data of the task being timed

@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "tgraph/graph/access_check.hpp"
 #include "tgraph/graph/cumulative.hpp"
 #include "tgraph/replay/workload.hpp"
 
@@ -29,6 +30,16 @@ class ProgramWorkload : public Workload {
   void set_program(std::span<const std::function<void()>> bodies,
                    std::span<const std::function<bool()>> conditions,
                    std::span<const Accumulator* const> accumulators = {});
+  /// Verifies accesses (`--verify-accesses`): every body then runs under `checker` (its
+  /// storage set by datum of the step, synced before each step by the caller), one at a
+  /// time whatever the executor's threads, and what it finds goes to `findings`, named by
+  /// the task's key. Reads are checked in a loop's first two iterations and every 8th.
+  /// Needs CwMode::kSerialize (no temporaries: a body that runs twice must write the datum
+  /// itself). nullptr: off (the default; one untaken branch per task).
+  void set_access_checker(AccessChecker* checker, AccessFindings* findings) {
+    checker_ = checker;
+    findings_ = findings;
+  }
   void bind(const ExecGraph& exec) override;
   bool needs_touch(DatumId d) const override;
   void first_touch(DatumId d) override;
@@ -44,6 +55,10 @@ class ProgramWorkload : public Workload {
   const ExecGraph* exec_ = nullptr;
   std::vector<std::shared_ptr<void>> temps_;  // by exec datum (temporaries only)
   std::vector<std::uint8_t> redirected_;      // by exec task: writes a temporary
+  AccessChecker* checker_ = nullptr;           // set_access_checker
+  AccessFindings* findings_ = nullptr;
+  void checked_run(const TaskRun& r);
+  bool checked_stop_after(LoopId loop);
 };
 
 }  // namespace tgraph::replay

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/access_check.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/samples/scene.hpp"
@@ -26,6 +27,12 @@ struct CaptureOptions {
   bool progress = false;       ///< a progress line on stderr
   /// Timed passes of every task body, median kept (Recorder::set_cost_passes; 1: one run).
   std::uint32_t cost_passes = 1;
+  /// Write steps in which the recorder saw API misuses (Recorder::step_errors) instead of
+  /// stopping before the first of them; the misuses are then reported as a warning.
+  bool allow_misuse = false;
+  /// Verify every task's declared accesses as it runs (Recorder::set_verify_accesses):
+  /// CaptureRun::access_findings lists the wrong declarations.
+  bool verify_accesses = false;
   /// Called with each of the scene's warnings (unstable dt...) before the first step; a
   /// warning names the options' fields as `{field}` (name_fields writes them in one's words).
   std::function<void(const std::string&)> warn;
@@ -47,6 +54,13 @@ struct CaptureRun {
   std::uint32_t cost_passes = 1;      ///< CaptureOptions::cost_passes
   /// Task runs timed once despite cost passes (Recorder::single_pass_runs).
   std::uint64_t single_pass_runs = 0;
+  /// API misuses the recorder counted (written anyway: CaptureOptions::allow_misuse).
+  std::uint64_t misuses = 0;
+  /// CaptureOptions::verify_accesses: the wrong declarations found (empty: none).
+  std::vector<AccessFinding> access_findings;
+  /// CaptureOptions::verify_accesses: task runs checked, reruns, runs whose reads were not
+  /// checked (they write a datum without storage).
+  AccessChecker::Counts access_counts;
 };
 
 /// The work of a capture failed (a diverging simulation, a failed write, API misuse): the
