@@ -10,6 +10,7 @@
 #include "flags.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/replay_command.hpp"
+#include "tgraph/measure/verify.hpp"
 #include "tgraph/viz/timeline.hpp"
 
 namespace tgraph::app {
@@ -107,10 +108,23 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_option("--cost-stride", live.cost_stride, "Time loop iterations 0, 1, every N-th");
   cmd->add_flag("--no-observe{false}", live.observe, "Skip the observed passes");
   cmd->add_flag("--check", live.check, "Compare the final state with a sequential run's");
+  auto verify = std::make_shared<bool>(false);
+  cmd->add_flag("--verify-accesses", *verify,
+                "Instead of timing: run every task between checksums of the state and again "
+                "with its undeclared data perturbed, and list the writes and reads it does not "
+                "declare (exit 1 when any; docs/instrumenting.md)");
   run->strategy.values.sticky_threshold = meas::live_sticky_threshold(live);  // unless --threshold
   add_strategy_flags(cmd, run->strategy);
-  cmd->callback([a, run] {
+  cmd->callback([a, run, verify] {
     run->method = method_flags(a->method, a->policy);
+    if (*verify) {
+      const meas::VerifyRunReport v = meas::verify_scene(*run);
+      std::cout << v.report << std::flush;
+      if (!v.result.findings.empty())
+        throw Failure(std::to_string(v.result.findings.size()) +
+                      " wrong access declaration(s) found (listed in the report)");
+      return;
+    }
     const meas::SceneRunReport r = meas::run_scene(*run);
     std::cout << r.report << std::flush;
     if (r.result.difference)

@@ -61,6 +61,7 @@ class CallbackEngine final : public LiveEngine {
     c_.step(rec);
     LiveStep step = detail::take_recorded_step(rec, "engine");
     recorded_ = true;
+    last_graph_ = step.graph;
     return step;
   }
 
@@ -72,8 +73,11 @@ class CallbackEngine final : public LiveEngine {
   }
 
   std::vector<StateRegion> state() const override {
-    if (c_.state) return c_.state();
-    return rec_ ? detail::recorded_state(*rec_) : std::vector<StateRegion>{};
+    std::vector<StateRegion> r = c_.state ? c_.state()
+                                 : rec_   ? detail::recorded_state(*rec_)
+                                          : std::vector<StateRegion>{};
+    if (recorded_) set_write_order(r, last_graph_);  // the first difference in program order
+    return r;
   }
 
  private:
@@ -91,6 +95,7 @@ class CallbackEngine final : public LiveEngine {
   EngineCallbacks c_;
   std::optional<capture::Recorder> rec_;
   bool recorded_ = false;
+  StepGraph last_graph_;  // the last step recorded: the state's write order
 };
 
 }  // namespace
@@ -110,6 +115,16 @@ LiveResult run_engine_live(const CallbacksFactory& make, const MethodChoice& met
     part = partition::step_partitioner(method.method, po);
   }
   return run_live([make] { return make_live_engine(make()); }, part ? &*part : nullptr, options);
+}
+
+VerifyResult verify_engine_accesses(const CallbacksFactory& make, const MethodChoice& method,
+                                    LiveOptions options) {
+  options.policy = method.policy;
+  std::optional<partition::StepPartitioner> part;
+  if (method.policy == replay::Policy::kPartition)
+    part = partition::step_partitioner(method.method, partition::Options{});
+  return verify_accesses([make] { return make_live_engine(make()); }, part ? &*part : nullptr,
+                         options);
 }
 
 std::string to_json(const LiveResult& r, const std::string& engine, const std::string& method,

@@ -25,7 +25,9 @@ class SceneEngine final : public LiveEngine {
       same.reuse_previous = true;
       return same;
     }
-    return detail::take_recorded_step(rec_, "scene " + scene_->name());
+    LiveStep step = detail::take_recorded_step(rec_, "scene " + scene_->name());
+    last_graph_ = step.graph;
+    return step;
   }
 
   void plain_step() override {
@@ -34,13 +36,18 @@ class SceneEngine final : public LiveEngine {
     used_ = &plain_;
   }
 
-  std::vector<StateRegion> state() const override { return detail::recorded_state(*used_); }
+  std::vector<StateRegion> state() const override {
+    std::vector<StateRegion> r = detail::recorded_state(*used_);
+    if (used_ == &rec_ && !last_graph_.tasks.empty()) set_write_order(r, last_graph_);
+    return r;
+  }
 
  private:
   std::unique_ptr<samples::Scene> scene_;
   capture::Recorder rec_;
   capture::Recorder plain_;
   const capture::Recorder* used_ = &rec_;  // the recorder whose ids name the state
+  StepGraph last_graph_;                   // the last step recorded: the state's write order
 };
 
 }  // namespace

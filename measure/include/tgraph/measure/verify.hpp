@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "tgraph/graph/access_check.hpp"
+#include "tgraph/measure/adapter.hpp"
 #include "tgraph/measure/engine.hpp"
 #include "tgraph/measure/live.hpp"
 
@@ -35,6 +36,14 @@ struct VerifyResult {
 VerifyResult verify_accesses(const EngineFactory& make_engine,
                              const partition::StepPartitioner* partitioner,
                              const LiveOptions& options);
+
+/// verify_accesses for an outside engine (adapter.hpp) under `method` (a strategy under the
+/// partition policy, or a baseline), as run_engine_live runs it:
+///
+///   VerifyResult v = verify_engine_accesses(make, choose_method("owner"), options);
+///   for (const AccessFinding& f : v.findings) std::printf("%s\n", to_string(f).c_str());
+VerifyResult verify_engine_accesses(const CallbacksFactory& make, const MethodChoice& method,
+                                    LiveOptions options);
 
 /// One JSON object: `scene`, `method`, `policy`, `threads`, `steps`, `access_findings` (list
 /// of {task, datum, found, declared}), `access_check` ({runs, reruns, reads_unchecked,
