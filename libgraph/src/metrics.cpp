@@ -106,4 +106,38 @@ UnitMetrics compute_unit_metrics(const StepGraph& g) {
   return m;
 }
 
+std::vector<std::vector<std::uint64_t>> robust_costs(const std::vector<StepGraph>& steps) {
+  // Steps grouped by structure: the hash first, same_structure to confirm.
+  std::vector<std::vector<std::size_t>> groups;
+  std::vector<std::uint64_t> hashes;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const std::uint64_t h = steps[i].structural_hash();
+    std::size_t g = 0;
+    while (g < groups.size() &&
+           !(hashes[g] == h && steps[groups[g].front()].same_structure(steps[i])))
+      ++g;
+    if (g == groups.size()) {
+      groups.emplace_back();
+      hashes.push_back(h);
+    }
+    groups[g].push_back(i);
+  }
+  std::vector<std::vector<std::uint64_t>> out(steps.size());
+  std::vector<std::uint64_t> costs;
+  for (const std::vector<std::size_t>& members : groups) {
+    const std::size_t n = steps[members.front()].tasks.size();
+    std::vector<std::uint64_t> median(n);
+    for (std::size_t t = 0; t < n; ++t) {
+      costs.clear();
+      for (const std::size_t i : members) costs.push_back(steps[i].tasks[t].cost_ns);
+      // The lower median of an even count: a cost that was measured, not an average.
+      const auto mid = costs.begin() + static_cast<std::ptrdiff_t>((costs.size() - 1) / 2);
+      std::nth_element(costs.begin(), mid, costs.end());
+      median[t] = *mid;
+    }
+    for (const std::size_t i : members) out[i] = median;
+  }
+  return out;
+}
+
 }  // namespace tgraph

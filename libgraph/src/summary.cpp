@@ -43,12 +43,22 @@ TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options) 
   s.steps = trace.steps.size();
   s.tasks_min = trace.steps.empty() ? 0 : UINT64_MAX;
   std::set<std::uint64_t> shapes;
+  const std::vector<std::vector<std::uint64_t>> robust = robust_costs(trace.steps);
   for (std::size_t i = 0; i < trace.steps.size(); ++i) {
     const StepGraph& g = trace.steps[i];
     const Metrics m = compute_metrics(g);
     StepSummary st;
     st.tasks = m.tasks;
     st.edges = m.edges;
+    st.edges_carried = g.carried_edges.size();
+    {
+      StepGraph r = g;
+      for (TaskId t = 0; t < r.tasks.size(); ++t) r.tasks[t].cost_ns = robust[i][t];
+      const Metrics rm = compute_metrics(r);
+      st.robust_work_ns = rm.work_ns;
+      st.robust_span_ns = rm.span_ns;
+      st.robust_parallelism = rm.parallelism;
+    }
     st.data = m.data;
     st.loops = m.loops;
     for (const Loop& l : g.loops) st.loop_iterations.push_back(l.iterations);
@@ -75,6 +85,10 @@ TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options) 
     s.tasks_min = std::min(s.tasks_min, st.tasks);
     s.tasks_max = std::max(s.tasks_max, st.tasks);
     s.edges += st.edges;
+    s.edges_carried += st.edges_carried;
+    s.robust_work_ns += st.robust_work_ns;
+    s.robust_span_ns += st.robust_span_ns;
+    s.robust_span_max_ns = std::max(s.robust_span_max_ns, st.robust_span_ns);
     s.data_max = std::max(s.data_max, st.data);
     s.loops += st.loops;
     s.loop_iterations += m.loop_iterations;
@@ -96,6 +110,9 @@ TraceSummary summarize_trace(const Trace& trace, const SummaryOptions& options) 
   s.tasks_mean = s.steps == 0 ? 0.0 : static_cast<double>(s.tasks) / static_cast<double>(s.steps);
   s.parallelism =
       s.span_ns == 0 ? 0.0 : static_cast<double>(s.work_ns) / static_cast<double>(s.span_ns);
+  s.robust_parallelism = s.robust_span_ns == 0 ? 0.0
+                                              : static_cast<double>(s.robust_work_ns) /
+                                                    static_cast<double>(s.robust_span_ns);
   s.unit_parallelism = s.span_tasks == 0 ? 0.0
                                           : static_cast<double>(s.work_tasks) /
                                                 static_cast<double>(s.span_tasks);
@@ -110,6 +127,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
     json one = {{"step", i},
                         {"tasks", st.tasks},
                         {"edges", st.edges},
+                        {"edges_carried", st.edges_carried},
                         {"data", st.data},
                         {"loops", st.loops},
                         {"loop_iterations", st.loop_iterations},
@@ -117,6 +135,9 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
                         {"span_ns", st.span_ns},
                         {"host_ns", st.host_ns},
                         {"parallelism", st.parallelism},
+                        {"robust_work_ns", st.robust_work_ns},
+                        {"robust_span_ns", st.robust_span_ns},
+                        {"robust_parallelism", st.robust_parallelism},
                         {"contacts", st.contacts},
                         {"collision_groups", st.collision_groups},
                         {"contacts_changed", st.contacts_changed},
@@ -139,6 +160,7 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"tasks", s.tasks},
       {"tasks_per_step", {{"min", s.tasks_min}, {"mean", s.tasks_mean}, {"max", s.tasks_max}}},
       {"edges", s.edges},
+      {"edges_carried", s.edges_carried},
       {"data", s.data_max},
       {"loops", s.loops},
       {"loop_iterations", s.loop_iterations},
@@ -148,6 +170,12 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
       {"span_max_ns", s.span_max_ns},
       {"host_ns", s.host_ns},
       {"parallelism", s.parallelism},
+      {"costs", "raw: work_ns, span_ns and parallelism use the recorded costs; robust_*: each "
+                "task's cost the median of its cost over the steps of its structure"},
+      {"robust_work_ns", s.robust_work_ns},
+      {"robust_span_ns", s.robust_span_ns},
+      {"robust_span_max_ns", s.robust_span_max_ns},
+      {"robust_parallelism", s.robust_parallelism},
       {"distinct_structures", s.distinct_structures},
       {"contact_changes", s.contact_changes},
       {"last_step_collision_groups", s.last_step_collision_groups},
@@ -177,8 +205,12 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
       s.tasks_mean, static_cast<unsigned long long>(s.tasks_max)));
   add(std::snprintf(line, sizeof line, "data           %llu (largest step)\n",
                     static_cast<unsigned long long>(s.data_max)));
-  add(std::snprintf(line, sizeof line, "edges          %llu\n",
-                    static_cast<unsigned long long>(s.edges)));
+  add(std::snprintf(line, sizeof line,
+                    "edges          %llu (%llu within a step or loop iteration, %llu "
+                    "loop-carried)\n",
+                    static_cast<unsigned long long>(s.edges),
+                    static_cast<unsigned long long>(s.edges - s.edges_carried),
+                    static_cast<unsigned long long>(s.edges_carried)));
   add(std::snprintf(line, sizeof line,
                     "loops          %llu, %llu iterations (max %u in one loop)\n",
                     static_cast<unsigned long long>(s.loops),
@@ -203,8 +235,16 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
   }
   out += "host           " + duration_text(s.host_ns) +
          " (sum of the engine's work outside the tasks)\n";
-  if (timed)
-    add(std::snprintf(line, sizeof line, "parallelism    %.2f (work / span)\n", s.parallelism));
+  if (timed) {
+    add(std::snprintf(line, sizeof line,
+                      "parallelism    %.2f (work / span, raw: the recorded costs)\n",
+                      s.parallelism));
+    add(std::snprintf(line, sizeof line,
+                      "robust         %.2f (work %s / span %s, each task's cost the median "
+                      "of its cost over the steps of its structure)\n",
+                      s.robust_parallelism, duration_text(s.robust_work_ns).c_str(),
+                      duration_text(s.robust_span_ns).c_str()));
+  }
   if (s.unit_cost)
     add(std::snprintf(line, sizeof line, "parallelism    %.2f (unit costs: work / span in tasks)\n",
                       s.unit_parallelism));

@@ -404,8 +404,8 @@ bool is_gzip(std::string_view bytes) {
 }
 
 std::string gunzip(std::string_view bytes, const std::string& name) {
-  // Ceiling of the inflated text: a timeline of 2 GiB is beyond what anything writes.
-  constexpr std::size_t kMaxText = std::size_t{1} << 31;
+  // Ceiling of the inflated text: a timeline of 1 GiB is beyond what anything writes.
+  constexpr std::size_t kMaxText = std::size_t{1} << 30;
   z_stream z{};
   if (inflateInit2(&z, 15 + 16) != Z_OK) throw std::runtime_error(name + ": zlib failed to start");
   std::string out;
@@ -424,7 +424,7 @@ std::string gunzip(std::string_view bytes, const std::string& name) {
     out.append(buffer, sizeof buffer - z.avail_out);
     if (out.size() > kMaxText) {
       inflateEnd(&z);
-      throw InputError(name, std::nullopt, "more than 2 GiB once inflated");
+      throw InputError(name, std::nullopt, "more than 1 GiB once inflated");
     }
     if (rc == Z_OK && z.avail_in == 0 && z.avail_out != 0) {
       inflateEnd(&z);

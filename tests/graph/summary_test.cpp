@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "tgraph/graph/generate.hpp"
 #include "tgraph/graph/metrics.hpp"
 
 namespace tgraph {
@@ -157,6 +158,52 @@ TEST(TraceSummary, OfAnEmptyTraceIsZero) {
   EXPECT_EQ(s.tasks_mean, 0.0);
   EXPECT_EQ(s.parallelism, 0.0);
   EXPECT_EQ(nlohmann::json::parse(trace_summary_json(s, "e.tgt"))["per_step"].size(), 0u);
+}
+
+// A capture beside a busy process: one task on a step's critical path interrupted (50x its
+// cost). The raw parallelism of that step collapses; the robust one (each task's median
+// over the steps of its structure) stays within 20 % of the quiet capture's.
+TEST(TraceSummary, RobustCostsIgnoreAnInterruptedTaskOnTheCriticalPath) {
+  GenerateOptions go;
+  go.pattern = Pattern::kDomain;
+  go.tasks = 200;
+  go.iterations = 5;
+  Trace quiet;
+  for (std::uint32_t i = 0; i < 5; ++i) {
+    quiet.steps.push_back(generate_step(go, i));
+    quiet.steps.back().derive_edges();
+  }
+  Trace busy = quiet;
+  StepGraph& g = busy.steps[2];
+  const std::vector<std::uint64_t> ef = earliest_finish(g);
+  const auto last = static_cast<TaskId>(std::max_element(ef.begin(), ef.end()) - ef.begin());
+  g.tasks[last].cost_ns *= 50;
+  const TraceSummary q = summarize_trace(quiet), b = summarize_trace(busy);
+  const auto within = [](double x, double ref) { return std::abs(x - ref) <= 0.2 * ref; };
+  EXPECT_FALSE(within(b.per_step[2].parallelism, q.per_step[2].parallelism))
+      << b.per_step[2].parallelism << " vs " << q.per_step[2].parallelism;
+  EXPECT_TRUE(within(b.per_step[2].robust_parallelism, q.per_step[2].robust_parallelism))
+      << b.per_step[2].robust_parallelism << " vs " << q.per_step[2].robust_parallelism;
+  EXPECT_TRUE(within(b.robust_parallelism, q.robust_parallelism));
+  // Every step of one structure has the same robust costs: the median of each task's.
+  const auto robust = robust_costs(busy.steps);
+  for (std::size_t i = 1; i < robust.size(); ++i) EXPECT_EQ(robust[i], robust[0]);
+  const nlohmann::json j = nlohmann::json::parse(trace_summary_json(b, "b.tgt"));
+  EXPECT_DOUBLE_EQ(j["robust_parallelism"].get<double>(), b.robust_parallelism);
+  EXPECT_TRUE(j["costs"].get<std::string>().find("median") != std::string::npos);
+  EXPECT_NE(trace_summary_text(b, "b.tgt").find("robust"), std::string::npos);
+}
+
+TEST(TraceSummary, SaysHowManyEdgesAreLoopCarried) {
+  Trace t;
+  t.steps.push_back(step(false, 3, 10));
+  const TraceSummary s = summarize_trace(t);
+  EXPECT_EQ(s.edges_carried, t.steps[0].carried_edges.size());
+  EXPECT_GT(s.edges_carried, 0u);
+  EXPECT_EQ(s.edges, t.steps[0].edges.size() + t.steps[0].carried_edges.size());
+  EXPECT_NE(trace_summary_text(s, "t.tgt").find("loop-carried"), std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(trace_summary_json(s, "t.tgt"));
+  EXPECT_EQ(j["edges_carried"], s.edges_carried);
 }
 
 }  // namespace

@@ -46,6 +46,13 @@ struct IncomingEdges {
 /// The incoming edges of each of `tasks` tasks (earliest_finish and viz's critical path).
 IncomingEdges incoming_edges(std::size_t tasks, const std::vector<Edge>& edges);
 
+/// Costs that noise cannot bend: per step, each task's cost replaced by the median of its
+/// cost over the steps of the same structure (same_structure: the same tasks with the same
+/// stable keys, in the same order). A task interrupted in one step (a preempted thread
+/// while capturing) keeps its usual cost; a step whose structure no other step has keeps
+/// its own costs. Indexed [step][task].
+std::vector<std::vector<std::uint64_t>> robust_costs(const std::vector<StepGraph>& steps);
+
 /// The step counted in tasks rather than time: every task run costs 1.
 struct UnitMetrics {
   std::uint64_t work_tasks = 0;  ///< task runs (a loop body task counts once per iteration)

@@ -14,6 +14,7 @@ namespace tgraph {
 struct StepSummary {
   std::uint64_t tasks = 0;
   std::uint64_t edges = 0;  ///< intra-step + loop-carried
+  std::uint64_t edges_carried = 0;  ///< of which loop-carried (iteration i to i + 1)
   std::uint64_t data = 0;
   std::uint64_t loops = 0;
   std::vector<std::uint32_t> loop_iterations;  ///< per loop
@@ -23,6 +24,10 @@ struct StepSummary {
   std::uint64_t span_tasks = 0;  ///< unit costs: hop count of the critical path
   std::uint64_t host_ns = 0;  ///< StepGraph::host_ns: serial engine time outside the tasks
   double parallelism = 0.0;
+  /// The same with robust costs (robust_costs: each task's median over its structure's steps).
+  std::uint64_t robust_work_ns = 0;
+  std::uint64_t robust_span_ns = 0;
+  double robust_parallelism = 0.0;
   std::uint64_t contacts = 0;
   std::uint64_t collision_groups = 0;  ///< distinct group ids (1 when none are recorded)
   bool contacts_changed = false;       ///< contact set differs from the previous step's
@@ -38,7 +43,8 @@ struct TraceSummary {
   std::uint64_t tasks = 0;  ///< over all steps
   std::uint64_t tasks_min = 0, tasks_max = 0;
   double tasks_mean = 0.0;
-  std::uint64_t edges = 0;
+  std::uint64_t edges = 0;          ///< intra-step + loop-carried, all steps
+  std::uint64_t edges_carried = 0;  ///< of which loop-carried
   std::uint64_t data_max = 0;  ///< data of the largest step
   std::uint64_t loops = 0;
   std::uint64_t loop_iterations = 0;
@@ -53,6 +59,12 @@ struct TraceSummary {
   double unit_parallelism = 0.0;     ///< unit costs: work_tasks / span_tasks
   std::uint64_t host_ns = 0;  ///< sum of the steps' host times (outside the tasks)
   double parallelism = 0.0;   ///< work / span (0 when the span is 0)
+  /// work, span and parallelism with robust costs (robust_costs), which one interrupted
+  /// task of the capture does not bend.
+  std::uint64_t robust_work_ns = 0;
+  std::uint64_t robust_span_ns = 0;
+  std::uint64_t robust_span_max_ns = 0;
+  double robust_parallelism = 0.0;
   std::uint64_t distinct_structures = 0;
   std::uint64_t contact_changes = 0;
   std::uint64_t last_step_collision_groups = 0;
