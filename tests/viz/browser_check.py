@@ -4,7 +4,8 @@
 
 Fails when the page reports a JavaScript error (uncaught exception, console.error, a chart
 that failed to render) or Chromium logs one, when a chart container holds no non-empty SVG
-or canvas, or when fewer charts rendered than the page declared. Checks the step graph's
+or canvas, or when fewer charts rendered than the page declared. Checks the lost time's
+stacked bars and the critical path outlined on the timeline, the step graph's
 first view (every node inside the box) and its pan and zoom (a copy of the page with a probe
 script wheels, clicks the zoom buttons and records the SVG's transform each time) and the quotient graph (K processor nodes p0..pK-1,
 K from the page's title, with loads that add up to the step's tasks and to 100 %, and
@@ -279,6 +280,26 @@ def check_quotient(dom):
     return failures
 
 
+def check_explain(dom, charts):
+    """Failures of the lost time's stacked bars (per step, per run) and of the executed
+    critical path outlined on the timeline (tgraph explain's view of the demo's replay)."""
+    failures = []
+    for cid in ("chart-lost-steps", "chart-lost-runs"):
+        if cid not in charts:
+            failures.append("no %s chart (the lost time by cause)" % cid)
+        elif not charts[cid]["drawn"]:
+            failures.append("%s holds no drawn chart" % cid)
+    bars = re.search(r'id="chart-lost-steps".*?role-mark marks"[^>]*>(.*?)</g>', dom, re.S)
+    if bars and bars.group(1).count("<path") < 2:
+        failures.append("chart-lost-steps draws %d bar segments" % bars.group(1).count("<path"))
+    path = re.search(r'class="mark-rect role-mark critical_path_marks"[^>]*>(.*?)</g>', dom, re.S)
+    if not path:
+        failures.append("the timeline has no critical-path layer (outlined bodies)")
+    elif path.group(1).count("<path") < 1:
+        failures.append("the timeline's critical-path layer draws no body")
+    return failures
+
+
 def chromium(binary, *args):
     cmd = [binary, "--headless", "--disable-gpu", "--no-sandbox", "--no-first-run",
            "--disable-extensions", "--disable-background-networking", "--enable-logging=stderr",
@@ -341,6 +362,7 @@ def main():
             failures.append("charts declared %s, rendered %s" % (declared, rendered))
 
         failures += check_quotient(dom_run.stdout)
+        failures += check_explain(dom_run.stdout, scan.charts)
         failures += check_pan_zoom(args.chromium, report, tmp)
 
         shot = chromium(args.chromium, "--hide-scrollbars", "--window-size=1280,4200",

@@ -12,6 +12,7 @@
 #include <set>
 #include <string>
 
+#include "tgraph/explain/explain.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
@@ -34,6 +35,8 @@ using detail::page_head;
 using detail::script_json;
 using detail::series_spec;
 using detail::speedup_spec;
+using detail::lost_runs_spec;
+using detail::lost_steps_spec;
 using detail::timeline_spec;
 using detail::with_commas;
 
@@ -52,6 +55,23 @@ std::uint64_t get_count(const json& j, const char* key, std::uint64_t max = UINT
 std::string inline_svg(const std::string& svg) {
   const auto at = svg.find("<svg");
   return at == std::string::npos ? svg : svg.substr(at);
+}
+
+RunAttribution run_attribution(const std::string& label, const explain::Attribution& a) {
+  RunAttribution r;
+  r.label = label;
+  r.lost_ns = a.lost_ns;
+  for (const std::string_view n : explain::cause_names())
+    r.causes.emplace_back(std::string(n), explain::cause(a.causes, n));
+  return r;
+}
+
+// The explanation of a timeline that carries its step graphs (nothing otherwise).
+std::optional<explain::Explanation> explained(const Timeline& t) {
+  if (t.step_info.empty()) return std::nullopt;
+  explain::ExplainOptions o;
+  o.what_ifs = false;
+  return explain::explain_timeline(t, "timeline", o);
 }
 
 std::string number_cell(const std::optional<double>& v, int decimals) {
@@ -247,9 +267,13 @@ void add_compare_json(ReportContent& c, std::string_view text, const std::string
 }
 
 void add_replay_json(ReportContent& c, std::string_view text, const std::string& name) {
-  const json j = json::parse(text, nullptr, false);
+  const bool gzip = text.size() >= 2 && static_cast<unsigned char>(text[0]) == 0x1f &&
+                    static_cast<unsigned char>(text[1]) == 0x8b;
+  const json j = gzip ? json(json::object({{"tasks", json::array()}}))
+                      : json::parse(text, nullptr, false);
   if (!j.is_discarded() && j.is_object() && j.contains("tasks")) {
     Timeline t = parse_timeline(text, name);
+    if (const auto e = explained(t)) c.attributions.push_back(run_attribution(name, e->attribution));
     if (!c.timeline) {
       c.timeline = std::move(t);
       c.timeline_caption = "From " + name + ".";
@@ -270,6 +294,15 @@ void add_replay_json(ReportContent& c, std::string_view text, const std::string&
     row.speedup = j.at("speedup").get<double>();
     row.efficiency = j.at("efficiency").get<double>();
     row.signals = get_count(j, "signals");
+    if (j.contains("attribution") && j["attribution"].is_object()) {
+      explain::Attribution a;
+      a.lost_ns = j["attribution"].at("lost_ns").get<std::int64_t>();
+      for (const std::string_view n : explain::cause_names())
+        explain::cause(a.causes, n) =
+            j["attribution"].at("causes").at(std::string(n)).get<std::int64_t>();
+      c.attributions.push_back(
+          run_attribution(row.method + " at " + std::to_string(row.k), a));
+    }
     c.rows.push_back(row);
   } catch (const json::exception& e) {
     std::string why = e.what();
@@ -328,9 +361,35 @@ std::string report_html(const ReportContent& c) {
     specs["chart-partition-time"] = series_spec(c, false);
     specs["chart-migrations"] = series_spec(c, true);
   }
+  std::optional<explain::Explanation> e;
+  if (c.timeline) {
+    try {
+      e = explained(*c.timeline);
+    } catch (const Error&) {
+      // A timeline whose steps cannot be explained is still drawn.
+    }
+  }
+  std::vector<RunAttribution> runs = c.attributions;
+  if (runs.empty() && e) runs.push_back(run_attribution("the timeline", e->attribution));
+  if (e || !runs.empty()) {
+    body += "<h2>Where the time went</h2><div class=\"charts\">";
+    if (e) {
+      body += "<div class=\"chart\" id=\"chart-lost-steps\"></div>";
+      specs["chart-lost-steps"] = lost_steps_spec(*e);
+    }
+    body += "<div class=\"chart\" id=\"chart-lost-runs\"></div></div>";
+    specs["chart-lost-runs"] = lost_runs_spec(runs);
+    body +=
+        "<p><small>Lost time = threads &times; makespan &minus; sequential work, split into "
+        "causes that add up to it (serial phases, imbalance, dependency waits, hand-offs, "
+        "interruptions, inflation, the runtime's own time, starvation, residual; "
+        "docs/explain.md). <code>tgraph explain</code> on the timeline gives the table, the "
+        "critical path and the what-ifs.</small></p>";
+  }
   if (c.timeline) {
     std::string caption = c.timeline_caption;
-    specs["chart-timeline"] = timeline_spec(*c.timeline, &caption);
+    if (e) caption += " Outlined in black: each step's executed critical path (tgraph explain).";
+    specs["chart-timeline"] = timeline_spec(*c.timeline, &caption, e ? &*e : nullptr);
     body +=
         "<h2>Replay timeline</h2><figure><div class=\"chart\" "
         "id=\"chart-timeline\"></div><figcaption>" +

@@ -196,7 +196,7 @@ json series_spec(const ReportContent& c, bool migrations) {
 }
 
 // The replay timeline as a Gantt chart (first steps, at most kMaxTimelineEvents tasks).
-json timeline_spec(const Timeline& t, std::string* caption) {
+json timeline_spec(const Timeline& t, std::string* caption, const explain::Explanation* path) {
   const std::vector<std::int64_t> offsets = t.step_offsets();
   json tasks = json::array(), waits = json::array();
   std::uint32_t last_step = 0;
@@ -265,6 +265,58 @@ json timeline_spec(const Timeline& t, std::string* caption) {
             {{{"field", "kind"}},
              {{"field", "start"}, {"format", ".3f"}},
              {{"field", "end"}, {"format", ".3f"}}}}}}});
+  // The executed critical path of the steps shown: its bodies outlined, its hand-offs as
+  // slanted links from the writer's end to the reader's start.
+  json path_bodies = json::array(), path_links = json::array();
+  if (path)
+    for (const explain::StepExplanation& s : path->steps) {
+      if (s.step > last_step || s.step >= offsets.size()) continue;
+      const double at = static_cast<double>(offsets[s.step] - s.serial_ns);
+      for (std::size_t k = 0; k < s.critical_path.size(); ++k) {
+        const explain::PathLink& l = s.critical_path[k];
+        if (l.link == explain::Link::kBody) {
+          path_bodies.push_back({{"thread", "thread " + std::to_string(l.thread)},
+                                 {"start", (at + static_cast<double>(l.start_ns)) / 1e6},
+                                 {"end", (at + static_cast<double>(l.end_ns)) / 1e6},
+                                 {"kind", l.kind},
+                                 {"link", "critical path: body"}});
+        } else if (l.link == explain::Link::kHandoff && k > 0) {
+          const explain::PathLink& from = s.critical_path[k - 1];
+          path_links.push_back({{"thread", "thread " + std::to_string(from.thread)},
+                                {"thread2", "thread " + std::to_string(l.thread)},
+                                {"start", (at + static_cast<double>(l.start_ns)) / 1e6},
+                                {"end", (at + static_cast<double>(l.end_ns)) / 1e6},
+                                {"link", "critical path: hand-off"}});
+        }
+      }
+    }
+  if (!path_bodies.empty())
+    layers.push_back({{"name", "critical-path"},
+                      {"data", {{"values", path_bodies}}},
+                      {"mark",
+                       {{"type", "bar"},
+                        {"height", {{"band", 0.95}}},
+                        {"fillOpacity", 0},
+                        {"stroke", "#000000"},
+                        {"strokeWidth", 2}}},
+                      {"encoding",
+                       {{"x", x},
+                        {"x2", {{"field", "end"}}},
+                        {"y", y},
+                        {"tooltip",
+                         {{{"field", "link"}},
+                          {{"field", "kind"}},
+                          {{"field", "start"}, {"format", ".3f"}},
+                          {{"field", "end"}, {"format", ".3f"}}}}}}});
+  if (!path_links.empty())
+    layers.push_back({{"data", {{"values", path_links}}},
+                      {"mark", {{"type", "rule"}, {"color", "#000000"}, {"strokeWidth", 2}}},
+                      {"encoding",
+                       {{"x", x},
+                        {"x2", {{"field", "end"}}},
+                        {"y", y},
+                        {"y2", {{"field", "thread2"}}},
+                        {"tooltip", {{{"field", "link"}}}}}}});
   layers.push_back({{"data", {{"values", steps}}},
                     {"mark", {{"type", "rule"}, {"color", "#000000"}, {"strokeWidth", 1.5}}},
                     {"encoding", {{"x", {{"field", "start"}, {"type", "quantitative"}}}}}});
@@ -273,9 +325,76 @@ json timeline_spec(const Timeline& t, std::string* caption) {
           {"height", {{"step", 34}}},
           {"title",
            {{"text", "Replay timeline"},
-            {"subtitle",
-             "one row per thread; dark thin bars: blocking waits; black rules: step starts"}}},
+            {"subtitle", path_bodies.empty()
+                             ? "one row per thread; dark thin bars: blocking waits; black "
+                               "rules: step starts"
+                             : "one row per thread; dark thin bars: blocking waits; black "
+                               "rules: step starts; outlined: the executed critical path"}}},
           {"layer", layers}};
+}
+
+namespace {
+
+// Stacked bars of lost time (ms) by cause; `rows` holds {bar, cause, ms} records.
+json lost_spec(const json& rows, const std::string& x_field, const std::string& x_title,
+               const std::string& title, const std::string& subtitle) {
+  json order = json::array();
+  for (const std::string_view n : explain::cause_names()) order.push_back(std::string(n));
+  json range = json::array();
+  for (std::uint32_t i = 0; i < order.size(); ++i) range.push_back(kind_colour(i));
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v5.json"},
+          {"width", 420},
+          {"height", 260},
+          {"title", {{"text", title}, {"subtitle", subtitle}}},
+          {"data", {{"values", rows}}},
+          {"mark", "bar"},
+          {"encoding",
+           {{"x", {{"field", x_field}, {"type", "ordinal"}, {"title", x_title}}},
+            {"y",
+             {{"field", "ms"},
+              {"type", "quantitative"},
+              {"stack", "zero"},
+              {"title", "lost processor time (ms)"}}},
+            {"color",
+             {{"field", "cause"},
+              {"type", "nominal"},
+              {"sort", order},
+              {"scale", {{"domain", order}, {"range", range}}}}},
+            {"order", {{"field", "rank"}}},
+            {"tooltip",
+             {{{"field", x_field}},
+              {{"field", "cause"}},
+              {{"field", "ms"}, {"format", ".3f"}}}}}}};
+}
+
+}  // namespace
+
+json lost_steps_spec(const explain::Explanation& e) {
+  json rows = json::array();
+  for (const explain::StepExplanation& s : e.steps) {
+    int rank = 0;
+    for (const std::string_view n : explain::cause_names())
+      rows.push_back({{"step", s.step},
+                      {"cause", std::string(n)},
+                      {"rank", rank++},
+                      {"ms", static_cast<double>(explain::cause(s.attribution.causes, n)) / 1e6}});
+  }
+  return lost_spec(rows, "step", "step", "Where the time went, step by step",
+                   "threads x makespan - sequential work, by cause (tgraph explain)");
+}
+
+json lost_runs_spec(const std::vector<RunAttribution>& runs) {
+  json rows = json::array();
+  for (const RunAttribution& r : runs) {
+    int rank = 0;
+    for (const auto& [cause, ns] : r.causes)
+      rows.push_back({{"run", r.label},
+                      {"cause", cause},
+                      {"rank", rank++},
+                      {"ms", static_cast<double>(ns) / 1e6}});
+  }
+  return lost_spec(rows, "run", "run", "Where the time went, by run",
+                   "the runs' lost processor time summed over their steps, by cause");
 }
 
 std::string with_commas(std::uint64_t v) {

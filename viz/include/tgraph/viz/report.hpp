@@ -45,6 +45,14 @@ struct StepSeries {
   std::vector<std::uint64_t> migrated_tasks;
 };
 
+/// The lost time of one run by cause (explain::Attribution's figures, by cause name), for
+/// the report's bars per policy.
+struct RunAttribution {
+  std::string label;  ///< the run: its policy or method and threads, or its file
+  std::int64_t lost_ns = 0;
+  std::vector<std::pair<std::string, std::int64_t>> causes;  ///< explain::cause_names() order
+};
+
 /// Everything the page shows.
 ///
 ///   ReportContent c = report_content(trace, "b.tgt", &assignment.steps[1], 1);
@@ -57,8 +65,9 @@ struct ReportContent {
   std::vector<std::uint32_t> contact_changes;  ///< steps whose contact set changed
   std::vector<MethodRow> rows;
   std::vector<StepSeries> series;
-  std::optional<Timeline> timeline;
+  std::optional<Timeline> timeline;  ///< with step graphs: explained (lost time, critical path)
   std::string timeline_caption;
+  std::vector<RunAttribution> attributions;  ///< replays' and timelines' lost time by cause
   std::string graph_svg;  ///< the step graph (Graphviz SVG), empty: none
   std::string graph_caption;
   std::size_t graph_step = 0;  ///< the step it shows
@@ -80,8 +89,10 @@ void set_quotient(ReportContent& c, const QuotientGraph& q, const std::string& m
 /// Adds the rows (and per-step series) of a comparison's JSON text (partition's
 /// comparison_json); throws InputError naming `name` when the text is not such a comparison.
 void add_compare_json(ReportContent& c, std::string_view json, const std::string& name);
-/// Adds a replay file: a timeline (timeline_json; the first one is drawn) or a measurement
-/// (a replay's JSON report, one measured row). Throws InputError otherwise.
+/// Adds a replay file: a timeline (timeline_json, gzip-compressed or not; the first one is
+/// drawn; one with step graphs adds its attribution) or a measurement (a replay's JSON
+/// report, one measured row, and its "attribution" when it has one). Throws InputError
+/// otherwise.
 void add_replay_json(ReportContent& c, std::string_view json, const std::string& name);
 
 /// A report of files: report_content of step `step` (step 0 when the trace has no such step),
