@@ -380,4 +380,18 @@ Explanation explain_timeline(const Timeline& t, const std::string& name,
   return e;
 }
 
+void set_kind_costs(Timeline& t,
+                    const std::vector<std::pair<std::string, double>>& mean_ns_by_kind) {
+  for (TimelineStep& s : t.step_info) {
+    const TimelineGraph& g = t.graphs[s.graph];
+    std::vector<std::int64_t> by_kind(g.kinds.size(), -1);
+    for (KindId k = 0; k < g.kinds.size(); ++k)
+      for (const auto& [name, mean] : mean_ns_by_kind)
+        if (name == g.kinds[k]) by_kind[k] = std::llround(mean);
+    for (TaskId task = 0; task < s.cost_ns.size(); ++task)
+      if (g.origin[task] != kNoTask && by_kind[g.task_kind[task]] >= 0)
+        s.cost_ns[task] = by_kind[g.task_kind[task]];
+  }
+}
+
 }  // namespace tgraph::explain

@@ -318,5 +318,16 @@ TEST(Explain, WritesTheJsonShapeChecksRead) {
             explanation_json(explain_timeline(b.t, "t.json")));
 }
 
+TEST(Explain, KindCostsReplaceTheGraphsCosts) {
+  Builder b(1);
+  b.run(b.task("f", 1000), 0, 0, 1500, 1500);
+  b.run(b.task("g", 1000), 0, 1500, 2500, 1000);
+  b.explain(2500);
+  set_kind_costs(b.t, {{"f", 1500.0}});
+  const Explanation e = explain_timeline(b.t, "t.json");
+  EXPECT_EQ(e.steps[0].work_ns, 2500);
+  EXPECT_EQ(e.attribution.causes.inflation, 0);
+}
+
 }  // namespace
 }  // namespace tgraph::explain

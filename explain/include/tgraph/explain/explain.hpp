@@ -128,6 +128,11 @@ struct ExplainOptions {
 Explanation explain_timeline(const Timeline& t, const std::string& name,
                              const ExplainOptions& options = {});
 
+/// Sets the sequential cost of every task of `t` whose kind is in `mean_ns_by_kind` to that
+/// mean (a live run's per-kind means in its observed sequential pass: its graphs' own costs
+/// were measured in parallel, inflation included); other tasks keep theirs.
+void set_kind_costs(Timeline& t, const std::vector<std::pair<std::string, double>>& mean_ns_by_kind);
+
 /// The attribution as JSON: {"lost_ns", "causes": {serial, ..., residual}}.
 std::string attribution_json(const Attribution& a);
 /// `tgraph explain --json`: {"threads", "attribution", "what_if", "steps": [{step,
