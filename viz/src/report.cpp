@@ -189,7 +189,11 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
       {"loops", with_commas(s.loops) + ", " + with_commas(s.loop_iterations) + " iterations"},
       {"work, span", round3(static_cast<double>(s.work_ns) / 1e6) + " ms, " +
                          round3(static_cast<double>(s.span_ns) / 1e6) + " ms (all steps)"},
-      {"parallelism (work/span)", round3(s.parallelism)},
+      {"parallelism (work/span)", round3(s.parallelism) + " (raw: the recorded costs)"},
+      {"parallelism, robust costs",
+       round3(s.robust_parallelism) +
+           " (each task's cost the median of its cost over the steps of its structure: one "
+           "interrupted task of the capture does not bend it)"},
       {"contact changes", with_commas(s.contact_changes) + " steps"}};
   c.parallelism = s.parallelism;
   for (std::size_t i = 0; i < s.per_step.size(); ++i)
