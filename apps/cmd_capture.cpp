@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "commands.hpp"
+#include "ode_verbs.hpp"
 #include "option_words.hpp"
 #include "tgraph/samples/capture_run.hpp"
 
@@ -49,7 +50,11 @@ void add_capture(CLI::App& app) {
                 "data perturbed; list each write or read it does not declare (exit 1 when any; "
                 "docs/instrumenting.md, \"Finding a wrong declaration\")");
   cmd->add_flag("--json", a->json, "Print a JSON summary");
-  cmd->callback([o, a] {
+  auto ode = std::make_shared<OdeFlags>();
+  add_ode_capture_flags(cmd, *ode);
+  cmd->callback([o, a, ode] {
+    if (is_ode_scene(o->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
+      return capture_ode(o->scene, o->steps, o->output, a->json, *ode);
     o->progress = isatty(STDERR_FILENO) != 0;
     o->warn = [](const std::string& w) { warn(name_fields(w, flag_of)); };
     // A file size limit (RLIMIT_FSIZE) then fails the write with EFBIG instead of killing us.

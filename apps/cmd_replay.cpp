@@ -8,6 +8,7 @@
 
 #include "commands.hpp"
 #include "flags.hpp"
+#include "ode_verbs.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/replay_command.hpp"
 #include "tgraph/measure/verify.hpp"
@@ -115,7 +116,13 @@ void add_replay_verbs(CLI::App& app) {
                 "declare (exit 1 when any; docs/instrumenting.md)");
   run->strategy.values.sticky_threshold = meas::live_sticky_threshold(live);  // unless --threshold
   add_strategy_flags(cmd, run->strategy);
-  cmd->callback([a, run, verify] {
+  auto ode = std::make_shared<OdeFlags>();
+  add_ode_flags(cmd, *ode);
+  cmd->callback([a, run, verify, ode] {
+    if (is_ode_scene(run->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
+      return run_ode(run->scene, run->steps, a->method, run->live.exec.threads, run->live.repeat,
+                     run->live.check, run->json,
+                     static_cast<double>(run->live.exec.partition.timeout_ms) / 1e3, *ode);
     run->method = method_flags(a->method, a->policy);
     if (*verify) {
       const meas::VerifyRunReport v = meas::verify_scene(*run);

@@ -4,6 +4,7 @@
 
 #include "commands.hpp"
 #include "flags.hpp"
+#include "ode_verbs.hpp"
 #include "tgraph/measure/report.hpp"
 #include "tgraph/measure/validate.hpp"
 
@@ -29,7 +30,11 @@ void add_validate(CLI::App& app) {
                 "Charge the capture's host time in the prediction instead of the live run's "
                 "serial work per step (record, partition wait, prepare)");
   cmd->add_flag("--json", a->json, "Print one JSON object");
-  cmd->callback([o, a] {
+  auto ode = std::make_shared<OdeFlags>();
+  add_ode_flags(cmd, *ode);
+  cmd->callback([o, a, ode] {
+    if (is_ode_scene(o->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
+      return validate_ode(o->scene, o->steps, o->method, o->threads, o->repeat, o->calibration, a->json, *ode);
     o->method = measure::method_name(method_flags(o->method));
     const measure::Validation v = measure::validate(*o);
     std::cout << (a->json ? measure::to_json(v, *o) : measure::to_text(v, *o));

@@ -2,6 +2,7 @@
 #include "recording.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <string>
 #include <tuple>
@@ -18,12 +19,14 @@ StepGraph build_step_graph(const StepLog& log) {
   order.reserve(log.segments.size());
   for (const SegmentRecord& s : log.segments)
     if (calls.count(s.call)) order.push_back(&s);
-  std::sort(order.begin(), order.end(),
-            [](const SegmentRecord* a, const SegmentRecord* b) { return a->seq < b->seq; });
+  std::sort(order.begin(), order.end(), [](const SegmentRecord* a, const SegmentRecord* b) {
+    return a->seq != b->seq ? a->seq < b->seq : a->call < b->call;
+  });
 
   auto label = [&](const CallRecord& c) {
-    return std::string(c.name) + " [" + std::to_string(c.instance) + "] #" +
-           std::to_string(c.occurrence);
+    char key[20];
+    std::snprintf(key, sizeof key, "%016llx", static_cast<unsigned long long>(c.key));
+    return std::string(c.name) + " [" + std::to_string(c.instance) + "] " + key;
   };
   // Data by relation: (kind, a, b) -> id.
   std::map<std::tuple<std::uint32_t, std::uint64_t, std::uint64_t>, DatumId> data;
@@ -95,8 +98,8 @@ StepGraph build_step_graph(const StepLog& log) {
           {datum(0, s->call, s->seg, [&] { return label(c) + " part " + std::to_string(s->seg); }),
            AccessMode::W});
     const KindId kind = g.intern_kind(c.name);
-    const auto cost =
-        static_cast<std::uint64_t>(std::max<std::int64_t>(s->end_ns - s->start_ns, 1));
+    const auto cost = static_cast<std::uint64_t>(
+        std::max(static_cast<double>(s->end - s->start) * log.ns_per_tick + 0.5, 1.0));
     g.add_task(kind, kNoObject, acc, cost, segment_key(c.key, s->seg));
   }
   g.derive_edges();

@@ -29,6 +29,17 @@ std::int64_t now_ns() {
       .count();
 }
 
+/// A segment's time stamp: the time-stamp counter where there is one (a quarter of a clock
+/// read on this VM; constant and synchronised across cores when the kernel's clocksource is
+/// tsc), converted to ns per step against the steady clock (StepLog::ns_per_tick).
+std::int64_t stamp() {
+#if defined(__x86_64__) || defined(__i386__)
+  return static_cast<std::int64_t>(__rdtsc());
+#else
+  return now_ns();
+#endif
+}
+
 /// Test-and-test-and-set lock for the deques and the pool (held for a few instructions).
 class SpinLock {
  public:
@@ -55,6 +66,7 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
 }
 
 constexpr std::uint32_t kNoRecord = CallRecord::kNone;
+constexpr int kBatch = 64;  // calls moved between a slot's free list and the shared pool
 
 }  // namespace
 
@@ -78,13 +90,30 @@ struct Call {
   Call* next = nullptr;
   std::uint32_t record = kNoRecord;
   std::uint32_t home = 0;
+  // Stable key (recording, placement): from the poster's key and its post count.
+  std::uint64_t key = 0;
+  std::uint32_t posts = 0;  // posts this call made so far (its own thread only)
+  // Recording: the order number its first segment must exceed (its poster's segment's, its
+  // releasers' last segments'); raised by fetch_max before the release that may start it.
+  std::atomic<std::uint64_t> ready_seq{0};
 };
+
+namespace {
+// Raises `a` to at least `v`. relaxed: published by the release (acq_rel count decrement, or
+// the wait's signal) that follows it.
+void raise_to(std::atomic<std::uint64_t>& a, std::uint64_t v) {
+  std::uint64_t cur = a.load(std::memory_order_relaxed);
+  while (cur < v && !a.compare_exchange_weak(cur, v, std::memory_order_relaxed)) {
+  }
+}
+}  // namespace
 
 struct Wait {
   // release on signal, acquire on the waiter's check: the call's fault and results are seen.
   std::atomic<std::uint32_t> signalled{0};
   std::uint32_t id = 0;
-  std::uint32_t generation = 0;  // recording: one datum per use
+  std::uint32_t generation = 0;       // recording: one datum per use
+  std::atomic<std::uint64_t> seq{0};  // recording: the signalling segments' largest order number
 };
 
 struct Frame {
@@ -109,12 +138,23 @@ struct alignas(64) Slot {
   std::atomic<std::uint64_t> generation{0};
   // Counters (relaxed; the slot's own thread writes them, read between steps).
   std::atomic<std::uint64_t> calls{0}, steals{0}, parks{0};
+  // The call running here (null: the stepping thread's own code) and the posts of the
+  // stepping thread's own code this step: the posted calls' keys.
+  Call* current = nullptr;
+  std::uint32_t root_posts = 0;
+  // Call names' hashes by address (direct-mapped; the names are static strings).
+  const char* hash_name[64] = {};
+  std::uint64_t hash_value[64] = {};
   // Recording (the slot's own thread only, between begin_step and end_step).
+  std::uint64_t clock = 0;  // the last order number given here
   std::vector<Frame> frames;
   std::vector<SegmentRecord> segments;
   std::vector<AccessRecord> accesses;
   std::vector<CallRecord> records;
   std::uint32_t next_record = 0;
+  // The slot's own free calls (its thread only): no shared line per post and completion.
+  Call* free = nullptr;
+  int free_count = 0;
 
   void push_front(Call* c) {
     lock.lock();
@@ -177,15 +217,6 @@ struct Runtime::Pool {
   }
 };
 
-struct Runtime::Names {
-  static constexpr std::uint32_t kSize = 256;  // distinct call names (ODE posts ~40)
-  static constexpr std::uint32_t kInstances = 16;
-  std::atomic<const char*> name[kSize] = {};
-  // 0 until the interning thread has hashed the text (release), then the hash (acquire).
-  std::atomic<std::uint64_t> hash[kSize] = {};
-  std::atomic<std::uint32_t> occurrence[kSize][kInstances] = {};
-};
-
 namespace {
 
 thread_local Runtime* tl_runtime = nullptr;
@@ -201,11 +232,11 @@ Runtime* rt(dThreadingImplementationID impl) { return reinterpret_cast<Runtime*>
 
 Runtime::Runtime(const RuntimeOptions& options)
     : threads_(options.threads),
+      advertised_(options.advertised_threads ? options.advertised_threads : options.threads),
       placed_(options.placed),
       spin_ns_(options.spin_ns),
       watchdog_s_(options.watchdog_s),
-      pool_(std::make_unique<Pool>()),
-      names_(std::make_unique<Names>()) {
+      pool_(std::make_unique<Pool>()) {
   functions_.struct_size = sizeof(dThreadingFunctionsInfo);
   functions_.alloc_mutex_group = [](dThreadingImplementationID impl, dmutexindex_t count,
                                     const char* const*) {
@@ -276,19 +307,40 @@ dThreadingImplementationID Runtime::id() {
 
 Slot& Runtime::my_slot() { return tl_runtime == this ? *slots_[tl_slot] : *slots_[0]; }
 
-Call* Runtime::allocate_call() {
-  pool_->lock.lock();
-  if (!pool_->free) pool_->grow(pool_->total);  // anticipated by preallocate; rare
-  Call* c = pool_->free;
-  pool_->free = c->next;
-  pool_->lock.unlock();
+Call* Runtime::allocate_call(Slot& slot) {
+  if (!slot.free) {
+    // The slot's own list is empty: a batch from the shared pool (grown when empty, which
+    // preallocate anticipates).
+    pool_->lock.lock();
+    if (!pool_->free) pool_->grow(pool_->total);
+    for (int i = 0; i < kBatch && pool_->free; ++i) {
+      Call* c = pool_->free;
+      pool_->free = c->next;
+      c->next = slot.free;
+      slot.free = c;
+      ++slot.free_count;
+    }
+    pool_->lock.unlock();
+  }
+  Call* c = slot.free;
+  slot.free = c->next;
+  --slot.free_count;
   return c;
 }
 
-void Runtime::free_call(Call* c) {
+void Runtime::free_call(Call* c, Slot& slot) {
+  c->next = slot.free;
+  slot.free = c;
+  if (++slot.free_count < 4 * kBatch) return;
+  // Calls posted here and completed elsewhere pile up there: half goes back.
   pool_->lock.lock();
-  c->next = pool_->free;
-  pool_->free = c;
+  for (int i = 0; i < 2 * kBatch; ++i) {
+    Call* x = slot.free;
+    slot.free = x->next;
+    x->next = pool_->free;
+    pool_->free = x;
+    --slot.free_count;
+  }
   pool_->lock.unlock();
 }
 
@@ -319,48 +371,31 @@ dCallWaitID Runtime::alloc_wait() {
 void Runtime::reset_wait(dCallWaitID wait) {
   auto* w = reinterpret_cast<Wait*>(wait);
   w->signalled.store(0, std::memory_order_relaxed);  // before the next post that signals it
+  w->seq.store(0, std::memory_order_relaxed);
   ++w->generation;
 }
 void Runtime::free_wait(dCallWaitID wait) { delete reinterpret_cast<Wait*>(wait); }
 
-std::uint64_t Runtime::call_key(const char* name, dcallindex_t instance,
-                                std::uint32_t* occurrence) {
+std::uint64_t Runtime::call_key(Slot& slot, const char* name, dcallindex_t instance) {
   const char* text = name ? name : "(unnamed call)";
-  std::uint32_t i =
-      static_cast<std::uint32_t>((reinterpret_cast<std::uintptr_t>(text) >> 3) * 2654435761u) %
-      Names::kSize;
-  std::uint64_t h = 0;
-  for (std::uint32_t probe = 0; probe < Names::kSize; ++probe, i = (i + 1) % Names::kSize) {
-    const char* at = names_->name[i].load(std::memory_order_acquire);
-    if (at == nullptr) {
-      // acq_rel: the winner publishes the slot; a loser sees who took it.
-      if (names_->name[i].compare_exchange_strong(at, text, std::memory_order_acq_rel)) {
-        names_->hash[i].store(fnv1a(text), std::memory_order_release);
-        at = text;
-      }
-    }
-    if (at == text) {
-      while ((h = names_->hash[i].load(std::memory_order_acquire)) == 0) TGRAPH_ODE_PAUSE();
-      break;
-    }
+  const std::size_t i = (reinterpret_cast<std::uintptr_t>(text) >> 3) % 64;
+  if (slot.hash_name[i] != text) {
+    slot.hash_name[i] = text;
+    slot.hash_value[i] = fnv1a(text);
   }
-  std::uint32_t occ = 0;
-  if (h == 0) {
-    h = fnv1a(text);  // table full: keys without occurrences
-  } else {
-    const std::size_t bucket = std::min<dcallindex_t>(instance, Names::kInstances - 1);
-    // relaxed: a count; which post gets which number is the posts' order, timing-dependent
-    // between threads anyway.
-    occ = names_->occurrence[i][bucket].fetch_add(1, std::memory_order_relaxed);
-  }
-  *occurrence = occ;
-  return mix(mix(h, instance), occ);
+  // The poster's key and how many posts it made before: the same call tree, the same keys.
+  const std::uint64_t parent = slot.current ? mix(slot.current->key, slot.current->posts++)
+                                            : mix(root_key_, slot.root_posts++);
+  return mix(mix(parent, slot.hash_value[i]), instance);
 }
 
 void Runtime::begin_step(const char* entry) {
-  for (std::uint32_t i = 0; i < Names::kSize; ++i)
-    for (std::uint32_t j = 0; j < Names::kInstances; ++j)
-      names_->occurrence[i][j].store(0, std::memory_order_relaxed);  // threads idle
+  root_key_ = fnv1a(entry);
+  if (first_tick_ == 0) {
+    first_ns_ = now_ns();
+    first_tick_ = stamp();
+  }
+  my_slot().root_posts = 0;
   if (!recording()) return;
   for (auto& s : slots_) {
     s->segments.clear();
@@ -376,15 +411,20 @@ void Runtime::begin_step(const char* entry) {
   r.key = mix(fnv1a(entry), 0);
   slot.records.push_back(r);
   slot.frames.push_back(Frame{});
-  open_segment(slot, r.id, 0);
+  open_segment(slot, r.id, 0, 0, stamp());
 }
 
 StepLog Runtime::end_step() {
   StepLog log;
   if (!recording()) return log;
+  const std::int64_t ns = now_ns(), tick = stamp();
+  log.ns_per_tick =
+      tick > first_tick_ && ns > first_ns_
+          ? static_cast<double>(ns - first_ns_) / static_cast<double>(tick - first_tick_)
+          : 1.0;
   Slot& slot = my_slot();
   if (!slot.frames.empty()) {
-    if (slot.frames.back().open) close_segment(slot, true);
+    if (slot.frames.back().open) close_segment(slot, true, stamp());
     slot.frames.pop_back();
   }
   for (auto& s : slots_) {
@@ -413,26 +453,28 @@ RuntimeCounters Runtime::counters() const {
   return c;
 }
 
-void Runtime::open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg) {
+void Runtime::open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg, std::uint64_t after,
+                           std::int64_t start_ns) {
   Frame& f = slot.frames.back();
   f.call = call;
   f.seg = seg;
-  // relaxed: the modification order of one atomic follows happens-before, so a segment that
-  // must follow another (posted after it, released by it) gets a larger number.
-  f.seq = seq_.fetch_add(1, std::memory_order_relaxed);
-  f.start_ns = now_ns();
+  // Larger than every segment it follows (on this thread; `after`: its poster's, releasers',
+  // signallers'): sorted by it, the segments are in a topological order.
+  f.seq = std::max(slot.clock, after) + 1;
+  slot.clock = f.seq;
+  f.start_ns = start_ns;
   f.access_begin = static_cast<std::uint32_t>(slot.accesses.size());
   f.open = true;
 }
 
-void Runtime::close_segment(Slot& slot, bool last) {
+void Runtime::close_segment(Slot& slot, bool last, std::int64_t end_ns) {
   Frame& f = slot.frames.back();
   SegmentRecord s;
   s.seq = f.seq;
   s.call = f.call;
   s.seg = f.seg;
-  s.start_ns = f.start_ns;
-  s.end_ns = now_ns();
+  s.start = f.start_ns;
+  s.end = end_ns;
   s.access_begin = f.access_begin;
   s.access_count = static_cast<std::uint32_t>(slot.accesses.size()) - f.access_begin;
   s.last = last;
@@ -442,9 +484,10 @@ void Runtime::close_segment(Slot& slot, bool last) {
 
 void Runtime::split(Slot& slot) {
   if (slot.frames.empty() || !slot.frames.back().open) return;
-  close_segment(slot, false);
+  const std::int64_t t = stamp();
+  close_segment(slot, false, t);
   const Frame& f = slot.frames.back();
-  open_segment(slot, f.call, f.seg + 1);
+  open_segment(slot, f.call, f.seg + 1, 0, t);
 }
 
 void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
@@ -452,7 +495,7 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
                    dCallWaitID call_wait, dThreadedCallFunction* function, void* context,
                    dcallindex_t instance, const char* name) {
   Slot& slot = my_slot();
-  Call* c = allocate_call();
+  Call* c = allocate_call(slot);
   c->function = function;
   c->context = context;
   c->instance = instance;
@@ -466,10 +509,12 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
   c->home = slot.index;
   c->record = kNoRecord;
   slot.calls.store(slot.calls.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  c->posts = 0;
+  c->ready_seq.store(0, std::memory_order_relaxed);
   const bool rec = recording();
   if (rec || placed_) {
-    std::uint32_t occurrence = 0;
-    const std::uint64_t key = call_key(name, instance, &occurrence);
+    const std::uint64_t key = call_key(slot, name, instance);
+    c->key = key;
     if (placed_) {
       auto it = placement_.find(segment_key(key, 0));
       if (it != placement_.end()) c->home = it->second % threads_;
@@ -479,12 +524,13 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
       r.id = (slot.index << 24) | slot.next_record++;
       r.name = name ? name : "(unnamed call)";
       r.instance = static_cast<std::uint32_t>(instance);
-      r.occurrence = occurrence;
       r.key = key;
       r.released = dependencies > 0;
       if (!slot.frames.empty() && slot.frames.back().open) {
         r.poster_call = slot.frames.back().call;
         r.poster_seg = slot.frames.back().seg;
+        c->ready_seq.store(slot.frames.back().seq,
+                           std::memory_order_relaxed);  // published by the push
         split(slot);  // the part before the post precedes the posted call, the rest does not
       }
       slot.records.push_back(r);
@@ -503,6 +549,7 @@ void Runtime::alter(dCallReleaseeID releasee, ddependencychange_t change) {
       !c->started.load(std::memory_order_relaxed) && !slot.frames.empty() &&
       slot.frames.back().open) {
     slot.accesses.push_back({AccessRecord::kRelease, c->record, 0});
+    raise_to(c->ready_seq, slot.frames.back().seq);
     split(slot);
   }
   const std::intptr_t left =
@@ -555,26 +602,34 @@ void Runtime::run(Call* c, Slot& slot) {
   const bool rec = c->record != kNoRecord && recording();
   if (rec) {
     slot.frames.push_back(Frame{});
-    open_segment(slot, c->record, 0);
+    open_segment(slot, c->record, 0, c->ready_seq.load(std::memory_order_relaxed), stamp());
   }
+  Call* outer_call = slot.current;
+  slot.current = c;
   const int ok = c->function(c->context, c->instance, reinterpret_cast<dCallReleaseeID>(c));
+  slot.current = outer_call;
   if (rec) {
     // The last part of the call precedes what its completion releases: its wait, and its
     // releasee, or, when that one already runs (this call is its sub-call), what that one's
     // completion releases in turn.
+    const std::uint64_t seq = slot.frames.back().seq;
     for (Call* x = c;;) {
-      if (x->wait)
+      if (x->wait) {
         slot.accesses.push_back({AccessRecord::kSignal, x->wait->id, x->wait->generation});
+        raise_to(x->wait->seq, seq);
+      }
       Call* dep = x->releasee;
       if (!dep) break;
       if (!dep->started.load(std::memory_order_relaxed)) {
-        if (dep->record != kNoRecord)
+        if (dep->record != kNoRecord) {
           slot.accesses.push_back({AccessRecord::kRelease, dep->record, 0});
+          raise_to(dep->ready_seq, seq);
+        }
         break;
       }
       x = dep;
     }
-    close_segment(slot, true);
+    close_segment(slot, true, stamp());
     slot.frames.pop_back();
   }
   slot.running.store(outer, std::memory_order_relaxed);
@@ -588,7 +643,7 @@ void Runtime::complete(Call* c, Slot& slot) {
     if (c->fault_out) *c->fault_out = fault;
     Wait* w = c->wait;
     Call* dep = c->releasee;
-    free_call(c);
+    free_call(c, slot);
     if (w) signal(w);  // after the fault is written: the waiter may read it at once
     if (!dep) return;
     if (fault) dep->fault.store(1, std::memory_order_relaxed);
@@ -622,7 +677,7 @@ void Runtime::wait(int* out_wait_status, dCallWaitID call_wait, const dThreadedW
   auto* w = reinterpret_cast<Wait*>(call_wait);
   Slot& slot = my_slot();
   const bool rec = recording() && !slot.frames.empty() && slot.frames.back().open;
-  if (rec) close_segment(slot, false);
+  if (rec) close_segment(slot, false, stamp());
   const char* outer = slot.running.exchange(nullptr, std::memory_order_relaxed);
   const bool bounded = timeout != nullptr;
   const std::int64_t deadline =
@@ -658,7 +713,8 @@ void Runtime::wait(int* out_wait_status, dCallWaitID call_wait, const dThreadedW
   slot.running.store(outer, std::memory_order_relaxed);
   if (rec) {
     const Frame f = slot.frames.back();
-    open_segment(slot, f.call, f.seg + 1);
+    open_segment(slot, f.call, f.seg + 1, status ? w->seq.load(std::memory_order_acquire) : 0,
+                 stamp());
     if (status) slot.accesses.push_back({AccessRecord::kWaitRead, w->id, w->generation});
   }
   if (out_wait_status) *out_wait_status = status;

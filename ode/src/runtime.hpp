@@ -25,10 +25,10 @@ struct Slot;
 /// A segment of a call (or of the world step's own code on the stepping thread) between two
 /// of its posts, alters or waits: one task of the recorded graph.
 struct SegmentRecord {
-  std::uint64_t seq = 0;   ///< global start order (topological)
-  std::uint32_t call = 0;  ///< CallRecord id
-  std::uint32_t seg = 0;   ///< index within the call
-  std::int64_t start_ns = 0, end_ns = 0;
+  std::uint64_t seq = 0;            ///< order number: larger than every segment it follows
+  std::uint32_t call = 0;           ///< CallRecord id
+  std::uint32_t seg = 0;            ///< index within the call
+  std::int64_t start = 0, end = 0;  ///< stamps (StepLog::ns_per_tick)
   std::uint32_t access_begin = 0, access_count = 0;  ///< into the slot's accesses
   bool last = false;                                 ///< the call's last segment
 };
@@ -45,8 +45,7 @@ struct CallRecord {
   std::uint32_t id = 0;
   const char* name = nullptr;
   std::uint32_t instance = 0;
-  std::uint32_t occurrence = 0;
-  std::uint64_t key = 0;              ///< stable key of the call (name, instance, occurrence)
+  std::uint64_t key = 0;  ///< stable key: the poster's key, its post count, name, instance
   std::uint32_t poster_call = kNone;  ///< the segment whose post made it
   std::uint32_t poster_seg = 0;
   bool released = false;  ///< posted with dependencies: waits for releases
@@ -63,11 +62,16 @@ struct StepLog {
   std::vector<CallRecord> calls;
   const char* entry = "";    ///< dWorldQuickStep or dWorldStep
   std::int64_t host_ns = 0;  ///< collision before the step
+  double ns_per_tick = 1.0;  ///< segments' stamps to ns
 };
 
 /// The runtime's knobs.
 struct RuntimeOptions {
   std::uint32_t threads = 2;
+  /// The thread count ODE is told (retrieve_thread_count; 0: threads): ODE posts as many
+  /// instances of a stage as it is told, so a larger count on fewer threads measures what
+  /// ODE's K-thread algorithm costs without K threads.
+  std::uint32_t advertised_threads = 0;
   bool placed = false;  ///< partition policy: calls go to their key's slot
   std::int64_t spin_ns = 50'000;
   double watchdog_s = 60.0;
@@ -94,7 +98,7 @@ class Runtime {
   /// Recording of the calls between begin_step and end_step (stepping thread, between steps).
   void set_recording(bool on) { recording_.store(on, std::memory_order_relaxed); }
   bool recording() const { return recording_.load(std::memory_order_relaxed); }
-  /// Before a world step: resets the occurrence counters and, when recording, opens the world
+  /// Before a world step: the root of the calls' keys and, when recording, opens the world
   /// step's own segment named `entry` on the stepping thread.
   void begin_step(const char* entry);
   /// After it: closes that segment; when recording, the step's log (else an empty one).
@@ -118,13 +122,13 @@ class Runtime {
   void alter(dCallReleaseeID releasee, ddependencychange_t change);
   void wait(int* out_wait_status, dCallWaitID wait, const dThreadedWaitTime* timeout,
             const char* name);
-  unsigned thread_count() const { return threads_; }
+  unsigned thread_count() const { return advertised_; }
   int preallocate(ddependencycount_t calls);
 
  private:
   Slot& my_slot();
-  Call* allocate_call();
-  void free_call(Call* call);
+  Call* allocate_call(Slot& slot);
+  void free_call(Call* call, Slot& slot);
   void make_ready(Call* call, Slot& slot);
   Call* find_work(Slot& slot);
   bool any_work() const;
@@ -135,13 +139,15 @@ class Runtime {
   void park(Slot& slot, const std::atomic<std::uint32_t>* done);
   void worker(std::uint32_t index);
   void watchdog();
-  std::uint64_t call_key(const char* name, dcallindex_t instance, std::uint32_t* occurrence);
+  std::uint64_t call_key(Slot& slot, const char* name, dcallindex_t instance);
   // Recording: the segment open on `slot` ends here (split at a post, alter or wait).
   void split(Slot& slot);
-  void open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg);
-  void close_segment(Slot& slot, bool last);
+  void open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg, std::uint64_t after,
+                    std::int64_t start_ns);
+  void close_segment(Slot& slot, bool last, std::int64_t end_ns);
 
   std::uint32_t threads_;
+  std::uint32_t advertised_;
   bool placed_;
   std::int64_t spin_ns_;
   double watchdog_s_;
@@ -155,14 +161,12 @@ class Runtime {
   std::atomic<std::uint32_t> epoch_{0};
   std::atomic<std::uint32_t> sleepers_{0};
   std::atomic<bool> recording_{false};
-  std::atomic<std::uint64_t> seq_{0};  ///< segments' start order
   std::atomic<std::uint32_t> wait_ids_{0};
   // The call pool (free list under a spin lock; grown by preallocate or when empty).
   struct Pool;
   std::unique_ptr<Pool> pool_;
-  // Call names interned by address (static strings) for the occurrence counters and keys.
-  struct Names;
-  std::unique_ptr<Names> names_;
+  std::int64_t first_ns_ = 0, first_tick_ = 0;  ///< the first step's clock and stamp
+  std::uint64_t root_key_ = 0;  ///< the world step's entry: the root of the calls' keys
   std::unordered_map<std::uint64_t, std::uint32_t> placement_;
 };
 

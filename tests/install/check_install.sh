@@ -9,7 +9,9 @@
 # live on 2 threads (check "identical", residual small); builds examples/instrument-your-engine
 # (COMPONENTS capture measure), runs it, checks its trace with the installed
 # `tgraph info --json` and runs it live on 2 threads (check "identical"), and builds it again
-# with pkg-config (capture only: --live refused); then imports the installed Python module
+# with pkg-config (capture only: --live refused); builds examples/ode-attach (COMPONENTS ode,
+# when tgraph::ode is installed) and runs it on 2 threads (check not "differs"); then imports
+# the installed Python module
 # and runs pytest on it. No speed-up is asserted (a noisy machine): docs/instrumenting.md
 # gives the measured ones with their commands.
 #   check_install.sh BUILD_DIR SOURCE_DIR [PYTHON]   (PYTHON: the interpreter with pytest)
@@ -173,6 +175,23 @@ c++ -O2 -DTGRAPH_PACKAGE_VERSION="\"$(pkg-config --modversion tgraph)\"" \
 rc=0
 "$tmp/springs-pc" 3 "$tmp/springs-pc.tgt" --live 2 2> "$tmp/springs-pc.err" || rc=$?
 [ "$rc" = 2 ] || { cat "$tmp/springs-pc.err"; echo "--live with the capture API only: exit $rc" >&2; exit 1; }
+if [ -e "$prefix/lib/cmake/tgraph/tgraph-ode-targets.cmake" ]; then
+  example="$src/examples/ode-attach"
+  step "configure and build $example against the package (COMPONENTS ode); run it on 2 threads"
+  configure_and_build "$example" "$tmp/ode-attach"
+  "$tmp/ode-attach/ode_attach" 40 --threads 2 --json > "$tmp/ode-attach.json"
+  "$python" - "$tmp/ode-attach.json" <<'PY'
+import json, sys
+text = open(sys.argv[1]).read()
+j = json.loads(text)  # one object, nothing else on stdout
+bad = [k for k, ok in [("check", j.get("check") in ("identical", "within-tolerance")),
+                       ("threads", j.get("threads") == 2), ("method", j.get("method") == "worksteal"),
+                       ("speedup", j.get("speedup", 0) > 0)] if not ok]
+if bad:
+    sys.exit("ode_attach: wrong " + ", ".join(bad) + ":\n" + text[:2000])
+print(f"ok: ode_attach on 2 threads: check {j['check']}, speed-up {j['speedup']:.2f}")
+PY
+fi
 if [ -n "$(find "$prefix" -path '*/tgraph/_tgraph*.so' -print -quit)" ]; then
   init="$(find "$prefix" -path '*/tgraph/__init__.py' -print -quit)"
   pydir="$(dirname "$(dirname "$init")")"

@@ -54,9 +54,9 @@ struct RunResult {
   std::string check;
   double max_abs_diff = 0;  ///< largest difference of a body position (m)
   double max_rel_diff = 0;  ///< largest relative difference of a state number
-  /// The tolerance of "within-tolerance" (m): how far ODE self-threaded's own final positions
-  /// move with another seed of its random constraint reordering (the same algorithm, another
-  /// equally valid order of its sweeps).
+  /// The tolerance of "within-tolerance" (m): twice the farthest a body of ODE self-threaded
+  /// moves with either of two other seeds of its random constraint reordering (the same
+  /// algorithm, other equally valid orders of its sweeps; docs/ode.md, "The check").
   double tolerance = 0;
 };
 
@@ -91,5 +91,45 @@ struct CaptureReport {
 /// Runs the scene once without and once with recording (worksteal at `threads`) and writes
 /// the recorded steps to `output`: one task per segment of ODE's calls (docs/ode.md).
 CaptureReport capture_scene(const CaptureOptions& options);
+
+}  // namespace tgraph::ode
+
+namespace tgraph::ode {
+
+/// What `tgraph validate --scene ode-*` does.
+struct ValidateOptions {
+  std::string scene;
+  std::uint32_t steps = 20;
+  std::uint32_t threads = 2;
+  Method method;             ///< the live run's (worksteal or a partition strategy)
+  std::uint32_t repeat = 3;  ///< rounds: live run, capture, prediction; medians
+  Stepper stepper = Stepper::kQuickStep;
+  std::string calibration;  ///< the simulator's ("": the default one if present)
+};
+
+/// One round, measured back to back.
+struct ValidateRound {
+  std::int64_t live_ns = 0;        ///< the live run's steps under the method
+  std::int64_t sequential_ns = 0;  ///< ODE self-threaded, same steps, same round
+  std::int64_t predicted_ns = 0;   ///< the simulator's makespans of a capture of those steps
+};
+
+/// The simulator's prediction from a capture against the live run.
+struct ValidateReport {
+  ValidateOptions options;
+  std::string strategy;  ///< the strategy whose assignment the simulator schedules
+  std::vector<ValidateRound> rounds;
+  double live_speedup = 0;         ///< median of sequential / live
+  double predicted_speedup = 0;    ///< median of sequential / predicted
+  double predicted_over_live = 0;  ///< median of predicted / live (time)
+};
+
+/// Each round: the live run (ode::run_scene, one pass), a capture of the same steps at the
+/// same threads (worksteal, recording on), and the built-in simulator on each captured step
+/// under the method's strategy (`list` for worksteal) at K processors, the step's host time
+/// (its collision) as serial work. OptionError for sequential or ode (no graph to predict).
+ValidateReport validate_scene(const ValidateOptions& options);
+std::string to_json(const ValidateReport& r);
+std::string to_text(const ValidateReport& r);
 
 }  // namespace tgraph::ode

@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+// The ODE scenes of `run`, `capture` and `validate` (ode_verbs.hpp).
+#include <iostream>
+
+#include "commands.hpp"
+#include "ode_verbs.hpp"
+#if TGRAPH_HAVE_ODE
+#include "tgraph/ode/run.hpp"
+#include "tgraph/ode/scenes.hpp"
+#endif
+
+namespace tgraph::app {
+namespace {
+
+[[maybe_unused]] void no_ode(const std::string& scene) {
+  throw InputError(scene, std::nullopt,
+                   "ODE scene, but this tgraph was built without tgraph::ode (pkg-config ode, "
+                   "Debian libode-dev)");
+}
+
+}  // namespace
+
+bool is_ode_scene(const std::string& scene) { return scene.rfind("ode-", 0) == 0; }
+
+void add_ode_flags(CLI::App* cmd, OdeFlags& flags) {
+  cmd->add_option("--stepper", flags.stepper,
+                  "ODE scenes: quickstep (dWorldQuickStep) or step (dWorldStep)")
+      ->check(CLI::IsMember({"quickstep", "step"}));
+  cmd->add_option(
+         "--repartition-interval", flags.repartition_interval,
+         "ODE scenes, a partition strategy: steps between partitionings of a recorded step")
+      ->check(CLI::Range(1u, 1000000u));
+}
+
+void add_ode_capture_flags(CLI::App* cmd, OdeFlags& flags) {
+  cmd->add_option("--stepper", flags.stepper,
+                  "ODE scenes: quickstep (dWorldQuickStep) or step (dWorldStep)")
+      ->check(CLI::IsMember({"quickstep", "step"}));
+  cmd->add_option("--threads,-k", flags.threads,
+                  "ODE scenes: threads ODE posts its calls for (default 2)")
+      ->check(CLI::Range(1u, 1024u));
+}
+
+#if TGRAPH_HAVE_ODE
+
+void run_ode(const std::string& scene, std::optional<std::uint32_t> steps,
+             const std::string& method, std::uint32_t threads, std::uint32_t repeat, bool check,
+             bool json, double timeout_s, const OdeFlags& flags) {
+  ode::RunOptions o;
+  o.scene = scene;
+  o.steps = steps;
+  o.method = ode::choose_method(method);
+  o.threads = threads;
+  o.repeat = repeat;
+  o.check = check;
+  o.stepper = ode::parse_stepper(flags.stepper);
+  o.watchdog_s = timeout_s;
+  o.repartition_interval = flags.repartition_interval;
+  o.json = json;
+  const ode::RunResult r = ode::run_scene(o);
+  std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
+  if (r.check == "differs")
+    throw Failure(
+        "final state differs from ODE self-threaded's by " + std::to_string(r.max_abs_diff) +
+        " m, more than its own spread with another seed (" + std::to_string(r.tolerance) + " m)");
+}
+
+void capture_ode(const std::string& scene, std::optional<int> steps, const std::string& output,
+                 bool json, const OdeFlags& flags) {
+  ode::CaptureOptions o;
+  o.scene = scene;
+  if (steps) {
+    if (*steps <= 0) throw OptionError("steps", "must be at least 1");
+    o.steps = static_cast<std::uint32_t>(*steps);
+  }
+  o.output = output;
+  o.threads = flags.threads;
+  o.stepper = ode::parse_stepper(flags.stepper);
+  const ode::CaptureReport r = ode::capture_scene(o);
+  if (json) {
+    std::cout << "{\"scene\":\"" << scene << "\",\"steps\":" << r.steps << ",\"tasks\":" << r.tasks
+              << ",\"edges\":" << r.edges << ",\"bytes\":" << r.bytes
+              << ",\"recorded_ns\":" << r.recorded_ns << ",\"unrecorded_ns\":" << r.unrecorded_ns
+              << ",\"capture_overhead\":" << r.overhead << ",\"output\":\"" << output << "\"}\n";
+  } else {
+    std::cout << "captured " << scene << ": " << r.steps << " steps, " << r.tasks << " tasks, "
+              << r.edges << " edges -> " << output << " (" << r.bytes << " bytes); recording cost "
+              << r.overhead * 100.0 << " % (" << static_cast<double>(r.recorded_ns) / 1e6
+              << " ms against " << static_cast<double>(r.unrecorded_ns) / 1e6
+              << " ms unrecorded, same run)\n";
+  }
+}
+
+void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,
+                  std::uint32_t threads, std::uint32_t repeat, const std::string& calibration,
+                  bool json, const OdeFlags& flags) {
+  ode::ValidateOptions o;
+  o.scene = scene;
+  o.steps = steps;
+  o.method = ode::choose_method(method);
+  o.threads = threads;
+  o.repeat = repeat;
+  o.calibration = calibration;
+  o.stepper = ode::parse_stepper(flags.stepper);
+  const ode::ValidateReport r = ode::validate_scene(o);
+  std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
+}
+
+#else
+
+void run_ode(const std::string& scene, std::optional<std::uint32_t>, const std::string&,
+             std::uint32_t, std::uint32_t, bool, bool, double, const OdeFlags&) {
+  no_ode(scene);
+}
+void capture_ode(const std::string& scene, std::optional<int>, const std::string&, bool,
+                 const OdeFlags&) {
+  no_ode(scene);
+}
+void validate_ode(const std::string& scene, std::uint32_t, const std::string&, std::uint32_t,
+                  std::uint32_t, const std::string&, bool, const OdeFlags&) {
+  no_ode(scene);
+}
+
+#endif
+
+}  // namespace tgraph::app

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
+#include "tgraph/ode/run.hpp"
+#include "tgraph/ode/scenes.hpp"
+#include "tgraph/partition/simulator.hpp"
+
+namespace tgraph::ode {
+ValidateReport validate_scene(const ValidateOptions& options) {
+  if (!is_scene(options.scene))
+    throw InputError(options.scene, std::nullopt,
+                     "unknown ODE scene (ode-piles, ode-heap, ode-chains)");
+  if (options.method.policy == Policy::kSequential || options.method.policy == Policy::kOde)
+    throw OptionError("method",
+                      "validate predicts tgraph's runtime from a capture: worksteal or a "
+                      "partition strategy, not '" +
+                          method_name(options.method) + "'");
+  if (options.threads == 0) throw OptionError("threads", "must be at least 1");
+  if (options.repeat == 0) throw OptionError("repeat", "must be at least 1");
+  if (options.steps == 0) throw OptionError("steps", "must be at least 1");
+  ValidateReport report;
+  report.options = options;
+  report.strategy = options.method.policy == Policy::kPartition ? options.method.strategy : "list";
+  const partition::CostModel model =
+      partition::select_cost_model("calibrated", options.calibration);
+  auto strategy = partition::make_strategy(report.strategy);
+  dInitODE2(0);
+  struct Close {
+    ~Close() { dCloseODE(); }
+  } close;
+  std::vector<double> live, predicted, over;
+  for (std::uint32_t round = 0; round < options.repeat; ++round) {
+    RunOptions run;
+    run.scene = options.scene;
+    run.steps = options.steps;
+    run.method = options.method;
+    run.threads = options.threads;
+    run.stepper = options.stepper;
+    const RunResult r = run_scene(run);
+    ValidateRound v;
+    v.live_ns = r.wall_ns;
+    v.sequential_ns = r.sequential_wall_ns;
+    {
+      auto scene = Scene::make(options.scene, options.stepper, 0);
+      AttachOptions a;
+      a.threads = options.threads;
+      a.record = true;
+      Attachment attach(scene->world(), a);
+      for (std::uint32_t i = 0; i < options.steps; ++i) scene->step(&attach);
+      for (const StepGraph& g : attach.take_steps()) {
+        const partition::Result p = strategy->partition(g, options.threads, {}, {});
+        v.predicted_ns +=
+            static_cast<std::int64_t>(partition::simulate(g, p.assignment, model).makespan_ns);
+      }
+    }
+    report.rounds.push_back(v);
+    const auto d = [](std::int64_t x) { return static_cast<double>(std::max<std::int64_t>(x, 1)); };
+    live.push_back(d(v.sequential_ns) / d(v.live_ns));
+    predicted.push_back(d(v.sequential_ns) / d(v.predicted_ns));
+    over.push_back(d(v.predicted_ns) / d(v.live_ns));
+  }
+  report.live_speedup = median(live);
+  report.predicted_speedup = median(predicted);
+  report.predicted_over_live = median(over);
+  return report;
+}
+
+std::string to_json(const ValidateReport& r) {
+  nlohmann::ordered_json j;
+  j["scene"] = r.options.scene;
+  j["stepper"] = std::string(to_string(r.options.stepper));
+  j["method"] = method_name(r.options.method);
+  j["predicted_with"] = r.strategy;
+  j["threads"] = r.options.threads;
+  j["steps"] = r.options.steps;
+  j["repeat"] = r.options.repeat;
+  j["live_speedup"] = r.live_speedup;
+  j["predicted_speedup"] = r.predicted_speedup;
+  j["predicted_over_live"] = r.predicted_over_live;
+  j["within_15_percent"] = std::abs(r.predicted_over_live - 1.0) <= 0.15;
+  nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
+  for (const ValidateRound& v : r.rounds)
+    rounds.push_back({{"live_ns", v.live_ns},
+                      {"sequential_ns", v.sequential_ns},
+                      {"predicted_ns", v.predicted_ns}});
+  j["rounds"] = std::move(rounds);
+  return j.dump() + "\n";
+}
+
+std::string to_text(const ValidateReport& r) {
+  std::ostringstream out;
+  out << r.options.scene << ", " << r.options.steps << " steps, " << method_name(r.options.method)
+      << " at " << r.options.threads << " threads, " << r.options.repeat << " round(s)\n"
+      << "  live speed-up " << r.live_speedup << ", predicted " << r.predicted_speedup << " ("
+      << r.strategy << " schedule of the capture)\n"
+      << "  predicted / live time: " << r.predicted_over_live << "\n";
+  return out.str();
+}
+
+}  // namespace tgraph::ode

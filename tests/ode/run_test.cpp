@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// run_scene, capture_scene and validate_scene: their reports' keys and their refusals.
+#include "tgraph/ode/run.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
+
+namespace tgraph::ode {
+namespace {
+
+TEST(OdeRun, ReportsTheSpeedUpsTheCheckAndEachStep) {
+  RunOptions o;
+  o.scene = "ode-chains";
+  o.steps = 5;
+  o.method = choose_method("worksteal");
+  o.threads = 2;
+  o.check = true;
+  const RunResult r = run_scene(o);
+  EXPECT_TRUE(r.check == "identical" || r.check == "within-tolerance" || r.check == "differs");
+  const auto j = nlohmann::json::parse(to_json(r));
+  for (const char* key : {"speedup", "world_speedup", "check", "sequential_wall_ns", "breakdown",
+                          "per_step", "threads", "method", "calls_per_step"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["per_step"].size(), 5u);
+  EXPECT_EQ(j["threads"], 2);
+  EXPECT_EQ(j["method"], "worksteal");
+  EXPECT_GT(j["speedup"].get<double>(), 0.0);
+  EXPECT_GT(j["calls_per_step"].get<double>(), 0.0);
+  EXPECT_GT(j["breakdown"]["collide_ns"].get<std::int64_t>(), 0);
+}
+
+TEST(OdeRun, SequentialIsIdenticalToItself) {
+  RunOptions o;
+  o.scene = "ode-piles";
+  o.steps = 3;
+  o.method = choose_method("sequential");
+  o.check = true;
+  EXPECT_EQ(run_scene(o).check, "identical");
+}
+
+TEST(OdeRun, OneThreadOfTgraphsRuntimeIsIdenticalToOdeSelfThreaded) {
+  // One thread runs the calls in an order ODE's own self-threaded stepping also takes.
+  RunOptions o;
+  o.scene = "ode-piles";
+  o.steps = 10;
+  o.method = choose_method("worksteal");
+  o.threads = 1;
+  o.check = true;
+  EXPECT_EQ(run_scene(o).check, "identical");
+}
+
+TEST(OdeRun, RefusesBadOptionsByName) {
+  RunOptions o;
+  o.scene = "ode-nothing";
+  EXPECT_THROW(run_scene(o), InputError);
+  o.scene = "ode-piles";
+  o.threads = 0;
+  EXPECT_THROW(run_scene(o), OptionError);
+  o.threads = 2;
+  o.repeat = 0;
+  EXPECT_THROW(run_scene(o), OptionError);
+  ValidateOptions v;
+  v.scene = "ode-piles";
+  v.method = choose_method("ode");
+  EXPECT_THROW(validate_scene(v), OptionError);
+  CaptureOptions c;
+  c.scene = "ode-piles";
+  EXPECT_THROW(capture_scene(c), OptionError);  // no output
+}
+
+TEST(OdeCapture, WritesATraceOfOdesCallsThatReadsBack) {
+  CaptureOptions o;
+  o.scene = "ode-chains";
+  o.steps = 3;
+  o.output = "ode_capture_test_" + std::to_string(::getpid()) + ".tgt";
+  const CaptureReport r = capture_scene(o);
+  EXPECT_EQ(r.steps, 3u);
+  const Trace t = read_trace(o.output);
+  std::remove(o.output.c_str());
+  ASSERT_EQ(t.steps.size(), 3u);
+  std::set<std::string> kinds(t.steps[1].kinds.begin(), t.steps[1].kinds.end());
+  EXPECT_TRUE(kinds.count("dWorldQuickStep"));
+  EXPECT_TRUE(kinds.count("World Islands Stepping Group"));
+  EXPECT_NE(t.header.engine.find("dWorldQuickStep"), std::string::npos);
+  std::uint64_t tasks = 0;
+  for (const StepGraph& g : t.steps) tasks += g.tasks.size();
+  EXPECT_EQ(tasks, r.tasks);
+}
+
+TEST(OdeValidate, PredictsTheLiveRunFromACapture) {
+  ValidateOptions o;
+  o.scene = "ode-chains";
+  o.steps = 3;
+  o.repeat = 1;
+  o.method = choose_method("worksteal");
+  const ValidateReport r = validate_scene(o);
+  ASSERT_EQ(r.rounds.size(), 1u);
+  EXPECT_GT(r.rounds[0].predicted_ns, 0);
+  EXPECT_GT(r.predicted_over_live, 0.0);
+  EXPECT_EQ(r.strategy, "list");
+  const auto j = nlohmann::json::parse(to_json(r));
+  EXPECT_TRUE(j.contains("predicted_over_live"));
+  EXPECT_TRUE(j.contains("live_speedup"));
+}
+
+}  // namespace
+}  // namespace tgraph::ode
