@@ -166,6 +166,13 @@ StepTime Scene::step(Attachment* attach) {
   return t;
 }
 
+void Scene::nudge(double dx) {
+  for (dBodyID b : bodies_) {
+    const dReal* p = dBodyGetPosition(b);
+    dBodySetPosition(b, p[0] + dx, p[1], p[2]);
+  }
+}
+
 std::vector<double> Scene::state() const {
   std::vector<double> s;
   s.reserve(bodies_.size() * 13);

@@ -50,13 +50,15 @@ struct RunResult {
   double speedup = 0;        ///< sequential_wall_ns / wall_ns: the whole step as the user sees it
   double world_speedup = 0;  ///< sequential_world_ns / world_ns
   AttachStats stats;         ///< the first timed pass (ODE self-threaded's for sequential)
-  /// The check: "identical" (bit for bit), "within-tolerance" or "differs"; empty: none.
+  /// The check: "identical" (bit for bit), "within-rounding" (no position 1e-9 m off),
+  /// "within-tolerance" (see `tolerance`) or "differs"; empty: none.
   std::string check;
   double max_abs_diff = 0;  ///< largest difference of a body position (m)
   double max_rel_diff = 0;  ///< largest relative difference of a state number
   /// The tolerance of "within-tolerance" (m): twice the farthest a body of ODE self-threaded
   /// moves with either of two other seeds of its random constraint reordering (the same
-  /// algorithm, other equally valid orders of its sweeps; docs/ode.md, "The check").
+  /// algorithm, other equally valid orders of its sweeps) or with the world moved by 1e-12 m
+  /// (rounding alone; docs/ode.md, "The check").
   double tolerance = 0;
 };
 

@@ -57,6 +57,9 @@ class Scene {
   StepTime step(Attachment* attach);
 
   std::size_t bodies() const { return bodies_.size(); }
+  /// Moves every body by `dx` along x (the scenes are invariant under it): a perturbation of
+  /// the size of rounding, whose growth is what rounding alone can do to a run.
+  void nudge(double dx);
   /// Every body's position, quaternion, linear and angular velocity (13 numbers a body).
   std::vector<double> state() const;
   /// The scene's length scale (m): its box edge or link length.
