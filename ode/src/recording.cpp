@@ -14,11 +14,15 @@ StepGraph build_step_graph(const StepLog& log) {
   StepGraph g;
   g.host_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(log.host_ns, 0));
   std::unordered_map<std::uint32_t, const CallRecord*> calls;
-  for (const CallRecord& c : log.calls) calls.emplace(c.id, &c);
   std::vector<const SegmentRecord*> order;
-  order.reserve(log.segments.size());
-  for (const SegmentRecord& s : log.segments)
-    if (calls.count(s.call)) order.push_back(&s);
+  std::unordered_map<const SegmentRecord*, const AccessRecord*> access_base;
+  for (const SlotLog& part : log.slots) {
+    for (const CallRecord& c : part.calls) calls.emplace(c.id, &c);
+    for (const SegmentRecord& s : part.segments) access_base.emplace(&s, part.accesses.data());
+  }
+  for (const SlotLog& part : log.slots)
+    for (const SegmentRecord& s : part.segments)
+      if (calls.count(s.call)) order.push_back(&s);
   std::sort(order.begin(), order.end(), [](const SegmentRecord* a, const SegmentRecord* b) {
     return a->seq != b->seq ? a->seq < b->seq : a->call < b->call;
   });
@@ -38,14 +42,16 @@ StepGraph build_step_graph(const StepLog& log) {
   // Which calls are released by someone in this log, which waits are signalled.
   std::unordered_map<std::uint32_t, bool> released;
   std::unordered_map<std::uint64_t, bool> signalled;
-  for (const AccessRecord& a : log.accesses) {
-    if (a.kind == AccessRecord::kRelease) released[a.a] = true;
-    if (a.kind == AccessRecord::kSignal) signalled[(std::uint64_t{a.a} << 32) | a.b] = true;
-  }
+  for (const SlotLog& part : log.slots)
+    for (const AccessRecord& a : part.accesses) {
+      if (a.kind == AccessRecord::kRelease) released[a.a] = true;
+      if (a.kind == AccessRecord::kSignal) signalled[(std::uint64_t{a.a} << 32) | a.b] = true;
+    }
   // A wait's uses this step, numbered from 0 (its generation counts from its allocation).
   std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> use;
-  for (const AccessRecord& a : log.accesses)
-    if (a.kind != AccessRecord::kRelease) use.emplace(std::pair{a.a, a.b}, 0);
+  for (const SlotLog& part : log.slots)
+    for (const AccessRecord& a : part.accesses)
+      if (a.kind != AccessRecord::kRelease) use.emplace(std::pair{a.a, a.b}, 0);
   {
     std::uint32_t last = CallRecord::kNone, n = 0;
     for (auto& [k, v] : use) {
@@ -77,7 +83,7 @@ StepGraph build_step_graph(const StepLog& log) {
         acc.push_back({datum(1, c.id, 0, [&] { return label(c) + " released"; }), AccessMode::R});
     }
     for (std::uint32_t i = 0; i < s->access_count; ++i) {
-      const AccessRecord& a = log.accesses[s->access_begin + i];
+      const AccessRecord& a = access_base.at(s)[s->access_begin + i];
       switch (a.kind) {
         case AccessRecord::kRelease:
           if (calls.count(a.a))

@@ -428,13 +428,15 @@ StepLog Runtime::end_step() {
     slot.frames.pop_back();
   }
   for (auto& s : slots_) {
-    const auto base = static_cast<std::uint32_t>(log.accesses.size());
-    log.accesses.insert(log.accesses.end(), s->accesses.begin(), s->accesses.end());
-    for (SegmentRecord seg : s->segments) {
-      seg.access_begin += base;
-      log.segments.push_back(seg);
-    }
-    log.calls.insert(log.calls.end(), s->records.begin(), s->records.end());
+    SlotLog part;
+    part.segments.swap(s->segments);
+    part.accesses.swap(s->accesses);
+    part.calls.swap(s->records);
+    // The next step starts with room for as much (one allocation, no regrowth).
+    s->segments.reserve(part.segments.size());
+    s->accesses.reserve(part.accesses.size());
+    s->records.reserve(part.calls.size());
+    log.slots.push_back(std::move(part));
   }
   return log;
 }

@@ -55,11 +55,16 @@ inline std::uint64_t segment_key(std::uint64_t call_key, std::uint32_t seg) {
   return call_key ^ ((static_cast<std::uint64_t>(seg) + 1) * 0x9e3779b97f4a7c15ull);
 }
 
-/// What one step recorded, all slots together.
-struct StepLog {
+/// What one thread recorded in a step.
+struct SlotLog {
   std::vector<SegmentRecord> segments;
   std::vector<AccessRecord> accesses;  ///< segments' ranges point here
   std::vector<CallRecord> calls;
+};
+
+/// What one step recorded: each thread's own part (moved out of the threads, not copied).
+struct StepLog {
+  std::vector<SlotLog> slots;
   const char* entry = "";    ///< dWorldQuickStep or dWorldStep
   std::int64_t host_ns = 0;  ///< collision before the step
   double ns_per_tick = 1.0;  ///< segments' stamps to ns
