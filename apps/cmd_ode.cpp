@@ -12,6 +12,12 @@
 namespace tgraph::app {
 namespace {
 
+// `owner`, the verbs' default strategy, follows objects; ODE's calls have none (its own
+// fallback would be list): an ODE scene's default is work stealing.
+[[maybe_unused]] std::string ode_method(const std::string& method) {
+  return method == "owner" ? "worksteal" : method;
+}
+
 [[maybe_unused]] void no_ode(const std::string& scene) {
   throw InputError(scene, std::nullopt,
                    "ODE scene, but this tgraph was built without tgraph::ode (pkg-config ode, "
@@ -49,7 +55,7 @@ void run_ode(const std::string& scene, std::optional<std::uint32_t> steps,
   ode::RunOptions o;
   o.scene = scene;
   o.steps = steps;
-  o.method = ode::choose_method(method);
+  o.method = ode::choose_method(ode_method(method));
   o.threads = threads;
   o.repeat = repeat;
   o.check = check;
@@ -97,7 +103,7 @@ void validate_ode(const std::string& scene, std::uint32_t steps, const std::stri
   ode::ValidateOptions o;
   o.scene = scene;
   o.steps = steps;
-  o.method = ode::choose_method(method);
+  o.method = ode::choose_method(ode_method(method));
   o.threads = threads;
   o.repeat = repeat;
   o.calibration = calibration;

@@ -124,12 +124,17 @@ struct ValidateReport {
   double live_speedup = 0;         ///< median of sequential / live
   double predicted_speedup = 0;    ///< median of sequential / predicted
   double predicted_over_live = 0;  ///< median of predicted / live (time)
+  /// The runtime's own time per call (a chain of trivial calls on one thread), charged by the
+  /// simulator as `task_overhead_ns` scaled to the captured steps' calls per part.
+  double runtime_ns_per_call = 0;
 };
 
 /// Each round: the live run (ode::run_scene, one pass), a capture of the same steps at the
 /// same threads (worksteal, recording on), and the built-in simulator on each captured step
 /// under the method's strategy (`list` for worksteal) at K processors, the step's host time
-/// (its collision) as serial work. OptionError for sequential or ode (no graph to predict).
+/// (its collision) as serial work, the runtime's measured time per call as each part's
+/// overhead, its spin before parking as the spin budget. OptionError for sequential or ode (no
+/// graph to predict).
 ValidateReport validate_scene(const ValidateOptions& options);
 std::string to_json(const ValidateReport& r);
 std::string to_text(const ValidateReport& r);
