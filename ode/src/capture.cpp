@@ -2,6 +2,7 @@
 #include <chrono>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/median.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/ode/run.hpp"
 #include "tgraph/ode/scenes.hpp"
@@ -22,21 +23,27 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   CaptureReport report;
   AttachOptions a;
   a.threads = options.threads;
-  // The same steps twice in one run, recording off then on: the recording's cost.
+  // The same steps recorded and not, in one run, three times each alternating (medians): the
+  // recording's cost. The last recorded pass is the one written.
   std::vector<StepGraph> steps;
-  for (const bool record : {false, true}) {
-    auto scene = Scene::make(options.scene, options.stepper, 0);
-    report.steps = options.steps.value_or(scene->default_steps());
-    a.record = record;
-    Attachment attach(scene->world(), a);
-    const auto t0 = std::chrono::steady_clock::now();
-    for (std::uint32_t i = 0; i < report.steps; ++i) scene->step(&attach);
-    const std::int64_t ns =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - t0)
-            .count();
-    (record ? report.recorded_ns : report.unrecorded_ns) = ns;
-    if (record) steps = attach.take_steps();  // built after the timed steps
+  std::vector<std::int64_t> off, on;
+  for (int round = 0; round < 3; ++round) {
+    for (const bool record : {false, true}) {
+      auto scene = Scene::make(options.scene, options.stepper, 0);
+      report.steps = options.steps.value_or(scene->default_steps());
+      a.record = record;
+      Attachment attach(scene->world(), a);
+      const auto t0 = std::chrono::steady_clock::now();
+      for (std::uint32_t i = 0; i < report.steps; ++i) scene->step(&attach);
+      const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::steady_clock::now() - t0)
+                                  .count();
+      (record ? on : off).push_back(ns);
+      if (record && round == 2) steps = attach.take_steps();  // built after the timed steps
+    }
   }
+  report.unrecorded_ns = median(off);
+  report.recorded_ns = median(on);
   report.overhead = report.unrecorded_ns > 0 ? static_cast<double>(report.recorded_ns) /
                                                        static_cast<double>(report.unrecorded_ns) -
                                                    1.0

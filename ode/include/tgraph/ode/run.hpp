@@ -85,13 +85,14 @@ struct CaptureOptions {
 struct CaptureReport {
   std::uint32_t steps = 0;
   std::uint64_t tasks = 0, edges = 0, bytes = 0;
-  std::int64_t recorded_ns = 0;    ///< the recorded pass's steps (recording on)
-  std::int64_t unrecorded_ns = 0;  ///< the same steps, recording off, same run
+  std::int64_t recorded_ns = 0;    ///< the steps recorded (median of 3 passes)
+  std::int64_t unrecorded_ns = 0;  ///< the same steps not recorded, alternating, same run
   double overhead = 0;             ///< recorded / unrecorded - 1
 };
 
-/// Runs the scene once without and once with recording (worksteal at `threads`) and writes
-/// the recorded steps to `output`: one task per segment of ODE's calls (docs/ode.md).
+/// Runs the scene three times without and three times with recording, alternating
+/// (worksteal at `threads`), and writes the last recorded steps to `output`: one task per
+/// part of ODE's calls (docs/ode.md).
 CaptureReport capture_scene(const CaptureOptions& options);
 
 }  // namespace tgraph::ode
