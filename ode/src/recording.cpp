@@ -26,6 +26,48 @@ StepGraph build_step_graph(const StepLog& log) {
   std::sort(order.begin(), order.end(), [](const SegmentRecord* a, const SegmentRecord* b) {
     return a->seq != b->seq ? a->seq < b->seq : a->call < b->call;
   });
+  // The order numbers are topological but depend on which thread ran what. A canonical order
+  // instead: by depth (one more than the deepest part it follows), then stable key, so that
+  // the same relations give the same program order (and the same structure) in every step.
+  {
+    std::unordered_map<std::uint64_t, std::uint32_t> depth;  // (call << 32 | seg)
+    std::unordered_map<std::uint32_t, std::uint32_t> released_after;
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> signalled_after;
+    std::unordered_map<const SegmentRecord*, std::pair<std::uint32_t, StableKey>> rank;
+    for (const SegmentRecord* s : order) {  // order numbers: predecessors first
+      const CallRecord& c = *calls.at(s->call);
+      std::uint32_t d = 0;
+      if (s->seg > 0) {
+        d = depth.at((std::uint64_t{s->call} << 32) | (s->seg - 1)) + 1;
+      } else {
+        if (c.poster_call != CallRecord::kNone) {
+          auto it = depth.find((std::uint64_t{c.poster_call} << 32) | c.poster_seg);
+          if (it != depth.end()) d = std::max(d, it->second + 1);
+        }
+        if (auto it = released_after.find(c.id); it != released_after.end())
+          d = std::max(d, it->second + 1);
+      }
+      const AccessRecord* acc = access_base.at(s) + s->access_begin;
+      for (std::uint32_t i = 0; i < s->access_count; ++i)
+        if (acc[i].kind == AccessRecord::kWaitRead)
+          if (auto it = signalled_after.find({acc[i].a, acc[i].b}); it != signalled_after.end())
+            d = std::max(d, it->second + 1);
+      depth[(std::uint64_t{s->call} << 32) | s->seg] = d;
+      for (std::uint32_t i = 0; i < s->access_count; ++i) {
+        if (acc[i].kind == AccessRecord::kRelease) {
+          std::uint32_t& r = released_after[acc[i].a];
+          r = std::max(r, d);
+        } else if (acc[i].kind == AccessRecord::kSignal) {
+          std::uint32_t& r = signalled_after[{acc[i].a, acc[i].b}];
+          r = std::max(r, d);
+        }
+      }
+      rank[s] = {d, segment_key(c.key, s->seg)};
+    }
+    std::stable_sort(
+        order.begin(), order.end(),
+        [&](const SegmentRecord* a, const SegmentRecord* b) { return rank.at(a) < rank.at(b); });
+  }
 
   auto label = [&](const CallRecord& c) {
     char key[20];
