@@ -52,8 +52,9 @@ std::string attribution_only(const nlohmann::json& j, const ExplainArgs& a) {
       x.step = step;
       x.threads = e.threads;
       x.attribution = read(s["attribution"]);
-      x.makespan_ns = s.value("wall_ns", std::int64_t{0});
-      x.work_ns = e.threads * x.makespan_ns - x.attribution.lost_ns;
+      // The attribution is of the observed pass, whose makespan the result does not give.
+      x.makespan_ns = 0;
+      x.work_ns = 0;
       e.steps.push_back(std::move(x));
     }
     if (a.step && e.steps.empty())

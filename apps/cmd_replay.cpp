@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.hpp"
@@ -55,6 +56,15 @@ void add_exec_flags(CLI::App* cmd, tr::ExecOptions& exec, bool& json) {
   cmd->add_flag("--json", json, "Print one JSON object");
 }
 
+// A JSON report naming the timeline file written beside it ("timeline": what tgraph explain
+// RESULT.json explains); text reports and runs without a timeline as they are.
+std::string named_timeline(const std::string& report, const std::string& timeline, bool json) {
+  if (!json || timeline.empty()) return report;
+  nlohmann::json j = nlohmann::json::parse(report);
+  j["timeline"] = timeline;
+  return j.dump() + "\n";
+}
+
 }  // namespace
 
 void add_replay_verbs(CLI::App& app) {
@@ -69,7 +79,9 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_option("--steps", c->replay.steps, "Steps to replay (default: all)");
   cmd->add_option("--first-step", c->replay.first_step, "First step replayed");
   cmd->add_option("--repeat", c->replay.repeat, "Timed passes (medians reported; default 3)");
-  cmd->add_option("--timeline", a->timeline, "Write the observed pass's timeline (JSON)");
+  cmd->add_option("--timeline", a->timeline,
+                  "Write the observed pass's timeline (gzip-compressed JSON; tgraph explain, "
+                  "timeline and report read it)");
   cmd->add_option("--chrome", a->chrome, "Write it as Chrome/Perfetto trace events");
   cmd->add_option("--scale", c->replay.synthetic.cost_scale, "Multiply every recorded cost");
   cmd->add_option("--model", c->model.model, "Prediction's cost model: calibrated or ideal")
@@ -82,9 +94,9 @@ void add_replay_verbs(CLI::App& app) {
     c->timeline = !a->timeline.empty() || !a->chrome.empty();
     const meas::ReplayReport r = meas::replay_command(*c);
     for (const std::string& w : r.result.warnings) warn(w);
-    if (!a->timeline.empty()) write_file_atomic(a->timeline, timeline_json(*r.timeline));
+    if (!a->timeline.empty()) write_timeline(a->timeline, *r.timeline);
     if (!a->chrome.empty()) write_file_atomic(a->chrome, viz::chrome_trace(*r.timeline));
-    std::cout << r.report;
+    std::cout << named_timeline(r.report, a->timeline, c->json);
   });
 
   auto run = std::make_shared<meas::SceneRun>();
@@ -109,6 +121,9 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_option("--cost-stride", live.cost_stride, "Time loop iterations 0, 1, every N-th");
   cmd->add_flag("--no-observe{false}", live.observe, "Skip the observed passes");
   cmd->add_flag("--check", live.check, "Compare the final state with a sequential run's");
+  cmd->add_option("--timeline", a->timeline,
+                  "Write the observed pass's timeline, serial phases included (gzip-compressed "
+                  "JSON; tgraph explain reads it)");
   auto verify = std::make_shared<bool>(false);
   cmd->add_flag("--verify-accesses", *verify,
                 "Instead of timing: run every task between checksums of the state and again "
@@ -124,6 +139,9 @@ void add_replay_verbs(CLI::App& app) {
                      run->live.check, run->json,
                      static_cast<double>(run->live.exec.partition.timeout_ms) / 1e3, *ode);
     run->method = method_flags(a->method, a->policy);
+    run->live.keep_timeline = !a->timeline.empty();
+    if (!a->timeline.empty() && !run->live.observe)
+      throw UsageError("--timeline needs the observed pass (drop --no-observe)");
     if (*verify) {
       const meas::VerifyRunReport v = meas::verify_scene(*run);
       std::cout << v.report << std::flush;
@@ -133,7 +151,8 @@ void add_replay_verbs(CLI::App& app) {
       return;
     }
     const meas::SceneRunReport r = meas::run_scene(*run);
-    std::cout << r.report << std::flush;
+    if (!a->timeline.empty() && r.result.timeline) write_timeline(a->timeline, *r.result.timeline);
+    std::cout << named_timeline(r.report, a->timeline, run->json) << std::flush;
     if (r.result.difference)
       throw Failure("state differs from the sequential run: " + to_string(*r.result.difference));
   });

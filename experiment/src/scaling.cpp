@@ -126,6 +126,7 @@ ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::u
   if (sequential_work > 0) rec.inflation = busy / sequential_work;
   if (thread_time > 0) rec.wait_share = std::max(0.0, thread_time - busy) / thread_time;
   rec.parks_per_step = static_cast<double>(r.parks) / std::max<double>(s.steps, 1);
+  rec.attribution = r.attribution;
   return rec;
 }
 
@@ -402,7 +403,11 @@ std::string scaling_json(const ScalingResult& res, int indent) {
        "default calibration), "
        "against its one-processor makespan with the capture's host time (the uninstrumented "
        "engine); null for the baselines"},
-      {"predicted_over_live", "predicted_speedup / speedup; null for the baselines"}};
+      {"predicted_over_live", "predicted_speedup / speedup; null for the baselines"},
+      {"attribution",
+       "the observed pass's lost processor time (threads x wall - sequential work) by cause, "
+       "summed over the steps: {lost_ns, causes: {serial, imbalance, dependency_wait, handoff, "
+       "interruption, inflation, runtime, starvation, residual}} (docs/explain.md)"}};
   j["machine"] = res.machine.summary();
   j["cores"] = res.plan.cores;
   j["date"] = res.date;
@@ -434,7 +439,11 @@ std::string scaling_json(const ScalingResult& res, int indent) {
                                                       : nlohmann::json(nullptr)},
                             {"predicted_over_live", r.predicted_over_live > 0
                                                         ? nlohmann::json(r.predicted_over_live)
-                                                        : nlohmann::json(nullptr)}});
+                                                        : nlohmann::json(nullptr)},
+                            {"attribution",
+                             r.attribution ? nlohmann::json::parse(
+                                                 explain::attribution_json(*r.attribution))
+                                           : nlohmann::json(nullptr)}});
   for (const auto& [key, list] : {std::pair{"skipped", &res.skipped}, std::pair{"failed", &res.failed}}) {
     j[key] = nlohmann::json::array();
     for (const ScalingMiss& m : *list)

@@ -100,8 +100,11 @@ std::string explanation_text(const Explanation& e, const std::string& name) {
                            ? static_cast<double>(work) /
                                  (static_cast<double>(threads) * static_cast<double>(makespan))
                            : 0.0;
-    add(std::snprintf(line, sizeof line, "%6s %8.3fms %8.3fms %6.2f", label, ms(makespan),
-                      ms(a.lost_ns), eff));
+    if (makespan > 0)
+      add(std::snprintf(line, sizeof line, "%6s %8.3fms %8.3fms %6.2f", label, ms(makespan),
+                        ms(a.lost_ns), eff));
+    else
+      add(std::snprintf(line, sizeof line, "%6s %10s %8.3fms %6s", label, "-", ms(a.lost_ns), "-"));
     for (const std::string_view n : cause_names())
       add(std::snprintf(line, sizeof line, " %6.1f%%", pct(cause(a.causes, n), a.lost_ns)));
     out += "\n";

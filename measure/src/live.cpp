@@ -156,10 +156,12 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     // The policy with per-thread and per-kind observers (every instance), then sequential.
     replay::StatsObserver stats;
     detail::KindObserver kinds;
+    replay::TimelineObserver timeline;  // the attribution's (docs/explain.md)
     ex = make();
     ex->set_observe_stride(1);
     ex->add_observer(stats);
     ex->add_observer(kinds);
+    ex->add_observer(timeline);
     detail::PassResult observed;
     detail::PassOptions po;
     po.feed_costs = partition;
@@ -190,6 +192,27 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
         k.sequential_mean_ns =
             static_cast<double>(it->second.first) / static_cast<double>(it->second.second);
       res.kinds.push_back(std::move(k));
+    }
+    // Where the observed pass's time went: its serial phases per step, its bodies against
+    // the kinds' sequential means.
+    Timeline t = timeline.timeline();
+    if (t.step_info.size() == o.steps) {
+      std::vector<std::pair<std::string, double>> means;
+      for (const KindTime& k : res.kinds)
+        if (k.sequential_mean_ns > 0) means.emplace_back(k.kind, k.sequential_mean_ns);
+      explain::set_kind_costs(t, means);
+      for (std::uint32_t s = 0; s < o.steps; ++s) {
+        TimelineStep& info = t.step_info[s];
+        info.record_ns = observed.steps[s].record_ns;
+        info.partition_ns = observed.steps[s].partition_ns;
+        info.prepare_ns = observed.steps[s].prepare_ns;
+      }
+      explain::ExplainOptions eo;
+      eo.what_ifs = false;
+      const explain::Explanation e = explain::explain_timeline(t, "observed pass", eo);
+      for (std::uint32_t s = 0; s < o.steps; ++s) res.steps[s].attribution = e.steps[s].attribution;
+      res.attribution = e.attribution;
+      if (o.keep_timeline) res.timeline = std::move(t);
     }
   }
 

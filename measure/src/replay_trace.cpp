@@ -240,9 +240,12 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
   if (o.observe) {
     StatsObserver stats;
     LocalityObserver locality;
+    TimelineObserver own;  // the attribution's, when the caller records none
+    TimelineObserver& recorded = timeline ? *timeline : own;
+    const std::size_t first_info = recorded.timeline().step_info.size();
     ex->add_observer(stats);
     ex->add_observer(locality);
-    if (timeline) ex->add_observer(*timeline);
+    ex->add_observer(recorded);
     for (std::uint32_t i = 0; i < n; ++i) {
       const StepGraph& g = trace.steps[o.first_step + i];
       w.set_step(g);
@@ -252,6 +255,17 @@ ReplayResult replay_trace(const Trace& trace, const TraceAssignment* assignments
       r.steps[i].migrated_bytes = locality.migrated_bytes();
     }
     ex->clear_observers();
+    // Where the observed pass's time went, step by step (docs/explain.md).
+    Timeline t = recorded.timeline();
+    t.step_info.erase(t.step_info.begin(),
+                      t.step_info.begin() + static_cast<std::ptrdiff_t>(first_info));
+    if (t.step_info.size() == n) {
+      explain::ExplainOptions eo;
+      eo.what_ifs = false;
+      const explain::Explanation e = explain::explain_timeline(t, "observed pass", eo);
+      for (std::uint32_t i = 0; i < n; ++i) r.steps[i].attribution = e.steps[i].attribution;
+      r.attribution = e.attribution;
+    }
   }
   // Amdahl: the host time is serial, in the sequential run and on the critical path alike.
   const double parallelism = r.span_ns == 0 ? 1.0

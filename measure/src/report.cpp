@@ -25,6 +25,10 @@ json threads_json(const std::vector<tr::StatsObserver::Thread>& threads) {
 }
 
 // The keys every per-step record has (replays and live runs alike).
+json attribution_json(const std::optional<explain::Attribution>& a) {
+  return a ? json::parse(explain::attribution_json(*a)) : json(nullptr);
+}
+
 json step_record_json(const StepRecord& m) {
   return {
       {"wall_ns", m.wall_ns},
@@ -33,7 +37,8 @@ json step_record_json(const StepRecord& m) {
       {"rebuilt_procs", m.rebuilt_procs},
       {"rebuild_over_wall",
        m.wall_ns > 0 ? static_cast<double>(m.rebuild_ns) / static_cast<double>(m.wall_ns) : 0.0},
-      {"threads", threads_json(m.threads)}};
+      {"threads", threads_json(m.threads)},
+      {"attribution", attribution_json(m.attribution)}};
 }
 
 }  // namespace
@@ -91,6 +96,7 @@ std::string to_json(const ReplayResult& r) {
               {"touch_ns_per_byte", r.touch_ns_per_byte},
               {"spin_offset_ns", r.spin_offset_ns},
               {"working_set_bytes", r.working_set_bytes}}},
+            {"attribution", attribution_json(r.attribution)},
             {"per_step", per_step}};
   j["cache_misses"] = r.cache_misses ? json(*r.cache_misses) : json(r.cache_misses_note);
   j["warnings"] = r.warnings;
@@ -236,6 +242,7 @@ std::string to_json(const LiveResult& r) {
             {"parks", r.parks},
             {"plans_built", r.plans_built},
             {"order_fallbacks", r.order_fallbacks},
+            {"attribution", attribution_json(r.attribution)},
             {"per_step", per_step}};
   if (r.check) {
     j["check"] = std::string(to_string(*r.check));

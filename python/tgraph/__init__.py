@@ -10,6 +10,7 @@
 Tables (Step.tasks(), .edges(), .data(), .accesses(), .loops()) are dicts of equal-length
 lists: pandas.DataFrame(step.tasks()) makes a data frame. See docs/python.md.
 """
+import gzip as _gzip
 import json as _json
 
 from . import _tgraph
@@ -52,6 +53,10 @@ def evaluate(trace, assignment, model="calibrated", calibration=""):
 
 def read_replay(path):
     """A replay result (`tgraph replay --json > R.json`, `tgraph run --json`) or timeline
-    (`tgraph replay --timeline R.json`), as a dict."""
-    with open(path, encoding="utf-8") as f:
-        return _json.load(f)
+    (`tgraph replay --timeline R.json`, gzip-compressed columns: docs/trace-format.md), as a
+    dict."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:2] == b"\x1f\x8b":
+        data = _gzip.decompress(data)
+    return _json.loads(data.decode("utf-8"))

@@ -24,6 +24,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/timeline.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "../scratch_dir.hpp"
@@ -252,10 +253,11 @@ TEST_F(Files, ReplayAndPartitionOutputsKilledAreTheOldFileOrTheNewOne) {
         EXPECT_EQ(a.steps.size(), 4u);
         ++new_seen;
       } else {
-        // Timelines hold measured times: a complete JSON document with every task.
-        nlohmann::json j;
-        ASSERT_NO_THROW(j = nlohmann::json::parse(now)) << wr.output << " kill " << i;
-        EXPECT_EQ(j["tasks"].size(), nlohmann::json::parse(new_bytes)["tasks"].size());
+        // Timelines hold measured times: a complete file (gzip-compressed JSON) with every
+        // task.
+        tgraph::Timeline t;
+        ASSERT_NO_THROW(t = tgraph::parse_timeline(now, "out.json")) << wr.output << " kill " << i;
+        EXPECT_EQ(t.tasks.size(), tgraph::parse_timeline(new_bytes, "new.json").tasks.size());
         ++new_seen;
       }
       // A killed atomic write may leave its temporary file (.out.json.tmp.N, killed between

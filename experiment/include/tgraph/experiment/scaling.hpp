@@ -13,6 +13,7 @@
 #include "tgraph/experiment/machine.hpp"
 #include "tgraph/experiment/progress.hpp"
 #include "tgraph/experiment/settings.hpp"
+#include "tgraph/explain/explain.hpp"
 
 namespace tgraph::experiment {
 
@@ -112,6 +113,8 @@ struct ScalingRecord {
   /// speed-up; 0 for the baselines.
   double predicted_speedup = 0;
   double predicted_over_live = 0;
+  /// The observed pass's lost time by cause, summed over the steps (meas::LiveResult's).
+  std::optional<explain::Attribution> attribution;
   // Beside the record (results.csv, the text table), not in results.json's `scaling`:
   std::uint32_t steps = 0;
   std::int64_t wall_ns = 0;             ///< median pass

@@ -61,6 +61,8 @@ struct LiveOptions {
   bool background_partition = true;
   /// Let the engine skip recording while the structure repeats (false: record every step).
   bool reuse_structure = true;
+  /// Keep the observed pass's timeline (LiveResult::timeline; `tgraph run --timeline F`).
+  bool keep_timeline = false;
 };
 
 /// The sticky threshold a live run partitions with unless told otherwise: its trigger's
@@ -127,6 +129,12 @@ struct LiveResult {
   std::string check_reference;  ///< what the final state was compared with
   std::optional<StateDifference> difference;
   std::size_t data_compared = 0;
+  /// The observed pass's lost time by cause, summed over the steps (StepRecord::attribution):
+  /// its serial phases, its bodies against the kinds' means in the observed sequential pass.
+  std::optional<explain::Attribution> attribution;
+  /// The observed pass's timeline with its serial phases and those sequential costs
+  /// (LiveOptions::keep_timeline).
+  std::optional<Timeline> timeline;
 };
 
 /// Runs `options.steps` steps of fresh engines from `make_engine` under `options.policy`

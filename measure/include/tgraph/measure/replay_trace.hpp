@@ -60,6 +60,8 @@ struct ReplayResult {
   double efficiency = 0;  ///< speedup / bound
   std::uint64_t work_ns = 0, span_ns = 0;
   std::uint64_t host_ns = 0;  ///< sum of the steps' host times (StepMeasure::host_ns)
+  /// The observed pass's lost time by cause, summed over the steps (StepRecord::attribution).
+  std::optional<explain::Attribution> attribution;
   std::uint64_t plans_built = 0;
   std::uint64_t order_fallbacks = 0;  ///< see Executor::order_fallbacks
   std::optional<std::uint64_t> cache_misses;

@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <vector>
 
+#include <optional>
+
+#include "tgraph/explain/explain.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::measure {
@@ -19,6 +22,8 @@ struct StepRecord {
   std::int64_t rebuild_ns = 0;
   std::uint32_t rebuilt_procs = 0;  ///< processors whose program was (re)built, first pass
   std::vector<replay::StatsObserver::Thread> threads;  ///< from the observed pass
+  /// The observed pass's lost time by cause (explain::explain_timeline; docs/explain.md).
+  std::optional<explain::Attribution> attribution;
 };
 
 }  // namespace tgraph::measure
