@@ -52,6 +52,35 @@ TEST_F(ExplainCli, ExplainsAReplayTimeline) {
   EXPECT_EQ(nlohmann::json::parse(one.out)["steps"].size(), 1u);
 }
 
+// `run --json`'s attribution (the observed pass), per run and per step: the causes add up
+// to the lost time and the residual is within 5 % of it (and so of K x makespan); `run
+// --timeline` names its file in the JSON, which explain then reads.
+TEST_F(ExplainCli, RunJsonCarriesAnAttributionThatAddsUp) {
+  for (const char* method : {"owner", "worksteal", "barrier"}) {
+    const auto r = run(std::string("run --scene fig2 --steps 3 --threads 2 --method ") + method +
+                       " --timeline r.tl --json");
+    ASSERT_EQ(r.code, 0) << method << ": " << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["timeline"], "r.tl");
+    ASSERT_EQ(j["per_step"].size(), 3u);
+    std::int64_t lost = 0;
+    for (const auto& s : j["per_step"]) {
+      const auto& a = s["attribution"];
+      std::int64_t sum = 0;
+      for (const auto& [name, ns] : a["causes"].items()) sum += ns.get<std::int64_t>();
+      EXPECT_EQ(sum, a["lost_ns"].get<std::int64_t>()) << method;
+      EXPECT_LE(std::abs(a["causes"]["residual"].get<std::int64_t>()),
+                std::abs(a["lost_ns"].get<std::int64_t>()) / 20)
+          << method;
+      lost += a["lost_ns"].get<std::int64_t>();
+    }
+    EXPECT_EQ(j["attribution"]["lost_ns"].get<std::int64_t>(), lost) << method;
+    const auto x = run("explain r.tl --json");
+    ASSERT_EQ(x.code, 0) << x.err;
+    EXPECT_EQ(nlohmann::json::parse(x.out)["attribution"], j["attribution"]) << method;
+  }
+}
+
 TEST_F(ExplainCli, RefusesWhatItCannotExplainWithOneLine) {
   ASSERT_EQ(run("capture --scene fig2 --steps 1 -o f.tgt").code, 0);
   for (const char* args : {"explain f.tgt", "explain missing.json", "explain r.json --step 7"}) {
