@@ -157,6 +157,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     replay::StatsObserver stats;
     detail::KindObserver kinds;
     replay::TimelineObserver timeline;  // the attribution's (docs/explain.md)
+    timeline.set_cpu_time(o.keep_timeline);  // asked for: interruptions told apart
     ex = make();
     ex->set_observe_stride(1);
     ex->add_observer(stats);

@@ -27,6 +27,7 @@ ReplayReport replay_command(const ReplayCommand& c) {
     throw OptionError("policy", "an assignment file is only used by {policy} partition");
   }
   replay::TimelineObserver timeline;
+  timeline.set_cpu_time(true);  // asked for: interruptions told apart (docs/explain.md)
   ReplayReport r;
   r.result = replay_trace(trace, as ? &*as : nullptr, c.replay, as ? &predicted : nullptr,
                           c.timeline ? &timeline : nullptr);
