@@ -120,10 +120,17 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_flag("--no-elide-waits{false}", live.exec.partition.elide_waits, "Keep implied waits");
   cmd->add_option("--cost-stride", live.cost_stride, "Time loop iterations 0, 1, every N-th");
   cmd->add_flag("--no-observe{false}", live.observe, "Skip the observed passes");
-  cmd->add_flag("--check", live.check, "Compare the final state with a sequential run's");
   cmd->add_option("--timeline", a->timeline,
                   "Write the observed pass's timeline, serial phases included (gzip-compressed "
                   "JSON; tgraph explain reads it)");
+  auto check = std::make_shared<std::string>();
+  cmd->add_option("--check", *check,
+                  "Compare the final state with the twin (default: a sequential run with the "
+                  "same reductions, bit for bit) or the plain run (the engine's own sequential "
+                  "steps, within rounding)")
+      ->expected(0, 1)
+      ->default_str("twin")
+      ->check(CLI::IsMember({"twin", "plain"}));
   auto verify = std::make_shared<bool>(false);
   cmd->add_flag("--verify-accesses", *verify,
                 "Instead of timing: run every task between checksums of the state and again "
@@ -133,8 +140,11 @@ void add_replay_verbs(CLI::App& app) {
   add_strategy_flags(cmd, run->strategy);
   auto ode = std::make_shared<OdeFlags>();
   add_ode_flags(cmd, *ode);
-  cmd->callback([a, run, verify, ode] {
-    if (is_ode_scene(run->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
+  cmd->callback([a, run, verify, ode, check] {
+    run->live.check = !check->empty();
+    run->live.check_reference =
+        *check == "plain" ? meas::CheckReference::kPlain : meas::CheckReference::kTwin;
+    if (is_ode_scene(run->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp; plain always)
       return run_ode(run->scene, run->steps, a->method, run->live.exec.threads, run->live.repeat,
                      run->live.check, run->json,
                      static_cast<double>(run->live.exec.partition.timeout_ms) / 1e3, *ode);
@@ -153,8 +163,12 @@ void add_replay_verbs(CLI::App& app) {
     const meas::SceneRunReport r = meas::run_scene(*run);
     if (!a->timeline.empty() && r.result.timeline) write_timeline(a->timeline, *r.result.timeline);
     std::cout << named_timeline(r.report, a->timeline, run->json) << std::flush;
-    if (r.result.difference)
-      throw Failure("state differs from the sequential run: " + to_string(*r.result.difference));
+    if (r.result.check == meas::Check::kDiffers)
+      throw Failure("state differs from the " +
+                    std::string(r.result.check_reference == meas::CheckReference::kPlain
+                                    ? "plain run beyond rounding: "
+                                    : "twin: ") +
+                    to_string(*r.result.difference));
   });
 }
 

@@ -27,7 +27,7 @@ namespace {
 std::size_t set_storage(AccessChecker& checker, const StepGraph& g,
                         const std::vector<StateRegion>& regions) {
   std::unordered_map<std::string, std::vector<DatumId>> by_name;
-  for (DatumId d = g.data.size(); d-- > 0;) by_name[g.data[d].name].push_back(d);
+  for (auto d = static_cast<DatumId>(g.data.size()); d-- > 0;) by_name[g.data[d].name].push_back(d);
   checker.clear_storage();
   std::size_t n = 0;
   for (const StateRegion& r : regions) {

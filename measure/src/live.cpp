@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "live_observers.hpp"
@@ -23,6 +24,18 @@ std::string_view to_string(Check check) {
       return "identical";
     case Check::kDiffers:
       return "differs";
+    case Check::kWithinRounding:
+      return "within-rounding";
+  }
+  return "?";
+}
+
+std::string_view to_string(CheckReference reference) {
+  switch (reference) {
+    case CheckReference::kTwin:
+      return "twin";
+    case CheckReference::kPlain:
+      return "plain";
   }
   return "?";
 }
@@ -62,6 +75,106 @@ void time_baseline_pass(const EngineFactory& make_engine, const LiveOptions& o, 
   b.fastest.end_pass();
 }
 
+/// The engine's plain run: `steps` plain steps of a fresh engine, its final state.
+StateSnapshot plain_state(const EngineFactory& make_engine, std::uint32_t steps) {
+  std::unique_ptr<LiveEngine> engine = make_engine();
+  for (std::uint32_t s = 0; s < steps; ++s) engine->plain_step();
+  return snapshot(engine->state());
+}
+
+/// The check of the first timed pass's final state against o.check_reference.
+void check_final_state(const EngineFactory& make_engine,
+                       const partition::StepPartitioner* partitioner, const LiveOptions& o,
+                       const detail::PassResult& first, LiveResult& res) {
+  res.check_reference = o.check_reference;
+  StateSnapshot reference;
+  try {
+    if (o.check_reference == CheckReference::kPlain) {
+      reference = plain_state(make_engine, o.steps);
+      res.reference = "the plain run (the engine's own sequential steps, uninstrumented)";
+    } else {
+      // A sequential run with the same reduction order (see the header).
+      tr::ExecOptions ro = o.exec;
+      std::unique_ptr<tr::Executor> ref;
+      detail::PassOptions po;
+      po.keep_state = true;
+      if (res.cw == tr::CwMode::kSerialize || o.policy == tr::Policy::kSequential) {
+        ro.threads = 1;
+        ro.reduce_scope = tr::ReduceScope::kNone;
+        ref = tr::make_executor(tr::Policy::kSequential, ro);
+        res.reference = "the twin (sequential executor, program order)";
+      } else if (o.policy == tr::Policy::kPartition) {
+        ro.partition.serial = true;
+        ref = tr::make_executor(tr::Policy::kPartition, ro);
+        po.fixed = &first.assignments;
+        res.reference =
+            "the twin (serial partition executor, same assignments and per-processor reducers)";
+      } else {
+        ro.threads = 1;
+        ro.reduce_scope = res.scope;
+        ref = tr::make_executor(tr::Policy::kSequential, ro);
+        res.reference = "the twin (sequential executor, same per-writer reducers)";
+      }
+      reference = detail::run_pass(make_engine, partitioner, *ref, o, po).state;
+    }
+  } catch (const UsageError& e) {
+    // The reference could not follow the same steps (its graphs differ): a difference.
+    res.difference = StateDifference{std::string("structure: ") + e.what(), 0, 0};
+    res.check = Check::kDiffers;
+    return;
+  }
+  res.data_compared = reference.names.size();
+  res.difference = compare(reference, first.state);
+  res.longest_reduction = first.longest_reduction;
+  res.reduction_rounds = 0;
+  for (const LiveStepMeasure& m : first.steps) {
+    res.reduction_rounds += 1;
+    for (const std::uint32_t it : m.loop_iterations) res.reduction_rounds += it;
+  }
+  if (o.check_reference == CheckReference::kPlain)
+    res.rounding_bound = reduction_order_bound(res.longest_reduction, res.reduction_rounds);
+  if (!res.difference) {
+    res.check = Check::kIdentical;
+    return;
+  }
+  std::optional<Magnitudes> involved;
+  if (o.check_reference == CheckReference::kPlain) {
+    // The magnitudes each datum held in program order: a sequential pass with CW writes in
+    // place, watched after every task.
+    LiveEngine* watched = nullptr;
+    const EngineFactory watch = [&make_engine, &watched] {
+      std::unique_ptr<LiveEngine> e = make_engine();
+      watched = e.get();
+      return e;
+    };
+    MagnitudeObserver observer([&watched] { return watched->state(); });
+    tr::ExecOptions so = o.exec;
+    so.threads = 1;
+    so.reduce_scope = tr::ReduceScope::kNone;
+    std::unique_ptr<tr::Executor> seq = tr::make_executor(tr::Policy::kSequential, so);
+    seq->add_observer(observer);
+    const detail::PassResult in_order = detail::run_pass(watch, nullptr, *seq, o, {});
+    seq->clear_observers();
+    involved = observer.magnitudes();
+    for (std::uint32_t s = 0; s < o.steps && s < in_order.steps.size() && !res.iterations; ++s) {
+      const std::vector<std::uint32_t>& a = in_order.steps[s].loop_iterations;
+      const std::vector<std::uint32_t>& b = first.steps[s].loop_iterations;
+      for (std::uint32_t l = 0; l < a.size() || l < b.size(); ++l) {
+        const std::uint32_t x = l < a.size() ? a[l] : 0, y = l < b.size() ? b[l] : 0;
+        if (x != y) {
+          res.iterations = IterationDifference{s, l, x, y};
+          break;
+        }
+      }
+    }
+  }
+  res.values = compare_values(reference, first.state, involved ? &*involved : nullptr);
+  const bool within = o.check_reference == CheckReference::kPlain &&
+                      res.values->incomparable.empty() && !res.iterations &&
+                      res.values->max_rel_diff <= res.rounding_bound;
+  res.check = within ? Check::kWithinRounding : Check::kDiffers;
+}
+
 }  // namespace
 
 LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
@@ -85,7 +198,8 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   res.cw = ex->cw();
   res.scope = ex->scope();
   ex.reset();
-  if (o.check && res.scope == tr::ReduceScope::kPerThread && res.cw == tr::CwMode::kReduce &&
+  if (o.check && o.check_reference == CheckReference::kTwin &&
+      res.scope == tr::ReduceScope::kPerThread && res.cw == tr::CwMode::kReduce &&
       res.threads > 1)
     throw OptionError("reduce_scope",
                       "per-thread temporaries sum in an order of the run's timing, which no "
@@ -217,39 +331,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     }
   }
 
-  if (o.check) {
-    // A sequential run with the same reduction order (see the header).
-    tr::ExecOptions ro = o.exec;
-    std::unique_ptr<tr::Executor> ref;
-    detail::PassOptions po;
-    po.keep_state = true;
-    if (res.cw == tr::CwMode::kSerialize || o.policy == tr::Policy::kSequential) {
-      ro.threads = 1;
-      ro.reduce_scope = tr::ReduceScope::kNone;
-      ref = tr::make_executor(tr::Policy::kSequential, ro);
-      res.check_reference = "sequential executor, program order";
-    } else if (partition) {
-      ro.partition.serial = true;
-      ref = tr::make_executor(tr::Policy::kPartition, ro);
-      po.fixed = &first.assignments;
-      res.check_reference =
-          "serial partition executor, same assignments and per-processor reducers";
-    } else {
-      ro.threads = 1;
-      ro.reduce_scope = res.scope;
-      ref = tr::make_executor(tr::Policy::kSequential, ro);
-      res.check_reference = "sequential executor, same per-writer reducers";
-    }
-    try {
-      const detail::PassResult reference = detail::run_pass(make_engine, partitioner, *ref, o, po);
-      res.difference = compare(reference.state, first.state);
-      res.data_compared = reference.state.names.size();
-    } catch (const UsageError& e) {
-      // The reference could not follow the same steps (its graphs differ): a difference.
-      res.difference = StateDifference{std::string("structure: ") + e.what(), 0, 0};
-    }
-    res.check = res.difference ? Check::kDiffers : Check::kIdentical;
-  }
+  if (o.check) check_final_state(make_engine, partitioner, o, first, res);
   return res;
 }
 

@@ -64,6 +64,8 @@ PassResult run_pass(const EngineFactory& make_engine, const partition::StepParti
           throw UsageError("live run: the engine reused a program at step 0");
         if (partition && s > 0) prev_graph = std::make_shared<const StepGraph>(std::move(cur.graph));
         cur = std::move(next);
+        if (po.keep_state)  // the check's pass: the bound of its reduction order
+          r.longest_reduction = std::max(r.longest_reduction, longest_reduction(cur.graph));
       }
       m.recorded = !reused;
       if (!reused) m.graph_update_ns = cur.graph_update_ns;

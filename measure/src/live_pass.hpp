@@ -29,6 +29,7 @@ struct PassResult {
   std::vector<Assignment> assignments;  ///< PassOptions::keep_assignments
   StateSnapshot state;                  ///< PassOptions::keep_state
   std::uint64_t signals = 0, waits = 0, blocked_waits = 0, parks = 0;
+  std::uint64_t longest_reduction = 1;  ///< over the steps recorded (measure::longest_reduction)
 };
 
 /// One pass of `options.steps` steps of a fresh engine through `ex`.

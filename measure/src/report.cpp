@@ -246,12 +246,31 @@ std::string to_json(const LiveResult& r) {
             {"per_step", per_step}};
   if (r.check) {
     j["check"] = std::string(to_string(*r.check));
-    j["check_reference"] = r.check_reference;
+    j["check_reference"] = std::string(to_string(r.check_reference));
+    j["reference"] = r.reference;
     j["data_compared"] = r.data_compared;
     if (r.difference)
       j["first_difference"] = {{"datum", r.difference->datum},
                                {"offset", r.difference->offset},
-                               {"differing_bytes", r.difference->differing_bytes}};
+                               {"differing_bytes", r.difference->differing_bytes},
+                               {"writer", r.difference->writer}};
+    if (r.values) {
+      j["max_abs_diff"] = r.values->max_abs_diff;
+      j["max_rel_diff"] = r.values->max_rel_diff;
+      j["max_abs_datum"] = r.values->max_abs_datum;
+      j["max_rel_datum"] = r.values->max_rel_datum;
+      j["differing_values"] = r.values->differing_values;
+      if (!r.values->incomparable.empty()) j["incomparable"] = r.values->incomparable;
+    }
+    if (r.iterations)
+      j["iterations_differ"] = {{"step", r.iterations->step},
+                                {"loop", r.iterations->loop},
+                                {"in_order", r.iterations->in_order},
+                                {"live", r.iterations->live}};
+    if (r.check_reference == CheckReference::kPlain)
+      j["rounding_bound"] = {{"max_rel_diff", r.rounding_bound},
+                             {"longest_reduction", r.longest_reduction},
+                             {"rounds", r.reduction_rounds}};
   }
   return j.dump();
 }
@@ -285,10 +304,38 @@ std::string to_text(const LiveResult& r, const std::string& scene, const std::st
                     b["record_ns"].get<double>() / 1e6, b["partition_ns"].get<double>() / 1e6,
                     b["background_partition_ns"].get<double>() / 1e6,
                     b["prepare_ns"].get<double>() / 1e6, b["execute_ns"].get<double>() / 1e6));
-  if (r.check)
+  if (r.check) {
+    const char* status = *r.check == Check::kIdentical        ? "identical bit for bit"
+                         : *r.check == Check::kWithinRounding ? "within rounding"
+                                                              : "DIFFERS";
     add(std::snprintf(line, sizeof line, "  check against %s: %s (%zu data compared)\n",
-                      r.check_reference.c_str(), r.difference ? "DIFFERS" : "identical bit for bit",
-                      r.data_compared));
+                      r.reference.c_str(), status, r.data_compared));
+    if (r.values)
+      add(std::snprintf(line, sizeof line,
+                        "    %llu values differ: max |diff| %.3g (%s), max relative %.3g (%s)\n",
+                        static_cast<unsigned long long>(r.values->differing_values),
+                        r.values->max_abs_diff, r.values->max_abs_datum.c_str(),
+                        r.values->max_rel_diff, r.values->max_rel_datum.c_str()));
+    if (r.values && !r.values->incomparable.empty())
+      add(std::snprintf(line, sizeof line, "    not within rounding: %s\n",
+                        r.values->incomparable.c_str()));
+    if (r.iterations)
+      add(std::snprintf(line, sizeof line,
+                        "    not within rounding: the runs took different paths, loop %u of step "
+                        "%u ran %u iterations in program order, %u live (its convergence test "
+                        "decided otherwise)\n",
+                        r.iterations->loop, r.iterations->step, r.iterations->in_order,
+                        r.iterations->live));
+    if (r.values && r.check_reference == CheckReference::kPlain)
+      add(std::snprintf(line, sizeof line,
+                        "    rounding bound %.3g relative (2 gamma(%llu) x %llu reductions in "
+                        "sequence)\n",
+                        r.rounding_bound,
+                        static_cast<unsigned long long>(r.longest_reduction > 0
+                                                            ? r.longest_reduction - 1
+                                                            : 0),
+                        static_cast<unsigned long long>(r.reduction_rounds)));
+  }
   return out;
 }
 

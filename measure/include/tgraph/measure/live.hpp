@@ -22,11 +22,29 @@ namespace tgraph::measure {
 /// The outcome of a live run's check of its final state.
 enum class Check : unsigned char {
   kIdentical = 0,  ///< bit for bit the reference's
-  kDiffers = 1,    ///< see LiveResult::difference
+  kDiffers = 1,    ///< see LiveResult::difference and LiveResult::values
+  /// Not bit-identical to the plain run, every value within LiveResult::rounding_bound of it
+  /// (CheckReference::kPlain only: the twin must be bit-identical).
+  kWithinRounding = 2,
 };
 
-/// "identical" or "differs".
+/// "identical", "differs" or "within-rounding".
 std::string_view to_string(Check check);
+
+/// What a live run's check compares the final state with.
+enum class CheckReference : unsigned char {
+  /// The serial twin: a sequential run with the run's own assignments and reduction order
+  /// (the partition policy's serial executor, the dynamic policies' per-writer temporaries);
+  /// any difference is a fault.
+  kTwin = 0,
+  /// The engine's own plain sequential run (LiveEngine::plain_step, uninstrumented, program
+  /// order): what a user's sequential loop computes, off by the rounding of the reductions
+  /// the run sums in another order.
+  kPlain = 1,
+};
+
+/// "twin" or "plain".
+std::string_view to_string(CheckReference reference);
 
 /// What a live run does.
 struct LiveOptions {
@@ -40,6 +58,7 @@ struct LiveOptions {
   bool observe = true;            ///< one more pass with observers (threads, kinds), plus a
                                   ///< sequential one for the per-kind comparison
   bool check = false;             ///< compare the final state with a sequential reference
+  CheckReference check_reference = CheckReference::kTwin;  ///< that reference
   /// Keep the assignment each step of the first pass ran (LiveResult::assignments): what a
   /// model of this run must simulate, carried-over steps included.
   bool keep_assignments = false;
@@ -99,6 +118,16 @@ struct LiveStepMeasure : StepRecord {
   std::vector<std::uint32_t> loop_iterations;  ///< first pass
 };
 
+/// A dynamic loop that ran another number of iterations live than in program order: the
+/// runs took different paths (a convergence test decided otherwise on values a rounding
+/// apart), and their states differ by the loop's tolerance, not by rounding.
+struct IterationDifference {
+  std::uint32_t step = 0;
+  std::uint32_t loop = 0;       ///< by index in the step's loops
+  std::uint32_t in_order = 0;   ///< iterations in program order (the plain run's)
+  std::uint32_t live = 0;       ///< iterations in the checked pass
+};
+
 /// A whole live run.
 struct LiveResult {
   replay::Policy policy = replay::Policy::kPartition;
@@ -126,8 +155,19 @@ struct LiveResult {
   std::vector<Assignment> assignments;
   /// The check of the final state (LiveOptions::check; nullopt: not checked).
   std::optional<Check> check;
-  std::string check_reference;  ///< what the final state was compared with
-  std::optional<StateDifference> difference;
+  CheckReference check_reference = CheckReference::kTwin;  ///< what it was compared with
+  std::string reference;  ///< that reference in words
+  std::optional<StateDifference> difference;  ///< the first difference (any reference)
+  /// Not bit-identical: how far apart the values are (max_abs_diff, max_rel_diff).
+  std::optional<ValueDifference> values;
+  /// kPlain: the relative bound max_rel_diff is held to, reduction_order_bound(
+  /// longest_reduction, reduction_rounds) (docs/instrumenting.md).
+  double rounding_bound = 0;
+  std::uint64_t longest_reduction = 0;  ///< terms of the run's longest CW reduction
+  std::uint64_t reduction_rounds = 0;   ///< the steps plus their loop iterations
+  /// kPlain, not bit-identical: the first loop whose iteration count differs (then the check
+  /// says kDiffers whatever the distance).
+  std::optional<IterationDifference> iterations;
   std::size_t data_compared = 0;
   /// The observed pass's lost time by cause, summed over the steps (StepRecord::attribution):
   /// its serial phases, its bodies against the kinds' means in the observed sequential pass.
@@ -141,10 +181,12 @@ struct LiveResult {
 /// (`partitioner` is required for replay::Policy::kPartition): `repeat` timed passes, each preceded
 /// by a pass of the uninstrumented engine, then the observed passes and the check.
 ///
-/// The check compares the final state with a sequential run that uses the same reduction
-/// order: for the partition policy the serial twin of the executor with the assignments of
-/// the first timed pass, for the dynamic policies the sequential executor with per-writer
-/// temporaries, for CwMode::kSerialize and the sequential policy the plain program order.
+/// The check (LiveOptions::check_reference) compares the final state of the first timed pass
+/// with the twin, a sequential run that uses the same reduction order (for the partition
+/// policy the serial twin of the executor with the assignments of the first timed pass, for
+/// the dynamic policies the sequential executor with per-writer temporaries, for
+/// CwMode::kSerialize and the sequential policy the plain program order), or with the
+/// engine's plain run (plain_step, steps times).
 LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
                     const LiveOptions& options);
 

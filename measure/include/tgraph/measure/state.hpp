@@ -4,13 +4,16 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "tgraph/graph/step_graph.hpp"
+#include "tgraph/replay/observer.hpp"
 
 namespace tgraph::measure {
 
@@ -69,5 +72,74 @@ std::optional<StateDifference> compare(const StateSnapshot& expected, const Stat
 /// "first differing datum <datum> (byte <offset>, <differing_bytes> bytes differ), last
 /// written by task <writer>".
 std::string to_string(const StateDifference& d);
+
+/// How far apart the values of two snapshots of the same regions are (matched by name as
+/// compare() matches them). A region whose size is a multiple of 8 bytes is read as IEEE
+/// binary64 values (what the engines in the tree store: positions, velocities, forces,
+/// solver vectors and scalars); any other region (a flag, a count) is compared bit for bit.
+struct ValueDifference {
+  double max_abs_diff = 0;  ///< largest |a - b| over every value
+  /// Largest over the data of max|a - b| / max|b|, the datum's largest difference relative to
+  /// its largest magnitude (max over a and b; the norm-wise relative difference in the
+  /// infinity norm, which a value near zero does not blow up).
+  double max_rel_diff = 0;
+  std::string max_abs_datum;  ///< the datum of max_abs_diff (empty: none differs)
+  std::string max_rel_datum;  ///< the datum of max_rel_diff
+  std::uint64_t differing_values = 0;  ///< values (doubles) not bit-identical
+  /// Why the values cannot be within rounding whatever their distance (empty: they can): a
+  /// region not read as doubles whose bytes differ, a NaN or infinity on one side only, a
+  /// region on one side only or of another size.
+  std::string incomparable;
+};
+
+/// By datum name: the largest magnitude of its values after any task that wrote it (a
+/// MagnitudeObserver's), the magnitudes involved in computing it.
+using Magnitudes = std::unordered_map<std::string, double>;
+
+/// The values of `actual` against those of `expected` (see ValueDifference). With
+/// `involved`, a datum's max_rel_diff is relative to the larger of its largest magnitude and
+/// its magnitude in `involved`: a value made small by cancellation (a converged residual
+/// r = b - A x) is measured against the magnitudes it was computed from.
+ValueDifference compare_values(const StateSnapshot& expected, const StateSnapshot& actual,
+                               const Magnitudes* involved = nullptr);
+
+/// Watches a sequential executor that runs CW writes in place (ReduceScope::kNone): after
+/// each task instance, the largest magnitude of each datum it wrote whose storage `regions`
+/// gives (matched by name, read as doubles when a multiple of 8 bytes), kept as the largest
+/// over the run. Single-threaded use only.
+class MagnitudeObserver final : public replay::Observer {
+ public:
+  /// `regions`: called at each step's start for the storage of the state (it may move).
+  explicit MagnitudeObserver(std::function<std::vector<StateRegion>()> regions)
+      : regions_(std::move(regions)) {}
+  void on_step_begin(const replay::ExecGraph& exec, std::uint32_t threads,
+                     std::int64_t t_ns) override;
+  void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
+              std::int64_t t_ns) override;
+  const Magnitudes& magnitudes() const { return magnitudes_; }
+
+ private:
+  std::function<std::vector<StateRegion>()> regions_;
+  const replay::ExecGraph* exec_ = nullptr;
+  std::vector<const StateRegion*> by_datum_;  // exec datum -> its region (nullptr: none)
+  std::vector<StateRegion> current_;
+  Magnitudes magnitudes_;
+};
+
+/// The unit roundoff of IEEE binary64, 2^-53.
+inline constexpr double kUnitRoundoff = 0x1p-53;
+
+/// The relative bound of a reduction order change (docs/instrumenting.md, "What the check
+/// compares with"): a sum of n terms taken in two orders differs by at most
+/// 2 gamma(n-1) = 2 (n-1) u / (1 - (n-1) u) of the sum of their magnitudes (Higham, Accuracy
+/// and Stability of Numerical Algorithms, 2nd ed., section 4.2); `rounds` such reductions in
+/// sequence, each feeding the next, add up to first order:
+/// rounds x 2 gamma(n-1). `longest_reduction`: terms of the longest reduction whose order
+/// may differ (its writers and the initial value).
+double reduction_order_bound(std::uint64_t longest_reduction, std::uint64_t rounds);
+
+/// The most terms one reduction of `g` sums: over the data, 1 (the initial value) + the
+/// tasks that write it CW. 1 when nothing is written CW.
+std::uint64_t longest_reduction(const StepGraph& g);
 
 }  // namespace tgraph::measure
