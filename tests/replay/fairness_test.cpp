@@ -34,48 +34,64 @@ class DynamicBaseline : public ::testing::TestWithParam<Policy> {};
 // The fairness bug this guards against: baselines that turned every CW into RW ran the
 // writers of one datum one after the other.
 TEST_P(DynamicBaseline, RunsCwWritersOfOneDatumOnTwoThreadsAtOnce) {
-  const StepGraph g = cw_group(8, 4'000'000);
   ExecOptions o;
   o.threads = 2;
   auto ex = make_executor(GetParam(), o);
   EXPECT_EQ(ex->cw(), CwMode::kReduce);
   EXPECT_EQ(ex->scope(), ReduceScope::kPerWriter);
-  SyntheticWorkload w;
-  w.set_step(g);
   // Whether the second thread gets to steal a writer while the first runs depends on the
   // machine's load (a loaded 2-core machine under TSan may not schedule it for 32 ms; at load
-  // average 15, five steps once saw none): up to ten steps, one of which must overlap two
-  // writers. A policy that serialized the writers never would.
+  // average 15, five steps once saw none). What holds under any load is checked at every
+  // step: no edge orders one writer after another, each but the first has its temporary, the
+  // reader follows the reducer. The overlap itself is retried with longer writers (4 ms, then
+  // 16, 64 and 256 ms each, three steps of each length) until one step shows two writers
+  // running at once on two threads: a policy that serialized the writers never would.
   TimelineObserver timeline;
   ex->add_observer(timeline);
   bool overlap = false;
-  for (std::uint32_t attempt = 0; attempt < 10 && !overlap; ++attempt) {
-    ex->run_step(g, nullptr, w);
-    const ExecGraph& x = *ex->last_exec();
-    ASSERT_EQ(x.reductions.size(), 1u);
-    EXPECT_EQ(x.reductions[0].temps.size(), 7u);  // the first writer adds into y itself
-    std::vector<TimelineTask> step;
-    for (const TimelineTask& e : timeline.timeline().tasks)
-      if (e.step == attempt) step.push_back(e);
-    std::vector<TimelineTask> writers;
-    for (const TimelineTask& e : step)
-      if (e.origin.has_value() && g.kind_name(*e.origin) == "add") writers.push_back(e);
-    ASSERT_EQ(writers.size(), 8u);
-    for (const auto& a : writers)
-      for (const auto& b : writers)
-        if (a.thread != b.thread && a.start_ns < b.end_ns && b.start_ns < a.end_ns) overlap = true;
-    // The reader ran after every writer and after the reducer.
-    std::int64_t last_writer_end = 0, reducer_end = 0, reader_start = 0;
-    for (const TimelineTask& e : step) {
-      if (!e.origin) reducer_end = e.end_ns;
-      else if (g.kind_name(*e.origin) == "add")
-        last_writer_end = std::max(last_writer_end, e.end_ns);
-      else if (g.kind_name(*e.origin) == "use") reader_start = e.start_ns;
+  std::uint32_t step_no = 0;
+  for (std::uint64_t cost = 4'000'000; cost <= 256'000'000 && !overlap; cost *= 4) {
+    const StepGraph g = cw_group(8, cost);
+    SyntheticWorkload w;
+    w.set_step(g);
+    for (int attempt = 0; attempt < 3 && !overlap; ++attempt, ++step_no) {
+      ex->run_step(g, nullptr, w);
+      const ExecGraph& x = *ex->last_exec();
+      ASSERT_EQ(x.reductions.size(), 1u);
+      EXPECT_EQ(x.reductions[0].temps.size(), 7u);  // the first writer adds into y itself
+      EXPECT_FALSE(x.added_edges);
+      std::set<TaskId> exec_writers;
+      for (TaskId t = 0; t < x.origin.size(); ++t)
+        if (x.origin[t] != kNoTask && g.kind_name(x.origin[t]) == "add") exec_writers.insert(t);
+      ASSERT_EQ(exec_writers.size(), 8u);
+      for (const Edge& e : x.graph.edges)
+        EXPECT_FALSE(exec_writers.count(e.from) && exec_writers.count(e.to))
+            << "an edge orders writer " << e.from << " before writer " << e.to;
+      std::vector<TimelineTask> step;
+      for (const TimelineTask& e : timeline.timeline().tasks)
+        if (e.step == step_no) step.push_back(e);
+      std::vector<TimelineTask> writers;
+      for (const TimelineTask& e : step)
+        if (e.origin.has_value() && g.kind_name(*e.origin) == "add") writers.push_back(e);
+      ASSERT_EQ(writers.size(), 8u);
+      for (const auto& a : writers)
+        for (const auto& b : writers)
+          if (a.thread != b.thread && a.start_ns < b.end_ns && b.start_ns < a.end_ns)
+            overlap = true;
+      // The reader ran after every writer and after the reducer.
+      std::int64_t last_writer_end = 0, reducer_end = 0, reader_start = 0;
+      for (const TimelineTask& e : step) {
+        if (!e.origin) reducer_end = e.end_ns;
+        else if (g.kind_name(*e.origin) == "add")
+          last_writer_end = std::max(last_writer_end, e.end_ns);
+        else if (g.kind_name(*e.origin) == "use") reader_start = e.start_ns;
+      }
+      EXPECT_GE(reader_start, reducer_end);
+      EXPECT_GE(reducer_end, last_writer_end);
     }
-    EXPECT_GE(reader_start, reducer_end);
-    EXPECT_GE(reducer_end, last_writer_end);
   }
-  EXPECT_TRUE(overlap) << "no two CW writers of y ran at the same time on two threads";
+  EXPECT_TRUE(overlap) << "no two CW writers of y ran at the same time on two threads in "
+                       << step_no << " steps, writers up to 256 ms each";
 }
 
 TEST_P(DynamicBaseline, SerializeIsStillAvailableAndOrdersTheWriters) {
