@@ -151,7 +151,8 @@ std::string partition_text(const TracePartition& tp, const std::string& output) 
   std::snprintf(line, sizeof line, "method %s, k = %u, %zu steps: %.3f ms partitioning",
                 tp.assignment.method.c_str(), tp.assignment.k, s.steps, s.partition_ms);
   std::string out = line;
-  if (s.edgecut) out += ", edgecut " + std::to_string(*s.edgecut);
+  if (s.edgecut)
+    out += ", edgecut " + std::to_string(*s.edgecut) + " (summed over the steps, in METIS's units)";
   out += ", " + std::to_string(s.moved_tasks) + " tasks moved";
   if (tp.assignment.method == "sticky")
     out += " (steps: " + std::to_string(s.reused_steps) + " reused, " +

@@ -439,6 +439,25 @@ TEST_F(Cli, ReduceScopeFlagReachesTheDynamicPoliciesOnly) {
 // `run` takes `partition`'s strategy flags: they reach the live partitioner (a calibration
 // file that does not exist fails when the strategy loads its cost model), are range-checked,
 // and a run with other phases still matches the sequential state bit for bit.
+// `partition` reports one edge cut for every method: the library graph's cut of each step's
+// assignment (METIS's units), summed over the steps; sticky's is no longer its step 0 alone.
+TEST_F(Cli, PartitionEdgecutIsTheSameMeasureForEveryMethodAndStep) {
+  ASSERT_EQ(run("capture --scene falling --steps 4 -o fp.tgt").code, 0);
+  for (const char* method : {"metis", "sticky", "owner"}) {
+    const auto j = run_json(std::string("partition fp.tgt -k 2 --json --method ") + method);
+    ASSERT_EQ(j["per_step"].size(), 4u) << method;
+    std::int64_t sum = 0;
+    for (const auto& st : j["per_step"]) {
+      ASSERT_TRUE(st.contains("edgecut")) << method << " step " << st["step"];
+      sum += st["edgecut"].get<std::int64_t>();
+    }
+    EXPECT_EQ(j["edgecut"].get<std::int64_t>(), sum) << method;
+  }
+  const Result text = run("partition fp.tgt -k 2 --method sticky");
+  ASSERT_EQ(text.code, 0) << text.err;
+  EXPECT_NE(text.out.find("summed over the steps"), std::string::npos) << text.out;
+}
+
 TEST_F(Cli, RunTakesThePartitioningFlags) {
   const std::string live = "run --scene fig2 --threads 2 --method sticky --steps 2 --no-pin --json ";
   const Result missing = run(live + "--calibration nope.json");
