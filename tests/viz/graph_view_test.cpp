@@ -434,6 +434,34 @@ TEST(GraphView, Bars64WithoutCollapseIsRefusedWithAHint) {
   EXPECT_EQ(view_error(g, o).rfind("max_nodes: the picture would have ", 0), 0u);
 }
 
+// A picture larger than dot lays out in about 15 s is refused before the layout, even with
+// the limits off, naming the aggregate with the fewest edges; .dot (no layout) is written.
+TEST(GraphView, DrawStepRefusesALayoutTooLargeAndNamesTheAggregate) {
+  const Trace t = testing::scene_trace("bars64", 1);
+  ViewOptions o;
+  o.max_nodes = 0;
+  o.max_edges = 0;
+  const auto dir = std::filesystem::temp_directory_path() / "tgraph_viz_layout_test";
+  std::filesystem::create_directories(dir);
+  try {
+    draw_step(t, "bars64.tgt", 0, nullptr, o, (dir / "b.svg").string());
+    FAIL() << "expected a refusal";
+  } catch (const OptionError& e) {
+    EXPECT_EQ(e.option(), "max_edges");
+    const std::regex hint(
+        "more than dot lays out in about 15 s \\(2500\\): aggregate with \\{collapse\\} "
+        "(loop|object|kind) \\(([0-9]+) nodes, ([0-9]+) edges\\), or write a \\.dot file");
+    std::smatch m;
+    const std::string problem = e.problem();
+    ASSERT_TRUE(std::regex_search(problem, m, hint)) << problem;
+    EXPECT_LE(std::stoul(m[3].str()), kLayoutEdges);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "b.svg"));
+  draw_step(t, "bars64.tgt", 0, nullptr, o, (dir / "b.dot").string());
+  EXPECT_GT(std::filesystem::file_size(dir / "b.dot"), 0u);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(GraphView, RejectsAnAssignmentThatDoesNotFit) {
   const StepGraph g = cw_loop_graph();
   Assignment a = by_object(g);

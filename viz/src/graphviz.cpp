@@ -338,6 +338,33 @@ std::string draw_step(const Trace& trace, const std::string& trace_name, std::si
                       const std::string& output) {
   const GraphFormat format = graph_format_of(output);
   const GraphView v = trace_step_view(trace, trace_name, step, assignment, options);
+  if (format != GraphFormat::kDot && v.edges.size() > kLayoutEdges) {
+    // The aggregate with the fewest edges, its size named; .dot needs no layout.
+    std::string best;
+    std::size_t best_nodes = 0, best_edges = 0;
+    for (const Collapse c : {Collapse::kLoop, Collapse::kObject, Collapse::kKind,
+                             Collapse::kProcessor}) {
+      if (c == options.collapse || (c == Collapse::kProcessor && assignment == nullptr)) continue;
+      ViewOptions o = options;
+      o.collapse = c;
+      o.max_nodes = 0;
+      o.max_edges = 0;
+      const GraphView a = trace_step_view(trace, trace_name, step, assignment, o);
+      if (best.empty() || a.edges.size() < best_edges) {
+        best = std::string(to_string(c));
+        best_nodes = a.nodes.size();
+        best_edges = a.edges.size();
+      }
+    }
+    std::string msg = "the picture would have " + std::to_string(v.edges.size()) +
+                      " edges, more than dot lays out in about 15 s (" +
+                      std::to_string(kLayoutEdges) + "): ";
+    if (!best.empty())
+      msg += "aggregate with {collapse} " + best + " (" + std::to_string(best_nodes) +
+             " nodes, " + std::to_string(best_edges) + " edges), or ";
+    msg += "write a .dot file (no layout)";
+    throw OptionError("max_edges", msg);
+  }
   write_file_atomic(output, render_graph(v, format));
   return v.collapse != Collapse::kNone && v.hidden_deps > 0 ? hidden_deps_note(v) : "";
 }
@@ -364,6 +391,18 @@ std::string render_graph(const GraphView& view, GraphFormat format) {
   if (!gvc) throw std::runtime_error("Graphviz: no context (libgvc)");
   Builder b(view);
   GraphPtr g = b.build();
+  if (view.edges.size() > kQuickLayoutEdges) {
+    set(g.get(), "mclimit", "0.1");
+    set(g.get(), "remincross", "false");
+    set(g.get(), "nslimit", "1");
+    set(g.get(), "nslimit1", "1");
+    set(g.get(), "splines", "line");
+  }
+  if (format == GraphFormat::kPng) {
+    // cairo's bitmaps stop at 32,767 pixels a side: at most 300 inches at 96 dpi (dot
+    // scales a larger drawing down to fit; "!" is not given, so a small one keeps its size).
+    set(g.get(), "size", "300,300");
+  }
   if (gvLayout(gvc, g.get(), "dot") != 0) {
     const char* why = aglasterr();
     throw std::runtime_error(std::string("Graphviz dot layout failed") +

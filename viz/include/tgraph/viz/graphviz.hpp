@@ -3,6 +3,7 @@
 // agsafeset), written as DOT by agwrite, or laid out by libgvc's dot engine and rendered.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
@@ -17,6 +18,15 @@ std::string_view to_string(GraphFormat f);
 /// Format from a file name's extension; throws UsageError naming the file (the field
 /// `output`) otherwise.
 GraphFormat graph_format_of(const std::string& path);
+
+/// Above this many edges render_graph lays out with dot's quick settings (crossing
+/// minimisation cut short: mclimit 0.1, remincross off; network simplex limited: nslimit 1;
+/// straight edges): a 1,979-edge view took 82 s with dot's defaults, 2.6 s with these.
+inline constexpr std::size_t kQuickLayoutEdges = 500;
+/// The most edges draw_step lays out (svg, png, pdf): 4,104 edges took 37 s even with the
+/// quick settings (2 shared cores). A larger picture is refused with the aggregate that
+/// fits; a .dot file (no layout) has only ViewOptions::max_edges.
+inline constexpr std::size_t kLayoutEdges = 2500;
 
 /// The picture as DOT text, without layout (what golden tests compare).
 std::string to_dot(const GraphView& view);
