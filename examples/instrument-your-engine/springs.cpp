@@ -8,7 +8,7 @@
 // with --live it also runs its steps on K threads through tgraph's executor, checks the
 // state bit for bit against the sequential engine and prints the result (`tgraph run`'s).
 //
-//   springs STEPS OUT.tgt [--live K [--method M] [--repeat R] [--json]]
+//   springs STEPS OUT.tgt [--live K [--method M] [--repeat R] [--json] [--verify-accesses]]
 //   (exit 0: trace written and checked, live state identical; 1: a check failed; 2: usage)
 #include <algorithm>
 #include <cmath>
@@ -25,6 +25,7 @@
 #include "tgraph/graph/trace_io.hpp"
 #ifdef SPRINGS_LIVE
 #include "tgraph/measure/adapter.hpp"
+#include "tgraph/measure/verify.hpp"
 #endif
 
 namespace {
@@ -329,7 +330,7 @@ int capture(int steps, const std::string& out, bool quiet) {
 #ifdef SPRINGS_LIVE
 // The live run: what connects the engine to tgraph's executor (docs/instrumenting.md,
 // "Run it live").
-int run_live(int steps, int threads, const std::string& method, int repeat, bool json) {
+int run_live(int steps, int threads, const std::string& method, int repeat, bool json, bool verify) {
   namespace tm = tgraph::measure;
   const tm::CallbacksFactory make = [] {
     auto inst = std::make_shared<Instrumented>();  // a fresh engine for every pass
@@ -345,6 +346,14 @@ int run_live(int steps, int threads, const std::string& method, int repeat, bool
   o.repeat = static_cast<std::uint32_t>(repeat);
   o.check = true;  // the final state against a sequential run, bit for bit
   const tm::MethodChoice choice = tm::choose_method(method);
+  if (verify) {  // every task between checksums of the state (docs/instrumenting.md, 9)
+    const tm::VerifyResult v = tm::verify_engine_accesses(make, choice, o);
+    const std::string m = tm::method_name(choice);
+    std::printf("%s\n", json ? tm::verify_json(v, "springs", m).c_str()
+                             : tm::verify_text(v, "springs", m).c_str());
+    if (!v.findings.empty()) return fail(std::to_string(v.findings.size()) + " wrong declaration(s)");
+    return 0;
+  }
   const tm::LiveResult r = tm::run_engine_live(make, choice, o);
   const std::string name = tm::method_name(choice);
   std::printf("%s\n", json ? tm::to_json(r, "springs", name).c_str()
@@ -357,7 +366,7 @@ int run_live(int steps, int threads, const std::string& method, int repeat, bool
 int usage(const char* why) {
   std::fprintf(stderr,
                "springs: %s (usage: springs STEPS OUT.tgt [--live K [--method M] [--repeat R] "
-               "[--json]])\n",
+               "[--json] [--verify-accesses]])\n",
                why);
   return 2;
 }
@@ -370,11 +379,13 @@ int main(int argc, char** argv) {
   const std::string out = argv[2];
   int threads = 0, repeat = 3;
   std::string method = "owner";
-  bool json = false;
+  bool json = false, verify = false;
   for (int i = 3; i < argc; ++i) {
     const std::string flag = argv[i];
     if (flag == "--json") {
       json = true;
+    } else if (flag == "--verify-accesses") {
+      verify = true;
     } else if ((flag == "--live" || flag == "--method" || flag == "--repeat") && i + 1 < argc) {
       const std::string value = argv[++i];
       if (flag == "--method") {
@@ -394,7 +405,7 @@ int main(int argc, char** argv) {
   try {
     if (const int rc = capture(steps, out, json); rc != 0 || threads == 0) return rc;
 #ifdef SPRINGS_LIVE
-    return run_live(steps, threads, method, repeat, json);
+    return run_live(steps, threads, method, repeat, json, verify);
 #endif
   } catch (const tgraph::UsageError& e) {
     return usage(e.what());

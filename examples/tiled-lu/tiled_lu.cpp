@@ -10,7 +10,7 @@
 // threads through tgraph's executor, checks the factors bit for bit against the sequential
 // engine, checks their residual and prints the result (`tgraph run`'s).
 //
-//   tiled_lu NT B OUT.tgt [STEPS] [--live K [--method M] [--repeat R] [--json]]
+//   tiled_lu NT B OUT.tgt [STEPS] [--live K [--method M] [--repeat R] [--json] [--verify-accesses]]
 //   (NT x NT tiles of B x B doubles; exit 0: factorisation, trace and live state checked;
 //    1: a check failed; 2: usage)
 #include <cblas.h>
@@ -34,6 +34,7 @@
 #include "tgraph/version.hpp"
 #ifdef TILED_LU_LIVE
 #include "tgraph/measure/adapter.hpp"
+#include "tgraph/measure/verify.hpp"
 #endif
 
 namespace {
@@ -238,7 +239,7 @@ int capture(int nt, int b, int steps, const std::string& out, bool quiet) {
 // "Run it live"). The residual is that of the factors of the first engine the run stepped
 // through the executor: its first timed pass, whose state the check compares.
 int run_live(int nt, int b, int steps, int threads, const std::string& method, int repeat,
-             bool json) {
+             bool json, bool verify) {
   namespace tm = tgraph::measure;
   std::shared_ptr<InstrumentedLu> live;  // the first engine stepped live
   const tm::CallbacksFactory make = [&live, nt, b] {
@@ -258,6 +259,14 @@ int run_live(int nt, int b, int steps, int threads, const std::string& method, i
   o.repeat = static_cast<std::uint32_t>(repeat);
   o.check = true;  // the final factors against a sequential run, bit for bit
   const tm::MethodChoice choice = tm::choose_method(method);
+  if (verify) {  // every task between checksums of the state (docs/instrumenting.md, 9)
+    const tm::VerifyResult v = tm::verify_engine_accesses(make, choice, o);
+    const std::string m = tm::method_name(choice);
+    std::printf("%s\n", json ? tm::verify_json(v, "tiled LU", m).c_str()
+                             : tm::verify_text(v, "tiled LU", m).c_str());
+    if (!v.findings.empty()) return fail(std::to_string(v.findings.size()) + " wrong declaration(s)");
+    return 0;
+  }
   const tm::LiveResult r = tm::run_engine_live(make, choice, o);
   const double residual = live->residual();
   const std::string name = tm::method_name(choice), engine = "tiled LU";
@@ -272,7 +281,7 @@ int run_live(int nt, int b, int steps, int threads, const std::string& method, i
 int usage(const std::string& why) {
   std::fprintf(stderr,
                "tiled_lu: %s (usage: tiled_lu NT B OUT.tgt [STEPS] [--live K [--method M] "
-               "[--repeat R] [--json]], 1 <= NT <= 64, 1 <= B <= 1024)\n",
+               "[--repeat R] [--json] [--verify-accesses]], 1 <= NT <= 64, 1 <= B <= 1024)\n",
                why.c_str());
   return 2;
 }
@@ -285,13 +294,15 @@ int main(int argc, char** argv) {
   const std::string out = argv[3];
   int steps = 3, threads = 0, repeat = 3;
   std::string method = "list";  // no objects: critical-path list scheduling
-  bool json = false;
+  bool json = false, verify = false;
   for (int i = 4; i < argc; ++i) {
     const std::string flag = argv[i];
     if (i == 4 && flag.rfind("--", 0) != 0) {
       steps = std::atoi(flag.c_str());
     } else if (flag == "--json") {
       json = true;
+    } else if (flag == "--verify-accesses") {
+      verify = true;
     } else if ((flag == "--live" || flag == "--method" || flag == "--repeat") && i + 1 < argc) {
       const std::string value = argv[++i];
       if (flag == "--method") {
@@ -313,7 +324,7 @@ int main(int argc, char** argv) {
   try {
     if (const int rc = capture(nt, b, steps, out, json); rc != 0 || threads == 0) return rc;
 #ifdef TILED_LU_LIVE
-    return run_live(nt, b, steps, threads, method, repeat, json);
+    return run_live(nt, b, steps, threads, method, repeat, json, verify);
 #endif
   } catch (const tgraph::UsageError& e) {
     return usage(e.what());
