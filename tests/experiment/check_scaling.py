@@ -16,7 +16,9 @@ from experiment_check import check, problems, run_quick_json  # noqa: E402
 tgraph = sys.argv[1]
 KEYS = {"scene", "policy", "method", "threads", "speedup", "serial_share", "inflation",
         "wait_share", "parks_per_step", "partitioned_steps", "predicted_speedup",
-        "predicted_over_live"}
+        "predicted_over_live", "attribution"}
+CAUSES = {"serial", "imbalance", "dependency_wait", "handoff", "interruption", "inflation",
+          "runtime", "starvation", "residual"}
 SCENES = {"bars64": 2, "falling64": 3, "torso": 3, "cloth256-s64": 1}  # --quick's steps
 BASELINES = {"worksteal", "barrier", "omp-tasks", "starpu"}
 
@@ -55,6 +57,10 @@ with tempfile.TemporaryDirectory() as tmp:
         check(0.05 < r["inflation"] < 20, f"inflation of {r}")
         check(0 <= r["wait_share"] < 1, f"wait_share of {r}")
         check(r["parks_per_step"] >= 0, f"parks_per_step of {r}")
+        a = r.get("attribution") or {}
+        causes = a.get("causes", {})
+        check(set(causes) == CAUSES, f"attribution causes of {r}")
+        check(sum(causes.values()) == a.get("lost_ns"), f"attribution of {r} does not add up")
         check(isinstance(r["partitioned_steps"], int) and
               0 <= r["partitioned_steps"] <= (steps or 0), f"partitioned_steps of {r}")
         if baseline:
@@ -82,7 +88,7 @@ with tempfile.TemporaryDirectory() as tmp:
     with open(os.path.join(out, "results.csv")) as f:
         rows = list(csv.DictReader(f))
     check(len(rows) == len(j["scaling"]), "results.csv and results.json differ in rows")
-    check(rows and KEYS <= set(rows[0]), "results.csv lacks a key")
+    check(rows and KEYS - {"attribution"} <= set(rows[0]), "results.csv lacks a key")
     for scene in SCENES:
         for ext in ("svg", "png"):
             f = os.path.join(out, f"speedup-{scene}.{ext}")
