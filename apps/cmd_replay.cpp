@@ -24,7 +24,7 @@ namespace meas = tgraph::measure;
 using Words = std::map<std::string, bool>;  // a yes-or-no flag's words
 // The flags `replay` and `run` share, bound to `exec`.
 void add_exec_flags(CLI::App* cmd, tr::ExecOptions& exec, bool& json) {
-  using enum tr::CwMode;
+  using enum CwMode;
   exec.threads = default_threads();
   exec.partition.timeout_exits = true;  // a body that never returns after the watchdog: exit 1
   cmd->add_option("--threads,-k", exec.threads, "Threads (processors)");
@@ -43,7 +43,7 @@ void add_exec_flags(CLI::App* cmd, tr::ExecOptions& exec, bool& json) {
   cmd->add_option_function<std::string>("--barrier-rule", rule, "omp-for, level or operation");
   cmd->add_option_function<std::string>("--openmp-runtime", tr::use_openmp_runtime, "gnu or llvm");
   add_enum(cmd, "--reduce-scope", exec.reduce_scope,
-           {tr::ReduceScope::kPerWriter, tr::ReduceScope::kPerThread},
+           {ReduceScope::kPerWriter, ReduceScope::kPerThread},
            "Dynamic policies' CW temporaries: per-writer or per-thread");
   cmd->add_option("--omp-wait", exec.omp_tasks.wait_depend, "omp-tasks: all or depend")
       ->transform(CLI::CheckedTransformer(Words{{"all", false}, {"depend", true}}));

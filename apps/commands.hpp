@@ -16,7 +16,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::app {
@@ -40,7 +40,7 @@ struct Args {
 };
 
 /// Adds `--live` and `--serial-ns` of evaluate and simulate to `cmd`.
-void add_serial_flags(CLI::App* cmd, partition::SerialWork& w);
+void add_serial_flags(CLI::App* cmd, model::SerialWork& w);
 /// Adds `--model` and `--calibration` (partition::NamedOptions::cost_model) to `cmd`.
 void add_model_flags(CLI::App* cmd, partition::NamedOptions& n);
 /// Adds `flag` to `cmd`, bound to the enum `out` (or an optional one): one of `values` by its

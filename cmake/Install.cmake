@@ -39,7 +39,8 @@ set(_tgraph_debian_PkgConfig::ODE "libode-dev")
 
 # The modules, as library targets tgraph_<module> in folder <folder>, in dependency order.
 set(_tgraph_modules "")
-foreach(pair graph:libgraph capture:capture partition:partition replay:replay explain:explain viz:viz
+foreach(pair graph:libgraph capture:capture model:model partition:partition replay:replay explain:explain
+             viz:viz
              samples:samples measure:measure ode:ode mpi:mpi experiment:experiment)
   string(REPLACE ":" ";" pair "${pair}")
   list(GET pair 0 module)

@@ -19,7 +19,7 @@ endfunction()
 
 if(TGRAPH_REQUIRE_ALL)
   set(_tgraph_missing "")
-  _tgraph_require(tgraph_partition INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_SIMGRID=1
+  _tgraph_require(tgraph_model INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_SIMGRID=1
                   "SimGrid (pkg-config simgrid, Debian libsimgrid-dev)")
   _tgraph_require(tgraph_replay INTERFACE_COMPILE_DEFINITIONS TGRAPH_HAVE_STARPU=1
                   "StarPU (pkg-config starpu-1.3, Debian libstarpu-dev)")

@@ -7,12 +7,12 @@
 
 #include "fuzz_util.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   try {
-    const tgraph::partition::CostModel m =
-        tgraph::partition::parse_calibration(tgraph::fuzz::as_text(data, size), "fuzz.json");
+    const tgraph::model::CostModel m =
+        tgraph::model::parse_calibration(tgraph::fuzz::as_text(data, size), "fuzz.json");
     if (!std::isfinite(m.sync_latency_ns) || m.sync_latency_ns < 0 ||
         !std::isfinite(m.per_byte_ns) || m.per_byte_ns < 0)
       tgraph::fuzz::invariant_failed();

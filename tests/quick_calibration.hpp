@@ -2,14 +2,14 @@
 // The smallest calibration the tests run for real: every measurement taken, few rounds.
 #pragma once
 
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::testing {
 
 /// 3 samples of 500 spinning and 20 parked hand-offs, 1 inflation round over 64 KiB, 100
 /// reductions and 20 ms of looking for interruptions: well under a second on 2 cores.
-inline partition::CalibrateOptions quick_calibration() {
-  partition::CalibrateOptions o;
+inline model::CalibrateOptions quick_calibration() {
+  model::CalibrateOptions o;
   o.rounds = 500;
   o.park_rounds = 20;
   o.inflation_rounds = 1;

@@ -10,8 +10,8 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/model/cost_model.hpp"
 #include "tgraph/mpi/calibrate.hpp"
-#include "tgraph/partition/cost_model.hpp"
 #include "verbs.hpp"
 
 namespace tgraph::mpi_app {
@@ -20,7 +20,7 @@ namespace {
 void calibrate(const std::string& path_flag, bool json) {
   int rank = 0;
   MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  const std::string path = path_flag.empty() ? partition::default_calibration_path() : path_flag;
+  const std::string path = path_flag.empty() ? model::default_calibration_path() : path_flag;
   // Every rank checks the file first: a bad one ends the job before any measurement.
   std::string text;
   try {

@@ -24,8 +24,8 @@
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/stg.hpp"
-#include "tgraph/partition/simulation.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/simulation.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/samples/scene.hpp"
 
@@ -109,7 +109,7 @@ void BM_Partition(benchmark::State& state, const std::string& name, const std::s
     r = s->partition(g, k, {}, {});
     benchmark::DoNotOptimize(r.assignment.proc.data());
   }
-  const Schedule sched = simulate(g, r.assignment, CostModel::defaults());
+  const model::Schedule sched = model::simulate(g, r.assignment, model::CostModel::defaults());
   const Metrics m = compute_metrics(g);
   state.counters["tasks"] = static_cast<double>(g.tasks.size());
   state.counters["predicted_speedup"] =
@@ -134,7 +134,7 @@ void BM_Simulate(benchmark::State& state, const std::string& name) {
       make_strategy("owner")->partition(g, static_cast<std::uint32_t>(state.range(0)), {}, {});
   std::uint64_t instances = 0;
   for (auto _ : state) {
-    const Schedule s = simulate(g, r.assignment, CostModel::defaults());
+    const model::Schedule s = model::simulate(g, r.assignment, model::CostModel::defaults());
     instances = s.first_instance.back();
     benchmark::DoNotOptimize(s.makespan_ns);
   }
@@ -164,7 +164,7 @@ StepGraph stencil(int width, int rows) {
   return g;
 }
 
-void BM_SimulateCluster(benchmark::State& state, int rows, SimulationEngine engine) {
+void BM_SimulateCluster(benchmark::State& state, int rows, model::SimulationEngine engine) {
   constexpr int kWidth = 1024;
   constexpr std::uint32_t kCores = 16;
   Trace trace;
@@ -174,19 +174,20 @@ void BM_SimulateCluster(benchmark::State& state, int rows, SimulationEngine engi
   a.steps.push_back({kWidth, {}, {}});
   for (std::size_t t = 0; t < trace.steps[0].tasks.size(); ++t)
     a.steps[0].proc.push_back(static_cast<ProcId>(t % kWidth));
-  SimulatedPlatform p;
-  p.cluster = ClusterShape{static_cast<std::uint32_t>(state.range(0)), kCores};
-  p.model = CostModel::defaults();
+  model::SimulatedPlatform p;
+  p.cluster = model::ClusterShape{static_cast<std::uint32_t>(state.range(0)), kCores};
+  p.model = model::CostModel::defaults();
   std::uint64_t makespan = 0;
-  for (auto _ : state) makespan = simulate_trace(trace, a, engine, p).makespan_ns;
+  for (auto _ : state) makespan = model::simulate_trace(trace, a, engine, p).makespan_ns;
   state.counters["makespan_ms"] = static_cast<double>(makespan) / 1e6;
   state.SetItemsProcessed(static_cast<std::int64_t>(trace.steps[0].tasks.size()) * state.iterations());
 }
 
 void register_all(bench::Size size) {
   const int rows = bench::by_size(size, 2, 20, 100);
-  for (SimulationEngine e : {SimulationEngine::builtin, SimulationEngine::simgrid}) {
-    if (e == SimulationEngine::simgrid && !simgrid_available()) continue;
+  for (model::SimulationEngine e :
+       {model::SimulationEngine::builtin, model::SimulationEngine::simgrid}) {
+    if (e == model::SimulationEngine::simgrid && !model::simgrid_available()) continue;
     auto* b = benchmark::RegisterBenchmark(
                   ("BM_SimulateCluster/stencil:" + std::to_string(rows * 1024) + "/" + to_string(e))
                       .c_str(),

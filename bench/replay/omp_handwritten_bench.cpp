@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "bench_main.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay {

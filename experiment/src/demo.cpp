@@ -14,11 +14,11 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/evaluate.hpp"
-#include "tgraph/partition/strategy.hpp"
 #include "tgraph/measure/capture.hpp"
 #include "tgraph/measure/replay_trace.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/partition/evaluate.hpp"
+#include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::experiment {
@@ -73,7 +73,7 @@ std::string format(const char* fmt, ...) {
 }
 
 // The cost model in words: the defaults' constants and where a calibration comes from.
-std::string cost_model_words(const std::string& name, const tp::CostModel& m) {
+std::string cost_model_words(const std::string& name, const model::CostModel& m) {
   if (name == "defaults")
     return format("its defaults (%.0f ns a signal, %.2f ns a byte; no calibration file: "
                   "`tgraph calibrate` writes one)",
@@ -104,8 +104,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   res.tasks = m0.tasks;
   res.parallelism = m0.parallelism;
   // The default calibration file when `tgraph calibrate` wrote one, else the defaults.
-  const tp::CostModel model = tp::select_cost_model("calibrated", "");
-  res.cost_model = model.source == tp::CostModel::defaults().source ? "defaults" : model.source;
+  const model::CostModel model = model::select_cost_model("calibrated", "");
+  res.cost_model = model.source == model::CostModel::defaults().source ? "defaults" : model.source;
 
   std::vector<viz::MethodRow> rows, predictions;  // predictions: K < threads, not replayed
   std::vector<viz::StepSeries> series;

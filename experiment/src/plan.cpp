@@ -6,7 +6,7 @@
 #include "common.hpp"
 #include "tgraph/experiment/experiment.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::experiment {
 namespace {
@@ -110,7 +110,7 @@ ExperimentPlan plan_experiment(const ExperimentOptions& o, std::uint32_t cores) 
   p.out_dir = o.out.empty() ? "tgraph-experiment-" + std::string(to_string(o.name)) : o.out;
   p.words = o.words;
   // Read now: a bad file stops the experiment before its first run.
-  if (!o.calibration.empty()) (void)partition::select_cost_model("calibrated", o.calibration);
+  if (!o.calibration.empty()) (void)model::select_cost_model("calibrated", o.calibration);
   p.calibration = o.calibration;
   const std::vector<std::uint32_t> ks =
       o.threads.empty() ? default_thread_list(p.cores) : thread_counts(o.threads);

@@ -17,13 +17,13 @@
 #include "tgraph/graph/fixed.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/evaluate.hpp"
-#include "tgraph/partition/strategy.hpp"
 #include "tgraph/measure/capture.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
 #include "tgraph/measure/replay_trace.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/partition/evaluate.hpp"
+#include "tgraph/partition/strategy.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::experiment {
@@ -132,7 +132,7 @@ struct Predictions {
   std::map<std::pair<std::string, std::uint32_t>, TraceAssignment> assignments;
 };
 
-Predictions predict(const Trace& trace, const ExperimentPlan& p, const tp::CostModel& model) {
+Predictions predict(const Trace& trace, const ExperimentPlan& p, const model::CostModel& model) {
   Predictions out;
   const double n = static_cast<double>(std::max<std::size_t>(trace.steps.size(), 1));
   for (const std::string& method : p.methods) {
@@ -210,8 +210,8 @@ ExperimentResult run_experiment(const ExperimentOptions& options, Progress& prog
   for (const std::string& n : p.notes) progress.note(n);
   // --calibration, else the default calibration file when `tgraph calibrate` wrote one,
   // else the defaults.
-  const tp::CostModel model = tp::select_cost_model("calibrated", p.calibration);
-  res.cost_model = model.source == tp::CostModel::defaults().source ? "defaults" : model.source;
+  const model::CostModel model = model::select_cost_model("calibrated", p.calibration);
+  res.cost_model = model.source == model::CostModel::defaults().source ? "defaults" : model.source;
 
   for (const SceneVariant& v : p.scenes) {
     progress.note("capturing " + v.label() + " (" + std::to_string(p.steps) +

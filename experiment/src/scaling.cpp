@@ -25,8 +25,8 @@
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/method.hpp"
 #include "tgraph/measure/validate.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/executor.hpp"
 #include "tgraph/replay/policy.hpp"
@@ -136,15 +136,15 @@ ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::u
 // simulated uninstrumented engine: one processor, the capture's host time as serial work
 // (the live speed-up's reference has no recording, partitioning or plans either).
 double predicted_speedup(const Trace& capture, const std::string& method, std::uint32_t k,
-                         const meas::LiveResult& r, tp::CostModel model) {
+                         const meas::LiveResult& r, model::CostModel model) {
   const TraceAssignment a = meas::live_assignment(capture, r.assignments, method, k, nullptr);
   const std::vector<std::uint64_t> serial = meas::live_serial_work(r);
   model.spin_budget_ns = meas::live_spin_budget_ns(k, tr::kDefaultSpinNs);
   double parallel = 0, sequential = 0;
-  for (std::uint64_t ns : tp::predicted_makespans(capture, a, model, &serial))
+  for (std::uint64_t ns : model::predicted_makespans(capture, a, model, &serial))
     parallel += static_cast<double>(ns);
-  for (std::uint64_t ns : tp::predicted_makespans(capture, meas::one_processor(capture), model,
-                                                  nullptr))
+  for (std::uint64_t ns :
+       model::predicted_makespans(capture, meas::one_processor(capture), model, nullptr))
     sequential += static_cast<double>(ns);
   return parallel > 0 ? sequential / parallel : 0.0;
 }
@@ -264,7 +264,7 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
   p.out_dir = o.out.empty() ? "tgraph-experiment-scaling" : o.out;
   p.words = o.words;
   // Read now, so that a bad file stops the sweep before its first run, not after hours.
-  if (!o.calibration.empty()) (void)tp::select_cost_model("calibrated", o.calibration);
+  if (!o.calibration.empty()) (void)model::select_cost_model("calibrated", o.calibration);
   p.calibration = o.calibration;
   if (o.steps && *o.steps == 0) throw OptionError("steps", "must be at least 1");
   if (o.repeat && *o.repeat == 0) throw OptionError("repeat", "must be at least 1");
@@ -314,7 +314,7 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
   for (const std::string& n : p.notes) progress.note(n);
   // The partition runs' predictions: --calibration, else the default calibration file when
   // there is one.
-  const tp::CostModel model = tp::select_cost_model("calibrated", p.calibration);
+  const model::CostModel model = model::select_cost_model("calibrated", p.calibration);
   progress.note("predictions: cost model " + model.source);
 
   for (const ScalingScene& s : p.scenes) {

@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
-// The partition executor's own time per task, beside partition's measurements of the machine.
+// The partition executor's own time per task, for the model's calibration of the machine.
 #include "tgraph/measure/calibrate.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <string>
 #include <vector>
 
@@ -46,27 +45,21 @@ std::vector<double> executor_overhead_samples(std::uint32_t threads,
   return out;
 }
 
-partition::Calibration calibrate_machine(const partition::CalibrateOptions& options) {
-  partition::Calibration c = partition::measure_calibration(options);
-  const auto start = std::chrono::steady_clock::now();
-  ExecutorOverheadOptions eo;
-  eo.samples = static_cast<std::uint32_t>(std::max(c.samples, 1));
-  // The same K as the inflation's (its curve lists 1 first).
-  for (const partition::ThreadsPoint& p : c.inflation) {
-    if (p.threads < 2) continue;
-    const partition::Spread s = partition::spread_of(executor_overhead_samples(p.threads, eo));
-    c.executor_overhead_spread.push_back({p.threads, s});
-    // Below 0 is the noise of a machine on which the executor costs nothing measurable.
-    c.executor_overhead.push_back({p.threads, std::max(0.0, s.median)});
-  }
-  c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return c;
+model::ExecutorOverheadSampler executor_overhead_sampler() {
+  return [](std::uint32_t threads, std::uint32_t samples) {
+    ExecutorOverheadOptions eo;
+    eo.samples = samples;
+    return executor_overhead_samples(threads, eo);
+  };
 }
 
-std::string calibrate_file(const partition::CalibrateOptions& options, const std::string& path,
+model::Calibration calibrate_machine(const model::CalibrateOptions& options) {
+  return model::calibrate_machine(options, executor_overhead_sampler());
+}
+
+std::string calibrate_file(const model::CalibrateOptions& options, const std::string& path,
                            bool json) {
-  const partition::Calibration c = calibrate_machine(options);  // runtime_error: the work's
-  return partition::calibration_report(c, partition::save_calibration(c, path), json);
+  return model::calibrate_file(options, path, json, executor_overhead_sampler());
 }
 
 }  // namespace tgraph::measure

@@ -10,13 +10,11 @@
 #include <utility>
 #include <vector>
 
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/step_graph.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::measure::detail {
-
-using replay::ExecGraph;
 
 /// A task's cost after a new measurement `sample`: an exponential average with the cost
 /// `old` already there (half weight to the new sample; `old` <= 1 means none yet), so that one

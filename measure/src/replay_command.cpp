@@ -9,8 +9,8 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/measure/report.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/assignment_io.hpp"
-#include "tgraph/partition/simulator.hpp"
 
 namespace tgraph::measure {
 
@@ -22,7 +22,7 @@ ReplayReport replay_command(const ReplayCommand& c) {
   if (c.replay.policy == replay::Policy::kPartition) {
     as = partition::load_or_partition(trace, c.trace, c.assignment, c.method, c.replay.exec.threads,
                                       &notes);
-    predicted = partition::predicted_makespans(trace, *as, c.model.cost_model());
+    predicted = model::predicted_makespans(trace, *as, c.model.cost_model());
   } else if (!c.assignment.empty()) {
     throw OptionError("policy", "an assignment file is only used by {policy} partition");
   }

@@ -12,11 +12,11 @@
 #include "tgraph/measure/capture.hpp"
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/replay_trace.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/model/simulator.hpp"
+#include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/thread_binding.hpp"
-#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::measure {
 
@@ -62,7 +62,7 @@ Validation validate(const ValidateOptions& o) {
   if (v.threads == 0) throw OptionError("threads", "must be at least 1");
   if (o.steps == 0) throw OptionError("steps", "must be at least 1");
   if (o.repeat == 0) throw OptionError("repeat", "must be at least 1");
-  partition::CostModel model = partition::select_cost_model("calibrated", o.calibration);
+  model::CostModel model = model::select_cost_model("calibrated", o.calibration);
   v.model = model.source;
 
   for (std::uint32_t round = 0; round < o.repeat; ++round) {
@@ -129,8 +129,7 @@ Validation validate(const ValidateOptions& o) {
         const StepGraph& g = trace.steps[s];
         std::optional<std::uint64_t> serial_s;
         if (o.live_serial && s < serial.size()) serial_s = serial[s];
-        const partition::Schedule sched =
-            partition::simulate(g, assignment->steps[s], model, serial_s);
+        const model::Schedule sched = model::simulate(g, assignment->steps[s], model, serial_s);
         r.predicted_ns += sched.makespan_ns;
         const std::uint64_t before = serial_s.value_or(g.host_ns);
         std::uint64_t body = 0, busy = 0;
@@ -181,13 +180,13 @@ Validation validate(const ValidateOptions& o) {
       // nor partitions: the simulated one is one processor with the capture's host time
       // (the engine's own work outside the tasks), not the live run's serial work.
       for (std::uint64_t ns :
-           partition::predicted_makespans(trace, one_processor(trace), model, nullptr))
+           model::predicted_makespans(trace, one_processor(trace), model, nullptr))
         r.predicted_sequential_ns += ns;
     }
     if (round == 0) {
       bool host = false;
       for (const StepGraph& g : trace.steps) host = host || g.host_ns > 0;
-      v.model_terms = partition::model_terms(model, o.live_serial, host);
+      v.model_terms = model::model_terms(model, o.live_serial, host);
     }
     v.rounds.push_back(r);
   }

@@ -13,8 +13,8 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/generate.hpp"
 #include "tgraph/graph/trace.hpp"
+#include "tgraph/model/cost_model.hpp"
 #include "tgraph/mpi/replay.hpp"
-#include "tgraph/partition/cost_model.hpp"
 #include "tgraph/replay/observer.hpp"
 
 namespace tgraph::mpi {
@@ -162,7 +162,7 @@ double measure_message_overhead(double task_overhead_ns, std::uint32_t messages,
 }
 
 std::string with_mpi_link(std::string_view text, const std::string& name, const MpiLink& link) {
-  partition::parse_calibration(text, name);  // InputError unless it is a calibration file
+  model::parse_calibration(text, name);  // InputError unless it is a calibration file
   nlohmann::json j = nlohmann::json::parse(text.begin(), text.end());
   j["mpi_latency_ns"] = link.latency_ns;
   j["mpi_per_byte_ns"] = link.per_byte_ns;
@@ -179,7 +179,7 @@ std::string with_mpi_link(std::string_view text, const std::string& name, const 
                                                    ? "per message and side of tgraph-mpi replay"
                                                    : "not measured"}};
   std::string out = j.dump(2) + "\n";
-  partition::parse_calibration(out, name);  // still a calibration file, with the new fields
+  model::parse_calibration(out, name);  // still a calibration file, with the new fields
   return out;
 }
 

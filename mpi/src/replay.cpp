@@ -9,7 +9,7 @@
 // time only to MPI calls and to explicit executions, so each rank runs its one processor's
 // program on the main thread, blocks in MPI_Waitsome where the threads would poll, charges
 // each task's recorded cost as flops on its host (1 flop per ns, the cost model of
-// partition::platform_xml, as SimGrid's partition::simulate_trace) and reads the simulated
+// model::platform_xml, as SimGrid's model::simulate_trace) and reads the simulated
 // clock.
 #include "tgraph/mpi/replay.hpp"
 

@@ -54,7 +54,7 @@ Plan& PlanCache::get(const StepGraph& step, const Assignment& a, bool& created) 
   p->structure = step;
   p->proc = a.proc;
   p->hash = hash;
-  p->exec = replay::lower(step, &a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
+  p->exec = lower(step, &a, CwMode::kReduce, ReduceScope::kPerProcessor);
   created = true;
   plans_.push_back(std::move(p));
   return *plans_.back();

@@ -83,7 +83,7 @@ bool uses_value(AccessMode m) { return m != AccessMode::W; }
 
 }  // namespace
 
-StepSchedule schedule_step(const replay::ExecGraph& x, const StepGraph& step, const Layout& layout,
+StepSchedule schedule_step(const ExecGraph& x, const StepGraph& step, const Layout& layout,
                            const Holders& before_in, ChannelTable& channels) {
   const StepGraph& g = x.graph;
   const std::uint32_t R = layout.ranks;
@@ -244,7 +244,7 @@ StepSchedule schedule_step(const replay::ExecGraph& x, const StepGraph& step, co
   return s;
 }
 
-Traffic predict_traffic(const replay::ExecGraph& x, const StepGraph& step, const Layout& layout,
+Traffic predict_traffic(const ExecGraph& x, const StepGraph& step, const Layout& layout,
                         const Holders& before) {
   ChannelTable channels;
   return schedule_step(x, step, layout, before, channels).traffic;

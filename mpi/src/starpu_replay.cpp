@@ -343,7 +343,7 @@ class StarpuMpiRun {
 
   void run_instance(const InstanceArg& arg, void* buffers[]) {
     try {
-      const replay::ExecGraph& x = *exec_;
+      const ExecGraph& x = *exec_;
       for (std::uint32_t i = begin_[arg.task]; i < begin_[arg.task + 1]; ++i) {
         const auto words = w_.words(datum_[i]);
         const void* got = reinterpret_cast<const void*>(
@@ -395,7 +395,7 @@ class StarpuMpiRun {
   std::vector<std::uint32_t> begin_;       // exec task -> first of its buffers
   std::vector<starpu_data_descr> descr_;   // buffers: handle and mode
   std::vector<DatumId> datum_;             // buffers: exec datum
-  const replay::ExecGraph* exec_ = nullptr;
+  const ExecGraph* exec_ = nullptr;
   std::vector<std::size_t> sent_before_;
   std::atomic<std::uint64_t> done_{0};
   std::mutex error_mu_;

@@ -49,7 +49,7 @@ struct Plan {
   StepGraph structure;
   std::vector<ProcId> proc;
   std::uint64_t hash = 0;
-  replay::ExecGraph exec;
+  ExecGraph exec;
   ChannelTable channels;
   std::vector<MPI_Request> requests;                // by channel (MPI_REQUEST_NULL: not ours)
   std::vector<std::vector<std::uint64_t>> buffers;  // by channel

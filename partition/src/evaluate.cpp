@@ -8,8 +8,8 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/assignment_io.hpp"
-#include "tgraph/partition/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {
@@ -93,7 +93,7 @@ void migrations(const StepGraph& g, const Assignment& a, const StepGraph& prev,
   }
 }
 
-StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostModel& model,
+StepReport evaluate_step(const StepGraph& g, const Assignment& a, const model::CostModel& model,
                          std::optional<std::uint64_t> serial_ns) {
   StepReport r;
   r.tasks = g.tasks.size();
@@ -111,7 +111,7 @@ StepReport evaluate_step(const StepGraph& g, const Assignment& a, const CostMode
   r.reducers = count_reducers(g, a);
   quotient(q, a.k, r);
 
-  const Schedule s = simulate(g, a, model, serial_ns);
+  const model::Schedule s = model::simulate(g, a, model, serial_ns);
   r.makespan_ns = s.makespan_ns;
   r.signals = s.signals;
   r.waits = s.waits;
@@ -138,7 +138,7 @@ void check_fits(const Trace& trace, const TraceAssignment& a, const std::string&
       throw InputError(a_name, std::nullopt, "step " + std::to_string(s) + ": " + why);
 }
 
-Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
+Report evaluate(const Trace& trace, const TraceAssignment& a, const model::CostModel& model,
                 const std::string& a_name, const std::vector<std::uint64_t>* serial_ns) {
   check_fits(trace, a, a_name);
   Report rep;
@@ -185,7 +185,8 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
     sum_partition_ms += r.partition_ms;
     rep.steps.push_back(r);
   }
-  rep.model_terms = model_terms(model, serial_ns != nullptr && !serial_ns->empty(), tot.host_ns > 0);
+  rep.model_terms =
+      model::model_terms(model, serial_ns != nullptr && !serial_ns->empty(), tot.host_ns > 0);
   tot.imbalance = sum_mean_load > 0 ? static_cast<double>(tot.max_load_ns) / sum_mean_load : 1.0;
   const double sequential = static_cast<double>(tot.work_ns + tot.host_ns);
   tot.speedup = tot.makespan_ns == 0 ? 1.0 : sequential / static_cast<double>(tot.makespan_ns);
@@ -195,7 +196,8 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
 }
 
 QuotientGraph step_quotient(const StepGraph& g, const Assignment& a) {
-  const Schedule s = simulate(g, a, CostModel::ideal());  // checks that `a` fits `g`
+  const model::Schedule s =
+      model::simulate(g, a, model::CostModel::ideal());  // checks that `a` fits `g`
   QuotientGraph q = quotient_graph(g, a);
   std::vector<QuotientEdge> edges;  // every (from, to) in order: q.edges merged with the waits
   std::size_t i = 0;
@@ -214,7 +216,8 @@ QuotientGraph step_quotient(const StepGraph& g, const Assignment& a) {
 }
 
 std::string evaluate_files(const std::string& trace, const std::string& assignment,
-                           const CostModel& model, const SerialWork& serial, bool json) {
+                           const model::CostModel& model, const model::SerialWork& serial,
+                           bool json) {
   const Trace t = read_trace(trace);
   const TraceAssignment as = load_assignment(assignment, t, trace);
   const std::vector<std::uint64_t> per_step = serial.per_step(t.steps.size());

@@ -20,7 +20,7 @@ struct Dag {
   std::vector<double> bottom;
 };
 
-Dag make_dag(const StepGraph& g, const CostModel& model) {
+Dag make_dag(const StepGraph& g, const model::CostModel& model) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   Dag d;
   d.work = task_work(g);
@@ -175,7 +175,7 @@ class ListSchedule final : public Strategy {
 std::unique_ptr<Strategy> make_list() { return std::make_unique<ListSchedule>(); }
 
 std::vector<std::vector<TaskId>> list_order(const StepGraph& g, const Assignment& a,
-                                            const CostModel& model) {
+                                            const model::CostModel& model) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   const std::uint32_t k = a.k;
   if (k <= 1 || n == 0) return {};

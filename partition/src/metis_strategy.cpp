@@ -5,16 +5,16 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 #include <stdexcept>
 #include <utility>
 
 #include "strategies.hpp"
 #include "tgraph/graph/metrics.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/evaluate.hpp"
-#include "tgraph/partition/simulator.hpp"
 
 static_assert(sizeof(idx_t) == 4, "tgraph expects METIS built with 32-bit idx_t");
 static_assert(sizeof(real_t) == sizeof(float), "tgraph expects METIS built with float real_t");
@@ -134,13 +134,13 @@ Result metis_partition(const StepGraph& g, std::uint32_t k, const Options& optio
     if (level_phases != phase) {
       // The candidates are compared without the machine's random interruptions: one draw
       // of them is noise, not a difference between the partitions.
-      CostModel model = options.model;
+      model::CostModel model = options.model;
       model.interruptions.clear();
       const auto predicted = [&](const std::vector<std::uint32_t>& p) {
         Assignment a;
         a.k = k;
         a.proc = p;
-        return simulate(g, a, model).makespan_ns;
+        return model::simulate(g, a, model).makespan_ns;
       };
       std::uint64_t best = predicted(part);
       const Metrics metrics = compute_metrics(g);

@@ -14,7 +14,7 @@ namespace {
 // iteration). Built once per rebalance and shared by its groups.
 using CutPrices = std::vector<std::vector<std::pair<TaskId, double>>>;
 
-CutPrices cut_prices(const StepGraph& g, const CostModel& model) {
+CutPrices cut_prices(const StepGraph& g, const model::CostModel& model) {
   CutPrices adj(g.tasks.size());
   auto link = [&](const Edge& e) {
     if (e.from == e.to) return;
@@ -171,7 +171,7 @@ std::vector<TaskId> all_tasks(const StepGraph& g) {
 // its own, moving only its tasks; without heavy loops, the whole step at once. The cut
 // prices and the scratch are made once for all groups.
 void phase_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
-                     double tolerance, const CostModel& model, const LoopGroups& lg,
+                     double tolerance, const model::CostModel& model, const LoopGroups& lg,
                      std::vector<ProcId>& proc) {
   const CutPrices adj = cut_prices(g, model);
   Scratch scratch(g.tasks.size());
@@ -192,7 +192,8 @@ void phase_rebalance(const StepGraph& g, const std::vector<std::uint64_t>& work,
 // the balance. A local search of cost O(edges) per pass
 // instead of a whole-step partition: what the paper's future work asks for.
 void refine(const StepGraph& g, const std::vector<std::uint64_t>& work, std::uint32_t k,
-            double tolerance, double target, const CostModel& model, std::vector<ProcId>& proc) {
+            double tolerance, double target, const model::CostModel& model,
+            std::vector<ProcId>& proc) {
   const CutPrices adj = cut_prices(g, model);
   const std::vector<TaskId> every = all_tasks(g);
   Scratch scratch(g.tasks.size());

@@ -27,7 +27,7 @@ std::unique_ptr<Strategy> make_list();
 /// arrived, the one with the longest path to the end of the step; loops kept as blocks
 /// (list's rule). Empty for k = 1.
 std::vector<std::vector<TaskId>> list_order(const StepGraph& g, const Assignment& a,
-                                            const CostModel& model);
+                                            const model::CostModel& model);
 
 /// Work of every task (cost x runs).
 std::vector<std::uint64_t> task_work(const StepGraph& g);

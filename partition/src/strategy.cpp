@@ -201,7 +201,9 @@ std::string default_method(const Trace& trace) {
   return "list";
 }
 
-CostModel NamedOptions::cost_model() const { return select_cost_model(model, calibration); }
+model::CostModel NamedOptions::cost_model() const {
+  return model::select_cost_model(model, calibration);
+}
 
 Options NamedOptions::options() const {
   Options o = values;

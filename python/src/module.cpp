@@ -14,9 +14,9 @@
 #include "tgraph/graph/summary.hpp"
 #include "tgraph/graph/trace.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/model/cost_model.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/compare.hpp"
-#include "tgraph/partition/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
 
@@ -340,7 +340,7 @@ PYBIND11_MODULE(_tgraph, m) {
   });
   m.def("_evaluate", [](const Trace& t, const TraceAssignment& a, const std::string& model,
                         const std::string& calibration) {
-    const partition::CostModel cm = partition::select_cost_model(model, calibration);
+    const model::CostModel cm = model::select_cost_model(model, calibration);
     py::gil_scoped_release release;
     return partition::report_json(partition::evaluate(t, a, cm));
   });

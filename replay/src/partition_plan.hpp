@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common.hpp"
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 namespace tgraph::replay::detail {
 

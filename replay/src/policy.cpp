@@ -28,37 +28,6 @@ std::optional<Policy> parse_policy(std::string_view name) {
   return std::nullopt;
 }
 
-std::string_view to_string(CwMode mode) {
-  switch (mode) {
-    case CwMode::kReduce:
-      return "reduce";
-    case CwMode::kSerialize:
-      return "serialize";
-  }
-  return "?";
-}
-
-std::string_view to_string(ReduceScope scope) {
-  switch (scope) {
-    case ReduceScope::kNone:
-      return "none";
-    case ReduceScope::kPerProcessor:
-      return "per-processor";
-    case ReduceScope::kPerWriter:
-      return "per-writer";
-    case ReduceScope::kPerThread:
-      return "per-thread";
-  }
-  return "?";
-}
-
-std::optional<ReduceScope> parse_reduce_scope(std::string_view name) {
-  for (ReduceScope s : {ReduceScope::kNone, ReduceScope::kPerProcessor, ReduceScope::kPerWriter,
-                        ReduceScope::kPerThread})
-    if (to_string(s) == name) return s;
-  return std::nullopt;
-}
-
 std::string_view to_string(BarrierRule rule) {
   switch (rule) {
     case BarrierRule::kLevel:

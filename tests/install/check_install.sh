@@ -43,7 +43,7 @@ configure_and_build() {
 }
 
 consumers="$src/tests/install/consumers"
-for component in graph capture partition replay viz measure; do
+for component in graph capture model partition replay viz measure; do
   if [ ! -f "$prefix/lib/cmake/tgraph/tgraph-$component-targets.cmake" ]; then
     echo "== component $component not built (TGRAPH_SKIP_MODULES): no consumer"
     continue

@@ -40,23 +40,22 @@ TEST(ExecutorOverhead, IsOneSamplePerStepOfTheExecutorsTimeBeyondItsBodies) {
 }
 
 TEST(ExecutorOverhead, CalibrationAddsItsCurveBesideTheInflations) {
-  const partition::Calibration c = calibrate_machine(tgraph::testing::quick_calibration());
+  const model::Calibration c = calibrate_machine(tgraph::testing::quick_calibration());
   // The same K as the inflation's but its K = 1 (no executor there).
   ASSERT_EQ(c.executor_overhead.size(), c.inflation.size() - 1);
   ASSERT_EQ(c.executor_overhead_spread.size(), c.executor_overhead.size());
   for (std::size_t i = 0; i < c.executor_overhead.size(); ++i) {
-    const partition::Spread& s = c.executor_overhead_spread[i].spread;
+    const model::Spread& s = c.executor_overhead_spread[i].spread;
     EXPECT_EQ(c.executor_overhead[i].threads, c.inflation[i + 1].threads);
     EXPECT_EQ(c.executor_overhead_spread[i].threads, c.inflation[i + 1].threads);
     EXPECT_EQ(c.executor_overhead[i].value, std::max(0.0, s.median));
     EXPECT_LE(s.min, s.median);
     EXPECT_LE(s.median, s.max);
   }
-  const partition::CostModel m =
-      partition::parse_calibration(partition::calibration_json(c), "cal.json");
+  const model::CostModel m = model::parse_calibration(model::calibration_json(c), "cal.json");
   EXPECT_EQ(m.executor_overhead, c.executor_overhead);
   EXPECT_EQ(m.executor_overhead_at(c.executor_overhead[0].threads), c.executor_overhead[0].value);
-  EXPECT_EQ(nlohmann::json::parse(partition::calibration_report(c, "cal.json", true))
+  EXPECT_EQ(nlohmann::json::parse(model::calibration_report(c, "cal.json", true))
                 .at("executor_overhead")
                 .size(),
             c.executor_overhead.size());

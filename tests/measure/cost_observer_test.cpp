@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "live_observers.hpp"
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 namespace tgraph::measure::detail {
 namespace {
@@ -36,7 +36,7 @@ void run(CostObserver& c, TaskId t, const std::vector<std::int64_t>& ns) {
 
 TEST(CostObserver, LeavesTheLongestSampleOutFromThreeOnAndAveragesWithThePreviousStep) {
   StepGraph g = two_tasks();
-  const replay::ExecGraph exec = replay::lower(g, nullptr, replay::CwMode::kReduce);
+  const ExecGraph exec = lower(g, nullptr, CwMode::kReduce);
   CostObserver c;
   c.on_step_begin(exec, 1, 0);
   // Task 0: seven 10 us instances, one preempted for 4 ms; task 1: two instances.

@@ -78,7 +78,7 @@ TEST(StickyOnFalling, RefiningAtMergesMovesAQuarterOfMetisRelabelsTasksAtMetissM
     const TracePartition sticky = partition_trace(trace, "sticky", k);
     const TracePartition relabel = partition_trace(trace, "metis-relabel", k);
     EXPECT_LE(4 * summarize(sticky.stats).moved_tasks, summarize(relabel.stats).moved_tasks) << k;
-    const CostModel model = CostModel::defaults();
+    const model::CostModel model = model::CostModel::defaults();
     const double s =
         static_cast<double>(evaluate(trace, sticky.assignment, model).total.makespan_ns);
     const double m =

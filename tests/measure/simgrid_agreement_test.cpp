@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "tgraph/measure/capture.hpp"
-#include "tgraph/partition/simulation.hpp"
+#include "tgraph/model/simulation.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {
@@ -16,11 +16,13 @@ namespace {
 // the built-in simulator agree within 1 % on every step of bars64 and falling.
 void expect_agreement(const Trace& trace, const char* method, std::uint32_t k) {
   const TracePartition tp = partition_trace(trace, method, k);
-  SimulatedPlatform p;
-  p.cluster = ClusterShape{1, k};
-  p.model = CostModel::defaults();
-  const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
-  const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
+  model::SimulatedPlatform p;
+  p.cluster = model::ClusterShape{1, k};
+  p.model = model::CostModel::defaults();
+  const model::Prediction b =
+      model::simulate_trace(trace, tp.assignment, model::SimulationEngine::builtin, p);
+  const model::Prediction s =
+      model::simulate_trace(trace, tp.assignment, model::SimulationEngine::simgrid, p);
   ASSERT_EQ(b.steps.size(), trace.steps.size());
   ASSERT_EQ(s.steps.size(), trace.steps.size());
   for (std::size_t i = 0; i < trace.steps.size(); ++i) {

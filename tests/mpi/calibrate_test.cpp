@@ -13,7 +13,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::mpi {
 namespace {
@@ -25,7 +25,7 @@ TEST(MpiLinkFile, AddsTheMpiFieldsAndKeepsTheOthers) {
   link.latency_ns = 310;
   link.per_byte_ns = 0.09;
   const std::string out = with_mpi_link(kCalibration, "cal.json", link);
-  const partition::CostModel m = partition::parse_calibration(out, "cal.json");
+  const model::CostModel m = model::parse_calibration(out, "cal.json");
   EXPECT_DOUBLE_EQ(m.sync_latency_ns, 85.5);
   EXPECT_DOUBLE_EQ(m.per_byte_ns, 0.04);
   EXPECT_DOUBLE_EQ(m.mpi_latency_ns, 310);
@@ -33,12 +33,12 @@ TEST(MpiLinkFile, AddsTheMpiFieldsAndKeepsTheOthers) {
   EXPECT_NE(out.find("\"cpus\""), std::string::npos);
   EXPECT_EQ(m.task_overhead_ns, 0.0);  // not measured: not written
   link.task_overhead_ns = 64.5;
-  EXPECT_EQ(partition::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
+  EXPECT_EQ(model::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
                 .task_overhead_ns,
             64.5);
   EXPECT_EQ(m.mpi_message_overhead_ns, 0.0);  // not measured: not written
   link.message_overhead_ns = 420;
-  EXPECT_EQ(partition::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
+  EXPECT_EQ(model::parse_calibration(with_mpi_link(kCalibration, "cal.json", link), "cal.json")
                 .mpi_message_overhead_ns,
             420.0);
 }
@@ -59,7 +59,7 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
                           " > " + (dir / "out.txt").string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(rc) && WEXITSTATUS(rc) == 0) << read_file_text((dir / "out.txt").string());
-  const partition::CostModel m = partition::load_calibration(file);
+  const model::CostModel m = model::load_calibration(file);
   EXPECT_DOUBLE_EQ(m.sync_latency_ns, 85.5);  // kept
   // Measured between two processes, in nanoseconds: above zero, below a second and 1 us/byte
   // (the units, not the speed: a loaded machine measured 5.8 ns/byte where a quiet one 0.09).
@@ -79,7 +79,7 @@ TEST(MpiCalibrate, WritesMeasuredMpiFieldsIntoTheCalibrationFile) {
   double most = m.mpi_message_overhead_ns;
   for (int again = 0; again < 2 && most <= 0.0; ++again) {
     ASSERT_EQ(std::system(cmd.c_str()), 0) << read_file_text((dir / "out.txt").string());
-    const double o = partition::load_calibration(file).mpi_message_overhead_ns;
+    const double o = model::load_calibration(file).mpi_message_overhead_ns;
     measured += ", " + std::to_string(o);
     most = std::max(most, o);
   }

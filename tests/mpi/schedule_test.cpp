@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 namespace tgraph::mpi {
 namespace {
@@ -29,8 +29,7 @@ TaskId add(Built& b, ProcId p, std::vector<Access> acc, LoopId loop = kNoLoop) {
 Traffic predict(Built& b, Layout layout, const Holders* before = nullptr) {
   b.g.derive_edges();
   b.a.k = layout.processors();
-  const replay::ExecGraph x =
-      replay::lower(b.g, &b.a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
+  const ExecGraph x = lower(b.g, &b.a, CwMode::kReduce, ReduceScope::kPerProcessor);
   const Holders h = before ? *before : everywhere(b.g.data.size(), layout.ranks);
   return predict_traffic(x, b.g, layout, h);
 }
@@ -106,8 +105,7 @@ TEST(Schedule, VersionsFromBeforeTheStepComeFromAHolder) {
   h.has = {0, 1, 0};  // only rank 1 holds d
   b.g.derive_edges();
   b.a.k = 3;
-  const replay::ExecGraph x =
-      replay::lower(b.g, &b.a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
+  const ExecGraph x = lower(b.g, &b.a, CwMode::kReduce, ReduceScope::kPerProcessor);
   ChannelTable channels;
   const StepSchedule s = schedule_step(x, b.g, {3, 1}, h, channels);
   EXPECT_EQ(s.traffic.messages, (std::vector<std::uint64_t>{0, 0, 0, 1, 0, 1, 0, 0, 0}));
@@ -128,8 +126,7 @@ TEST(Schedule, ChannelsAreReusedByLaterSteps) {
   add(b, 1, {{d, AccessMode::RW}});
   b.g.derive_edges();
   b.a.k = 2;
-  const replay::ExecGraph x =
-      replay::lower(b.g, &b.a, replay::CwMode::kReduce, replay::ReduceScope::kPerProcessor);
+  const ExecGraph x = lower(b.g, &b.a, CwMode::kReduce, ReduceScope::kPerProcessor);
   ChannelTable channels;
   const StepSchedule s1 = schedule_step(x, b.g, {2, 1}, everywhere(1, 2), channels);
   const std::size_t after_first = channels.channels().size();

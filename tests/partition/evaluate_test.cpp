@@ -42,7 +42,7 @@ StepGraph writer_two_reducers_reader() {
 TEST(Evaluate, CountsCutSignalsReducersAndImbalance) {
   Trace tr;
   tr.steps = {writer_two_reducers_reader()};
-  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), CostModel::ideal());
+  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), model::CostModel::ideal());
   const StepReport& s = r.steps[0];
   // Cross edges: 0->2 (x, 100 bytes) and 2->3 (f, 40 bytes).
   EXPECT_EQ(s.cut_edges, 2u);
@@ -73,7 +73,7 @@ TEST(Evaluate, ReportJsonAndTextCarryTheTotals) {
   b.task({{f, M::R}}, 10);
   Trace tr;
   tr.steps = {b.done()};
-  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), CostModel::ideal());
+  const Report r = evaluate(tr, one_step(2, {0, 0, 1, 0}), model::CostModel::ideal());
   const nlohmann::json j = nlohmann::json::parse(report_json(r));
   EXPECT_EQ(j["method"], "hand");
   EXPECT_EQ(j["k"], 2);
@@ -103,7 +103,7 @@ TEST(Evaluate, ReportsPingPongBetweenProcessorsAsACycle) {
   b.task({{y, M::R}}, 1);                // p0
   Trace tr;
   tr.steps = {b.done()};
-  const Report r = evaluate(tr, one_step(2, {0, 1, 0}), CostModel::defaults());
+  const Report r = evaluate(tr, one_step(2, {0, 1, 0}), model::CostModel::defaults());
   EXPECT_FALSE(r.steps[0].quotient_acyclic);
   EXPECT_EQ(r.steps[0].ping_pong_pairs, 1u);
   EXPECT_EQ(r.cyclic_steps, 1u);
@@ -130,7 +130,7 @@ TEST(Evaluate, CountsMigrationsByStableKey) {
   s1.proc = {1, 0, 0};  // key 2 moved from p1 to p0; key 1 stayed on p0
   a.steps.push_back(s1);
   a.partition_ms.push_back(0.5);
-  const Report r = evaluate(tr, a, CostModel::ideal());
+  const Report r = evaluate(tr, a, model::CostModel::ideal());
   EXPECT_EQ(r.steps[0].migrated_tasks, 0u);
   EXPECT_EQ(r.steps[1].migrated_tasks, 1u);
   EXPECT_EQ(r.steps[1].migrated_bytes, 130u);
@@ -141,9 +141,10 @@ TEST(Evaluate, CountsMigrationsByStableKey) {
 TEST(Evaluate, RejectsAnAssignmentThatDoesNotFitTheTrace) {
   Trace tr;
   tr.steps = {testing::two_halves(3)};
-  EXPECT_THROW(evaluate(tr, one_step(2, {0, 1, 0}), CostModel::ideal(), "a.tga"), InputError);
+  EXPECT_THROW(evaluate(tr, one_step(2, {0, 1, 0}), model::CostModel::ideal(), "a.tga"),
+               InputError);
   try {
-    evaluate(tr, one_step(2, {0, 1, 0, 1, 0}), CostModel::ideal(), "a.tga");
+    evaluate(tr, one_step(2, {0, 1, 0, 1, 0}), model::CostModel::ideal(), "a.tga");
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("a.tga: step 0: assignment covers 5 tasks, the step has 6"), std::string::npos)
@@ -151,10 +152,10 @@ TEST(Evaluate, RejectsAnAssignmentThatDoesNotFitTheTrace) {
   }
   TraceAssignment two = one_step(2, {0, 1, 0, 1, 0, 1});
   two.steps.push_back(two.steps[0]);
-  EXPECT_THROW(evaluate(tr, two, CostModel::ideal(), "a.tga"), InputError);
+  EXPECT_THROW(evaluate(tr, two, model::CostModel::ideal(), "a.tga"), InputError);
   TraceAssignment deadlock = one_step(1, {0, 0, 0, 0, 0, 0});
   deadlock.steps[0].order = {{1, 0, 2, 3, 4, 5}};
-  EXPECT_THROW(evaluate(tr, deadlock, CostModel::ideal(), "a.tga"), InputError);
+  EXPECT_THROW(evaluate(tr, deadlock, model::CostModel::ideal(), "a.tga"), InputError);
 }
 
 TEST(Evaluate, EvaluatesATracePartitionedByEveryMethod) {
@@ -163,7 +164,7 @@ TEST(Evaluate, EvaluatesATracePartitionedByEveryMethod) {
   for (const std::string& m : strategy_names()) {
     const TracePartition tp = partition_trace(tr, m, 4);
     ASSERT_EQ(tp.assignment.steps.size(), 4u);
-    const Report ideal = evaluate(tr, tp.assignment, CostModel::ideal());
+    const Report ideal = evaluate(tr, tp.assignment, model::CostModel::ideal());
     EXPECT_GE(ideal.total.makespan_ns, ideal.total.lower_bound_ns) << m;
     EXPECT_GE(ideal.total.imbalance, 1.0) << m;
     EXPECT_GT(ideal.total.speedup, 0.0) << m;
@@ -202,7 +203,7 @@ TEST(StepQuotient, SumsToEvaluatesCutAndWaitsOnRandomGraphs) {
     TraceAssignment a = one_step(3, {});
     for (TaskId t = 0; t < tr.steps[0].tasks.size(); ++t)
       a.steps[0].proc.push_back(static_cast<ProcId>((t * 7 + seed) % 3));
-    const StepReport r = evaluate(tr, a, CostModel::ideal()).steps[0];
+    const StepReport r = evaluate(tr, a, model::CostModel::ideal()).steps[0];
     const QuotientGraph q = step_quotient(tr.steps[0], a.steps[0]);
     std::uint64_t deps = 0, bytes = 0, signals = 0, work = 0;
     for (const QuotientEdge& e : q.edges) {

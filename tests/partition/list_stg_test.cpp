@@ -8,7 +8,7 @@
 #include "../stg_files.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/stg.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {
@@ -23,11 +23,13 @@ TEST(ListOnStg, BeatsRandomPlacementAndRespectsTheBound) {
     const Metrics m = compute_metrics(g);
     for (std::uint32_t k : {2u, 4u}) {
       Options o;
-      o.model = CostModel::ideal();
+      o.model = model::CostModel::ideal();
       const Result list = make_strategy("list")->partition(g, k, {}, o);
       const Result rnd = make_strategy("random")->partition(g, k, {}, o);
-      const std::uint64_t lm = simulate(g, list.assignment, CostModel::ideal()).makespan_ns;
-      const std::uint64_t rm = simulate(g, rnd.assignment, CostModel::ideal()).makespan_ns;
+      const std::uint64_t lm =
+          model::simulate(g, list.assignment, model::CostModel::ideal()).makespan_ns;
+      const std::uint64_t rm =
+          model::simulate(g, rnd.assignment, model::CostModel::ideal()).makespan_ns;
       EXPECT_GE(lm, std::max<std::uint64_t>((m.work_ns + k - 1) / k, m.span_ns)) << f;
       EXPECT_LE(lm, m.work_ns) << f;
       list_total += lm;

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Each strategy on hand-made graphs whose right answer is known.
+#include "tgraph/partition/strategy.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,9 +13,8 @@
 
 #include "test_graphs.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/partition_graph.hpp"
-#include "tgraph/partition/simulator.hpp"
-#include "tgraph/partition/strategy.hpp"
 
 namespace tgraph::partition {
 namespace {
@@ -61,7 +62,7 @@ TEST_P(EveryStrategy, GivesValidAssignmentsWhenKIsAtLeastTheTaskCount) {
     const Result r = make_strategy(GetParam())->partition(g, k, {}, {});
     ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
     for (ProcId p : r.assignment.proc) EXPECT_LT(p, k);
-    EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults()));
+    EXPECT_NO_THROW(model::simulate(g, r.assignment, model::CostModel::defaults()));
   }
 }
 
@@ -77,7 +78,8 @@ TEST_P(EveryStrategy, GivesValidAssignmentsOnRandomGraphs) {
       const Result r = make_strategy(GetParam())->partition(g, k, {}, {});
       ASSERT_EQ(r.assignment.proc.size(), g.tasks.size());
       for (ProcId p : r.assignment.proc) ASSERT_LT(p, k);
-      EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults())) << GetParam() << " seed " << seed;
+      EXPECT_NO_THROW(model::simulate(g, r.assignment, model::CostModel::defaults()))
+          << GetParam() << " seed " << seed;
     }
   }
 }
@@ -313,8 +315,8 @@ TEST(Metis, BalancesAHeavyLoopOnItsOwnWithLoopShare) {
   Options no_loops = o;
   no_loops.loop_share = 0.0;
   const Result plain = make_strategy("metis")->partition(g, 2, {}, no_loops);
-  EXPECT_LE(simulate(g, r.assignment, o.model).makespan_ns,
-            simulate(g, plain.assignment, o.model).makespan_ns);
+  EXPECT_LE(model::simulate(g, r.assignment, o.model).makespan_ns,
+            model::simulate(g, plain.assignment, o.model).makespan_ns);
 }
 
 // Strategy `name` on a random graph of `seed` gives, on 4 threads partitioning 10 times each,
@@ -572,7 +574,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplitByDefault
     EXPECT_EQ(r1.assignment.proc, m1.assignment.proc) << k;
     EXPECT_EQ(r1.stats.moved_tasks, m1.stats.moved_tasks);
     EXPECT_EQ(r1.stats.matched_tasks, merged.tasks.size());
-    EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
+    EXPECT_NO_THROW(model::simulate(merged, r1.assignment, model::CostModel::defaults()));
     // Every processor gets work: a real partition, not everything kept in place.
     std::set<ProcId> used(r1.assignment.proc.begin(), r1.assignment.proc.end());
     EXPECT_EQ(used.size(), k);
@@ -580,7 +582,7 @@ TEST(Sticky, FallsBackToAFreshRelabelledPartitionWhenGroupsMergeOrSplitByDefault
     const Result r2 = s->partition(apart, k, {&merged, &r1.assignment}, fresh);
     EXPECT_TRUE(r2.stats.fallback) << k;
     EXPECT_EQ(r2.stats.matched_tasks, apart.tasks.size() - 2) << "all but the second group's own tasks";
-    EXPECT_NO_THROW(simulate(apart, r2.assignment, CostModel::defaults()));
+    EXPECT_NO_THROW(model::simulate(apart, r2.assignment, model::CostModel::defaults()));
   }
   // Over a trace: apart, apart, merged, merged, apart = reused, fallback, reused, fallback.
   Trace trace;
@@ -598,7 +600,7 @@ TEST(Sticky, RepartitionsFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
   for (std::uint32_t k : {2u, 3u, 4u}) {
     const auto [s, r0, r1] = sticky_merge(apart, merged, k, o);
     EXPECT_FALSE(r1.stats.rebalanced);
-    EXPECT_NO_THROW(simulate(merged, r1.assignment, CostModel::defaults()));
+    EXPECT_NO_THROW(model::simulate(merged, r1.assignment, model::CostModel::defaults()));
     // Balanced within the tolerance METIS gets, with fewer moves than a fresh partition
     // relabelled: the previous placement is the starting point.
     const auto l = loads_of(merged, r1.assignment);
@@ -628,7 +630,8 @@ TEST(Sticky, RefinesFromTheIncrementalPlacementWhenGroupsMergeIfAsked) {
     EXPECT_LT(r1.stats.moved_tasks, m1.stats.moved_tasks) << k;
     const StepGraph& merged_step = merged;  // clang 14: a lambda cannot capture a binding
     const auto makespan = [&merged_step](const Assignment& a) {
-      return static_cast<double>(simulate(merged_step, a, CostModel::defaults()).makespan_ns);
+      return static_cast<double>(
+          model::simulate(merged_step, a, model::CostModel::defaults()).makespan_ns);
     };
     EXPECT_LE(makespan(r1.assignment), 1.05 * makespan(m1.assignment)) << k;
     const auto l = loads_of(merged, r1.assignment);
@@ -660,10 +663,10 @@ TEST(List, SchedulesForkJoinOnTwoProcessorsOptimally) {
   b.task({{u, M::R}, {v, M::R}, {w, M::W}}, 1);  // 3
   const StepGraph g = b.done();
   Options o;
-  o.model = CostModel::ideal();
+  o.model = model::CostModel::ideal();
   const Result r = make_strategy("list")->partition(g, 2, {}, o);
   EXPECT_NE(r.assignment.proc[1], r.assignment.proc[2]);
-  EXPECT_EQ(simulate(g, r.assignment, CostModel::ideal()).makespan_ns, 12u);
+  EXPECT_EQ(model::simulate(g, r.assignment, model::CostModel::ideal()).makespan_ns, 12u);
   ASSERT_EQ(r.assignment.order.size(), 2u);
   EXPECT_EQ(r.assignment.order[0].size() + r.assignment.order[1].size(), 4u);
 }
@@ -683,7 +686,7 @@ TEST(List, OrdersEachProcessorByStartTimeKeepingLoopsTogether) {
     }
     EXPECT_LE(runs, 1);
   }
-  EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults()));
+  EXPECT_NO_THROW(model::simulate(g, r.assignment, model::CostModel::defaults()));
 }
 
 TEST(TaskOrder, ListStartsFirstTheTaskAnotherProcessorWaitsFor) {
@@ -698,16 +701,16 @@ TEST(TaskOrder, ListStartsFirstTheTaskAnotherProcessorWaitsFor) {
   b.task({{a, M::R}, {c, M::W}}, 1000);  // 3: C
   const StepGraph g = b.done();
   Options o;
-  o.model = CostModel::ideal();
+  o.model = model::CostModel::ideal();
   const Result program = make_strategy("roundrobin")->partition(g, 2, {}, o);
   EXPECT_TRUE(program.assignment.order.empty());
-  EXPECT_EQ(simulate(g, program.assignment, CostModel::ideal()).makespan_ns, 2100u);
+  EXPECT_EQ(model::simulate(g, program.assignment, model::CostModel::ideal()).makespan_ns, 2100u);
   o.order = TaskOrder::kList;
   const Result list = make_strategy("roundrobin")->partition(g, 2, {}, o);
   EXPECT_EQ(list.assignment.proc, program.assignment.proc);  // the mapping is kept
   const std::vector<std::vector<TaskId>> expected = {{2, 0}, {1, 3}};
   EXPECT_EQ(list.assignment.order, expected);
-  EXPECT_EQ(simulate(g, list.assignment, CostModel::ideal()).makespan_ns, 1100u);
+  EXPECT_EQ(model::simulate(g, list.assignment, model::CostModel::ideal()).makespan_ns, 1100u);
   EXPECT_EQ(parse_task_order("list"), TaskOrder::kList);
   EXPECT_THROW(parse_task_order("fifo"), UsageError);
 }
@@ -739,7 +742,8 @@ TEST(TaskOrder, ListOrdersEveryStrategysMappingWithoutDeadlockLoopsTogether) {
             open = l;
           }
         }
-        EXPECT_NO_THROW(simulate(g, r.assignment, CostModel::defaults())) << method << " seed " << seed;
+        EXPECT_NO_THROW(model::simulate(g, r.assignment, model::CostModel::defaults()))
+            << method << " seed " << seed;
       }
   }
 }

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 #include <gtest/gtest.h>
 

@@ -2,16 +2,17 @@
 // The partition executor's plans, built directly (replay/src/partition_plan.hpp): each
 // processor's program, the wait points it keeps after elision, which tasks signal, the one
 // readiness rule, and the serial twin's deadlock check of an explicit order.
+#include "partition_plan.hpp"
+
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "partition_plan.hpp"
 #include "partition_serial.hpp"
 #include "random_graph.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 namespace tgraph::replay {
 namespace {

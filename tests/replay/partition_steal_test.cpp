@@ -10,8 +10,8 @@
 
 #include "partition_plan.hpp"
 #include "random_graph.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay {

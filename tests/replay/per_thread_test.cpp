@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "random_graph.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/synthetic.hpp"
 
 namespace tgraph::replay {

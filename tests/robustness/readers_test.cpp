@@ -6,7 +6,7 @@
 #include <string>
 
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 #if defined(TGRAPH_HAVE_VIZ)
 #include "tgraph/viz/report.hpp"
 #include "tgraph/viz/timeline.hpp"
@@ -17,7 +17,7 @@ namespace {
 
 std::string calibration_error(const std::string& text) {
   try {
-    partition::parse_calibration(text, "c.json");
+    model::parse_calibration(text, "c.json");
   } catch (const InputError& e) {
     return e.what();
   }

@@ -18,10 +18,10 @@
 #include "partition_testing.hpp"  // replay/src: the lost-signal fault
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/lowering.hpp"
+#include "tgraph/measure/live.hpp"
 #include "tgraph/partition/strategy.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/measure/live.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/samples/scene.hpp"
 
 namespace tgraph::replay {

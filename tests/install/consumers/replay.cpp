@@ -7,8 +7,8 @@
 
 #include "fork_join.hpp"
 #include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/replay/executor.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/workload.hpp"
 
 namespace {

@@ -1,12 +1,13 @@
 // SPDX-License-Identifier: MIT
-// `tgraph calibrate`: partition's measurements of the machine, and the partition executor's
-// own time per task, which only this module (it runs the executor) can measure.
+// The partition executor's own time per task, which only this module (it runs the executor)
+// can measure, for the model's calibration (tgraph::model::calibrate_machine).
 #pragma once
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::measure {
 
@@ -29,13 +30,15 @@ struct ExecutorOverheadOptions {
 std::vector<double> executor_overhead_samples(std::uint32_t threads,
                                               const ExecutorOverheadOptions& options = {});
 
-/// partition::measure_calibration(options), with the executor's time per task at the same
-/// K (2, 4, ..., the CPUs this process may use; `options.samples` samples each; the median
-/// kept, at least 0) in `executor_overhead`.
-partition::Calibration calibrate_machine(const partition::CalibrateOptions& options = {});
+/// executor_overhead_samples with the default options and `samples` samples: the sampler
+/// model::calibrate_machine takes.
+model::ExecutorOverheadSampler executor_overhead_sampler();
 
-/// calibrate_machine(options), saved to `path` (partition::save_calibration): its report.
-std::string calibrate_file(const partition::CalibrateOptions& options, const std::string& path,
+/// model::calibrate_machine(options) with this module's executor_overhead_sampler.
+model::Calibration calibrate_machine(const model::CalibrateOptions& options = {});
+
+/// `tgraph calibrate`: model::calibrate_file with this module's executor_overhead_sampler.
+std::string calibrate_file(const model::CalibrateOptions& options, const std::string& path,
                            bool json);
 
 }  // namespace tgraph::measure

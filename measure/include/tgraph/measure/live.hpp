@@ -132,8 +132,8 @@ struct IterationDifference {
 struct LiveResult {
   replay::Policy policy = replay::Policy::kPartition;
   std::uint32_t threads = 1;
-  replay::CwMode cw = replay::CwMode::kReduce;
-  replay::ReduceScope scope = replay::ReduceScope::kNone;
+  CwMode cw = CwMode::kReduce;
+  ReduceScope scope = ReduceScope::kNone;
   std::vector<LiveStepMeasure> steps;
   std::vector<std::int64_t> pass_wall_ns;
   /// Uninstrumented engine passes, by core (thread p's core, p < min(threads, 4); one

@@ -49,8 +49,8 @@ struct StepMeasure : StepRecord {
 struct ReplayResult {
   replay::Policy policy = replay::Policy::kPartition;
   std::uint32_t threads = 1;  ///< ExecOptions::threads; 1 for the sequential policy
-  replay::CwMode cw = replay::CwMode::kReduce;             ///< how CW groups ran
-  replay::ReduceScope scope = replay::ReduceScope::kNone;  ///< where their temporaries lived
+  CwMode cw = CwMode::kReduce;             ///< how CW groups ran
+  ReduceScope scope = ReduceScope::kNone;  ///< where their temporaries lived
   std::vector<StepMeasure> steps;
   std::int64_t wall_ns = 0;             ///< median over passes of the pass total
   std::int64_t sequential_wall_ns = 0;  ///< same for sequential

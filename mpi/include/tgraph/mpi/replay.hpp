@@ -28,7 +28,7 @@ class RankWorkload : public replay::Workload {
   explicit RankWorkload(double touch_ns_per_byte) : inner_(options(touch_ns_per_byte)) {}
   /// The step the next run replays (kept by pointer).
   void set_step(const StepGraph& step);
-  void bind(const replay::ExecGraph& exec) override { inner_.bind(exec); }
+  void bind(const ExecGraph& exec) override { inner_.bind(exec); }
   bool needs_touch(DatumId d) const override { return inner_.needs_touch(d); }
   void first_touch(DatumId d) override { inner_.first_touch(d); }
   void run(const replay::TaskRun& r) override;

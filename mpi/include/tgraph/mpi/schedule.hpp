@@ -10,8 +10,8 @@
 #include <tuple>
 #include <vector>
 
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/step_graph.hpp"
-#include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::mpi {
 
@@ -141,12 +141,12 @@ struct StepSchedule {
 /// for `layout`, given who holds each datum's latest version before it (`before`, sized
 /// for at least the step's original data; missing data count as held everywhere).
 /// Channels are taken from (and added to) `channels`.
-StepSchedule schedule_step(const replay::ExecGraph& x, const StepGraph& step, const Layout& layout,
+StepSchedule schedule_step(const ExecGraph& x, const StepGraph& step, const Layout& layout,
                            const Holders& before, ChannelTable& channels);
 
 /// The traffic that schedule_step predicts (the prediction `tgraph-mpi replay` compares with
 /// what it sent).
-Traffic predict_traffic(const replay::ExecGraph& x, const StepGraph& step, const Layout& layout,
+Traffic predict_traffic(const ExecGraph& x, const StepGraph& step, const Layout& layout,
                         const Holders& before);
 
 /// Holders of `data` data with every rank holding everything (a trace's start).

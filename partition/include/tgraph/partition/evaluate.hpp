@@ -9,7 +9,7 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::partition {
 
@@ -54,7 +54,7 @@ struct Report {
 /// not fit the trace (step count, task count, processor range, order). `serial_ns` (when
 /// not null): the main thread's serial work per step that the simulation charges instead
 /// of the host time (simulate()).
-Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& model,
+Report evaluate(const Trace& trace, const TraceAssignment& a, const model::CostModel& model,
                 const std::string& a_name = "<assignment>",
                 const std::vector<std::uint64_t>* serial_ns = nullptr);
 
@@ -62,7 +62,8 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const CostModel& m
 /// charging `serial`'s work per step (none: the trace's host time): report_json and a newline
 /// when `json`, else report_text. InputError for the files, OptionError for `serial`.
 std::string evaluate_files(const std::string& trace, const std::string& assignment,
-                           const CostModel& model, const SerialWork& serial, bool json);
+                           const model::CostModel& model, const model::SerialWork& serial,
+                           bool json);
 
 /// The JSON of an evaluation: the totals' keys, method, k, model, steps, imbalance_max,
 /// cyclic_steps, predicted_speedup_with_partitioning and (when `per_step`) one object per step.

@@ -13,7 +13,7 @@
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 namespace tgraph::partition {
 
@@ -85,7 +85,7 @@ struct Options {
   /// sticky, Scotch repartitioning (rebalance or fallback): emraval, the weight of migrated
   /// load against the cut (quantised to 0.01 by Scotch)
   double migration_cost = 1.0;
-  CostModel model = CostModel::defaults();  ///< list: communication cost estimate
+  model::CostModel model = model::CostModel::defaults();  ///< list: communication cost estimate
   /// Every strategy but list (which orders itself): the order each processor runs its tasks
   TaskOrder order = TaskOrder::kProgram;
 };
@@ -103,7 +103,7 @@ struct NamedOptions {
   std::string calibration;                ///< calibration file ("": the default one if present)
 
   /// The cost model named by `model` and `calibration`.
-  CostModel cost_model() const;
+  model::CostModel cost_model() const;
   /// `values` with the named enumerations and the cost model filled in.
   Options options() const;
 };

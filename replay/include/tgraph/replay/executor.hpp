@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "tgraph/graph/assignment.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/step_graph.hpp"
-#include "tgraph/replay/lowering.hpp"
 #include "tgraph/replay/observer.hpp"
 #include "tgraph/replay/policy.hpp"
 #include "tgraph/replay/workload.hpp"

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/graph/timeline.hpp"
-#include "tgraph/replay/lowering.hpp"
 
 namespace tgraph::replay {
 

@@ -1,11 +1,19 @@
 // SPDX-License-Identifier: MIT
-// Execution policies of the replay executors and how cumulative writes are handled.
+// Execution policies of the replay executors (how cumulative writes are lowered: CwMode and
+// ReduceScope, tgraph/graph/lowering.hpp).
 #pragma once
 
 #include <optional>
 #include <string_view>
 
+#include "tgraph/graph/lowering.hpp"
+
 namespace tgraph::replay {
+
+// Transitional: libgraph's lowering modes under their former replay:: names, for the files
+// of other helpers that still write them (measure/src/adapter.cpp); delete with them.
+using tgraph::CwMode;
+using tgraph::ReduceScope;
 
 /// How the tasks of a step are put on threads.
 enum class Policy : unsigned char {
@@ -21,35 +29,6 @@ enum class Policy : unsigned char {
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);
-
-/// How cumulative (CW) writes by tasks on different threads are made safe.
-enum class CwMode : unsigned char {
-  kReduce = 0,     ///< per-processor temporaries summed by a reducer task in processor order
-  kSerialize = 1,  ///< CW treated as RW: writers run in program order (bit-identical to sequential)
-};
-
-/// "reduce" or "serialize".
-std::string_view to_string(CwMode mode);
-
-/// Where the temporaries of a CW group whose writers may run on different threads live
-/// (CwMode::kReduce).
-enum class ReduceScope : unsigned char {
-  kNone = 0,          ///< no temporaries: the writers run on one thread (sequential)
-  kPerProcessor = 1,  ///< one temporary per processor off the group's home (partition)
-  /// One temporary per writer after the group's first, added in program order (the dynamic
-  /// policies: any writer may run on any thread, the combine stays deterministic).
-  kPerWriter = 2,
-  /// One temporary per executor thread for every writer of the group, added in thread order
-  /// by the reducer (the dynamic policies as their users write them: oneTBB's
-  /// enumerable_thread_specific, OpenMP's `reduction`). Which writers share a temporary is
-  /// the run's: the sum is the sequential one within rounding, not bit for bit.
-  kPerThread = 3,
-};
-
-/// "none", "per-processor", "per-writer" or "per-thread".
-std::string_view to_string(ReduceScope scope);
-/// Inverse of to_string; nullopt for an unknown name.
-std::optional<ReduceScope> parse_reduce_scope(std::string_view name);
 
 /// What one parallel phase of the barrier policy holds (a barrier follows each phase).
 enum class BarrierRule : unsigned char {

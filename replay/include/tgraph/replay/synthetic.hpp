@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 #include "tgraph/replay/workload.hpp"
 
 namespace tgraph::replay {

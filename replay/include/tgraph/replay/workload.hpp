@@ -9,13 +9,16 @@
 
 #include "tgraph/graph/step_graph.hpp"
 
-namespace tgraph::replay {
+namespace tgraph {
+struct ExecGraph;  // tgraph/graph/lowering.hpp
+}  // namespace tgraph
 
-struct ExecGraph;
+namespace tgraph::replay {
 
 /// One execution of one task, as handed to Workload::run.
 struct TaskRun {
-  const ExecGraph* exec = nullptr;  ///< the graph being executed (lowered, see lowering.hpp)
+  const ExecGraph* exec =
+      nullptr;  ///< the graph being executed (lowered: tgraph/graph/lowering.hpp)
   TaskId task = 0;                  ///< task id in exec->graph
   TaskId origin = kNoTask;          ///< task id in the original step, kNoTask for a reducer
   std::uint32_t iteration = 0;      ///< loop iteration (0 outside loops)

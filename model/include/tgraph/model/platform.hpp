@@ -7,9 +7,9 @@
 #include <string>
 #include <string_view>
 
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 /// N identical nodes of C cores each. Processor p of an assignment runs on core p % C of
 /// node p / C.
@@ -56,4 +56,4 @@ std::string write_platform(const std::string& output, std::uint64_t nodes, std::
 inline constexpr std::string_view kSimgridNetworkConfig[] = {
     "network/model:CM02", "network/crosstraffic:0", "network/TCP-gamma:0"};
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

@@ -7,21 +7,21 @@
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <xbt/log.h>
 
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <simgrid/s4u.hpp>
-#include <xbt/log.h>
 #include <stdexcept>
 #include <string>
 
 #include "simgrid_engine.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
-#include "tgraph/partition/simulation.hpp"
+#include "tgraph/model/simulation.hpp"
 
-namespace tgraph::partition::detail {
+namespace tgraph::model::detail {
 
 namespace {
 
@@ -71,7 +71,8 @@ void send_message(int fd, char tag, const std::string& text) {
       engine.load_platform(file);
     } catch (const std::exception& e) {
       if (!temp.empty()) ::unlink(temp.c_str());
-      send_message(fd, kInputError, "SimGrid cannot load this platform (" + std::string(e.what()) + ")");
+      send_message(fd, kInputError,
+                   "SimGrid cannot load this platform (" + std::string(e.what()) + ")");
       ::_exit(0);
     }
     if (!temp.empty()) ::unlink(temp.c_str());
@@ -110,7 +111,8 @@ std::string last_line(std::FILE* f) {
   std::size_t end = text.find_last_not_of(" \n\r\t");
   if (end == std::string::npos) return "";
   const std::size_t begin = text.rfind('\n', end);
-  return text.substr(begin == std::string::npos ? 0 : begin + 1, end + 1 - (begin == std::string::npos ? 0 : begin + 1));
+  return text.substr(begin == std::string::npos ? 0 : begin + 1,
+                     end + 1 - (begin == std::string::npos ? 0 : begin + 1));
 }
 
 // One line: SimGrid's messages may span several.
@@ -171,16 +173,19 @@ Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
       throw InputError(platform.file, std::nullopt, one_line(rest.substr(1)));
     throw Error(one_line(rest.substr(1)));
   }
-  if (!rest.empty() && rest[0] == kFailure) throw std::runtime_error("simgrid: " + one_line(rest.substr(1)));
+  if (!rest.empty() && rest[0] == kFailure)
+    throw std::runtime_error("simgrid: " + one_line(rest.substr(1)));
   const std::size_t step_bytes = 5 * sizeof(std::uint64_t);
   if (rest.empty() || rest[0] != kResult || rest.size() < 1 + 2 * sizeof(std::uint64_t) ||
       (rest.size() - 1 - 2 * sizeof(std::uint64_t)) % step_bytes != 0) {
-    const std::string why = "SimGrid ended " +
-                            (WIFSIGNALED(status) ? "with signal " + std::to_string(WTERMSIG(status))
-                                                 : "with status " + std::to_string(WEXITSTATUS(status))) +
-                            (said.empty() ? "" : ": " + said);
+    const std::string why =
+        "SimGrid ended " +
+        (WIFSIGNALED(status) ? "with signal " + std::to_string(WTERMSIG(status))
+                             : "with status " + std::to_string(WEXITSTATUS(status))) +
+        (said.empty() ? "" : ": " + said);
     if (!loaded && !platform.file.empty())
-      throw InputError(platform.file, std::nullopt, "SimGrid cannot load this platform (" + why + ")");
+      throw InputError(platform.file, std::nullopt,
+                       "SimGrid cannot load this platform (" + why + ")");
     throw std::runtime_error("simulate on " + where + ": " + why);
   }
   Prediction r;
@@ -201,4 +206,4 @@ Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
   return r;
 }
 
-}  // namespace tgraph::partition::detail
+}  // namespace tgraph::model::detail

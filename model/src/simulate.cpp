@@ -1,14 +1,12 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/measure/lowered.hpp"
+#include "tgraph/model/simulate.hpp"
 
 #include <algorithm>
 
 #include "tgraph/graph/error.hpp"
-#include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/assignment_io.hpp"
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
-namespace tgraph::measure {
+namespace tgraph::model {
 
 LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment) {
   LoweredTrace out;
@@ -20,8 +18,7 @@ LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment) 
   for (std::size_t s = 0; s < steps; ++s) {
     Assignment a = assignment.steps[s];
     a.order.clear();  // as tgraph-mpi replay: each processor in program order
-    replay::ExecGraph x = replay::lower(trace.steps[s], &a, replay::CwMode::kReduce,
-                                        replay::ReduceScope::kPerProcessor);
+    ExecGraph x = tgraph::lower(trace.steps[s], &a, CwMode::kReduce, ReduceScope::kPerProcessor);
     x.graph.host_ns = trace.steps[s].host_ns;
     x.assignment.k = assignment.k;
     out.trace.steps.push_back(std::move(x.graph));
@@ -31,35 +28,37 @@ LoweredTrace lower_trace(const Trace& trace, const TraceAssignment& assignment) 
   return out;
 }
 
-partition::Prediction simulate(const Trace& trace, const TraceAssignment& assignment,
-                               partition::SimulationEngine engine,
-                               const partition::SimulatedPlatform& platform, bool lower) {
-  if (!lower) return partition::simulate_trace(trace, assignment, engine, platform);
+Prediction simulate(const Trace& trace, const TraceAssignment& assignment, SimulationEngine engine,
+                    const SimulatedPlatform& platform, bool lower) {
+  if (!lower) return simulate_trace(trace, assignment, engine, platform);
   const LoweredTrace low = lower_trace(trace, assignment);
-  partition::Prediction r = partition::simulate_trace(low.trace, low.assignment, engine, platform);
+  Prediction r = simulate_trace(low.trace, low.assignment, engine, platform);
   r.lowered = true;
   return r;
 }
 
-std::string simulate_command(const SimulateCommand& c) {
-  using partition::SimulationEngine;
-  partition::SimulatedPlatform p;
-  p.model = c.model.cost_model();
-  if (!c.cluster.empty()) p.cluster = partition::parse_cluster(c.cluster);
+SimulatedPlatform simulated_platform(const SimulateCommand& c) {
+  SimulatedPlatform p;
+  p.model = c.model;
+  if (!c.cluster.empty()) p.cluster = parse_cluster(c.cluster);
   p.file = c.platform;
   p.intra_node = c.intra_node;
   if (c.engine == SimulationEngine::builtin && !p.file.empty())
     throw OptionError("platform",
                       "the builtin engine has no platform model (use {engine} simgrid)");
-  const Trace trace = read_trace(c.trace);
-  const TraceAssignment as = partition::load_assignment(c.assignment, trace, c.trace);
+  return p;
+}
+
+std::string simulate_command(const SimulateCommand& c, const SimulatedPlatform& platform,
+                             const Trace& trace, const TraceAssignment& as) {
+  SimulatedPlatform p = platform;
   p.serial_ns = c.serial.per_step(trace.steps.size());
   if (!p.serial_ns.empty() && c.engine != SimulationEngine::builtin)
     throw UsageError("",
                      "{live}/{serial_ns}: only the builtin engine charges the main thread's work",
                      kNamesFields);
-  const partition::Prediction r = simulate(trace, as, c.engine, p, c.lower);
-  return c.json ? partition::prediction_json(r) + "\n" : partition::prediction_text(r);
+  const Prediction r = simulate(trace, as, c.engine, p, c.lower);
+  return c.json ? prediction_json(r) + "\n" : prediction_text(r);
 }
 
-}  // namespace tgraph::measure
+}  // namespace tgraph::model

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/partition/simulation.hpp"
+#include "tgraph/model/simulation.hpp"
 
-namespace tgraph::partition::detail {
+namespace tgraph::model::detail {
 
 /// What one simulation of a trace on the loaded platform gives: per-step predictions, or
 /// the reason the platform cannot run the assignment (`input_error`).
@@ -25,4 +25,4 @@ struct PlatformRun {
 PlatformRun run_on_loaded_platform(const Trace& trace, const TraceAssignment& a,
                                    const SimulatedPlatform& platform);
 
-}  // namespace tgraph::partition::detail
+}  // namespace tgraph::model::detail

@@ -16,9 +16,9 @@
 #include <thread>
 #include <vector>
 
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 namespace {
 
@@ -115,7 +115,8 @@ double measure_per_byte(int cpu_a, int cpu_b, std::size_t bytes, int repeats) {
   pin(b, cpu_b);
   std::thread a([&] {
     for (int r = 0; r < repeats; ++r) {
-      for (std::size_t i = 0; i < words; ++i) buf[i] = i * 2654435761u + static_cast<std::uint64_t>(r);
+      for (std::size_t i = 0; i < words; ++i)
+        buf[i] = i * 2654435761u + static_cast<std::uint64_t>(r);
       go.value.store(static_cast<std::uint64_t>(r + 1), std::memory_order_release);
       while (done.value.load(std::memory_order_acquire) != static_cast<std::uint64_t>(r + 1)) {
       }
@@ -148,8 +149,8 @@ double measure_park_wake(int cpu_a, int cpu_b, int rounds) {
       // acquire: A's clock reading before its store is visible after.
       for (std::uint32_t v = word.load(std::memory_order_acquire); v != want;
            v = word.load(std::memory_order_acquire))
-        syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, v,
-                nullptr, nullptr, 0);
+        syscall(SYS_futex, reinterpret_cast<std::uint32_t*>(&word), FUTEX_WAIT_PRIVATE, v, nullptr,
+                nullptr, 0);
       woke[static_cast<std::size_t>(i)] = ns();
       // release: B's reading is visible to A once it sees the acknowledgement.
       ack.value.store(static_cast<std::uint64_t>(i + 1), std::memory_order_release);
@@ -175,8 +176,8 @@ double measure_park_wake(int cpu_a, int cpu_b, int rounds) {
   b.join();
   std::vector<double> d;
   for (int i = 0; i < rounds; ++i)
-    d.push_back(static_cast<double>(woke[static_cast<std::size_t>(i)] -
-                                    sent[static_cast<std::size_t>(i)]));
+    d.push_back(
+        static_cast<double>(woke[static_cast<std::size_t>(i)] - sent[static_cast<std::size_t>(i)]));
   return median(d);
 }
 
@@ -297,7 +298,7 @@ double reduction_round_ns(const std::vector<int>& cpus, std::size_t k, int round
             std::uint64_t sum = 0;
             for (std::size_t q = 0; q < k; ++q)
               sum += partial[q].value.load(std::memory_order_relaxed);  // ordered above
-            result.value.store(sum, std::memory_order_relaxed);  // relaxed: published below
+            result.value.store(sum, std::memory_order_relaxed);         // relaxed: published below
             // release: the sum is visible to every thread that sees round + 1.
             published.value.store(round + 1, std::memory_order_release);
           }
@@ -307,8 +308,7 @@ double reduction_round_ns(const std::vector<int>& cpus, std::size_t k, int round
         }
         const auto t1 = Clock::now();
         if (t == 0 && blk >= 0)
-          per_block.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() /
-                              kBlock);
+          per_block.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count() / kBlock);
       }
     });
     pin(threads.back(), cpus[t]);
@@ -326,8 +326,8 @@ void interruption_gaps(const std::vector<int>& cpus, std::size_t k, double ns,
   std::vector<std::vector<double>> found(k);
   std::vector<double> length(k, 0);
   std::vector<std::thread> threads;
-  const auto duration = std::chrono::duration_cast<Clock::duration>(
-      std::chrono::duration<double, std::nano>(ns));
+  const auto duration =
+      std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double, std::nano>(ns));
   for (std::size_t t = 0; t < k; ++t) {
     threads.emplace_back([&, t] {
       std::vector<double> mine;
@@ -409,7 +409,8 @@ Calibration measure_calibration(const CalibrateOptions& options) {
     spans[i].assign(ks[i], 0.0);
   }
   // Bytes one pass of the memory body touches (each word once: read, or read and written).
-  const double pass_bytes = static_cast<double>(std::max<std::size_t>(c.inflation_bytes / 8, 4096) * 8);
+  const double pass_bytes =
+      static_cast<double>(std::max<std::size_t>(c.inflation_bytes / 8, 4096) * 8);
   const int rounds = std::max(options.inflation_rounds, 1), passes = 20;
   for (int sample = 0; sample < c.samples; ++sample) {
     latency.push_back(measure_latency(c.cpu_a, c.cpu_b, c.rounds));
@@ -485,4 +486,27 @@ Calibration measure_calibration(const CalibrateOptions& options) {
   return c;
 }
 
-}  // namespace tgraph::partition
+Calibration calibrate_machine(const CalibrateOptions& options,
+                              const ExecutorOverheadSampler& sampler) {
+  Calibration c = measure_calibration(options);
+  const auto start = std::chrono::steady_clock::now();
+  const auto samples = static_cast<std::uint32_t>(std::max(c.samples, 1));
+  // The same K as the inflation's (its curve lists 1 first).
+  for (const ThreadsPoint& p : c.inflation) {
+    if (p.threads < 2) continue;
+    const Spread s = spread_of(sampler(p.threads, samples));
+    c.executor_overhead_spread.push_back({p.threads, s});
+    // Below 0 is the noise of a machine on which the executor costs nothing measurable.
+    c.executor_overhead.push_back({p.threads, std::max(0.0, s.median)});
+  }
+  c.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return c;
+}
+
+std::string calibrate_file(const CalibrateOptions& options, const std::string& path, bool json,
+                           const ExecutorOverheadSampler& sampler) {
+  const Calibration c = calibrate_machine(options, sampler);  // runtime_error: the work's
+  return calibration_report(c, save_calibration(c, path), json);
+}
+
+}  // namespace tgraph::model

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 CostModel CostModel::ideal() {
   CostModel m;
@@ -56,8 +56,7 @@ double CostModel::compute_inflation_at(double busy) const {
 double CostModel::task_inflation(double busy, double cost_ns, double bytes) const {
   if (inflation_ns_per_byte <= 0 || cost_ns <= 0) return inflation_at(busy);
   const double memory = std::min(cost_ns, bytes * inflation_ns_per_byte);
-  return (memory * inflation_at(busy) + (cost_ns - memory) * compute_inflation_at(busy)) /
-         cost_ns;
+  return (memory * inflation_at(busy) + (cost_ns - memory) * compute_inflation_at(busy)) / cost_ns;
 }
 
 const ThreadInterruptions* CostModel::interruptions_at(std::uint32_t k, std::uint32_t p) const {
@@ -163,10 +162,9 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   auto curve = [&](const char* key, const char* value_key, double min_value) {
     std::vector<ThreadsPoint> out;
     const nlohmann::json& list = j[key];
-    const std::string what = std::string("expected \"") + key +
-                             "\" as a list of {\"threads\": K, \"" + value_key +
-                             "\": v} with K rising from 1 and v in [" +
-                             (min_value > 0 ? "0.001" : "0") + ", 1e9]";
+    const std::string what =
+        std::string("expected \"") + key + "\" as a list of {\"threads\": K, \"" + value_key +
+        "\": v} with K rising from 1 and v in [" + (min_value > 0 ? "0.001" : "0") + ", 1e9]";
     if (!list.is_array() || list.size() > 1024) throw InputError(name, std::nullopt, what);
     for (const nlohmann::json& e : list) {
       if (!e.is_object() || !e.contains("threads") || !e["threads"].is_number_integer() ||
@@ -184,9 +182,10 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   CostModel m;
   // Files written before "spin_handoff_ns" existed have only "sync_latency_ns" (the same
   // measurement); either names the spinning hand-off.
-  m.sync_latency_ns = j.is_object() && !j.contains("sync_latency_ns") && j.contains("spin_handoff_ns")
-                          ? number("spin_handoff_ns")
-                          : number("sync_latency_ns");
+  m.sync_latency_ns =
+      j.is_object() && !j.contains("sync_latency_ns") && j.contains("spin_handoff_ns")
+          ? number("spin_handoff_ns")
+          : number("sync_latency_ns");
   m.per_byte_ns = number("per_byte_ns");
   // The terms of issue 39 are optional: an older file predicts as it did.
   if (j.contains("park_wake_ns")) m.park_wake_ns = number("park_wake_ns");
@@ -194,10 +193,10 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
   if (j.contains("inflation")) m.inflation = curve("inflation", "factor", 0.001);
   if (j.contains("compute_inflation"))
     m.compute_inflation = curve("compute_inflation", "factor", 0.001);
-  if (j.contains("inflation_ns_per_byte")) m.inflation_ns_per_byte = number("inflation_ns_per_byte");
+  if (j.contains("inflation_ns_per_byte"))
+    m.inflation_ns_per_byte = number("inflation_ns_per_byte");
   if (j.contains("reduction")) m.reduction = curve("reduction", "ns", 0.0);
-  if (j.contains("executor_overhead"))
-    m.executor_overhead = curve("executor_overhead", "ns", 0.0);
+  if (j.contains("executor_overhead")) m.executor_overhead = curve("executor_overhead", "ns", 0.0);
   if (j.contains("interruptions")) {
     const std::string what =
         "expected \"interruptions\" as a list of {\"threads\": K, \"cpus\": [{\"lost\": "
@@ -211,12 +210,14 @@ CostModel parse_calibration(std::string_view text, const std::string& name) {
         throw bad();
       const auto k = e["threads"].get<std::int64_t>();
       if (k < 1 || k > 65536 ||
-          (!m.interruptions.empty() && static_cast<std::uint32_t>(k) <= m.interruptions.back().threads))
+          (!m.interruptions.empty() &&
+           static_cast<std::uint32_t>(k) <= m.interruptions.back().threads))
         throw bad();
       InterruptionsPoint point{static_cast<std::uint32_t>(k), {}};
       for (const nlohmann::json& c : e["cpus"]) {
         if (!c.is_object() || !c.contains("lost") || !c["lost"].is_number() ||
-            !c.contains("lengths_ns") || !c["lengths_ns"].is_array() || c["lengths_ns"].size() > 1024)
+            !c.contains("lengths_ns") || !c["lengths_ns"].is_array() ||
+            c["lengths_ns"].size() > 1024)
           throw bad();
         ThreadInterruptions t;
         t.lost = c["lost"].get<double>();
@@ -250,8 +251,9 @@ std::vector<std::uint64_t> load_serial_work(const std::string& path) {
   } catch (const nlohmann::json::exception&) {
     throw InputError(path, std::nullopt, "expected a live run's JSON report (malformed JSON)");
   }
-  const char* what = "expected a live run's JSON report: per_step[] with record_ns, "
-                     "partition_ns and prepare_ns";
+  const char* what =
+      "expected a live run's JSON report: per_step[] with record_ns, "
+      "partition_ns and prepare_ns";
   if (!j.is_object() || !j.contains("per_step") || !j["per_step"].is_array())
     throw InputError(path, std::nullopt, what);
   std::vector<std::uint64_t> out;
@@ -291,8 +293,7 @@ std::string calibration_json(const Calibration& c) {
     j["inflation_ns_per_byte"] = c.inflation_ns_per_byte;
   }
   j["reduction"] = curve_json(c.reduction, "ns");
-  if (!c.executor_overhead.empty())
-    j["executor_overhead"] = curve_json(c.executor_overhead, "ns");
+  if (!c.executor_overhead.empty()) j["executor_overhead"] = curve_json(c.executor_overhead, "ns");
   if (!c.interruptions.empty()) {
     j["interruptions"] = nlohmann::json::array();
     for (const InterruptionsPoint& p : c.interruptions) {
@@ -391,8 +392,8 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
     std::snprintf(b, sizeof b, fmt, s.max);
     return std::string(what) + " " + a + "-" + b;
   };
-  out += "spread over " + std::to_string(c.samples) + " samples: " +
-         range("spinning", c.latency_spread, "%.1f") + " ns, " +
+  out += "spread over " + std::to_string(c.samples) +
+         " samples: " + range("spinning", c.latency_spread, "%.1f") + " ns, " +
          range("parked", c.park_wake_spread, "%.0f") + " ns, " +
          range("transfer", c.per_byte_spread, "%.4f") + " ns/byte";
   for (const CurveSpread& p : c.inflation_spread) {
@@ -401,8 +402,8 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
     out += line;
   }
   for (const CurveSpread& p : c.compute_inflation_spread) {
-    std::snprintf(line, sizeof line, ", compute inflation at %u %.3f-%.3f", p.threads,
-                  p.spread.min, p.spread.max);
+    std::snprintf(line, sizeof line, ", compute inflation at %u %.3f-%.3f", p.threads, p.spread.min,
+                  p.spread.max);
     out += line;
   }
   for (const CurveSpread& p : c.executor_overhead_spread) {
@@ -415,4 +416,4 @@ std::string calibration_report(const Calibration& c, const std::string& path, bo
   return out + line + "wrote " + path + "\n";
 }
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

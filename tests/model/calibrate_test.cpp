@@ -1,22 +1,20 @@
 // SPDX-License-Identifier: MIT
 // measure_calibration (`tgraph calibrate`): what it reports when the machine cannot be measured.
 #include <gtest/gtest.h>
-
-#include <algorithm>
 #include <pthread.h>
 #include <sched.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
-
 #include <stdexcept>
 #include <string>
 #include <thread>
 
 #include "../quick_calibration.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 namespace {
 
 // On one CPU there is nothing to measure: a failure of the work (exit 1 on the command
@@ -112,4 +110,4 @@ TEST(Calibration, ReportsTheMedianOfItsSamplesAndTheirSpread) {
 }
 
 }  // namespace
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

@@ -1,27 +1,31 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/partition/simulation.hpp"
+#include "tgraph/model/simulation.hpp"
 
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/simulator.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 std::string to_string(SimulationEngine e) {
   switch (e) {
-    case SimulationEngine::builtin: return "builtin";
-    case SimulationEngine::simgrid: return "simgrid";
+    case SimulationEngine::builtin:
+      return "builtin";
+    case SimulationEngine::simgrid:
+      return "simgrid";
   }
   return "?";
 }
 
 std::string to_string(IntraNodeTransfer t) {
   switch (t) {
-    case IntraNodeTransfer::reader: return "reader";
-    case IntraNodeTransfer::link: return "link";
+    case IntraNodeTransfer::reader:
+      return "reader";
+    case IntraNodeTransfer::link:
+      return "link";
   }
   return "?";
 }
@@ -153,4 +157,4 @@ std::string prediction_text(const Prediction& p) {
   return out;
 }
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

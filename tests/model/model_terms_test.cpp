@@ -11,16 +11,18 @@
 #include "test_graphs.hpp"
 #include "test_model.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/model/simulator.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 namespace {
 
-using testing::assign;
-using testing::Builder;
-using testing::M;
-using testing::model;
+using namespace tgraph::partition;  // the strategies that place the tasks
+
+using model::testing::link_model;
+using partition::testing::assign;
+using partition::testing::Builder;
+using partition::testing::M;
 
 // t0 (cost 1000) writes x; t1 (cost 100) reads it.
 StepGraph producer_consumer() {
@@ -41,7 +43,7 @@ StepGraph two_independent() {
 }
 
 TEST(ModelTerms, AWaitPastTheSpinBudgetAddsTheWakeUp) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   m.spin_budget_ns = 200;
   // Without the term: p1 waits 0 -> 1010 and starts at 1000 + 10.
   const Schedule spin = simulate(producer_consumer(), assign(2, {0, 1}), m);
@@ -62,7 +64,7 @@ TEST(ModelTerms, AWaitPastTheSpinBudgetAddsTheWakeUp) {
 }
 
 TEST(ModelTerms, InflationTwoAtTwoBusyProcessorsDoublesABody) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   m.inflation = {{1, 1.0}, {2, 2.0}};
   // Both bodies run at once on two processors: each takes 2 x 1000.
   const Schedule both = simulate(two_independent(), assign(2, {0, 1}), m);
@@ -86,7 +88,7 @@ StepGraph two_independent_of_1000_bytes() {
 }
 
 TEST(ModelTerms, InflationScalesATasksMemoryShareByTheMemoryCurveAndTheRestByTheComputeCurve) {
-  CostModel m = model(0);
+  CostModel m = link_model(0);
   m.inflation = {{1, 1.0}, {2, 2.0}};
   m.compute_inflation = {{1, 1.0}, {2, 1.0}};
   // 1000 bytes at 0.5 ns/byte: half of each 1000 ns body is memory, doubled; the other
@@ -119,7 +121,7 @@ TEST(ModelTerms, InflationScalesABodyByTheMeanBusyCountDuringIt) {
   const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
   b.task({{x, M::W}}, 1000);
   b.task({{y, M::W}}, 500);
-  CostModel m = model(0);
+  CostModel m = link_model(0);
   m.inflation = {{1, 1.0}, {2, 2.0}};
   const Schedule s = simulate(b.done(), assign(2, {0, 1}), m);
   // Mean busy 1.5 -> factor 1.5 for t0; 2 -> factor 2 for t1.
@@ -139,7 +141,7 @@ TEST(ModelTerms, InflationCurveInterpolatesAndHoldsItsLastPoint) {
 }
 
 TEST(ModelTerms, TheExecutorsTimePerTaskIsChargedAtItsProcessorCountOnly) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   m.executor_overhead = {{2, 40}, {4, 100}};
   // Two processors: each instance takes its cost plus 40 ns.
   const Schedule two = simulate(two_independent(), assign(2, {0, 1}), m);
@@ -171,7 +173,7 @@ StepGraph one_task(std::uint64_t cost) {
 }
 
 TEST(ModelTerms, InterruptionsTakeTheirShareOfAProcessorsTimeInGapsOfTheMeasuredLengths) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   // One thread busy: 5 % of its time lost in gaps of 50 us.
   m.interruptions = {{1, {{0.05, {50'000}}}}};
   // A 1 s body is lengthened by whole gaps, about lost / (1 - lost) of it: 52.6 ms (the
@@ -198,7 +200,7 @@ TEST(ModelTerms, InterruptionsTakeTheirShareOfAProcessorsTimeInGapsOfTheMeasured
 }
 
 TEST(ModelTerms, AnInterruptedProcessorStallsTheOneThatWaitsForIt) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   // At two busy threads only the second CPU is interrupted.
   m.interruptions = {{1, {{0.0, {}}}}, {2, {{0.0, {}}, {0.1, {20'000, 40'000}}}}};
   // A 100 ms producer on p1 and its consumer on p0: the consumer starts when the
@@ -224,7 +226,8 @@ TEST(ModelTerms, AnInterruptedProcessorStallsTheOneThatWaitsForIt) {
 TEST(ModelTerms, InterruptionsAtKBusyProcessorsComeFromTheMostThreadsMeasuredUpToK) {
   CostModel m;
   EXPECT_EQ(m.interruptions_at(2, 0), nullptr);
-  m.interruptions = {{1, {{0.01, {6000}}}}, {2, {{0.02, {7000}}, {0.03, {8000}}}},
+  m.interruptions = {{1, {{0.01, {6000}}}},
+                     {2, {{0.02, {7000}}, {0.03, {8000}}}},
                      {4, {{0.04, {9000}}, {0.0, {9000}}}}};
   EXPECT_DOUBLE_EQ(m.interruptions_at(1, 0)->lost, 0.01);
   EXPECT_DOUBLE_EQ(m.interruptions_at(2, 1)->lost, 0.03);
@@ -237,7 +240,7 @@ TEST(ModelTerms, InterruptionsAtKBusyProcessorsComeFromTheMostThreadsMeasuredUpT
 }
 
 TEST(ModelTerms, GivenSerialWorkRunsBeforeTheTasksAndWakesTheOthers) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   m.spin_budget_ns = 200;
   m.park_wake_ns = 50;
   // 300 ns of the main thread's work (past the budget): p0 starts at 300, p1 is woken 50
@@ -252,28 +255,28 @@ TEST(ModelTerms, GivenSerialWorkRunsBeforeTheTasksAndWakesTheOthers) {
   StepGraph g = two_independent();
   g.host_ns = 5000;
   EXPECT_EQ(simulate(g, assign(2, {0, 1}), m, 100).makespan_ns, 1100u);
-  EXPECT_EQ(simulate(g, assign(2, {0, 1}), model(10)).makespan_ns, 6000u);
+  EXPECT_EQ(simulate(g, assign(2, {0, 1}), link_model(10)).makespan_ns, 6000u);
 }
 
 TEST(ModelTerms, NamesTheTermsAPredictionCharges) {
-  CostModel m = model(10);
+  CostModel m = link_model(10);
   EXPECT_EQ(model_terms(m, false, false), (std::vector<std::string>{"sync_latency", "per_byte"}));
   m.park_wake_ns = 5000;
   m.inflation = {{1, 1.0}, {2, 1.1}};
   m.task_overhead_ns = 3;
   m.executor_overhead = {{2, 150}};
-  EXPECT_EQ(model_terms(m, true, true),
-            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead",
-                                      "executor_overhead", "park_wake", "inflation",
-                                      "serial_main_thread"}));
+  EXPECT_EQ(
+      model_terms(m, true, true),
+      (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead", "executor_overhead",
+                                "park_wake", "inflation", "serial_main_thread"}));
   m.compute_inflation = {{1, 1.0}, {2, 1.01}};
   m.inflation_ns_per_byte = 0.05;
-  EXPECT_EQ(model_terms(m, false, false),
-            (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead",
-                                      "executor_overhead", "park_wake", "inflation",
-                                      "compute_inflation", "memory_share"}));
+  EXPECT_EQ(
+      model_terms(m, false, false),
+      (std::vector<std::string>{"sync_latency", "per_byte", "task_overhead", "executor_overhead",
+                                "park_wake", "inflation", "compute_inflation", "memory_share"}));
   EXPECT_EQ(model_terms(CostModel::ideal(), false, true), (std::vector<std::string>{"host_time"}));
-  m = model(10);
+  m = link_model(10);
   m.interruptions = {{1, {{0.02, {7000}}}}};
   EXPECT_EQ(model_terms(m, false, false),
             (std::vector<std::string>{"sync_latency", "per_byte", "interruptions"}));
@@ -329,16 +332,17 @@ TEST(CalibrationFile, NewKeysRoundTripThroughTheFile) {
 }
 
 TEST(CalibrationFile, RejectsACurveThatIsNotOne) {
-  for (const char* bad : {R"("inflation": 3)", R"("inflation": [{"threads": 2}])",
-                          R"("inflation": [{"threads": 2, "factor": 1.1}, {"threads": 1, "factor": 1}])",
-                          R"("inflation": [{"threads": 0, "factor": 1}])",
-                          R"("inflation": [{"threads": 2, "factor": -1}])",
-                          R"("executor_overhead": [{"threads": 2, "factor": 1}])",
-                          R"("executor_overhead": [{"threads": 2, "ns": -5}])",
-                          R"("interruptions": [{"threads": 1}])",
-                          R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.7, "lengths_ns": []}]}])",
-                          R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.1, "lengths_ns": [-1]}]}])",
-                          R"("interruptions": [{"threads": 2, "cpus": []}, {"threads": 2, "cpus": []}])"}) {
+  for (const char* bad :
+       {R"("inflation": 3)", R"("inflation": [{"threads": 2}])",
+        R"("inflation": [{"threads": 2, "factor": 1.1}, {"threads": 1, "factor": 1}])",
+        R"("inflation": [{"threads": 0, "factor": 1}])",
+        R"("inflation": [{"threads": 2, "factor": -1}])",
+        R"("executor_overhead": [{"threads": 2, "factor": 1}])",
+        R"("executor_overhead": [{"threads": 2, "ns": -5}])",
+        R"("interruptions": [{"threads": 1}])",
+        R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.7, "lengths_ns": []}]}])",
+        R"("interruptions": [{"threads": 1, "cpus": [{"lost": 0.1, "lengths_ns": [-1]}]}])",
+        R"("interruptions": [{"threads": 2, "cpus": []}, {"threads": 2, "cpus": []}])"}) {
     const std::string text =
         std::string(R"({"sync_latency_ns": 80, "per_byte_ns": 0.04, )") + bad + "}";
     try {
@@ -379,4 +383,4 @@ TEST(SerialWork, ReadsRecordPartitionAndPrepareOfALiveRunPerStep) {
 }
 
 }  // namespace
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

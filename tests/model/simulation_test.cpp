@@ -3,6 +3,8 @@
 // XML, exact transfer costs on SimGrid, agreement of SimGrid with the built-in simulator on
 // one host (random graphs; bars64 and falling in tests/measure/simgrid_agreement_test.cpp),
 // bad platforms and assignments.
+#include "tgraph/model/simulation.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,19 +13,20 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 
+#include "../scratch_dir.hpp"
 #include "test_graphs.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/platform.hpp"
-#include "tgraph/partition/simulation.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/platform.hpp"
+#include "tgraph/model/simulator.hpp"
 #include "tgraph/partition/strategy.hpp"
-#include "../scratch_dir.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 namespace {
 
-using testing::Builder;
-using testing::M;
+using namespace tgraph::partition;  // the strategies that place the tasks
+
+using partition::testing::Builder;
+using partition::testing::M;
 
 SimulatedPlatform on_cluster(ClusterShape c, const CostModel& m,
                              IntraNodeTransfer intra = IntraNodeTransfer::reader) {
@@ -121,30 +124,34 @@ TEST(Calibration, InterNodeFieldsAreOptionalWithDefaults) {
       "c");
   EXPECT_EQ(mpi.mpi_latency_ns, 2500);
   EXPECT_EQ(mpi.mpi_per_byte_ns, 0.2);
-  EXPECT_THROW(parse_calibration(R"({"sync_latency_ns": 1, "per_byte_ns": 0, "mpi_latency_ns": -1})", "c"),
-               InputError);
+  EXPECT_THROW(
+      parse_calibration(R"({"sync_latency_ns": 1, "per_byte_ns": 0, "mpi_latency_ns": -1})", "c"),
+      InputError);
 }
 
 TEST(Calibration, TaskOverheadIsOptionalAndZeroByDefault) {
-  EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03})", "c").task_overhead_ns,
-            0.0);
+  EXPECT_EQ(
+      parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03})", "c").task_overhead_ns,
+      0.0);
   EXPECT_EQ(CostModel::ideal().task_overhead_ns, 0.0);
-  EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "task_overhead_ns": 61.5})",
-                              "c")
+  EXPECT_EQ(parse_calibration(
+                R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "task_overhead_ns": 61.5})", "c")
                 .task_overhead_ns,
             61.5);
   EXPECT_EQ(parse_calibration(R"({"sync_latency_ns": 70, "per_byte_ns": 0.03})", "c")
                 .mpi_message_overhead_ns,
             0.0);
-  EXPECT_EQ(parse_calibration(
-                R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "mpi_message_overhead_ns": 412.5})",
-                "c")
-                .mpi_message_overhead_ns,
-            412.5);
+  EXPECT_EQ(
+      parse_calibration(
+          R"({"sync_latency_ns": 70, "per_byte_ns": 0.03, "mpi_message_overhead_ns": 412.5})", "c")
+          .mpi_message_overhead_ns,
+      412.5);
+  EXPECT_THROW(
+      parse_calibration(
+          R"({"sync_latency_ns": 1, "per_byte_ns": 0, "mpi_message_overhead_ns": -3})", "c"),
+      InputError);
   EXPECT_THROW(parse_calibration(
-                   R"({"sync_latency_ns": 1, "per_byte_ns": 0, "mpi_message_overhead_ns": -3})", "c"),
-               InputError);
-  EXPECT_THROW(parse_calibration(R"({"sync_latency_ns": 1, "per_byte_ns": 0, "task_overhead_ns": "x"})", "c"),
+                   R"({"sync_latency_ns": 1, "per_byte_ns": 0, "task_overhead_ns": "x"})", "c"),
                InputError);
 }
 
@@ -202,9 +209,8 @@ TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
   // One node of two cores: the loopback link, the bytes paid by the reader or the link.
   const double inside = 300 + 1000 + 100 + (1 << 20) * 0.05 + 2000;
   for (IntraNodeTransfer mode : {IntraNodeTransfer::reader, IntraNodeTransfer::link}) {
-    const Prediction in = simulate_trace(
-        t, a, SimulationEngine::simgrid,
-        on_cluster(ClusterShape{1, 2}, m, mode));
+    const Prediction in =
+        simulate_trace(t, a, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, m, mode));
     ASSERT_EQ(in.steps.size(), 1u);
     EXPECT_NEAR(static_cast<double>(in.steps[0].makespan_ns), inside, 2) << to_string(mode);
     EXPECT_EQ(in.steps[0].bytes, 1u << 20);
@@ -214,8 +220,8 @@ TEST(SimgridEngine, ChargesLatencyPlusSizeOverBandwidthInsideAndBetweenNodes) {
   const Prediction builtin = simulate_trace(t, a, SimulationEngine::builtin, on_file("", m));
   EXPECT_NEAR(static_cast<double>(builtin.steps[0].makespan_ns), inside, 2);
   // Two nodes of one core: two private links, the MPI latency and bandwidth.
-  const Prediction between = simulate_trace(t, a, SimulationEngine::simgrid,
-                                            on_cluster(ClusterShape{2, 1}, m));
+  const Prediction between =
+      simulate_trace(t, a, SimulationEngine::simgrid, on_cluster(ClusterShape{2, 1}, m));
   EXPECT_NEAR(static_cast<double>(between.steps[0].makespan_ns),
               300 + 1000 + 2000 + (1 << 20) * 0.5 + 2000, 2);
   EXPECT_EQ(between.steps[0].inter_node_messages, 1u);
@@ -293,10 +299,11 @@ TEST(SimgridEngine, ChargesEachMessageBetweenNodesToTheSenderAndToOneReceiver) {
   CostModel none = m;
   none.mpi_message_overhead_ns = 0;
   const TraceAssignment in_node = split(2, {0, 1, 1});
-  EXPECT_EQ(simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, m))
-                .makespan_ns,
-            simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, none))
-                .makespan_ns);
+  EXPECT_EQ(
+      simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, m))
+          .makespan_ns,
+      simulate_trace(t, in_node, SimulationEngine::simgrid, on_cluster(ClusterShape{1, 2}, none))
+          .makespan_ns);
 }
 
 TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
@@ -315,8 +322,9 @@ TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
   // Three processors on one two-core host would share it: the engine's mapping gives
   // processor 2 the first core of node 1 instead.
   const SimulatedPlatform twonodes = on_cluster(ClusterShape{2, 2}, CostModel::defaults());
-  EXPECT_EQ(simulate_trace(t, split(3, {0, 1, 2, 2}), SimulationEngine::simgrid, twonodes).makespan_ns,
-            2000u);
+  EXPECT_EQ(
+      simulate_trace(t, split(3, {0, 1, 2, 2}), SimulationEngine::simgrid, twonodes).makespan_ns,
+      2000u);
 }
 
 // Random graphs with loops, several processor counts, steps of one trace: on one host with
@@ -328,36 +336,36 @@ TEST(SimgridEngine, EqualsTheBuiltinSimulatorOnOneHostOnRandomGraphs) {
   with_overhead.task_overhead_ns = 37;
   with_overhead.source = "defaults + task overhead";
   for (const CostModel& model : {CostModel::ideal(), CostModel::defaults(), with_overhead})
-  for (std::uint32_t k : {1u, 2u, 3u, 5u}) {
-    Trace trace;
-    for (std::uint64_t seed = 0; seed < 40; ++seed)
-      trace.steps.push_back(testing::random_graph(1000 * k + seed, 12 + static_cast<int>(seed % 20),
-                                                  5, seed % 3 != 0));
-    for (const char* method : {"roundrobin", "random", "list"}) {
-      const TracePartition tp = partition_trace(trace, method, k);
-      const SimulatedPlatform p = on_cluster(ClusterShape{1, k}, model);
-      const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
-      const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
-      ASSERT_EQ(b.steps.size(), s.steps.size());
-      for (std::size_t i = 0; i < b.steps.size(); ++i) {
-        // At most 1 ns of SimGrid's timing precision per task instance (loops run 1-4
-        // times); a wrong order or a missed dependency costs tasks of up to 1000 ns.
-        const std::uint64_t instances = trace.steps[i].tasks.size() * 4;
-        EXPECT_NEAR(static_cast<double>(s.steps[i].makespan_ns),
-                    static_cast<double>(b.steps[i].makespan_ns), static_cast<double>(instances))
-            << model.source << " " << method << " k " << k << " step " << i;
-        EXPECT_EQ(s.steps[i].bytes, b.steps[i].bytes) << method << " k " << k << " step " << i;
+    for (std::uint32_t k : {1u, 2u, 3u, 5u}) {
+      Trace trace;
+      for (std::uint64_t seed = 0; seed < 40; ++seed)
+        trace.steps.push_back(testing::random_graph(
+            1000 * k + seed, 12 + static_cast<int>(seed % 20), 5, seed % 3 != 0));
+      for (const char* method : {"roundrobin", "random", "list"}) {
+        const TracePartition tp = partition_trace(trace, method, k);
+        const SimulatedPlatform p = on_cluster(ClusterShape{1, k}, model);
+        const Prediction b = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
+        const Prediction s = simulate_trace(trace, tp.assignment, SimulationEngine::simgrid, p);
+        ASSERT_EQ(b.steps.size(), s.steps.size());
+        for (std::size_t i = 0; i < b.steps.size(); ++i) {
+          // At most 1 ns of SimGrid's timing precision per task instance (loops run 1-4
+          // times); a wrong order or a missed dependency costs tasks of up to 1000 ns.
+          const std::uint64_t instances = trace.steps[i].tasks.size() * 4;
+          EXPECT_NEAR(static_cast<double>(s.steps[i].makespan_ns),
+                      static_cast<double>(b.steps[i].makespan_ns), static_cast<double>(instances))
+              << model.source << " " << method << " k " << k << " step " << i;
+          EXPECT_EQ(s.steps[i].bytes, b.steps[i].bytes) << method << " k " << k << " step " << i;
+        }
       }
     }
-  }
 }
 
 TEST(SimgridEngine, ReportsADeadlockedOrder) {
   Builder b;
   const DatumId x = b.datum("x", 8), y = b.datum("y", 8);
-  b.task({{x, M::W}}, 10);            // 0 on processor 0
+  b.task({{x, M::W}}, 10);             // 0 on processor 0
   b.task({{x, M::R}, {y, M::W}}, 10);  // 1 on processor 1, needs 0
-  b.task({{y, M::R}}, 10);            // 2 on processor 0, needs 1
+  b.task({{y, M::R}}, 10);             // 2 on processor 0, needs 1
   Trace t;
   t.steps = {b.done()};
   TraceAssignment a = split(2, {0, 1, 0});
@@ -373,9 +381,7 @@ TEST(SimgridEngine, ReportsADeadlockedOrder) {
 
 class PlatformFiles : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = tgraph::test::scratch_dir("tgraph_platform_");
-  }
+  void SetUp() override { dir_ = tgraph::test::scratch_dir("tgraph_platform_"); }
   void TearDown() override { std::filesystem::remove_all(dir_); }
   std::string write(const std::string& name, const std::string& text) {
     const std::string path = (dir_ / name).string();
@@ -390,8 +396,7 @@ TEST_F(PlatformFiles, AWrittenPlatformGivesWhatTheClusterGives) {
   const TraceAssignment a = split(3, {0, 2});
   const CostModel m = CostModel::defaults();
   const std::string file = write("p.xml", platform_xml({2, 2}, m));
-  const Prediction from_file =
-      simulate_trace(t, a, SimulationEngine::simgrid, on_file(file, m));
+  const Prediction from_file = simulate_trace(t, a, SimulationEngine::simgrid, on_file(file, m));
   const Prediction from_shape =
       simulate_trace(t, a, SimulationEngine::simgrid, on_cluster(ClusterShape{2, 2}, m));
   EXPECT_EQ(from_file.steps, from_shape.steps);
@@ -426,4 +431,4 @@ TEST_F(PlatformFiles, TooFewCoresIsAnError) {
 #endif  // TGRAPH_HAVE_SIMGRID
 
 }  // namespace
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

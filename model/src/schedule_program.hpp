@@ -11,7 +11,7 @@
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
 
-namespace tgraph::partition::detail {
+namespace tgraph::model::detail {
 
 /// An instance index that names no instance (the dependency has no source this iteration).
 inline constexpr std::uint64_t kNoInstance = std::numeric_limits<std::uint64_t>::max();
@@ -43,7 +43,8 @@ struct VersionOnProc {
 struct VersionOnProcHash {
   std::size_t operator()(const VersionOnProc& k) const {
     std::uint64_t h = k.instance * 0x9E3779B97F4A7C15ull;
-    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    h ^= (static_cast<std::uint64_t>(k.datum) << 32 | k.proc) + 0x7F4A7C159E3779B9ull + (h << 6) +
+         (h >> 2);
     return static_cast<std::size_t>(h);
   }
 };
@@ -118,4 +119,4 @@ inline std::uint64_t dependency_source(const StepGraph& g, const std::vector<std
   return runs == 0 ? kNoInstance : first[d.from] + runs - 1;
 }
 
-}  // namespace tgraph::partition::detail
+}  // namespace tgraph::model::detail

@@ -10,14 +10,14 @@
 
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/partition/cost_model.hpp"
-#include "tgraph/partition/platform.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/model/platform.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 /// Which simulator predicts the schedule.
 enum class SimulationEngine {
-  builtin,  ///< tgraph::partition::simulate (one machine, the cost model; fast)
+  builtin,  ///< tgraph::model::simulate (one machine, the cost model; fast)
   simgrid,  ///< SimGrid 3.32 s4u activities on a platform's hosts and links
 };
 /// "builtin" or "simgrid".
@@ -44,9 +44,9 @@ std::string to_string(IntraNodeTransfer t);
 ///   p.cluster = ClusterShape{4, 16};                 // or p.file = "P.xml"
 ///   Prediction r = simulate_trace(trace, assignment, SimulationEngine::simgrid, p);
 struct SimulatedPlatform {
-  std::string file;                    ///< a platform file P.xml (SimGrid engine only), or empty
-  std::optional<ClusterShape> cluster; ///< an N x C cluster, or none
-  CostModel model;                     ///< the built-in engine's costs; the links of `cluster`
+  std::string file;                     ///< a platform file P.xml (SimGrid engine only), or empty
+  std::optional<ClusterShape> cluster;  ///< an N x C cluster, or none
+  CostModel model;                      ///< the built-in engine's costs; the links of `cluster`
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: who pays bytes in a node
   /// Built-in engine: the main thread's serial work before each step's tasks (ns per step,
   /// replacing the trace's host time; load_serial_work); empty: the host time.
@@ -56,8 +56,9 @@ struct SimulatedPlatform {
 /// One step's prediction.
 struct StepPrediction {
   std::uint64_t makespan_ns = 0;
-  std::uint64_t messages = 0;  ///< builtin: (version, receiving processor) waits; simgrid: transfers
-  std::uint64_t bytes = 0;     ///< datum bytes read from another processor's writes
+  std::uint64_t messages =
+      0;                    ///< builtin: (version, receiving processor) waits; simgrid: transfers
+  std::uint64_t bytes = 0;  ///< datum bytes read from another processor's writes
   std::uint64_t inter_node_messages = 0;  ///< simgrid: transfers between two nodes
   std::uint64_t inter_node_bytes = 0;     ///< simgrid: their bytes
   friend bool operator==(const StepPrediction&, const StepPrediction&) = default;
@@ -73,10 +74,10 @@ struct Prediction {
   std::uint64_t cores = 0;        ///< cores of the platform (simgrid; builtin: N x C or k)
   std::string platform;           ///< the platform file, "NxC", or "one machine"
   IntraNodeTransfer intra_node = IntraNodeTransfer::reader;  ///< simgrid: as asked
-  double simulation_ms = 0;       ///< wall time of the simulation itself
-  double task_overhead_ns = 0;    ///< CostModel::task_overhead_ns charged per task instance
+  double simulation_ms = 0;                                  ///< wall time of the simulation itself
+  double task_overhead_ns = 0;     ///< CostModel::task_overhead_ns charged per task instance
   double message_overhead_ns = 0;  ///< CostModel::mpi_message_overhead_ns (SimGrid engine)
-  bool lowered = false;           ///< the steps were lowered first (`tgraph simulate`, lowered)
+  bool lowered = false;            ///< the steps were lowered first (`tgraph simulate`, lowered)
   std::vector<std::string> model_terms;  ///< what the prediction charged (model_terms())
 };
 
@@ -103,4 +104,4 @@ Prediction simgrid_predict(const Trace& trace, const TraceAssignment& a,
                            const SimulatedPlatform& platform);
 }  // namespace detail
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

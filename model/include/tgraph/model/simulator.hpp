@@ -10,9 +10,9 @@
 #include "tgraph/graph/assignment.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/graph/trace.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 /// A simulated schedule. Task instances are numbered task by task: instance
 /// `first_instance[t] + i` is iteration i of task t (i < g.runs(t)).
@@ -28,13 +28,13 @@ struct Schedule {
   /// The instances' costs alone (inflated), summed by task kind (indexed by KindId of the
   /// step's kinds).
   std::vector<std::uint64_t> kind_body_ns;
-  std::vector<std::uint64_t> finish_ns;   ///< per processor: end of its last task
-  std::uint64_t signals = 0;     ///< datum versions (and loop decisions) sent to other processors
-  std::uint64_t waits = 0;       ///< (version, receiving processor) pairs
+  std::vector<std::uint64_t> finish_ns;  ///< per processor: end of its last task
+  std::uint64_t signals = 0;  ///< datum versions (and loop decisions) sent to other processors
+  std::uint64_t waits = 0;    ///< (version, receiving processor) pairs
   /// k x k, [from * k + to]: the waits of processor `to` for versions sent by `from`
   /// (summed: `waits`); what the report's quotient graph calls the signals from -> to.
   std::vector<std::uint64_t> waits_between;
-  std::uint64_t transfer_bytes = 0;  ///< bytes read from another processor's writes
+  std::uint64_t transfer_bytes = 0;           ///< bytes read from another processor's writes
   std::vector<std::uint64_t> first_instance;  ///< per task, plus the total at the end
   std::vector<std::uint64_t> start_ns;        ///< per instance
   std::vector<std::uint64_t> end_ns;          ///< per instance
@@ -86,4 +86,4 @@ std::vector<std::uint64_t> predicted_makespans(
 /// the trace has host time.
 std::vector<std::string> model_terms(const CostModel& model, bool serial_given, bool host_time);
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

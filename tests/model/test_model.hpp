@@ -2,12 +2,12 @@
 // The cost model of the simulator tests: link costs only.
 #pragma once
 
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 
-namespace tgraph::partition::testing {
+namespace tgraph::model::testing {
 
 /// A cost model with only these link costs (no reduction, inflation or overheads).
-inline CostModel model(double latency, double per_byte = 0) {
+inline CostModel link_model(double latency, double per_byte = 0) {
   CostModel m;
   m.sync_latency_ns = latency;
   m.per_byte_ns = per_byte;
@@ -15,4 +15,4 @@ inline CostModel model(double latency, double per_byte = 0) {
   return m;
 }
 
-}  // namespace tgraph::partition::testing
+}  // namespace tgraph::model::testing

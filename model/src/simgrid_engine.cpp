@@ -4,6 +4,8 @@
 // receiving processor on the platform's links), created when they become ready.
 //
 // The process that hosts it (one engine per process) is simgrid_process.cpp.
+#include "simgrid_engine.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,11 +18,10 @@
 #include <utility>
 
 #include "schedule_program.hpp"
-#include "simgrid_engine.hpp"
 #include "tgraph/graph/error.hpp"
-#include "tgraph/partition/simulation.hpp"
+#include "tgraph/model/simulation.hpp"
 
-namespace tgraph::partition::detail {
+namespace tgraph::model::detail {
 
 namespace {
 
@@ -48,7 +49,7 @@ struct InFlight {
   Kind kind;
   TaskId task;
   std::uint32_t iteration;
-  ProcId proc;  ///< exec: where it runs; comm: the sender
+  ProcId proc;                    ///< exec: where it runs; comm: the sender
   std::vector<ProcId> receivers;  ///< comm: the processors that know the instance on arrival
   std::uint32_t messages = 0;     ///< comm between nodes: the MPI messages it stands for
 };
@@ -64,7 +65,10 @@ class Driver {
   Driver(const Trace& trace, const TraceAssignment& a, std::vector<sg::Host*> hosts,
          std::vector<double> read_ns_per_byte, IntraNodeTransfer intra_node, double overhead_ns,
          double message_ns)
-      : trace_(trace), a_(a), hosts_(std::move(hosts)), read_ns_per_byte_(std::move(read_ns_per_byte)),
+      : trace_(trace),
+        a_(a),
+        hosts_(std::move(hosts)),
+        read_ns_per_byte_(std::move(read_ns_per_byte)),
         overhead_(static_cast<std::uint64_t>(std::llround(overhead_ns))),
         message_(static_cast<std::uint64_t>(std::llround(message_ns))),
         reader_pays_(intra_node == IntraNodeTransfer::reader),
@@ -185,9 +189,9 @@ class Driver {
       for (const Dep& d : deps_[u]) {
         if (pa_->proc[d.from] == pu) continue;
         const LoopId lf = g_->tasks[d.from].loop;
-        const When when = d.carried                       ? When::not_last
-                          : lf != kNoLoop && lf == lu     ? When::every
-                                                          : When::last;
+        const When when = d.carried                   ? When::not_last
+                          : lf != kNoLoop && lf == lu ? When::every
+                                                      : When::last;
         if (g_->runs(u) == 0) continue;  // a reader that never runs waits for nothing
         outs_[d.from].push_back({pu, d.datum, d.raw, when});
       }
@@ -265,7 +269,8 @@ class Driver {
       if (received_.insert({src, d.datum, p}) && d.raw) bytes += g_->data[d.datum].bytes;
     }
     current_.bytes += bytes;
-    return static_cast<std::uint64_t>(std::llround(static_cast<double>(bytes) * read_ns_per_byte_[p]));
+    return static_cast<std::uint64_t>(
+        std::llround(static_cast<double>(bytes) * read_ns_per_byte_[p]));
   }
 
   void step_forward(ProcId p) {
@@ -366,8 +371,8 @@ class Driver {
       receivers_.clear();
       for (; e < outs.size() && same_group(outs[e], outs[b]); ++e) {
         const Out& o = outs[e];
-        const bool applies = o.when == When::every ||
-                             (o.when == When::not_last ? i + 1 < runs : i + 1 == runs);
+        const bool applies =
+            o.when == When::every || (o.when == When::not_last ? i + 1 < runs : i + 1 == runs);
         if (!applies) continue;
         if (receivers_.empty() || receivers_.back() != o.to) receivers_.push_back(o.to);
         decisions = std::max<std::uint32_t>(decisions, o.decision ? 1 : 0);
@@ -377,8 +382,7 @@ class Driver {
           bytes += g_->data[o.datum].bytes;
         }
       }
-      if (!receivers_.empty())
-        fn(bytes, static_cast<std::uint32_t>(sent_.size()) + decisions);
+      if (!receivers_.empty()) fn(bytes, static_cast<std::uint32_t>(sent_.size()) + decisions);
       b = e;
     }
   }
@@ -478,9 +482,8 @@ PlatformRun run_on_loaded_platform(const Trace& trace, const TraceAssignment& a,
   }
   if (proc_hosts.size() < a.k) {
     out.input_error = "the assignment has " + std::to_string(a.k) + " processors, the platform " +
-                      (platform.file.empty() ? std::string("cluster") : platform.file) +
-                      " only " + std::to_string(cores) + " cores on " +
-                      std::to_string(all.size()) + " hosts";
+                      (platform.file.empty() ? std::string("cluster") : platform.file) + " only " +
+                      std::to_string(cores) + " cores on " + std::to_string(all.size()) + " hosts";
     return out;
   }
   // A host's loopback link (its route to itself) prices a byte read from another core.
@@ -510,4 +513,4 @@ PlatformRun run_on_loaded_platform(const Trace& trace, const TraceAssignment& a,
   return out;
 }
 
-}  // namespace tgraph::partition::detail
+}  // namespace tgraph::model::detail

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/simulator.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +8,10 @@
 #include <tuple>
 #include <vector>
 
-#include "tgraph/graph/error.hpp"
 #include "schedule_program.hpp"
+#include "tgraph/graph/error.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 namespace {
 
@@ -23,14 +23,19 @@ void check_assignment(const StepGraph& g, const Assignment& a) {
   if (std::string why = validate(g, a, a.k); !why.empty()) throw Error(why);
 }
 
-std::uint64_t to_ns(double ns) { return static_cast<std::uint64_t>(std::llround(std::max(0.0, ns))); }
+std::uint64_t to_ns(double ns) {
+  return static_cast<std::uint64_t>(std::llround(std::max(0.0, ns)));
+}
 
 class Simulator {
  public:
   // `inflation`: per instance, the factor its cost is scaled by (nullptr: 1).
   Simulator(const StepGraph& g, const Assignment& a, const CostModel& m, std::uint64_t serial_ns,
             const std::vector<double>* inflation)
-      : g_(g), a_(a), k_(a.k), latency_(to_ns(m.sync_latency_ns)),
+      : g_(g),
+        a_(a),
+        k_(a.k),
+        latency_(to_ns(m.sync_latency_ns)),
         per_byte_(m.per_byte_ns),
         overhead_(to_ns(m.task_overhead_ns + m.executor_overhead_at(a.k))),
         wake_(to_ns(m.park_wake_ns)),
@@ -151,7 +156,8 @@ class Simulator {
       });
       std::size_t best = 0, best_len = 0;
       for (std::size_t b = 0, e = 0; b < deps.size(); b = e) {
-        for (e = b; e < deps.size() && deps[e].datum == deps[b].datum; ++e) {}
+        for (e = b; e < deps.size() && deps[e].datum == deps[b].datum; ++e) {
+        }
         if (e - b > best_len) {
           best = b;
           best_len = e - b;
@@ -162,8 +168,8 @@ class Simulator {
                   deps.begin() + static_cast<std::ptrdiff_t>(best + best_len));
       key.assign({deps[0].datum, g_.tasks[t].loop});
       for (std::size_t j = 0; j < best_len; ++j)
-        key.push_back((static_cast<std::uint64_t>(deps[j].from) << 2) |
-                      (deps[j].raw ? 2u : 0u) | (deps[j].carried ? 1u : 0u));
+        key.push_back((static_cast<std::uint64_t>(deps[j].from) << 2) | (deps[j].raw ? 2u : 0u) |
+                      (deps[j].carried ? 1u : 0u));
       const auto [it, fresh] = ids.emplace(key, static_cast<std::uint32_t>(ids.size()));
       fan_in_[t] = {it->second, static_cast<std::uint32_t>(best_len)};
     }
@@ -231,7 +237,7 @@ class Simulator {
   // A processor's interruptions, in time order: the next gap is [start, end).
   struct Pauses {
     const ThreadInterruptions* of = nullptr;  // nullptr: none
-    double mean_gap = 0;  // mean time from one gap's end to the next's start
+    double mean_gap = 0;                      // mean time from one gap's end to the next's start
     std::uint64_t rng = 0;
     std::uint64_t start = 0, end = 0;
   };
@@ -325,8 +331,8 @@ class Simulator {
   const double per_byte_;
   // CostModel::task_overhead_ns and the executor's time at a.k processors, per instance
   const std::uint64_t overhead_;
-  const std::uint64_t wake_;      // CostModel::park_wake_ns (0: term off)
-  const std::uint64_t budget_;    // CostModel::spin_budget_ns
+  const std::uint64_t wake_;              // CostModel::park_wake_ns (0: term off)
+  const std::uint64_t budget_;            // CostModel::spin_budget_ns
   const std::vector<double>* inflation_;  // per instance, or nullptr
   Schedule s_;
   std::vector<std::vector<Dep>> deps_;
@@ -338,7 +344,6 @@ class Simulator {
   detail::VersionSet waits_, signals_;
   std::vector<Pauses> pauses_;  // by processor
 };
-
 
 // Per instance of `s`, the time-weighted mean number of instances running at once during
 // it (itself included), from the instances' intervals.
@@ -361,14 +366,16 @@ std::vector<double> mean_busy(const Schedule& s) {
   double a = 0;
   for (std::size_t e = 0; e < events.size();) {
     const std::uint64_t t = events[e].first;
-    if (!times.empty()) a += static_cast<double>(count.back()) * static_cast<double>(t - times.back());
+    if (!times.empty())
+      a += static_cast<double>(count.back()) * static_cast<double>(t - times.back());
     for (; e < events.size() && events[e].first == t; ++e) c += events[e].second;
     times.push_back(t);
     area.push_back(a);
     count.push_back(c);
   }
   auto area_at = [&](std::uint64_t t) {  // t is an event time
-    const auto j = static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t) - times.begin());
+    const auto j =
+        static_cast<std::size_t>(std::lower_bound(times.begin(), times.end(), t) - times.begin());
     return area[j];
   };
   std::vector<double> busy(n, 1.0);
@@ -394,7 +401,8 @@ Schedule simulate(const StepGraph& g, const Assignment& a, const CostModel& mode
   std::vector<double> factor = mean_busy(s);
   for (TaskId t = 0; t < g.tasks.size(); ++t) {
     double bytes = 0;
-    for (const Access& acc : g.accesses_of(t)) bytes += static_cast<double>(g.data[acc.datum].bytes);
+    for (const Access& acc : g.accesses_of(t))
+      bytes += static_cast<double>(g.data[acc.datum].bytes);
     const auto cost = static_cast<double>(g.tasks[t].cost_ns);
     for (std::uint64_t i = s.first_instance[t]; i < s.first_instance[t + 1]; ++i)
       factor[i] = model.task_inflation(factor[i], cost, bytes);
@@ -433,4 +441,4 @@ std::vector<std::string> model_terms(const CostModel& model, bool serial_given, 
   return terms;
 }
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

@@ -1,13 +1,45 @@
 // SPDX-License-Identifier: MIT
 // CW lowering (paper section 3.2): temporaries + reducer, or serialisation.
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 #include <algorithm>
 #include <cstdint>
 #include <string>
 #include <unordered_map>
 
-namespace tgraph::replay {
+namespace tgraph {
+
+std::string_view to_string(CwMode mode) {
+  switch (mode) {
+    case CwMode::kReduce:
+      return "reduce";
+    case CwMode::kSerialize:
+      return "serialize";
+  }
+  return "?";
+}
+
+std::string_view to_string(ReduceScope scope) {
+  switch (scope) {
+    case ReduceScope::kNone:
+      return "none";
+    case ReduceScope::kPerProcessor:
+      return "per-processor";
+    case ReduceScope::kPerWriter:
+      return "per-writer";
+    case ReduceScope::kPerThread:
+      return "per-thread";
+  }
+  return "?";
+}
+
+std::optional<ReduceScope> parse_reduce_scope(std::string_view name) {
+  for (ReduceScope s : {ReduceScope::kNone, ReduceScope::kPerProcessor, ReduceScope::kPerWriter,
+                        ReduceScope::kPerThread})
+    if (to_string(s) == name) return s;
+  return std::nullopt;
+}
+
 namespace {
 
 struct Segment {
@@ -344,4 +376,4 @@ ExecGraph lower(const StepGraph& g, const Assignment* a, CwMode mode, ReduceScop
   return x;
 }
 
-}  // namespace tgraph::replay
+}  // namespace tgraph

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "tgraph/partition/platform.hpp"
+#include "tgraph/model/platform.hpp"
 
 #include <charconv>
 #include <cstdio>
@@ -7,13 +7,13 @@
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 namespace {
 
 OptionError not_a_shape(std::string_view whole, std::string_view field) {
-  return OptionError(std::string(field),
-                     "expected NxC (nodes x cores, e.g. 64x16), found '" + std::string(whole) + "'");
+  return OptionError(std::string(field), "expected NxC (nodes x cores, e.g. 64x16), found '" +
+                                             std::string(whole) + "'");
 }
 
 std::uint64_t parse_count(std::string_view text, std::string_view whole, std::string_view field) {
@@ -39,11 +39,11 @@ std::string bandwidth(double per_byte_ns) {
 
 ClusterShape cluster_shape(std::uint64_t nodes, std::uint64_t cores) {
   if (nodes < 1 || nodes > kMaxNodes)
-    throw OptionError("nodes", "expected 1 to " + std::to_string(kMaxNodes) + ", found " +
-                                   std::to_string(nodes));
+    throw OptionError(
+        "nodes", "expected 1 to " + std::to_string(kMaxNodes) + ", found " + std::to_string(nodes));
   if (cores < 1 || cores > kMaxCores)
-    throw OptionError("cores", "expected 1 to " + std::to_string(kMaxCores) + ", found " +
-                                   std::to_string(cores));
+    throw OptionError(
+        "cores", "expected 1 to " + std::to_string(kMaxCores) + ", found " + std::to_string(cores));
   return {static_cast<std::uint32_t>(nodes), static_cast<std::uint32_t>(cores)};
 }
 
@@ -70,10 +70,14 @@ std::string platform_xml(const ClusterShape& c, const CostModel& m) {
   }
   return "<?xml version='1.0'?>\n"
          "<!DOCTYPE platform SYSTEM \"https://simgrid.org/simgrid.dtd\">\n"
-         "<!-- tgraph platform: " + std::to_string(c.nodes) + " nodes x " +
-         std::to_string(c.cores) + " cores; costs from " + source + " -->\n"
+         "<!-- tgraph platform: " +
+         std::to_string(c.nodes) + " nodes x " + std::to_string(c.cores) + " cores; costs from " +
+         source +
+         " -->\n"
          "<platform version=\"4.1\">\n"
-         "  <config>\n" + config + "  </config>\n"
+         "  <config>\n" +
+         config +
+         "  </config>\n"
          "  <zone id=\"world\" routing=\"Full\">\n"
          "    <cluster id=\"cluster\" prefix=\"node-\" suffix=\"\" radical=\"0-" +
          std::to_string(c.nodes - 1) + "\" speed=\"1Gf\" core=\"" + std::to_string(c.cores) +
@@ -94,4 +98,4 @@ std::string write_platform(const std::string& output, std::uint64_t nodes, std::
          std::to_string(c.cores) + " cores, costs from " + m.source + "\n";
 }
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model

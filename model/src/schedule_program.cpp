@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-namespace tgraph::partition {
+namespace tgraph::model {
 
 namespace detail {
 
@@ -32,7 +32,8 @@ std::vector<std::vector<Dep>> dependencies(const StepGraph& g) {
 std::vector<std::vector<Item>> programs(const StepGraph& g, const Assignment& a) {
   const auto n = static_cast<TaskId>(g.tasks.size());
   std::vector<std::vector<Item>> items(a.k);
-  std::vector<std::vector<std::size_t>> block(a.k, std::vector<std::size_t>(g.loops.size(), SIZE_MAX));
+  std::vector<std::vector<std::size_t>> block(a.k,
+                                              std::vector<std::size_t>(g.loops.size(), SIZE_MAX));
   auto place = [&](ProcId p, TaskId t) {
     const LoopId l = g.tasks[t].loop;
     if (l == kNoLoop) {
@@ -55,7 +56,7 @@ std::vector<std::vector<Item>> programs(const StepGraph& g, const Assignment& a)
 }
 
 std::string deadlock_message(const StepGraph& g, const Item& it, std::size_t pos, ProcId p) {
-  const TaskId t = it.task != kNoTask ? it.task
+  const TaskId t = it.task != kNoTask     ? it.task
                    : pos < it.body.size() ? it.body[pos]
                                           : g.loops[it.loop].last - 1;
   return "assignment order deadlocks: processor " + std::to_string(p) +
@@ -64,4 +65,4 @@ std::string deadlock_message(const StepGraph& g, const Item& it, std::size_t pos
 
 }  // namespace detail
 
-}  // namespace tgraph::partition
+}  // namespace tgraph::model
