@@ -74,7 +74,7 @@ void add_replay_verbs(CLI::App& app) {
   cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", c->assignment, "Assignment file (.tga; default: --method)");
   add_exec_flags(cmd, c->replay.exec, c->json);
-  cmd->add_option("--policy", a->policy, "partition (default), worksteal, barrier, starpu...");
+  cmd->add_option("--policy", a->policy, "Policy: " + tr::policy_list("or") + " (default partition)");
   cmd->add_option("--method", c->method, "Strategy without assignment (default: owner or list)");
   cmd->add_option("--steps", c->replay.steps, "Steps to replay (default: all)");
   cmd->add_option("--first-step", c->replay.first_step, "First step replayed");

@@ -15,8 +15,8 @@ namespace tgraph::app {
 /// The policy named by flag `flag`; UsageError naming the flag and the names otherwise.
 inline replay::Policy policy_flag(std::string_view name, std::string_view flag) {
   if (const auto p = replay::parse_policy(name)) return *p;
-  throw UsageError(std::string(flag) + " " + std::string(name) +
-                   ": expected partition, worksteal, barrier, starpu, omp-tasks or sequential");
+  throw UsageError(std::string(flag) + " " + std::string(name) + ": expected " +
+                   replay::policy_list("or"));
 }
 
 /// `--barrier-rule omp-for|level|operation`; UsageError naming the flag otherwise.

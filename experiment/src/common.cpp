@@ -25,12 +25,12 @@ std::vector<std::string> check_methods(const std::vector<std::string>& methods) 
                                    "instead of partition");
     if (!p && std::find(strategies.begin(), strategies.end(), m) == strategies.end())
       throw OptionError("methods", "unknown method '" + m + "' (expected strategies " +
-                                       join(strategies, ", ") +
-                                       " or baselines worksteal, barrier, omp-tasks, starpu)");
-#ifndef TGRAPH_HAVE_STARPU
-    if (p == replay::Policy::kStarpu)
-      throw OptionError("methods", "starpu is not in this build (libstarpu-dev was not found)");
-#endif
+                                       join(strategies, ", ") + " or baselines " +
+                                       replay::policy_list("", true) + ")");
+    for (const replay::PolicyInfo& info : replay::policies())
+      if (p == info.policy && !info.built)
+        throw OptionError("methods", m + " is not in this build (" + std::string(info.missing) +
+                                         ")");
     if (std::find(out.begin(), out.end(), m) == out.end()) out.push_back(m);
   }
   return out;

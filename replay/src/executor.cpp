@@ -334,11 +334,13 @@ class SequentialExecutor final : public detail::PlannedExecutor<SequentialPlan> 
 
 }  // namespace
 
-std::unique_ptr<Executor> make_partition_executor(const ExecOptions& o);
-std::unique_ptr<Executor> make_worksteal_executor(const ExecOptions& o);
-std::unique_ptr<Executor> make_barrier_executor(const ExecOptions& o);
-std::unique_ptr<Executor> make_starpu_executor(const ExecOptions& o);
-std::unique_ptr<Executor> make_omp_tasks_executor(const ExecOptions& o);
+std::unique_ptr<Executor> make_sequential_executor(const ExecOptions& options) {
+  ExecOptions o = options;
+  o.threads = 1;  // one thread, whatever was asked for
+  return std::make_unique<SequentialExecutor>(o);
+}
+
+std::unique_ptr<Executor> make_registered_executor(Policy policy, const ExecOptions& options);
 
 std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& options) {
   if (options.threads == 0) throw OptionError("threads", "must be at least 1");
@@ -352,24 +354,7 @@ std::unique_ptr<Executor> make_executor(Policy policy, const ExecOptions& option
     throw OptionError("reduce_scope",
                       "applies to the dynamic policies (worksteal, barrier, starpu, omp-tasks); the "
                       "partition policy reduces per processor");
-  switch (policy) {
-    case Policy::kSequential: {  // one thread, whatever was asked for
-      ExecOptions o = options;
-      o.threads = 1;
-      return std::make_unique<SequentialExecutor>(o);
-    }
-    case Policy::kPartition:
-      return make_partition_executor(options);
-    case Policy::kWorksteal:
-      return make_worksteal_executor(options);
-    case Policy::kBarrier:
-      return make_barrier_executor(options);
-    case Policy::kStarpu:
-      return make_starpu_executor(options);
-    case Policy::kOmpTasks:
-      return make_omp_tasks_executor(options);
-  }
-  throw UsageError("unknown policy");
+  return make_registered_executor(policy, options);  // registry.cpp
 }
 
 }  // namespace tgraph::replay

@@ -3,31 +3,6 @@
 
 namespace tgraph::replay {
 
-std::string_view to_string(Policy policy) {
-  switch (policy) {
-    case Policy::kSequential:
-      return "sequential";
-    case Policy::kPartition:
-      return "partition";
-    case Policy::kWorksteal:
-      return "worksteal";
-    case Policy::kBarrier:
-      return "barrier";
-    case Policy::kStarpu:
-      return "starpu";
-    case Policy::kOmpTasks:
-      return "omp-tasks";
-  }
-  return "?";
-}
-
-std::optional<Policy> parse_policy(std::string_view name) {
-  for (Policy p : {Policy::kSequential, Policy::kPartition, Policy::kWorksteal, Policy::kBarrier,
-                   Policy::kStarpu, Policy::kOmpTasks})
-    if (to_string(p) == name) return p;
-  return std::nullopt;
-}
-
 std::string_view to_string(BarrierRule rule) {
   switch (rule) {
     case BarrierRule::kLevel:

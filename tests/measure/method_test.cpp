@@ -3,7 +3,9 @@
 #include "tgraph/measure/method.hpp"
 
 #include <gtest/gtest.h>
+#include <string>
 
+#include "tgraph/graph/error.hpp"
 #include "tgraph/measure/live.hpp"
 
 namespace tgraph::measure {
@@ -18,8 +20,22 @@ TEST(Method, BaselinePolicyNamesGiveThatPolicyAndOtherNamesAStrategy) {
   const MethodChoice m = choose_method("metis");
   EXPECT_EQ(m.policy, Policy::kPartition);
   EXPECT_EQ(m.method, "metis");
-  // No command-line alias here: "partition" is not a strategy's name (apps map it to owner).
-  EXPECT_EQ(choose_method("partition").method, "partition");
+}
+
+TEST(Method, AnUnknownNameListsTheStrategiesAndTheBaselinePolicies) {
+  // Issue 52 saw `unknown method 'metsi' (known: list, metis, ...)` without the baselines.
+  try {
+    choose_method("metsi");
+    FAIL() << "metsi was accepted";
+  } catch (const UsageError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind("unknown method 'metsi' (strategies: ", 0), 0u) << m;
+    for (const char* name : {"owner", "metis", "sticky", "worksteal", "barrier", "omp-tasks",
+                             "starpu", "sequential"})
+      EXPECT_NE(m.find(name), std::string::npos) << name << " missing from: " << m;
+  }
+  // No command-line alias here: "partition" is a policy, not a method (apps map it to owner).
+  EXPECT_THROW(choose_method("partition"), UsageError);
 }
 
 TEST(Method, ReportsNameTheStrategyUnderThePartitionPolicyElseThePolicy) {

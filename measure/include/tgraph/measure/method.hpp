@@ -16,8 +16,9 @@ struct MethodChoice {
   std::string method = "owner";  ///< the strategy (partition policy)
 };
 
-/// `name`: a baseline policy's name (worksteal, barrier, omp-tasks, starpu, sequential) gives
-/// that policy; any other name is a strategy under the partition policy.
+/// `name`: a baseline policy's name (worksteal, barrier, omp-tasks, starpu, sequential: the
+/// replay registry's) gives that policy; a strategy's name (partition's registry) that
+/// strategy under the partition policy. UsageError naming both lists for any other name.
 MethodChoice choose_method(std::string_view name);
 
 /// How reports name the method: the strategy under the partition policy, else the policy.

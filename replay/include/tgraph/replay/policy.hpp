@@ -4,7 +4,9 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "tgraph/graph/lowering.hpp"
 
@@ -15,7 +17,8 @@ namespace tgraph::replay {
 using tgraph::CwMode;
 using tgraph::ReduceScope;
 
-/// How the tasks of a step are put on threads.
+/// How the tasks of a step are put on threads: the identity of a registered policy
+/// (replay/src/registry.cpp holds its name, help and factory).
 enum class Policy : unsigned char {
   kSequential = 0,  ///< one thread, program order
   kPartition = 1,   ///< one pinned thread per processor of an Assignment, signal/wait
@@ -25,10 +28,26 @@ enum class Policy : unsigned char {
   kOmpTasks = 5,    ///< OpenMP tasks with one `depend` object per datum (libgomp)
 };
 
-/// "sequential", "partition", "worksteal", "barrier", "starpu" or "omp-tasks".
+/// What the registry says of a policy.
+struct PolicyInfo {
+  Policy policy = Policy::kSequential;
+  std::string_view name;  ///< its word on the command line and in reports
+  std::string_view help;  ///< one line
+  bool built = true;      ///< in this build (StarPU's needs libstarpu-dev)
+  bool baseline = false;  ///< a run's method of its own, beside the strategies (not partition)
+  std::string_view missing;  ///< why a build lacks it ("" when built)
+};
+
+/// Every registered policy, in the order the command line lists them.
+std::vector<PolicyInfo> policies();
+/// The registered name: "partition", "worksteal", "barrier", "starpu", "omp-tasks" or
+/// "sequential".
 std::string_view to_string(Policy policy);
 /// Inverse of to_string; nullopt for an unknown name.
 std::optional<Policy> parse_policy(std::string_view name);
+/// The registered names, ", " between them and `last` (e.g. "or") before the last one
+/// ("" : ", " there too); the baselines only when `baselines_only`.
+std::string policy_list(std::string_view last = "", bool baselines_only = false);
 
 /// What one parallel phase of the barrier policy holds (a barrier follows each phase).
 enum class BarrierRule : unsigned char {
