@@ -14,11 +14,12 @@ void add_validate(CLI::App& app) {
   auto o = std::make_shared<measure::ValidateOptions>();
   auto a = std::make_shared<Args>();
   o->threads = default_threads();
+  a->method = "owner";
   auto* cmd = app.add_subcommand(
       "validate", "Live run, replay of a capture and simulator side by side, with their ratios");
   cmd->add_option("--scene", o->scene, "Built-in scene or scene file")->required();
   cmd->add_option("--threads,-k", o->threads, "Threads");
-  cmd->add_option("--method", o->method,
+  cmd->add_option("--method", a->method,
                   "Partitioning strategy, or a baseline policy (worksteal, barrier, sequential)");
   cmd->add_option("--steps", o->steps, "Steps (default 20)");
   cmd->add_option("--split", o->scene_options.split, "Force-field tasks per deformable object")
@@ -34,8 +35,9 @@ void add_validate(CLI::App& app) {
   add_ode_flags(cmd, *ode);
   cmd->callback([o, a, ode] {
     if (is_ode_scene(o->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
-      return validate_ode(o->scene, o->steps, o->method, o->threads, o->repeat, o->calibration, a->json, *ode);
-    o->method = measure::method_name(method_flags(o->method));
+      return validate_ode(o->scene, o->steps, a->method, o->threads, o->repeat, o->calibration,
+                          a->json, *ode);
+    o->method = method_flags(a->method);
     const measure::Validation v = measure::validate(*o);
     std::cout << (a->json ? measure::to_json(v, *o) : measure::to_text(v, *o));
   });

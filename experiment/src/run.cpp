@@ -49,21 +49,6 @@ Trace capture_variant(const SceneVariant& v, std::uint32_t steps) {
 
 // A strategy as a step partitioner that keeps each call's statistics (migrations). Live,
 // sticky rebalances at the live trigger's tolerance, as `tgraph run` does.
-struct RecordingPartitioner {
-  std::shared_ptr<tp::Strategy> strategy;
-  std::shared_ptr<std::vector<tp::Stats>> calls = std::make_shared<std::vector<tp::Stats>>();
-  tp::StepPartitioner callback(const meas::LiveOptions& live) const {
-    tp::Options options;
-    options.sticky_threshold = meas::live_sticky_threshold(live);
-    return [s = strategy, c = calls, options](const StepGraph& g, std::uint32_t k,
-                                              const StepGraph* pg, const Assignment* pa) {
-      tp::Result r = s->partition(g, k, tp::Previous{pg, pa}, options);
-      c->push_back(r.stats);
-      return std::move(r.assignment);
-    };
-  }
-};
-
 struct LiveRun {
   meas::LiveResult result;
   std::vector<tp::Stats> calls;  // the partitioner's calls, in order (first pass first)
@@ -71,26 +56,23 @@ struct LiveRun {
 
 LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t k,
                  const ExperimentPlan& p, bool every_step) {
-  const meas::MethodChoice m = meas::choose_method(method);
   meas::LiveOptions o;
-  o.policy = m.policy;
   o.exec.threads = k;
   o.steps = p.steps;
   o.repeat = p.repeat;
   o.observe = false;
   o.repartition_every_step = every_step;
-  std::optional<RecordingPartitioner> rp;
-  tp::StepPartitioner callback;
-  if (m.policy == tr::Policy::kPartition) {
-    rp = RecordingPartitioner{tp::make_strategy(m.method)};
-    callback = rp->callback(o);
-  }
+  tp::Options po;
+  po.sticky_threshold = meas::live_sticky_threshold(o);  // as `tgraph run` partitions
+  auto calls = std::make_shared<std::vector<tp::Stats>>();  // in order, first pass first
+  const std::optional<tp::StepPartitioner> part =
+      meas::live_partitioner(meas::choose_method(method), po, o, calls);
   const std::string scene = v.scene;
   const samples::SceneOptions so = scene_options(v);
   LiveRun run;
   run.result = meas::run_live([scene, so] { return meas::make_live_engine(scene, so); },
-                            rp ? &callback : nullptr, o);
-  if (rp) run.calls = *rp->calls;
+                            part ? &*part : nullptr, o);
+  run.calls = *calls;
   return run;
 }
 

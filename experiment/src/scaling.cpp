@@ -81,19 +81,15 @@ meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std:
                           const ScalingPlan& p) {
   const meas::MethodChoice m = meas::choose_method(method);
   meas::LiveOptions o;
-  o.policy = m.policy;
   o.exec.threads = k;
   o.steps = s.steps;
   o.repeat = p.repeat;
   o.baseline = false;
   o.observe = true;
   o.keep_assignments = m.policy == tr::Policy::kPartition;
-  std::optional<tp::StepPartitioner> part;
-  if (m.policy == tr::Policy::kPartition) {
-    tp::Options po;
-    po.sticky_threshold = meas::live_sticky_threshold(o);  // as `tgraph run` partitions
-    part = tp::step_partitioner(m.method, po);
-  }
+  tp::Options po;
+  po.sticky_threshold = meas::live_sticky_threshold(o);  // as `tgraph run` partitions
+  const std::optional<tp::StepPartitioner> part = meas::live_partitioner(m, po, o);
   return meas::run_live(factory(s), part ? &*part : nullptr, o);
 }
 

@@ -1,19 +1,29 @@
 // SPDX-License-Identifier: MIT
-// `tgraph run`: a samples scene live, its partitioner and its report.
+// A method choice as a live run takes it; `tgraph run`: a samples scene live, its partitioner
+// and its report.
+#include <memory>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "tgraph/measure/live.hpp"
 #include "tgraph/measure/report.hpp"
 
 namespace tgraph::measure {
 
+std::optional<partition::StepPartitioner> live_partitioner(
+    const MethodChoice& choice, const partition::Options& strategy, LiveOptions& options,
+    std::shared_ptr<std::vector<partition::Stats>> calls) {
+  options.policy = choice.policy;
+  if (choice.policy != replay::Policy::kPartition) return std::nullopt;
+  return partition::step_partitioner(choice.method, strategy, std::move(calls));
+}
+
 SceneRunReport run_scene(const SceneRun& run) {
-  std::optional<partition::StepPartitioner> part;
-  if (run.method.policy == replay::Policy::kPartition)
-    part = partition::step_partitioner(run.method.method, run.strategy.options());
-  const int scene_steps = samples::make_scene(run.scene, run.scene_options)->default_steps();
   LiveOptions o = run.live;
-  o.policy = run.method.policy;
+  const std::optional<partition::StepPartitioner> part =
+      live_partitioner(run.method, run.strategy.options(), o);
+  const int scene_steps = samples::make_scene(run.scene, run.scene_options)->default_steps();
   o.loop_share = run.strategy.values.loop_share;
   o.steps = run.steps.value_or(static_cast<std::uint32_t>(scene_steps));
   const std::string scene = run.scene, method = method_name(run.method);

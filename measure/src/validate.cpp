@@ -54,10 +54,11 @@ double live_spin_budget_ns(std::uint32_t k, std::int64_t spin_ns) {
 
 Validation validate(const ValidateOptions& o) {
   Validation v;
-  v.choice = choose_method(o.method);
+  v.choice = o.method;
   const bool partition = v.choice.policy == replay::Policy::kPartition;
-  std::optional<partition::StepPartitioner> part;
-  if (partition) part = partition::step_partitioner(v.choice.method);
+  LiveOptions method_options;  // the method's policy, each round's live run starts from it
+  const std::optional<partition::StepPartitioner> part =
+      live_partitioner(v.choice, partition::Options{}, method_options);
   v.threads = v.choice.policy == replay::Policy::kSequential ? 1 : o.threads;
   if (v.threads == 0) throw OptionError("threads", "must be at least 1");
   if (o.steps == 0) throw OptionError("steps", "must be at least 1");
@@ -68,8 +69,7 @@ Validation validate(const ValidateOptions& o) {
   for (std::uint32_t round = 0; round < o.repeat; ++round) {
     ValidationRound r;
     // 1. The live run (the truth), timed against the uninstrumented engine.
-    LiveOptions lo;
-    lo.policy = v.choice.policy;
+    LiveOptions lo = method_options;
     lo.exec.threads = v.threads;
     lo.steps = o.steps;
     lo.repeat = 1;

@@ -216,11 +216,14 @@ Options NamedOptions::options() const {
   return o;
 }
 
-StepPartitioner step_partitioner(std::string_view method, const Options& options) {
+StepPartitioner step_partitioner(std::string_view method, const Options& options,
+                                 std::shared_ptr<std::vector<Stats>> calls) {
   std::shared_ptr<Strategy> strategy = make_strategy(method);
-  return [strategy, options](const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph,
-                             const Assignment* prev) {
-    return strategy->partition(g, k, Previous{prev_graph, prev}, options).assignment;
+  return [strategy, options, calls](const StepGraph& g, std::uint32_t k,
+                                    const StepGraph* prev_graph, const Assignment* prev) {
+    Result r = strategy->partition(g, k, Previous{prev_graph, prev}, options);
+    if (calls) calls->push_back(r.stats);
+    return std::move(r.assignment);
   };
 }
 

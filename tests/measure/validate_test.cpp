@@ -26,7 +26,7 @@ double median(std::vector<double> v) {
 ValidateOptions falling(const std::string& method, std::uint32_t steps, std::uint32_t rounds) {
   ValidateOptions o;
   o.scene = "falling";
-  o.method = method;
+  o.method = choose_method(method);
   o.threads = 2;
   o.steps = steps;
   o.repeat = rounds;

@@ -190,6 +190,14 @@ struct LiveResult {
 LiveResult run_live(const EngineFactory& make_engine, const partition::StepPartitioner* partitioner,
                     const LiveOptions& options);
 
+/// A method choice as a live run takes it, the one translation every verb and experiment
+/// that runs a method live calls: `options.policy` set to the choice's; under the partition
+/// policy the strategy's partitioner for run_live (partition::step_partitioner with
+/// `strategy`, each call's Stats appended to `calls` when given), else none.
+std::optional<partition::StepPartitioner> live_partitioner(
+    const MethodChoice& choice, const partition::Options& strategy, LiveOptions& options,
+    std::shared_ptr<std::vector<partition::Stats>> calls = nullptr);
+
 /// `tgraph run`: a samples scene live under one method.
 struct SceneRun {
   std::string scene;  ///< a built-in scene or a scene file

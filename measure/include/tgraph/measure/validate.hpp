@@ -20,7 +20,7 @@ struct LiveResult;  // tgraph/measure/live.hpp
 struct ValidateOptions {
   std::string scene;
   samples::SceneOptions scene_options;  ///< the scene's overrides (split), live and captured
-  std::string method = "owner";  ///< strategy, or a baseline policy (choose_method)
+  MethodChoice method;  ///< a strategy under the partition policy, or a baseline policy
   std::uint32_t threads = 1;
   std::uint32_t steps = 20;
   std::uint32_t repeat = 3;  ///< rounds (live pass, capture, replay pass, simulation); medians

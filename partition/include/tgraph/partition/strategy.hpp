@@ -189,8 +189,10 @@ std::string default_method(const Trace& trace);
 /// run calls at each step (measure::run_live).
 using StepPartitioner = std::function<Assignment(
     const StepGraph& g, std::uint32_t k, const StepGraph* prev_graph, const Assignment* prev)>;
-/// Strategy `method` as a StepPartitioner (UsageError for an unknown name).
-StepPartitioner step_partitioner(std::string_view method, const Options& options = {});
+/// Strategy `method` as a StepPartitioner (UsageError for an unknown name); each call's Stats
+/// appended to `calls` when given.
+StepPartitioner step_partitioner(std::string_view method, const Options& options = {},
+                                 std::shared_ptr<std::vector<Stats>> calls = nullptr);
 
 /// A quick assignment of `g` for a step that cannot wait for its strategy (O(tasks +
 /// accesses)): every task found in `prev_graph` by stable key keeps its processor in `prev`;
