@@ -9,13 +9,12 @@
 
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/fixed.hpp"
+#include "tgraph/graph/json_util.hpp"
 
 namespace tgraph::experiment {
 namespace {
 
 using nlohmann::json;
-
-json opt(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
 
 std::string thread_list(const std::vector<std::uint32_t>& ks) {
   std::string s;
@@ -61,9 +60,9 @@ json measured_json(const Measured& m) {
           {"plans_built", m.plans_built},
           {"structure_changes", m.structure_changes},
           {"signals", m.signals},
-          {"replay_ms_per_step", opt(m.replay_ms_per_step)},
-          {"replay_sequential_ms_per_step", opt(m.replay_sequential_ms_per_step)},
-          {"replay_speedup", opt(m.replay_speedup)}};
+          {"replay_ms_per_step", optional_json(m.replay_ms_per_step)},
+          {"replay_sequential_ms_per_step", optional_json(m.replay_sequential_ms_per_step)},
+          {"replay_speedup", optional_json(m.replay_speedup)}};
 }
 
 json predicted_json(const Predicted& p) {
@@ -319,7 +318,7 @@ std::string experiment_json(const ExperimentResult& res, int indent) {
   json scenes = json::array();
   for (const SceneVariant& v : p.scenes)
     scenes.push_back({{"scene", v.scene},
-                      {"subobjects", v.subobjects ? json(*v.subobjects) : json(nullptr)},
+                      {"subobjects", optional_json(v.subobjects)},
                       {"label", v.label()}});
   json paper_ms = json::object();
   for (const auto& [scene, t] : paper.sequential_ms) paper_ms[scene] = t;
@@ -327,7 +326,7 @@ std::string experiment_json(const ExperimentResult& res, int indent) {
   for (const ResultRow& r : res.rows)
     rows.push_back({{"experiment", r.experiment},
                     {"scene", r.scene},
-                    {"subobjects", r.subobjects ? json(*r.subobjects) : json(nullptr)},
+                    {"subobjects", optional_json(r.subobjects)},
                     {"method", r.method},
                     {"policy", r.policy},
                     {"threads", r.threads},

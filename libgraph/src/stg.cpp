@@ -8,6 +8,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
+#include "tgraph/graph/json_util.hpp"
 #include "tgraph/graph/trace_io.hpp"
 
 namespace tgraph {
@@ -155,7 +156,7 @@ std::string stg_import_report(const StgGraph& stg, const std::string& input,
                         {"tasks", g.tasks.size()},
                         {"edges", g.edges.size()},
                         {"unit_ns", unit_ns}};
-    j["cp_length"] = stg.cp_length ? nlohmann::json(*stg.cp_length) : nlohmann::json(nullptr);
+    j["cp_length"] = optional_json(stg.cp_length);
     return j.dump() + "\n";
   }
   std::string out = "imported " + input + ": " + std::to_string(g.tasks.size()) + " tasks, " +

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "tgraph/graph/json_util.hpp"
+
 namespace tgraph::measure {
 
 namespace tr = tgraph::replay;
@@ -63,7 +65,7 @@ std::string to_json(const ReplayResult& r) {
               {"span_ns", m.span_ns},
               {"host_ns", m.host_ns}});
     s["predicted_makespan_ns"] =
-        m.predicted_makespan_ns ? json(*m.predicted_makespan_ns) : json(nullptr);
+        optional_json(m.predicted_makespan_ns);
     per_step.push_back(std::move(s));
   }
   json j = {{"policy", std::string(to_string(r.policy))},

@@ -38,6 +38,8 @@
 #include <string>
 #include <thread>
 
+#include "tgraph/replay/starpu_modes.hpp"
+
 namespace tgraph::mpi {
 namespace {
 
@@ -51,18 +53,7 @@ struct InstanceArg {
 class StarpuMpiRun;
 StarpuMpiRun* g_run = nullptr;  // the one StarPU-MPI runtime of this process, for the codelet
 
-starpu_data_access_mode to_starpu(AccessMode m) {
-  switch (m) {
-    case AccessMode::R:
-      return STARPU_R;
-    case AccessMode::W:
-      return STARPU_W;
-    case AccessMode::RW:
-    case AccessMode::CW:  // lowered: one processor's writers of one datum, in program order
-      return STARPU_RW;
-  }
-  return STARPU_RW;
-}
+using replay::to_starpu;  // CW: one processor's writers of one datum, in program order
 
 /// A registered datum: its handle, the buffer it was registered on and its owner.
 struct Registered {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "tgraph/graph/json_util.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/partition/evaluate.hpp"
 
@@ -67,9 +68,6 @@ void add_summary(json& j, const PartitionSummary& s) {
   j["rebalanced_steps"] = s.rebalanced_steps;
   if (s.edgecut) j["edgecut"] = *s.edgecut;
 }
-
-json optional_json(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-json optional_json(const std::optional<std::uint64_t>& v) { return v ? json(*v) : json(nullptr); }
 
 const StickyMoves* sticky_moves_at(const Comparison& c, std::uint32_t k) {
   for (const StickyMoves& s : c.sticky_moves)
@@ -169,7 +167,7 @@ std::string comparison_json(const Comparison& c, const std::string& trace_name) 
     json row = report_object(r.report, false);
     add_summary(row, r.partition);
     row["label"] = row_label(r);
-    row["migration_cost"] = r.migration_cost ? json(*r.migration_cost) : json(nullptr);
+    row["migration_cost"] = optional_json(r.migration_cost);
     row["pareto_makespan"] = r.pareto_makespan;
     row["pareto_cut"] = r.pareto_cut;
     if (r.method == "sticky" && !r.migration_cost)

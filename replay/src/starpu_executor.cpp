@@ -37,6 +37,7 @@
 #include "planned_executor.hpp"
 #include "sync.hpp"
 #include "tsan.hpp"
+#include "tgraph/replay/starpu_modes.hpp"
 
 namespace tgraph::replay {
 namespace {
@@ -81,23 +82,6 @@ struct StarpuPlan {
     std::erase(registry->plans, this);
   }
 };
-
-/// StarPU's mode for `m`. `commute`: CW groups were left with several writers per datum
-/// (no per-writer temporaries), which StarPU may then run in any order, one at a time.
-starpu_data_access_mode to_starpu(AccessMode m, bool commute) {
-  switch (m) {
-    case AccessMode::R:
-      return STARPU_R;
-    case AccessMode::W:
-      return STARPU_W;
-    case AccessMode::RW:
-      return STARPU_RW;
-    case AccessMode::CW:
-      return commute ? static_cast<starpu_data_access_mode>(STARPU_RW | STARPU_COMMUTE)
-                     : STARPU_RW;
-  }
-  return STARPU_RW;
-}
 
 /// What the break task of a loop iteration does after its body.
 enum class Check : std::uint8_t {
