@@ -39,9 +39,9 @@ set(_tgraph_debian_PkgConfig::ODE "libode-dev")
 
 # The modules, as library targets tgraph_<module> in folder <folder>, in dependency order.
 set(_tgraph_modules "")
-foreach(pair graph:libgraph capture:capture model:model partition:partition replay:replay explain:explain
-             viz:viz
-             samples:samples measure:measure ode:ode mpi:mpi experiment:experiment)
+foreach(pair graph:libgraph capture:capture model:model partition:partition replay:replay
+             explain:explain viz:viz samples:samples measure:measure ode:ode mpi:mpi
+             experiment:experiment)
   string(REPLACE ":" ";" pair "${pair}")
   list(GET pair 0 module)
   list(GET pair 1 folder)
