@@ -211,8 +211,12 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   const std::uint32_t baseline_cores =
       o.exec.pin ? std::min<std::uint32_t>({res.threads, tr::hardware_pus(), 4}) : 1;
   Baseline baseline{std::vector<PassTimes>(baseline_cores, PassTimes(o.steps)), PassTimes(o.steps)};
-  PassTimes wall(o.steps), record(o.steps), part(o.steps), background(o.steps), prepare(o.steps),
-      execute(o.steps);
+  // The step times every pass records; their medians are the result's (wall first).
+  StepFieldTimes<LiveStepMeasure, 6> times(
+      {&LiveStepMeasure::wall_ns, &LiveStepMeasure::record_ns, &LiveStepMeasure::partition_ns,
+       &LiveStepMeasure::background_partition_ns, &LiveStepMeasure::prepare_ns,
+       &LiveStepMeasure::execute_ns},
+      o.steps);
   for (std::uint32_t pass = 0; pass < o.repeat; ++pass) {
     if (o.baseline) time_baseline_pass(make_engine, o, baseline);
     if (!ex) ex = make();
@@ -224,36 +228,20 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
     res.plans_built += ex->plans_built();
     res.order_fallbacks += ex->order_fallbacks();
     ex.reset();
-    for (std::uint32_t s = 0; s < o.steps; ++s) {
-      const LiveStepMeasure& m = passes.back().steps[s];
-      wall.add(s, m.wall_ns);
-      record.add(s, m.record_ns);
-      part.add(s, m.partition_ns);
-      background.add(s, m.background_partition_ns);
-      prepare.add(s, m.prepare_ns);
-      execute.add(s, m.execute_ns);
-    }
-    for (PassTimes* t : {&wall, &record, &part, &background, &prepare, &execute}) t->end_pass();
+    times.add_pass(passes.back().steps);
   }
   const detail::PassResult& first = passes[0];
   res.signals = first.signals;
   res.waits = first.waits;
   res.blocked_waits = first.blocked_waits;
   res.parks = first.parks;
-  res.pass_wall_ns = wall.pass_totals();
+  res.pass_wall_ns = times.times(0).pass_totals();
   res.steps = first.steps;  // the first pass's plan and structure figures
+  times.write_medians(res.steps);
   if (o.keep_assignments) res.assignments = first.assignments;
-  for (std::uint32_t s = 0; s < o.steps; ++s) {
-    LiveStepMeasure& m = res.steps[s];
-    m.wall_ns = wall.step_median(s);
-    m.record_ns = record.step_median(s);
-    m.partition_ns = part.step_median(s);
-    m.background_partition_ns = background.step_median(s);
-    m.prepare_ns = prepare.step_median(s);
-    m.execute_ns = execute.step_median(s);
-    m.baseline_ns = baseline.fastest.step_median(s);
-  }
-  res.wall_ns = wall.median_total();
+  for (std::uint32_t s = 0; s < o.steps; ++s)
+    res.steps[s].baseline_ns = baseline.fastest.step_median(s);
+  res.wall_ns = times.times(0).median_total();
   for (const PassTimes& core : baseline.by_core) {
     res.baseline_core_pass_wall_ns.push_back(core.pass_totals());
     const std::int64_t m = core.median_total();

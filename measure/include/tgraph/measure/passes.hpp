@@ -4,6 +4,7 @@
 // the same machine noise, and reports the median over passes of each step and of the totals.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -34,6 +35,41 @@ class PassTimes {
   std::vector<std::vector<std::int64_t>> by_step_;
   std::vector<std::int64_t> totals_;
   std::int64_t current_ = 0;
+};
+
+/// Several fields of a per-step record, timed over the same passes: a pass's records added at
+/// once, each field's median over the passes written back step by step.
+///
+///   StepFieldTimes<LiveStepMeasure, 2> t({&LiveStepMeasure::wall_ns,
+///                                         &LiveStepMeasure::execute_ns}, steps);
+///   for (pass...) t.add_pass(pass_steps);
+///   t.write_medians(result_steps);  t.times(0).median_total();
+template <class Step, std::size_t N>
+class StepFieldTimes {
+ public:
+  using Field = std::int64_t Step::*;
+  StepFieldTimes(const std::array<Field, N>& fields, std::size_t steps) : fields_(fields) {
+    times_.fill(PassTimes(steps));
+  }
+  /// One pass: the fields of its first steps() records, then the pass closed.
+  void add_pass(const std::vector<Step>& pass) {
+    for (std::size_t f = 0; f < N; ++f) {
+      for (std::size_t s = 0; s < times_[f].steps(); ++s) times_[f].add(s, pass[s].*fields_[f]);
+      times_[f].end_pass();
+    }
+  }
+  /// Each field of each of the first steps() records set to its median over the passes.
+  void write_medians(std::vector<Step>& steps) const {
+    for (std::size_t f = 0; f < N; ++f)
+      for (std::size_t s = 0; s < times_[f].steps(); ++s)
+        steps[s].*fields_[f] = times_[f].step_median(s);
+  }
+  /// The passes of field `f` (in the order given).
+  const PassTimes& times(std::size_t f) const { return times_[f]; }
+
+ private:
+  std::array<Field, N> fields_;
+  std::array<PassTimes, N> times_;
 };
 
 }  // namespace tgraph::measure
