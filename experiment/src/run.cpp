@@ -62,11 +62,9 @@ LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t
   o.repeat = p.repeat;
   o.observe = false;
   o.repartition_every_step = every_step;
-  tp::Options po;
-  po.sticky_threshold = meas::live_sticky_threshold(o);  // as `tgraph run` partitions
   auto calls = std::make_shared<std::vector<tp::Stats>>();  // in order, first pass first
-  const std::optional<tp::StepPartitioner> part =
-      meas::live_partitioner(meas::choose_method(method), po, o, calls);
+  const std::optional<tp::StepPartitioner> part = meas::live_partitioner(
+      meas::choose_method(method), meas::live_strategy_options(o), o, calls);
   const std::string scene = v.scene;
   const samples::SceneOptions so = scene_options(v);
   LiveRun run;

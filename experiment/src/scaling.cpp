@@ -87,9 +87,8 @@ meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std:
   o.baseline = false;
   o.observe = true;
   o.keep_assignments = m.policy == tr::Policy::kPartition;
-  tp::Options po;
-  po.sticky_threshold = meas::live_sticky_threshold(o);  // as `tgraph run` partitions
-  const std::optional<tp::StepPartitioner> part = meas::live_partitioner(m, po, o);
+  const std::optional<tp::StepPartitioner> part =
+      meas::live_partitioner(m, meas::live_strategy_options(o), o);  // as `tgraph run` partitions
   return meas::run_live(factory(s), part ? &*part : nullptr, o);
 }
 

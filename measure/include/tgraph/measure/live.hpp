@@ -89,6 +89,13 @@ struct LiveOptions {
 /// trigger already waits for that tolerance (at sticky's default 1.20, torso's loops ran up
 /// to 20 % off for 60 steps). `tgraph run` and the experiments' live runs both use it.
 inline double live_sticky_threshold(const LiveOptions& o) { return 1.0 + o.rebalance_tolerance; }
+/// The strategies' options of a live run that sets none of its own: the defaults with
+/// live_sticky_threshold(o).
+inline partition::Options live_strategy_options(const LiveOptions& o) {
+  partition::Options po;
+  po.sticky_threshold = live_sticky_threshold(o);
+  return po;
+}
 
 /// Mean duration of the instances of one task kind.
 struct KindTime {
