@@ -47,7 +47,7 @@ const std::vector<Registered>& registry() {
         true, true, ""},
        make_barrier_executor},
       {{Policy::kStarpu, "starpu", "StarPU tasks, one data handle per datum", kStarpuBuilt, true,
-        "libstarpu-dev was not found"},
+        kStarpuBuilt ? "" : "libstarpu-dev was not found"},
        make_starpu_executor},
       {{Policy::kOmpTasks, "omp-tasks", "OpenMP tasks, one depend object per datum", true, true,
         ""},
