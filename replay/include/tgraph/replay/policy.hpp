@@ -13,8 +13,10 @@
 namespace tgraph::replay {
 
 // Transitional: libgraph's lowering modes under their former replay:: names, for the files
-// of other helpers that still write them (measure/src/adapter.cpp); delete with them.
+// of other helpers that still write them (measure/src/adapter.cpp, measure/src/state.*);
+// delete with them.
 using tgraph::CwMode;
+using tgraph::ExecGraph;
 using tgraph::ReduceScope;
 
 /// How the tasks of a step are put on threads: the identity of a registered policy
