@@ -53,6 +53,9 @@ void add_capture(CLI::App& app) {
   auto ode = std::make_shared<OdeFlags>();
   add_ode_capture_flags(cmd, *ode);
   cmd->callback([o, a, ode] {
+    if (is_ode_scene(o->scene) && o->verify_accesses)  // ODE declares dependencies, no data
+      throw UsageError("--verify-accesses: ODE's calls declare no data accesses (" + o->scene +
+                       " is captured through ODE's threading interface)");
     if (is_ode_scene(o->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
       return capture_ode(o->scene, o->steps, o->output, a->json, *ode);
     o->progress = isatty(STDERR_FILENO) != 0;

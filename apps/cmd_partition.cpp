@@ -11,7 +11,7 @@
 #include "tgraph/partition/partition_graph.hpp"
 #include "tgraph/measure/calibrate.hpp"
 #include "tgraph/partition/compare.hpp"
-#include "tgraph/partition/cost_model.hpp"
+#include "tgraph/model/cost_model.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/partition/strategy.hpp"
 
@@ -23,7 +23,7 @@ void add_model_flags(CLI::App* cmd, tp::NamedOptions& n) {
   cmd->add_option("--model", n.model, "Cost model: calibrated (default) or ideal (free syncs)")
       ->check(CLI::IsMember({"ideal", "calibrated"}));
   cmd->add_option("--calibration", n.calibration,
-                  "Calibration file (default: " + tp::default_calibration_path() + " if present)");
+                  "Calibration file (default: " + tgraph::model::default_calibration_path() + " if present)");
 }
 
 void add_strategy_flags(CLI::App* cmd, tp::NamedOptions& n) {
@@ -102,7 +102,7 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("trace", a->input, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", a->assignment, "Assignment file (.tga)")->required();
   add_model_flags(cmd, *n);
-  auto serial = std::make_shared<tp::SerialWork>();
+  auto serial = std::make_shared<tgraph::model::SerialWork>();
   add_serial_flags(cmd, *serial);
   cmd->callback([a, n, serial] {
     std::cout << tp::evaluate_files(a->input, a->assignment, n->cost_model(), *serial, a->json);
@@ -138,10 +138,10 @@ void add_partition_verbs(CLI::App& app) {
     std::cout << import_stg(a->input, a->output, a->unit_ns, a->edge_bytes, a->json);
   });
 
-  auto cal = std::make_shared<tp::CalibrateOptions>();
+  auto cal = std::make_shared<tgraph::model::CalibrateOptions>();
   cmd = verb(app, "calibrate", "Measure signal/wait latency and transfer costs for simulation", a);
   cmd->add_option("--out,-o", a->output,
-                  "Output file (default " + tp::default_calibration_path() + ")");
+                  "Output file (default " + tgraph::model::default_calibration_path() + ")");
   cmd->add_option("--rounds", cal->rounds, "Ping-pong round trips (default 20000)")
       ->check(CLI::Range(500, 10000000));
   cmd->add_option("--samples", cal->samples,

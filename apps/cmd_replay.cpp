@@ -144,10 +144,18 @@ void add_replay_verbs(CLI::App& app) {
     run->live.check = !check->empty();
     run->live.check_reference =
         *check == "plain" ? meas::CheckReference::kPlain : meas::CheckReference::kTwin;
-    if (is_ode_scene(run->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp; plain always)
+    if (is_ode_scene(run->scene)) {  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp; plain always)
+      // ODE posts calls with dependencies, never the data they touch: nothing to verify.
+      if (*verify)
+        throw UsageError("--verify-accesses: ODE's calls declare no data accesses (" +
+                         run->scene + " is run through ODE's threading interface)");
+      if (!a->timeline.empty())
+        throw UsageError("--timeline: not written for ODE's scenes (" + run->scene +
+                         "; tgraph capture --scene " + run->scene + " records the calls)");
       return run_ode(run->scene, run->steps, a->method, run->live.exec.threads, run->live.repeat,
                      run->live.check, run->json,
                      static_cast<double>(run->live.exec.partition.timeout_ms) / 1e3, *ode);
+    }
     run->method = method_flags(a->method, a->policy);
     run->live.keep_timeline = !a->timeline.empty();
     if (!a->timeline.empty() && !run->live.observe)

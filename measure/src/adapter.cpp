@@ -141,7 +141,7 @@ VerifyResult verify_accesses(const EngineFactory& make_engine,
   if (partition && (partitioner == nullptr || !*partitioner))
     throw UsageError("the partition policy needs a partitioning method");
   replay::ExecOptions eo = o.exec;
-  eo.cw = replay::CwMode::kSerialize;  // a body that runs twice writes its datum itself
+  eo.cw = CwMode::kSerialize;  // a body that runs twice writes its datum itself
   std::unique_ptr<replay::Executor> ex = replay::make_executor(o.policy, eo);
   VerifyResult res;
   res.policy = o.policy;

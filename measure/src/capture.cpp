@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "tgraph/capture/recorder.hpp"
+#include "tgraph/capture/write_step.hpp"
 #include "tgraph/samples/capture_run.hpp"
 
 namespace tgraph::measure {
@@ -17,10 +18,10 @@ Trace capture_trace(const std::string& scene, std::uint32_t steps,
   for (std::uint32_t s = 0; s < steps; ++s) {
     sc->step(rec);
     trace.steps.push_back(rec.end_step());
+    if (rec.step_errors() != 0)  // the misuse named, as tgraph capture names it
+      throw std::runtime_error(scene + " step " + std::to_string(s) + ": " +
+                               capture::step_misuse_line(rec));
   }
-  if (rec.errors() != 0)
-    throw std::runtime_error(scene + ": the capture API reported " + std::to_string(rec.errors()) +
-                             " misuses");
   return trace;
 }
 

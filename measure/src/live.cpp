@@ -98,9 +98,9 @@ void check_final_state(const EngineFactory& make_engine,
       std::unique_ptr<tr::Executor> ref;
       detail::PassOptions po;
       po.keep_state = true;
-      if (res.cw == tr::CwMode::kSerialize || o.policy == tr::Policy::kSequential) {
+      if (res.cw == CwMode::kSerialize || o.policy == tr::Policy::kSequential) {
         ro.threads = 1;
-        ro.reduce_scope = tr::ReduceScope::kNone;
+        ro.reduce_scope = ReduceScope::kNone;
         ref = tr::make_executor(tr::Policy::kSequential, ro);
         res.reference = "the twin (sequential executor, program order)";
       } else if (o.policy == tr::Policy::kPartition) {
@@ -150,7 +150,7 @@ void check_final_state(const EngineFactory& make_engine,
     MagnitudeObserver observer([&watched] { return watched->state(); });
     tr::ExecOptions so = o.exec;
     so.threads = 1;
-    so.reduce_scope = tr::ReduceScope::kNone;
+    so.reduce_scope = ReduceScope::kNone;
     std::unique_ptr<tr::Executor> seq = tr::make_executor(tr::Policy::kSequential, so);
     seq->add_observer(observer);
     const detail::PassResult in_order = detail::run_pass(watch, nullptr, *seq, o, {});
@@ -199,7 +199,7 @@ LiveResult run_live(const EngineFactory& make_engine, const partition::StepParti
   res.scope = ex->scope();
   ex.reset();
   if (o.check && o.check_reference == CheckReference::kTwin &&
-      res.scope == tr::ReduceScope::kPerThread && res.cw == tr::CwMode::kReduce &&
+      res.scope == ReduceScope::kPerThread && res.cw == CwMode::kReduce &&
       res.threads > 1)
     throw OptionError("reduce_scope",
                       "per-thread temporaries sum in an order of the run's timing, which no "

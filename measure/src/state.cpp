@@ -168,7 +168,7 @@ ValueDifference compare_values(const StateSnapshot& expected, const StateSnapsho
   return out;
 }
 
-void MagnitudeObserver::on_step_begin(const replay::ExecGraph& exec, std::uint32_t, std::int64_t) {
+void MagnitudeObserver::on_step_begin(const ExecGraph& exec, std::uint32_t, std::int64_t) {
   exec_ = &exec;
   current_ = regions_();
   std::unordered_map<std::string, const StateRegion*> by_name;

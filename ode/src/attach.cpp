@@ -10,15 +10,12 @@
 #include "recording.hpp"
 #include "runtime.hpp"
 #include "tgraph/graph/error.hpp"
+#include "tgraph/replay/observer.hpp"
 
 namespace tgraph::ode {
 namespace {
 
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using replay::now_ns;  // the steady clock of every timeline
 
 bool runtime_policy(Policy p) { return p == Policy::kWorksteal || p == Policy::kPartition; }
 

@@ -13,6 +13,8 @@
 #include <cstring>
 #include <string_view>
 
+#include "tgraph/replay/observer.hpp"
+
 #if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
 #define TGRAPH_ODE_PAUSE() _mm_pause()
@@ -23,11 +25,7 @@
 namespace tgraph::ode::detail {
 namespace {
 
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using replay::now_ns;  // the steady clock of every timeline
 
 /// A segment's time stamp: the time-stamp counter where there is one (a quarter of a clock
 /// read on this VM; constant and synchronised across cores when the kernel's clocksource is

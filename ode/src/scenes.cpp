@@ -7,15 +7,12 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/ode/attach.hpp"
+#include "tgraph/replay/observer.hpp"
 
 namespace tgraph::ode {
 namespace {
 
-std::int64_t now_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(
-             std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
+using replay::now_ns;  // the steady clock of every timeline
 
 constexpr int kMaxContacts = 4;
 

@@ -9,7 +9,8 @@
 #include "tgraph/graph/median.hpp"
 #include "tgraph/ode/run.hpp"
 #include "tgraph/ode/scenes.hpp"
-#include "tgraph/partition/simulator.hpp"
+#include "tgraph/model/cost_model.hpp"
+#include "tgraph/model/simulator.hpp"
 
 namespace tgraph::ode {
 namespace {
@@ -74,11 +75,11 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   ValidateReport report;
   report.options = options;
   report.strategy = options.method.policy == Policy::kPartition ? options.method.strategy : "list";
-  partition::CostModel model = partition::select_cost_model("calibrated", options.calibration);
+  model::CostModel costs = model::select_cost_model("calibrated", options.calibration);
   // The runtime's own time per call, which no part's recorded cost holds (charged per part
   // below, scaled by the step's calls per part), and its spin before a thread parks.
   report.runtime_ns_per_call = runtime_ns_per_call();
-  model.spin_budget_ns = static_cast<double>(AttachOptions{}.spin_ns);
+  costs.spin_budget_ns = static_cast<double>(AttachOptions{}.spin_ns);
   auto strategy = partition::make_strategy(report.strategy);
   dInitODE2(0);
   struct Close {
@@ -106,7 +107,7 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       for (const StepGraph& g : attach.take_steps()) {
         const partition::Result p = strategy->partition(g, options.threads, {}, {});
         v.predicted_ns +=
-            static_cast<std::int64_t>(partition::simulate(g, p.assignment, model).makespan_ns);
+            static_cast<std::int64_t>(model::simulate(g, p.assignment, costs).makespan_ns);
       }
     }
     report.rounds.push_back(v);

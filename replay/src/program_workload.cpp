@@ -2,7 +2,7 @@
 #include "tgraph/replay/program_workload.hpp"
 
 #include "tgraph/graph/error.hpp"
-#include "tgraph/replay/lowering.hpp"
+#include "tgraph/graph/lowering.hpp"
 
 namespace tgraph::replay {
 

@@ -139,6 +139,28 @@ TEST_F(Cli, ExperimentVizTimelineValidateAndDemoErrorsNameTheFlag) {
   EXPECT_EQ(j["command"], "tgraph experiment metg --quick --threads 1,2 --methods sequential --out m");
 }
 
+#ifdef TGRAPH_HAVE_ODE
+// What ODE's scenes cannot honour is refused by flag, not ignored: ODE posts calls with
+// dependencies and never the data they touch, and its runs keep no timeline.
+TEST_F(Cli, OdeScenesRefuseTheFlagsTheyCannotHonour) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"run --scene ode-piles --steps 2 --threads 2 --verify-accesses",
+       "tgraph: --verify-accesses: ODE's calls declare no data accesses (ode-piles"},
+      {"capture --scene ode-piles --steps 2 -o o.tgt --verify-accesses",
+       "tgraph: --verify-accesses: ODE's calls declare no data accesses (ode-piles"},
+      {"run --scene ode-heap --steps 2 --threads 2 --timeline t.json",
+       "tgraph: --timeline: not written for ODE's scenes (ode-heap"}};
+  for (const auto& [args, start] : cases) {
+    const Result r = run(args);
+    EXPECT_EQ(r.code, 2) << args << ": " << r.err;
+    EXPECT_TRUE(one_line(r.err)) << args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind(start, 0), 0u) << args << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "o.tgt"));
+  EXPECT_FALSE(fs::exists(dir_ / "t.json"));
+}
+#endif
+
 // The modules' option errors of generate, capture and partition, in the flags' words.
 TEST_F(Cli, ModuleOptionErrorsOfGenerateCaptureAndPartitionNameTheFlags) {
   const std::pair<const char*, const char*> cases[] = {

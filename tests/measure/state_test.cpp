@@ -226,7 +226,7 @@ TEST(State, APlantedRealDifferenceDiffersFromThePlainRunWithItsFigures) {
 // under kReduce the plain check says so and gives its figures and the bound it held them to
 // (the implicit CG's values exceed a rounding bound: docs/instrumenting.md).
 TEST(State, Bars64IsBitIdenticalToThePlainRunWithSerializedCwAndGivesFiguresWithout) {
-  auto run = [](replay::CwMode cw) {
+  auto run = [](CwMode cw) {
     LiveOptions o;
     o.exec.threads = 2;
     o.exec.pin = false;
@@ -239,10 +239,10 @@ TEST(State, Bars64IsBitIdenticalToThePlainRunWithSerializedCwAndGivesFiguresWith
     const partition::StepPartitioner part = partition::step_partitioner("owner", {});
     return run_live([] { return make_live_engine("bars64"); }, &part, o);
   };
-  const LiveResult serialized = run(replay::CwMode::kSerialize);
+  const LiveResult serialized = run(CwMode::kSerialize);
   EXPECT_EQ(serialized.check, Check::kIdentical)
       << (serialized.difference ? to_string(*serialized.difference) : "");
-  const LiveResult reduced = run(replay::CwMode::kReduce);
+  const LiveResult reduced = run(CwMode::kReduce);
   ASSERT_TRUE(reduced.check.has_value());
   EXPECT_EQ(reduced.check_reference, CheckReference::kPlain);
   EXPECT_FALSE(reduced.iterations.has_value());  // the same CG iterations in both runs

@@ -157,7 +157,7 @@ TEST(Calibration, TaskOverheadIsOptionalAndZeroByDefault) {
 
 TEST(SimulateTrace, BuiltinEngineIsTheScheduleSimulator) {
   Trace trace;
-  trace.steps = {testing::random_graph(3, 30, 6, true), testing::random_graph(4, 30, 6, true)};
+  trace.steps = {partition::testing::random_graph(3, 30, 6, true), partition::testing::random_graph(4, 30, 6, true)};
   const TracePartition tp = partition_trace(trace, "roundrobin", 3);
   const SimulatedPlatform p = on_file("", CostModel::defaults());
   const Prediction r = simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p);
@@ -174,7 +174,7 @@ TEST(SimulateTrace, BuiltinEngineIsTheScheduleSimulator) {
 
 TEST(SimulateTrace, RefusesMoreProcessorsThanTheClusterHas) {
   Trace trace;
-  trace.steps = {testing::random_graph(5, 20, 4, false)};
+  trace.steps = {partition::testing::random_graph(5, 20, 4, false)};
   const TracePartition tp = partition_trace(trace, "roundrobin", 5);
   const SimulatedPlatform p = on_cluster(ClusterShape{2, 2}, CostModel::defaults());
   EXPECT_THROW(simulate_trace(trace, tp.assignment, SimulationEngine::builtin, p), Error);
@@ -310,7 +310,7 @@ TEST(SimgridEngine, RunsEachProcessorsTasksOneAfterTheOther) {
   // Four independent tasks of 1000 ns on one processor of a one-core host, and on two
   // processors of a two-core host: 4000 ns and 2000 ns, never shared CPU time.
   Builder b;
-  for (int i = 0; i < 4; ++i) b.task({{b.datum(testing::name("d", i), 8), M::W}}, 1000);
+  for (int i = 0; i < 4; ++i) b.task({{b.datum(partition::testing::name("d", i), 8), M::W}}, 1000);
   Trace t;
   t.steps = {b.done()};
   const SimulatedPlatform one = on_cluster(ClusterShape{1, 1}, CostModel::defaults());
@@ -339,7 +339,7 @@ TEST(SimgridEngine, EqualsTheBuiltinSimulatorOnOneHostOnRandomGraphs) {
     for (std::uint32_t k : {1u, 2u, 3u, 5u}) {
       Trace trace;
       for (std::uint64_t seed = 0; seed < 40; ++seed)
-        trace.steps.push_back(testing::random_graph(
+        trace.steps.push_back(partition::testing::random_graph(
             1000 * k + seed, 12 + static_cast<int>(seed % 20), 5, seed % 3 != 0));
       for (const char* method : {"roundrobin", "random", "list"}) {
         const TracePartition tp = partition_trace(trace, method, k);

@@ -112,7 +112,7 @@ class MagnitudeObserver final : public replay::Observer {
   /// `regions`: called at each step's start for the storage of the state (it may move).
   explicit MagnitudeObserver(std::function<std::vector<StateRegion>()> regions)
       : regions_(std::move(regions)) {}
-  void on_step_begin(const replay::ExecGraph& exec, std::uint32_t threads,
+  void on_step_begin(const ExecGraph& exec, std::uint32_t threads,
                      std::int64_t t_ns) override;
   void on_end(std::uint32_t thread, TaskId task, std::uint32_t iteration,
               std::int64_t t_ns) override;
@@ -120,7 +120,7 @@ class MagnitudeObserver final : public replay::Observer {
 
  private:
   std::function<std::vector<StateRegion>()> regions_;
-  const replay::ExecGraph* exec_ = nullptr;
+  const ExecGraph* exec_ = nullptr;
   std::vector<const StateRegion*> by_datum_;  // exec datum -> its region (nullptr: none)
   std::vector<StateRegion> current_;
   Magnitudes magnitudes_;

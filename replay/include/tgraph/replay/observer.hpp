@@ -11,7 +11,6 @@
 #include "tgraph/graph/lowering.hpp"
 #include "tgraph/graph/step_graph.hpp"
 #include "tgraph/graph/timeline.hpp"
-#include "tgraph/replay/policy.hpp"  // replay::ExecGraph, transitional (policy.hpp)
 
 namespace tgraph::replay {
 

@@ -12,13 +12,6 @@
 
 namespace tgraph::replay {
 
-// Transitional: libgraph's lowering modes under their former replay:: names, for the files
-// of other helpers that still write them (measure/src/adapter.cpp, measure/src/state.*);
-// delete with them.
-using tgraph::CwMode;
-using tgraph::ExecGraph;
-using tgraph::ReduceScope;
-
 /// How the tasks of a step are put on threads: the identity of a registered policy
 /// (replay/src/registry.cpp holds its name, help and factory).
 enum class Policy : unsigned char {
