@@ -93,8 +93,32 @@ void migrations(const StepGraph& g, const Assignment& a, const StepGraph& prev,
   }
 }
 
+// Load, imbalance and the predicted makespan of `a` with each task's robust cost.
+void robust_figures(const StepGraph& g, const Assignment& a, const std::vector<std::uint64_t>& costs,
+                    const model::CostModel& model, std::optional<std::uint64_t> serial_ns,
+                    StepReport& r) {
+  StepGraph robust = g;
+  for (TaskId t = 0; t < robust.tasks.size(); ++t) robust.tasks[t].cost_ns = costs[t];
+  std::vector<std::uint64_t> load(a.k, 0);
+  for (TaskId t = 0; t < robust.tasks.size(); ++t)
+    load[a.proc[t]] += robust.tasks[t].cost_ns * robust.runs(t);
+  for (std::uint64_t l : load) {
+    r.robust_work_ns += l;
+    r.robust_max_load_ns = std::max(r.robust_max_load_ns, l);
+  }
+  r.robust_imbalance = r.robust_work_ns == 0 ? 1.0
+                                             : static_cast<double>(r.robust_max_load_ns) * a.k /
+                                                   static_cast<double>(r.robust_work_ns);
+  r.robust_makespan_ns = model::simulate(robust, a, model, serial_ns).makespan_ns;
+  r.robust_speedup = r.robust_makespan_ns == 0
+                         ? 1.0
+                         : static_cast<double>(r.robust_work_ns + g.host_ns) /
+                               static_cast<double>(r.robust_makespan_ns);
+}
+
 StepReport evaluate_step(const StepGraph& g, const Assignment& a, const model::CostModel& model,
-                         std::optional<std::uint64_t> serial_ns) {
+                         std::optional<std::uint64_t> serial_ns,
+                         const std::vector<std::uint64_t>& robust_costs) {
   StepReport r;
   r.tasks = g.tasks.size();
   const QuotientGraph q = quotient_graph(g, a);
@@ -123,6 +147,7 @@ StepReport evaluate_step(const StepGraph& g, const Assignment& a, const model::C
   r.speedup = r.makespan_ns == 0 ? 1.0
                                  : static_cast<double>(r.work_ns + r.host_ns) /
                                        static_cast<double>(r.makespan_ns);
+  robust_figures(g, a, robust_costs, model, serial_ns, r);
   return r;
 }
 
@@ -146,14 +171,15 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const model::CostM
   rep.k = a.k;
   rep.model = model.source;
   StepReport& tot = rep.total;
-  double sum_mean_load = 0.0, sum_partition_ms = 0.0;
+  double sum_mean_load = 0.0, sum_robust_mean_load = 0.0, sum_partition_ms = 0.0;
   tot.quotient_acyclic = true;
+  const std::vector<std::vector<std::uint64_t>> robust = robust_costs(trace.steps);
   for (std::size_t s = 0; s < trace.steps.size(); ++s) {
     StepReport r;
     try {
       std::optional<std::uint64_t> serial;
       if (serial_ns != nullptr && s < serial_ns->size()) serial = (*serial_ns)[s];
-      r = evaluate_step(trace.steps[s], a.steps[s], model, serial);
+      r = evaluate_step(trace.steps[s], a.steps[s], model, serial, robust[s]);
     } catch (const InputError&) {
       throw;
     } catch (const Error& e) {
@@ -178,6 +204,10 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const model::CostM
     tot.migrated_bytes += r.migrated_bytes;
     tot.partition_ms += r.partition_ms;
     tot.ping_pong_pairs += r.ping_pong_pairs;
+    tot.robust_work_ns += r.robust_work_ns;
+    tot.robust_max_load_ns += r.robust_max_load_ns;
+    tot.robust_makespan_ns += r.robust_makespan_ns;
+    sum_robust_mean_load += static_cast<double>(r.robust_work_ns) / a.k;
     tot.quotient_acyclic = tot.quotient_acyclic && r.quotient_acyclic;
     if (!r.quotient_acyclic) ++rep.cyclic_steps;
     rep.imbalance_max = std::max(rep.imbalance_max, r.imbalance);
@@ -190,6 +220,13 @@ Report evaluate(const Trace& trace, const TraceAssignment& a, const model::CostM
   tot.imbalance = sum_mean_load > 0 ? static_cast<double>(tot.max_load_ns) / sum_mean_load : 1.0;
   const double sequential = static_cast<double>(tot.work_ns + tot.host_ns);
   tot.speedup = tot.makespan_ns == 0 ? 1.0 : sequential / static_cast<double>(tot.makespan_ns);
+  tot.robust_imbalance = sum_robust_mean_load > 0
+                             ? static_cast<double>(tot.robust_max_load_ns) / sum_robust_mean_load
+                             : 1.0;
+  tot.robust_speedup = tot.robust_makespan_ns == 0
+                           ? 1.0
+                           : static_cast<double>(tot.robust_work_ns + tot.host_ns) /
+                                 static_cast<double>(tot.robust_makespan_ns);
   const double with_partitioning = static_cast<double>(tot.makespan_ns) + sum_partition_ms * 1e6;
   rep.speedup_with_partitioning = with_partitioning <= 0 ? 1.0 : sequential / with_partitioning;
   return rep;

@@ -35,7 +35,12 @@ json step_json(const StepReport& r) {
           {"migrated_bytes", r.migrated_bytes},
           {"partition_ms", r.partition_ms},
           {"quotient_acyclic", r.quotient_acyclic},
-          {"ping_pong_pairs", r.ping_pong_pairs}};
+          {"ping_pong_pairs", r.ping_pong_pairs},
+          {"robust_work_ns", r.robust_work_ns},
+          {"robust_max_load_ns", r.robust_max_load_ns},
+          {"robust_imbalance", r.robust_imbalance},
+          {"robust_predicted_makespan_ns", r.robust_makespan_ns},
+          {"robust_predicted_speedup", r.robust_speedup}};
 }
 
 json report_object(const Report& rep, bool per_step) {
@@ -48,6 +53,9 @@ json report_object(const Report& rep, bool per_step) {
   j["cyclic_steps"] = rep.cyclic_steps;
   j["predicted_speedup_with_partitioning"] = rep.speedup_with_partitioning;
   j["model_terms"] = rep.model_terms;
+  j["costs"] =
+      "raw: the recorded costs; robust_*: each task's cost the median of its cost over the "
+      "steps of its structure";
   if (per_step) {
     json per = json::array();
     for (std::size_t s = 0; s < rep.steps.size(); ++s) {
@@ -113,6 +121,11 @@ std::string report_text(const Report& rep) {
       static_cast<double>(t.makespan_ns) / 1e6, static_cast<double>(t.lower_bound_ns) / 1e6,
       static_cast<double>(t.work_ns) / 1e6, t.speedup, rep.speedup_with_partitioning,
       t.partition_ms));
+  add(std::snprintf(line, sizeof line,
+                    "  robust costs (each task's the median of its key over the steps of its "
+                    "structure): imbalance %.3f, predicted makespan %.3f ms, speed-up %.2f\n",
+                    t.robust_imbalance, static_cast<double>(t.robust_makespan_ns) / 1e6,
+                    t.robust_speedup));
   add(std::snprintf(
       line, sizeof line, "  quotient graph: %s (%llu steps with cycles, %llu ping-pong pairs)\n",
       t.quotient_acyclic ? "acyclic" : "cyclic", static_cast<unsigned long long>(rep.cyclic_steps),

@@ -92,7 +92,39 @@ TEST(Evaluate, ReportJsonAndTextCarryTheTotals) {
                 "  imbalance 1.500 (worst step 1.500); migrations: 0 tasks, 0 bytes\n"
                 "  predicted makespan 0.000 ms, lower bound 0.000 ms, work 0.000 ms: speed-up 1.33 "
                 "(0.00 with 2.500 ms partitioning)\n"
+                "  robust costs (each task's the median of its key over the steps of its "
+                "structure): imbalance 1.500, predicted makespan 0.000 ms, speed-up 1.33\n"
                 "  quotient graph: cyclic (1 steps with cycles, 1 ping-pong pairs)\n");
+}
+
+// One task interrupted in one of three steps of one structure (1,000 ns instead of 10): the
+// raw prediction of that step carries it, the robust one (the median of the task's key over
+// the three) does not.
+TEST(Evaluate, RobustFiguresIgnoreOneInterruptedTask) {
+  Trace tr;
+  tr.steps = {writer_two_reducers_reader(), writer_two_reducers_reader(),
+              writer_two_reducers_reader()};
+  tr.steps[1].tasks[3].cost_ns = 1000;
+  TraceAssignment a = one_step(2, {0, 0, 1, 0});
+  a.steps = {a.steps[0], a.steps[0], a.steps[0]};
+  a.partition_ms = {0, 0, 0};
+  const Report r = evaluate(tr, a, model::CostModel::ideal());
+  EXPECT_EQ(r.steps[1].makespan_ns, 1020u);
+  EXPECT_DOUBLE_EQ(r.steps[1].imbalance, 1020.0 * 2 / 1030.0);
+  for (const StepReport& s : r.steps) {
+    EXPECT_EQ(s.robust_makespan_ns, 30u);
+    EXPECT_EQ(s.robust_work_ns, 40u);
+    EXPECT_DOUBLE_EQ(s.robust_imbalance, 1.5);
+    EXPECT_DOUBLE_EQ(s.robust_speedup, 40.0 / 30.0);
+  }
+  EXPECT_EQ(r.total.makespan_ns, 1080u);
+  EXPECT_EQ(r.total.robust_makespan_ns, 90u);
+  EXPECT_DOUBLE_EQ(r.total.robust_imbalance, 1.5);
+  const nlohmann::json j = nlohmann::json::parse(report_json(r));
+  EXPECT_EQ(j["robust_predicted_makespan_ns"], 90);
+  EXPECT_EQ(j["per_step"][1]["predicted_makespan_ns"], 1020);
+  EXPECT_EQ(j["per_step"][1]["robust_predicted_makespan_ns"], 30);
+  EXPECT_TRUE(j["costs"].get<std::string>().starts_with("raw: the recorded costs; robust_*"));
 }
 
 TEST(Evaluate, ReportsPingPongBetweenProcessorsAsACycle) {

@@ -35,6 +35,13 @@ struct StepReport {
   double partition_ms = 0.0;
   bool quotient_acyclic = true;       ///< processor graph of intra-step cross edges acyclic
   std::uint64_t ping_pong_pairs = 0;  ///< processor pairs with cross edges both ways
+  // The same under robust costs (each task's cost the median of its stable key's over the
+  // steps of its structure, graph::robust_costs: what one interrupted task cannot bend).
+  std::uint64_t robust_work_ns = 0;
+  std::uint64_t robust_max_load_ns = 0;
+  double robust_imbalance = 1.0;
+  std::uint64_t robust_makespan_ns = 0;  ///< predicted by simulate() (host time included)
+  double robust_speedup = 1.0;           ///< (robust work + host) / robust makespan
 };
 
 /// Evaluation of a whole trace's assignment.
