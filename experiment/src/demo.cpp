@@ -191,6 +191,8 @@ DemoResult run_demo(const DemoOptions& o, const std::function<void(const std::st
   c.timeline = observed_timeline(trace, assignments[best], o);
   c.timeline_caption =
       rows[best].method + " on " + std::to_string(o.threads) + " threads, observed pass.";
+  viz::draw_executed_path(c, trace, res.trace_path, &assignments[best].steps[graph_step],
+                          rows[best].method);
   res.report_path = o.out + "/report.html";
   write_file_atomic(res.report_path, viz::report_html(c));
   res.rows = std::move(rows);

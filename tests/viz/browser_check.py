@@ -5,7 +5,7 @@
 Fails when the page reports a JavaScript error (uncaught exception, console.error, a chart
 that failed to render) or Chromium logs one, when a chart container holds no non-empty SVG
 or canvas, or when fewer charts rendered than the page declared. Checks the lost time's
-stacked bars and the critical path outlined on the timeline, the step graph's
+stacked bars and the critical path outlined on the timeline and drawn on the step graph, the step graph's
 first view (every node inside the box) and its pan and zoom (a copy of the page with a probe
 script wheels, clicks the zoom buttons and records the SVG's transform each time) and the quotient graph (K processor nodes p0..pK-1,
 K from the page's title, with loads that add up to the step's tasks and to 100 %, and
@@ -297,6 +297,14 @@ def check_explain(dom, charts):
         failures.append("the timeline has no critical-path layer (outlined bodies)")
     elif path.group(1).count("<path") < 1:
         failures.append("the timeline's critical-path layer draws no body")
+    # The same executed path on the step graph: its title names it, with its instances.
+    graph = re.search(r'id="graph-step"[^>]*>(.*?)</svg>', dom, re.S)
+    drawn = graph and re.search(r'executed critical path \(thick, double border\): [^<]*? over (\d+) task instances',
+                                graph.group(1))
+    if not drawn:
+        failures.append("the step graph does not draw the executed critical path")
+    elif int(drawn.group(1)) < 1:
+        failures.append("the step graph's executed critical path has no task instance")
     return failures
 
 

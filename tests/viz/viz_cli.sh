@@ -85,5 +85,13 @@ for id in chart-speedup chart-methods chart-timeline; do
   grep -q "id=\"$id\"" "$d/report.html" || fail "report.html has no $id"
 done
 ! grep -q '<script src' "$d/report.html" || fail "report.html loads a script from elsewhere"
+# The timeline replayed steps 0 and 1: step 1's graph draws the executed critical path, step
+# 2's (not in the timeline) the graph's own longest path.
+grep -q "executed critical path (thick, double border): .* over [1-9][0-9]* task instances" "$d/report.html" ||
+  fail "report.html's step graph does not draw the timeline's executed critical path"
+"$T" report "$d/fig2.tgt" --replay "$d/r.json" --step 2 -o "$d/report2.html" >/dev/null
+grep -q "critical path (thick, double border)" "$d/report2.html" || fail "report2.html draws no critical path"
+! grep -q "executed critical path (thick" "$d/report2.html" ||
+  fail "report2.html draws an executed path for a step the timeline does not hold"
 expect_refusal "$d/y.html" "$T" report "$d/fig2.tgt" --compare "$d/r.json" -o "$d/y.html"
 echo "viz command line: all checks passed"

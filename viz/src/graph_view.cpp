@@ -139,7 +139,7 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
   v.collapse = o.collapse;
   v.critical_path = o.critical_path;
   CriticalPath cp;
-  if (o.critical_path) cp = critical_path(g);
+  if (o.critical_path) cp = o.path ? *o.path : critical_path(g);
   const CriticalPath* cpp = o.critical_path ? &cp : nullptr;
   if (o.collapse == Collapse::kNone) {
     detail::build_task_view(g, o, cpp, v);
@@ -181,9 +181,11 @@ GraphView make_graph_view(const StepGraph& g, const ViewOptions& o) {
     v.title.push_back("collapsed by " + std::string(to_string(o.collapse)) +
                       ": work = cost \xC3\x97 runs, edge bytes per step; " + hidden_deps_note(v));
   if (o.critical_path)
-    v.title.push_back(
-        "critical path (thick, double border): " + format_ns(static_cast<double>(cp.length_ns)) +
-        " over " + std::to_string(cp.instances.size()) + " task instances" + loop_summary(g, cp));
+    v.title.push_back(std::string(o.path ? "executed critical path" : "critical path") +
+                      " (thick, double border): " +
+                      format_ns(static_cast<double>(cp.length_ns)) + " over " +
+                      std::to_string(cp.instances.size()) + " task instances" +
+                      loop_summary(g, cp));
   return v;
 }
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 
@@ -17,6 +18,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/metrics.hpp"
 #include "tgraph/graph/summary.hpp"
+#include "tgraph/viz/critical_path.hpp"
 #include "tgraph/viz/graph_view.hpp"
 #include "tgraph/viz/graphviz.hpp"
 #include "tgraph/viz/palette.hpp"
@@ -161,6 +163,92 @@ const char* kPanZoomScript = R"js(
 })();
 )js";
 
+// The step graph of the report: step `step` collapsed by object, coloured by `assignment`,
+// with `executed` (a timeline's executed critical path) or else its own critical path.
+void set_step_graph(ReportContent& c, const StepGraph& g, const std::string& trace_name,
+                    const Assignment* assignment, std::size_t step,
+                    const std::string& assignment_name, const CriticalPath* executed) {
+  ViewOptions o;
+  o.collapse = Collapse::kObject;
+  o.assignment = assignment;
+  o.critical_path = true;
+  o.path = executed;
+  o.max_nodes = 0;
+  o.max_edges = 0;
+  o.edge_labels = false;  // on hover: drawn, they overlap on a scene of many objects
+  o.title = trace_name + ", step " + std::to_string(step) +
+            (assignment
+                 ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors"
+                 : "");
+  const GraphView view = make_graph_view(g, o);
+  c.graph_step = step;
+  c.graph_svg = inline_svg(render_graph(view, GraphFormat::kSvg));
+  c.graph_executed_path = executed != nullptr;
+  c.graph_caption =
+      "Step " + std::to_string(step) +
+      " collapsed by object (one node per object and loop, and per object before and "
+      "after each loop; work = cost × runs), "
+      "coloured by processor" +
+      (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
+      "; vermillion edges cross processors; thick black: " +
+      (executed ? "the executed critical path of this step in the timeline (tgraph explain)"
+                : "the critical path (the longest through the recorded costs)") +
+      "; " + hidden_deps_note(view) +
+      ". Hover a node or an edge for its text (edge labels: data, bytes per step, "
+      "crossings). Same picture with edge labels drawn: step " + std::to_string(step) +
+      " of " + trace_name + " collapsed by object, with the critical path" +
+      (assignment ? " and the assignment" : "") + ", drawn on its own as SVG";
+}
+
+// The executed critical path of step `step` of the timeline, on the step graph `g` it
+// replayed: each body of the path named by its task of `g` (the timeline's graph's origin;
+// reducers, which `g` has not, left out), each pair of consecutive bodies joined by the edge
+// of `g` between them where there is one. Nothing when the timeline has no explanation of
+// that step or its graph is not `g`'s (another trace's: a kind or a task out of place).
+std::optional<CriticalPath> executed_path(const StepGraph& g, const Timeline& t,
+                                          const explain::Explanation& e, std::size_t step) {
+  const explain::StepExplanation* se = nullptr;
+  for (const explain::StepExplanation& s : e.steps)
+    if (s.step == step) se = &s;
+  const TimelineStep* info = t.info(static_cast<std::uint32_t>(step));
+  if (!se || !info || info->graph >= t.graphs.size()) return std::nullopt;
+  const TimelineGraph& x = t.graphs[info->graph];
+  CriticalPath cp;
+  cp.task_hits.assign(g.tasks.size(), 0);
+  cp.edge_hits.assign(g.edges.size(), 0);
+  cp.carried_hits.assign(g.carried_edges.size(), 0);
+  std::optional<TaskInstance> prev;
+  for (const explain::PathLink& l : se->critical_path) {
+    cp.length_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(0, l.end_ns));
+    if (l.link != explain::Link::kBody || !l.task) continue;
+    if (*l.task >= x.origin.size()) return std::nullopt;
+    const TaskId o = x.origin[*l.task];
+    if (o == kNoTask) continue;  // a reducer of the lowered graph
+    if (o >= g.tasks.size() || g.kind_name(o) != l.kind) return std::nullopt;
+    const TaskInstance here{o, l.iteration};
+    PathLink link = PathLink::kStart;
+    std::uint32_t edge = 0;
+    if (prev) {
+      const bool same_iteration = prev->iteration == here.iteration;
+      const std::vector<Edge>& edges = same_iteration ? g.edges : g.carried_edges;
+      for (std::uint32_t i = 0; i < edges.size(); ++i)
+        if (edges[i].from == prev->task && edges[i].to == o) {
+          link = same_iteration ? PathLink::kEdge : PathLink::kCarried;
+          edge = i;
+          (same_iteration ? cp.edge_hits : cp.carried_hits)[i]++;
+          break;
+        }
+    }
+    ++cp.task_hits[o];
+    cp.instances.push_back(here);
+    cp.links.push_back(link);
+    cp.edge_of.push_back(edge);
+    prev = here;
+  }
+  if (cp.instances.empty()) return std::nullopt;
+  return cp;
+}
+
 }  // namespace
 
 std::string round3(double v) {
@@ -199,34 +287,8 @@ ReportContent report_content(const Trace& trace, const std::string& trace_name,
   for (std::size_t i = 0; i < s.per_step.size(); ++i)
     if (s.per_step[i].contacts_changed && i > 0)
       c.contact_changes.push_back(static_cast<std::uint32_t>(i));
-  if (step < trace.steps.size()) {
-    ViewOptions o;
-    o.collapse = Collapse::kObject;
-    o.assignment = assignment;
-    o.critical_path = true;
-    o.max_nodes = 0;
-    o.max_edges = 0;
-    o.edge_labels = false;  // on hover: drawn, they overlap on a scene of many objects
-    o.title = trace_name + ", step " + std::to_string(step) +
-              (assignment
-                   ? ", " + assignment_name + " on " + std::to_string(assignment->k) + " processors"
-                   : "");
-    const GraphView view = make_graph_view(trace.steps[step], o);
-    c.graph_step = step;
-    c.graph_svg = inline_svg(render_graph(view, GraphFormat::kSvg));
-    c.graph_caption =
-        "Step " + std::to_string(step) +
-        " collapsed by object (one node per object and loop, and per object before and "
-        "after each loop; work = cost × runs), "
-        "coloured by processor" +
-        (assignment ? " (" + assignment_name + ")" : " (no assignment: grey)") +
-        "; vermillion edges cross processors; thick black: the critical path; " +
-        hidden_deps_note(view) +
-        ". Hover a node or an edge for its text (edge labels: data, bytes per step, "
-        "crossings). Same picture with edge labels drawn: step " + std::to_string(step) +
-        " of " + trace_name + " collapsed by object, with the critical path" +
-        (assignment ? " and the assignment" : "") + ", drawn on its own as SVG";
-  }
+  if (step < trace.steps.size())
+    set_step_graph(c, trace.steps[step], trace_name, assignment, step, assignment_name, nullptr);
   return c;
 }
 
@@ -325,7 +387,26 @@ ReportContent report_from_files(const Trace& trace, const std::string& trace_nam
                                    step, assignment ? assignment->method : std::string());
   if (!compare_path.empty()) add_compare_json(c, read_file_text(compare_path), compare_path);
   for (const std::string& r : replay_paths) add_replay_json(c, read_file_text(r), r);
+  draw_executed_path(c, trace, trace_name, coloured ? &assignment->steps[step] : nullptr,
+                     assignment ? assignment->method : std::string());
   return c;
+}
+
+bool draw_executed_path(ReportContent& c, const Trace& trace, const std::string& trace_name,
+                        const Assignment* assignment, const std::string& assignment_name) {
+  if (!c.timeline || c.graph_svg.empty() || c.graph_step >= trace.steps.size()) return false;
+  std::optional<explain::Explanation> e;
+  try {
+    e = explained(*c.timeline);
+  } catch (const Error&) {
+    return false;  // not explained: the graph's own critical path stays
+  }
+  if (!e) return false;
+  const StepGraph& g = trace.steps[c.graph_step];
+  const std::optional<CriticalPath> path = executed_path(g, *c.timeline, *e, c.graph_step);
+  if (!path) return false;
+  set_step_graph(c, g, trace_name, assignment, c.graph_step, assignment_name, &*path);
+  return true;
 }
 
 void write_report(const Trace& trace, const std::string& trace_name,

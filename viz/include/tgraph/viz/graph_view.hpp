@@ -16,6 +16,8 @@
 
 namespace tgraph::viz {
 
+struct CriticalPath;  // critical_path.hpp
+
 /// How tasks are aggregated into nodes. Object, kind and processor groups are made per loop
 /// body and, outside loops, per region between loops (before loop 0, after loop 0, ...).
 enum class Collapse : std::uint8_t {
@@ -93,6 +95,10 @@ struct ViewOptions {
   Collapse collapse = Collapse::kNone;
   const Assignment* assignment = nullptr;  ///< colours, cross edges, sync nodes
   bool critical_path = false;
+  /// With critical_path: the path to draw (an executed one, from a timeline: the report's
+  /// executed_path) instead of the graph's own longest path; its instances name tasks of
+  /// the step drawn.
+  const CriticalPath* path = nullptr;
   /// Refuse (OptionError) when the picture would have more nodes than this (0: no limit).
   std::size_t max_nodes = 2000;
   /// Likewise for edges (0: no limit): dot's layout time grows with the edges (bars64's

@@ -71,6 +71,9 @@ struct ReportContent {
   std::string graph_svg;  ///< the step graph (Graphviz SVG), empty: none
   std::string graph_caption;
   std::size_t graph_step = 0;  ///< the step it shows
+  /// Its thick black path is a timeline's executed critical path (tgraph explain's), not
+  /// the graph's own longest path.
+  bool graph_executed_path = false;
   std::string quotient_svg;    ///< the assignment's quotient graph of that step, empty: none
   std::string quotient_caption;
   std::vector<std::string> notes;  ///< paragraphs under the title
@@ -95,9 +98,17 @@ void add_compare_json(ReportContent& c, std::string_view json, const std::string
 /// otherwise.
 void add_replay_json(ReportContent& c, std::string_view json, const std::string& name);
 
+/// Draws the step graph of `c` again with the executed critical path of its step in
+/// `c.timeline` (tgraph explain's) instead of the graph's own longest path, when the timeline
+/// explains that step of `trace` (its graph replayed from this trace's step); `assignment`
+/// colours it as report_content's did. Returns whether it did (else the picture stays).
+bool draw_executed_path(ReportContent& c, const Trace& trace, const std::string& trace_name,
+                        const Assignment* assignment, const std::string& assignment_name = {});
+
 /// A report of files: report_content of step `step` (step 0 when the trace has no such step),
 /// coloured by that step of `assignment` (nullptr: none), then the comparison file
-/// `compare_path` (empty: none) and each replay file (add_compare_json, add_replay_json).
+/// `compare_path` (empty: none) and each replay file (add_compare_json, add_replay_json),
+/// then the first timeline's executed critical path on the step graph (draw_executed_path).
 ReportContent report_from_files(const Trace& trace, const std::string& trace_name,
                                 const TraceAssignment* assignment, std::size_t step,
                                 const std::string& compare_path,
