@@ -183,7 +183,6 @@ void set_step_graph(ReportContent& c, const StepGraph& g, const std::string& tra
   const GraphView view = make_graph_view(g, o);
   c.graph_step = step;
   c.graph_svg = inline_svg(render_graph(view, GraphFormat::kSvg));
-  c.graph_executed_path = executed != nullptr;
   c.graph_caption =
       "Step " + std::to_string(step) +
       " collapsed by object (one node per object and loop, and per object before and "

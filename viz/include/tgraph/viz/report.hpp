@@ -71,9 +71,6 @@ struct ReportContent {
   std::string graph_svg;  ///< the step graph (Graphviz SVG), empty: none
   std::string graph_caption;
   std::size_t graph_step = 0;  ///< the step it shows
-  /// Its thick black path is a timeline's executed critical path (tgraph explain's), not
-  /// the graph's own longest path.
-  bool graph_executed_path = false;
   std::string quotient_svg;    ///< the assignment's quotient graph of that step, empty: none
   std::string quotient_caption;
   std::vector<std::string> notes;  ///< paragraphs under the title
