@@ -216,6 +216,9 @@ std::optional<CriticalPath> executed_path(const StepGraph& g, const Timeline& t,
   cp.task_hits.assign(g.tasks.size(), 0);
   cp.edge_hits.assign(g.edges.size(), 0);
   cp.carried_hits.assign(g.carried_edges.size(), 0);
+  // The edges into each task (the first from the previous body is the link), per list.
+  const IncomingEdges into = incoming_edges(g.tasks.size(), g.edges);
+  const IncomingEdges into_carried = incoming_edges(g.tasks.size(), g.carried_edges);
   std::optional<TaskInstance> prev;
   for (const explain::PathLink& l : se->critical_path) {
     cp.length_ns = static_cast<std::uint64_t>(std::max<std::int64_t>(0, l.end_ns));
@@ -230,8 +233,9 @@ std::optional<CriticalPath> executed_path(const StepGraph& g, const Timeline& t,
     if (prev) {
       const bool same_iteration = prev->iteration == here.iteration;
       const std::vector<Edge>& edges = same_iteration ? g.edges : g.carried_edges;
-      for (std::uint32_t i = 0; i < edges.size(); ++i)
-        if (edges[i].from == prev->task && edges[i].to == o) {
+      const IncomingEdges& in = same_iteration ? into : into_carried;
+      for (std::uint32_t k = in.begin[o]; k < in.begin[o + 1]; ++k)
+        if (const std::uint32_t i = in.edge[k]; edges[i].from == prev->task) {
           link = same_iteration ? PathLink::kEdge : PathLink::kCarried;
           edge = i;
           (same_iteration ? cp.edge_hits : cp.carried_hits)[i]++;
