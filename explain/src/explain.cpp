@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "step_view.hpp"
 #include "tgraph/graph/error.hpp"
@@ -351,16 +352,20 @@ Explanation explain_timeline(const Timeline& t, const std::string& name,
                      "them; record it again with --timeline)");
   Explanation e;
   e.threads = t.threads;
-  std::map<std::pair<std::string, std::string>, WhatIf> total;
-  std::vector<std::pair<std::string, std::string>> order;
+  // The steps' what-ifs summed, by (scope, target, change), in the order first seen.
+  using Key = std::tuple<std::string, std::string, std::string>;
+  std::map<Key, WhatIf> total;
+  std::vector<Key> order;
   for (const TimelineStep& info : t.step_info) {
     if (options.step && info.step != *options.step) continue;
     e.steps.push_back(explain_step(t, info, options));
     const StepExplanation& s = e.steps.back();
     e.attribution += s.attribution;
     for (const WhatIf& w : s.what_if) {
-      auto [it, fresh] = total.try_emplace({w.target, w.change}, WhatIf{w.target, w.change, 0, 0});
-      if (fresh) order.push_back({w.target, w.change});
+      const Key key{w.scope, w.target, w.change};
+      auto [it, fresh] = total.try_emplace(key, WhatIf{w.target, w.change, 0, 0, w.model, w.scope});
+      if (fresh) order.push_back(key);
+      if (it->second.model != w.model) it->second.model = "mixed";  // steps on both models
       it->second.predicted_ns += w.predicted_ns;
       it->second.gain += w.gain;
     }

@@ -79,10 +79,14 @@ struct LateWriter {
 
 /// One virtual speed-up: the step's (or run's) time if `target` changed as `change` says.
 struct WhatIf {
-  std::string target;  ///< a kind name, or a cause ("handoff", "parks", "serial", ...)
+  std::string target;  ///< a kind's or an object's name, or a cause ("handoff", "parks", ...)
   std::string change;  ///< "10% faster", "50% faster", "free", ...
   std::int64_t predicted_ns = 0;
   std::int64_t gain = 0;  ///< makespan - predicted_ns
+  /// What predicted it: "simulator" (tgraph::model::simulate on the step's executed graph)
+  /// or "executed_schedule" (the schedule as it ran, re-timed); docs/explain.md.
+  std::string model;
+  std::string scope;  ///< what target names: "kind", "object" or "cause"
 };
 
 /// The explanation of one step.
