@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Where the time of a step went: its executed critical path, its lost processor time split
-// into named causes that add up to it, and what-ifs (virtual speed-ups, after Coz) on the
-// executed schedule. Works on a tgraph::Timeline that carries its steps' graphs
+// into named causes that add up to it, and what-ifs (virtual speed-ups, after Coz) through
+// the built-in simulator or on the executed schedule. Works on a tgraph::Timeline that carries its steps' graphs
 // (replay::TimelineObserver records them; docs/explain.md defines every figure).
 #pragma once
 
