@@ -338,7 +338,7 @@ StepExplanation explain_step(const Timeline& t, const TimelineStep& info,
   s.makespan_split = {{"work", along_work},           {"serial", s.serial_ns},
                       {"inflation", along.inflation}, {"interruption", along.interruption},
                       {"handoff", along.handoff},     {"runtime", along.runtime}};
-  if (options.what_ifs) s.what_if = detail::what_ifs(v, s);
+  if (options.what_ifs) s.what_if = detail::what_ifs(v, s, options.simulator_fit, &s.simulated_ns);
   return s;
 }
 

@@ -68,7 +68,8 @@ std::string explanation_json(const Explanation& e) {
                      {"makespan_split", split},
                      {"critical_path", path},
                      {"late_writers", late},
-                     {"what_if", what_if_array(s.what_if)}});
+                     {"what_if", what_if_array(s.what_if)},
+                     {"simulated_ns", s.simulated_ns}});
   }
   return json{{"threads", e.threads},
               {"attribution", attribution_object(e.attribution)},

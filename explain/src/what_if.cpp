@@ -252,19 +252,25 @@ std::int64_t predict_kind_faster(const StepView& v, std::int64_t serial_ns, Kind
   return run(v, sh, c);
 }
 
-std::vector<WhatIf> what_ifs(const StepView& v, const StepExplanation& s) {
+std::vector<WhatIf> what_ifs(const StepView& v, const StepExplanation& s, double fit,
+                             std::int64_t* simulated_ns) {
   const Shape sh = shape_of(v);
   Change base;
   base.serial = s.serial_ns;
   const std::optional<Simulated> sim = Simulated::of(v, sh);
   const std::int64_t as_run = run(v, sh, base);
   const std::int64_t as_simulated = sim ? sim->makespan(base) : 0;
+  if (simulated_ns != nullptr) *simulated_ns = as_simulated;
+  // A simulator that does not reproduce the step unchanged does not predict its changes.
+  const bool fits = as_simulated > 0 && s.makespan_ns > 0 &&
+                    std::abs(static_cast<double>(as_simulated) / static_cast<double>(s.makespan_ns) -
+                             1.0) <= fit;
   std::vector<WhatIf> out;
   // Each prediction the observed makespan scaled by the model's changed / unchanged time;
   // `simulated`: on the simulator when it has the step, else on the executed schedule.
   const auto add = [&](std::string target, std::string change, const Change& c, bool simulated,
                        const char* scope = "cause") {
-    const bool on_sim = simulated && sim && as_simulated > 0;
+    const bool on_sim = simulated && fits;
     const double ratio =
         on_sim ? static_cast<double>(sim->makespan(c)) / static_cast<double>(as_simulated)
         : as_run > 0 ? static_cast<double>(run(v, sh, c)) / static_cast<double>(as_run)

@@ -16,8 +16,11 @@ namespace tgraph::explain::detail {
 /// executed graph and assignment, or the executed schedule re-run (every thread's order,
 /// the time between its bodies and each hand-off's latency as measured) for the causes
 /// the simulator has no parameter for and for steps it cannot run (WhatIf::model says
-/// which; docs/explain.md); the largest gain first.
-std::vector<WhatIf> what_ifs(const StepView& v, const StepExplanation& s);
+/// which; docs/explain.md); the largest gain first. The simulator is used when its makespan
+/// of the step unchanged is within `fit` of the observed (ExplainOptions::simulator_fit);
+/// `simulated_ns` (when not null) gets that makespan (0: not simulated).
+std::vector<WhatIf> what_ifs(const StepView& v, const StepExplanation& s, double fit = 0.25,
+                             std::int64_t* simulated_ns = nullptr);
 
 /// The makespan (serial phases + execution) of the step re-run with bodies of kind `kind`
 /// `fraction` shorter (0.5: half as long); the executed schedule otherwise as measured.

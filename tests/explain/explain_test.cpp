@@ -299,6 +299,7 @@ TEST(Explain, AKindFasterOnAChainPredictsItsShare) {
   ASSERT_NE(w, nullptr);
   EXPECT_EQ(w->predicted_ns, 2100);  // a in 1000 ns, the same 100 ns hand-off, c
   EXPECT_EQ(w->model, "simulator");
+  EXPECT_EQ(e.steps[0].simulated_ns, 3100);  // the step as observed
   EXPECT_EQ(e.steps[0].what_if.front().target, "a");  // ranked first
   // Hand-offs free: the simulator's latency (the measured 100 ns) gone.
   w = find(e.steps[0], "handoff", "free");
@@ -397,6 +398,26 @@ TEST(Explain, OnlyTheObjectsWithTheMostWorkGetWhatIfs) {
   EXPECT_NE(find(s, "o9", "50% faster"), nullptr);
 }
 
+TEST(Explain, AStepTheSimulatorDoesNotReproduceIsReTimed) {
+  // The bodies end at 1 us, the step at 10 us (a long join the simulator does not model).
+  Builder b(2);
+  b.run(b.task("f", 1000), 0, 0, 1000);
+  b.run(b.task("f", 1000), 1, 0, 1000);
+  const Explanation e = b.explain(10'000);
+  EXPECT_EQ(e.steps[0].simulated_ns, 1000);
+  const WhatIf* w = find(e.steps[0], "f", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->model, "executed_schedule");
+  EXPECT_EQ(w->predicted_ns, 9500);  // the bodies 500 ns shorter, the join as measured
+  // Asked to, the simulator predicts it all the same: the step x 500 / 1000.
+  ExplainOptions o;
+  o.simulator_fit = 1e9;
+  w = find(explain_timeline(b.t, "t.json", o).steps[0], "f", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->model, "simulator");
+  EXPECT_EQ(w->predicted_ns, 5000);
+}
+
 TEST(Explain, ASampledStepIsReTimedOnItsExecutedSchedule) {
   Builder b = chain(2000, 1000, 100);
   b.task("z", 500);  // never observed: the simulator would have to guess where it ran
@@ -406,6 +427,7 @@ TEST(Explain, ASampledStepIsReTimedOnItsExecutedSchedule) {
   ASSERT_NE(w, nullptr);
   EXPECT_EQ(w->predicted_ns, 2100);
   for (const WhatIf& x : e.steps[0].what_if) EXPECT_EQ(x.model, "executed_schedule") << x.target;
+  EXPECT_EQ(e.steps[0].simulated_ns, 0);
 }
 
 TEST(Explain, RefusesATimelineWithoutGraphs) {

@@ -106,6 +106,10 @@ struct StepExplanation {
   std::vector<PathLink> critical_path;  ///< chronological
   std::vector<LateWriter> late_writers;  ///< the largest first (at most 5)
   std::vector<WhatIf> what_if;          ///< the largest gain first
+  /// The built-in simulator's makespan of the step unchanged, what its what-ifs are scaled
+  /// against (0: not simulated: no what-ifs asked, or a step the simulator cannot run);
+  /// beyond ExplainOptions::simulator_fit of makespan_ns, the what-ifs are re-timed.
+  std::int64_t simulated_ns = 0;
 };
 
 /// A whole timeline's explanation.
@@ -119,6 +123,10 @@ struct Explanation {
 /// What to compute.
 struct ExplainOptions {
   bool what_ifs = true;
+  /// A step's what-ifs come from the built-in simulator when its simulated makespan
+  /// unchanged is within this fraction of the observed one (|simulated / observed - 1|),
+  /// else from the executed schedule (docs/explain.md).
+  double simulator_fit = 0.25;
   /// Only this step (by number); nullopt: every step with a graph.
   std::optional<std::uint32_t> step;
 };
@@ -142,7 +150,7 @@ std::string attribution_json(const Attribution& a);
 /// `tgraph explain --json`: {"threads", "attribution", "what_if", "steps": [{step,
 /// makespan_ns, work_ns, span_ns, attribution, makespan_split, critical_path: [{task, kind,
 /// thread, start_ns, end_ns, link}], late_writers, what_if: [{target, change,
-/// predicted_ns, gain}]}]}.
+/// predicted_ns, gain, model, scope}], simulated_ns}]}.
 std::string explanation_json(const Explanation& e);
 /// `tgraph explain`'s table: one line per step (causes in % of the lost time), then the
 /// run's causes and its what-ifs; with one step, its critical path and late writers too.
