@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "step_view.hpp"
 #include "tgraph/graph/error.hpp"
@@ -337,7 +338,7 @@ StepExplanation explain_step(const Timeline& t, const TimelineStep& info,
   s.makespan_split = {{"work", along_work},           {"serial", s.serial_ns},
                       {"inflation", along.inflation}, {"interruption", along.interruption},
                       {"handoff", along.handoff},     {"runtime", along.runtime}};
-  if (options.what_ifs) s.what_if = detail::what_ifs(v, s);
+  if (options.what_ifs) s.what_if = detail::what_ifs(v, s, options.simulator_fit, &s.simulated_ns);
   return s;
 }
 
@@ -351,16 +352,20 @@ Explanation explain_timeline(const Timeline& t, const std::string& name,
                      "them; record it again with --timeline)");
   Explanation e;
   e.threads = t.threads;
-  std::map<std::pair<std::string, std::string>, WhatIf> total;
-  std::vector<std::pair<std::string, std::string>> order;
+  // The steps' what-ifs summed, by (scope, target, change), in the order first seen.
+  using Key = std::tuple<std::string, std::string, std::string>;
+  std::map<Key, WhatIf> total;
+  std::vector<Key> order;
   for (const TimelineStep& info : t.step_info) {
     if (options.step && info.step != *options.step) continue;
     e.steps.push_back(explain_step(t, info, options));
     const StepExplanation& s = e.steps.back();
     e.attribution += s.attribution;
     for (const WhatIf& w : s.what_if) {
-      auto [it, fresh] = total.try_emplace({w.target, w.change}, WhatIf{w.target, w.change, 0, 0});
-      if (fresh) order.push_back({w.target, w.change});
+      const Key key{w.scope, w.target, w.change};
+      auto [it, fresh] = total.try_emplace(key, WhatIf{w.target, w.change, 0, 0, w.model, w.scope});
+      if (fresh) order.push_back(key);
+      if (it->second.model != w.model) it->second.model = "mixed";  // steps on both models
       it->second.predicted_ns += w.predicted_ns;
       it->second.gain += w.gain;
     }

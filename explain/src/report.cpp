@@ -25,7 +25,9 @@ json what_if_array(const std::vector<WhatIf>& v) {
     a.push_back({{"target", w.target},
                  {"change", w.change},
                  {"predicted_ns", w.predicted_ns},
-                 {"gain", w.gain}});
+                 {"gain", w.gain},
+                 {"model", w.model},
+                 {"scope", w.scope}});
   return a;
 }
 
@@ -66,7 +68,8 @@ std::string explanation_json(const Explanation& e) {
                      {"makespan_split", split},
                      {"critical_path", path},
                      {"late_writers", late},
-                     {"what_if", what_if_array(s.what_if)}});
+                     {"what_if", what_if_array(s.what_if)},
+                     {"simulated_ns", s.simulated_ns}});
   }
   return json{{"threads", e.threads},
               {"attribution", attribution_object(e.attribution)},
@@ -151,11 +154,15 @@ std::string explanation_text(const Explanation& e, const std::string& name) {
                         ms(w.wait_ns), w.kind.c_str(), w.task, w.datum.c_str(), ms(w.late_ns)));
   }
   const std::vector<WhatIf>& wi = e.steps.size() == 1 ? e.steps.front().what_if : e.what_if;
-  if (!wi.empty()) out += "\nwhat if (predicted time, gain; the executed schedule re-run):\n";
+  if (!wi.empty())
+    out += "\nwhat if (predicted time, gain, the model: simulator or executed schedule):\n";
   for (std::size_t k = 0; k < std::min<std::size_t>(wi.size(), 10); ++k)
-    add(std::snprintf(line, sizeof line, "  %-24s %-34s %10.3f ms  %+8.3f ms (%.1f%%)\n",
-                      wi[k].target.c_str(), wi[k].change.c_str(), ms(wi[k].predicted_ns),
-                      ms(wi[k].gain), pct(wi[k].gain, wi[k].predicted_ns + wi[k].gain)));
+    add(std::snprintf(line, sizeof line, "  %-31s %-34s %10.3f ms  %+8.3f ms (%.1f%%)  %s\n",
+                      (wi[k].scope == "cause" ? wi[k].target : wi[k].scope + " " + wi[k].target)
+                          .c_str(),
+                      wi[k].change.c_str(), ms(wi[k].predicted_ns),
+                      ms(wi[k].gain), pct(wi[k].gain, wi[k].predicted_ns + wi[k].gain),
+                      wi[k].model.c_str()));
   return out;
 }
 

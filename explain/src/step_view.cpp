@@ -53,16 +53,9 @@ StepView make_view(const Timeline& t, const TimelineStep& info) {
   const std::size_t n = g.task_kind.size();
   for (const TimelineTask& e : t.tasks) {
     if (e.step != info.step) continue;
-    Instance i;
-    i.task = e.task;
-    i.iteration = e.iteration;
-    i.thread = e.thread;
-    i.start = e.start_ns;
-    i.end = e.end_ns;
-    i.cpu = e.cpu_ns;
-    i.cost = info.cost_ns[e.task];
-    i.reducer = g.origin[e.task] == kNoTask;
-    v.instances.push_back(i);
+    v.instances.push_back({.task = e.task, .iteration = e.iteration, .thread = e.thread,
+                           .start = e.start_ns, .end = e.end_ns, .cpu = e.cpu_ns,
+                           .cost = info.cost_ns[e.task], .reducer = g.origin[e.task] == kNoTask});
   }
   std::stable_sort(v.instances.begin(), v.instances.end(), [](const Instance& a, const Instance& b) {
     return a.start != b.start ? a.start < b.start : a.end < b.end;

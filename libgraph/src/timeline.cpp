@@ -280,6 +280,12 @@ TimelineGraph graph_of(const json& g) {
       out.task_loop[t] = static_cast<LoopId>(l);
   out.edges = edges_of(g.at("edges"), n, out.data.size());
   out.carried_edges = edges_of(g.at("carried_edges"), n, out.data.size());
+  if (g.contains("task_object")) {
+    out.objects = strings(g, "objects");
+    for (const std::int64_t o :
+         column(g, "task_object", n, -1, static_cast<std::int64_t>(out.objects.size()) - 1))
+      out.task_object.push_back(o < 0 ? kNoObject : static_cast<ObjectId>(o));
+  }
   for (const Edge& e : out.edges)
     if (e.from >= e.to)
       throw json::other_error::create(501, "an intra-step edge must go forward in program order",
@@ -572,6 +578,12 @@ json graphs_json(const Timeline& t) {
                       {"loop_last", last},
                       {"edges", edges_json(g.edges)},
                       {"carried_edges", edges_json(g.carried_edges)}});
+    if (g.task_object.empty()) continue;
+    json objects = json::array();
+    for (const ObjectId o : g.task_object)
+      objects.push_back(o == kNoObject ? std::int64_t{-1} : static_cast<std::int64_t>(o));
+    graphs.back()["objects"] = g.objects;
+    graphs.back()["task_object"] = objects;
   }
   return graphs;
 }

@@ -132,9 +132,11 @@ TimelineGraph timeline_graph(const ExecGraph& exec) {
   for (const Datum& d : g.data) out.data.push_back(d.name);
   out.task_kind.reserve(g.tasks.size());
   out.task_loop.reserve(g.tasks.size());
+  for (const ObjectInfo& o : g.objects) out.objects.push_back(o.name);
   for (const Task& t : g.tasks) {
     out.task_kind.push_back(t.kind);
     out.task_loop.push_back(t.loop);
+    out.task_object.push_back(t.object < g.objects.size() ? t.object : kNoObject);
   }
   out.origin = exec.origin;
   for (const Loop& l : g.loops) out.loops.emplace_back(l.first, l.last);

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "step_view.hpp"
@@ -32,6 +33,14 @@ struct Builder {
     info.cost_ns.push_back(cost);
     return static_cast<TaskId>(g.task_kind.size() - 1);
   }
+  // Task `task` belongs to object `name`.
+  void object(TaskId task, const std::string& name) {
+    ObjectId o = 0;
+    while (o < g.objects.size() && g.objects[o] != name) ++o;
+    if (o == g.objects.size()) g.objects.push_back(name);
+    g.task_object.resize(g.task_kind.size(), kNoObject);
+    g.task_object[task] = o;
+  }
   void edge(TaskId from, TaskId to) {
     if (g.data.empty()) g.data.push_back("x");
     g.edges.push_back({from, to, 0, EdgeKind::RAW});
@@ -48,6 +57,7 @@ struct Builder {
   Explanation explain(std::int64_t wall, std::int64_t serial = 0) {
     info.wall_ns = wall;
     info.record_ns = serial;
+    if (!g.objects.empty()) g.task_object.resize(g.task_kind.size(), kNoObject);
     t.graphs = {g};
     t.step_info = {info};
     t.steps = 1;
@@ -265,18 +275,159 @@ TEST(Explain, LoopInstancesWaitForTheirIterationAndTheGate) {
   EXPECT_EQ(handoffs, 5u);
 }
 
-TEST(Explain, AKindFasterOnAChainPredictsItsShare) {
+// Task "a" on thread 0, then its reader "c" on thread 1, `handoff` ns after a's end.
+Builder chain(std::int64_t a_ns, std::int64_t c_ns, std::int64_t handoff) {
   Builder b(2);
-  const TaskId a = b.task("a", 2000), c = b.task("c", 1000);
+  const TaskId a = b.task("a", a_ns), c = b.task("c", c_ns);
   b.edge(a, c);
-  b.run(a, 0, 0, 2000);
-  b.run(c, 1, 2100, 3100);
+  b.run(a, 0, 0, a_ns);
+  b.run(c, 1, a_ns + handoff, a_ns + handoff + c_ns);
+  return b;
+}
+
+// The what-if of `target` changed as `change` says in the step's list (nullptr: none).
+const WhatIf* find(const StepExplanation& s, const std::string& target, const std::string& change) {
+  for (const WhatIf& w : s.what_if)
+    if (w.target == target && w.change == change) return &w;
+  return nullptr;
+}
+
+TEST(Explain, AKindFasterOnAChainPredictsItsShare) {
+  Builder b = chain(2000, 1000, 100);
   const Explanation e = b.explain(3100);
-  std::int64_t predicted = -1;
-  for (const WhatIf& w : e.steps[0].what_if)
-    if (w.target == "a" && w.change == "50% faster") predicted = w.predicted_ns;
-  EXPECT_EQ(predicted, 2100);  // a in 1000 ns, the same 100 ns hand-off, c
+  const WhatIf* w = find(e.steps[0], "a", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->predicted_ns, 2100);  // a in 1000 ns, the same 100 ns hand-off, c
+  EXPECT_EQ(w->model, "simulator");
+  EXPECT_EQ(e.steps[0].simulated_ns, 3100);  // the step as observed
   EXPECT_EQ(e.steps[0].what_if.front().target, "a");  // ranked first
+  // Hand-offs free: the simulator's latency (the measured 100 ns) gone.
+  w = find(e.steps[0], "handoff", "free");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->predicted_ns, 3000);
+  EXPECT_EQ(w->model, "simulator");
+}
+
+// Thread 0: tasks 0 -> 1 of kind "a" (the critical path, 4 us); thread 1: task 2 of kind
+// "b", 1 us, on its own.
+Builder path_and_side() {
+  Builder b(2);
+  const TaskId a1 = b.task("a", 2000), a2 = b.task("a", 2000), x = b.task("b", 1000);
+  b.edge(a1, a2);
+  b.run(a1, 0, 0, 2000);
+  b.run(a2, 0, 2000, 4000);
+  b.run(x, 1, 0, 1000);
+  return b;
+}
+
+TEST(Explain, AKindOffTheCriticalPathGainsNothing) {
+  Builder b = path_and_side();
+  const StepExplanation s = b.explain(4000).steps[0];
+  for (const auto& [target, change, predicted] :
+       std::vector<std::tuple<std::string, std::string, std::int64_t>>{
+           {"a", "50% faster", 2000}, {"a", "10% faster", 3600},
+           {"b", "50% faster", 4000}, {"b", "10% faster", 4000}}) {
+    const WhatIf* w = find(s, target, change);
+    ASSERT_NE(w, nullptr) << target << " " << change;
+    EXPECT_EQ(w->predicted_ns, predicted) << target << " " << change;
+    EXPECT_EQ(w->gain, 4000 - predicted) << target << " " << change;
+    EXPECT_EQ(w->model, "simulator");
+  }
+  // Ranked: a 50 % first, a 10 % before either of b's.
+  EXPECT_EQ(&s.what_if.front(), find(s, "a", "50% faster"));
+  EXPECT_LT(find(s, "a", "10% faster"), find(s, "b", "50% faster"));
+  EXPECT_LT(find(s, "a", "10% faster"), find(s, "b", "10% faster"));
+  // The causes the simulator has no parameter for are re-timed on the executed schedule.
+  for (const char* target : {"inflation", "interruption"}) {
+    const WhatIf* w = find(s, target, "free");
+    ASSERT_NE(w, nullptr) << target;
+    EXPECT_EQ(w->model, "executed_schedule") << target;
+  }
+}
+
+TEST(Explain, ObjectsGetWhatIfsRankedWithTheRest) {
+  // Object p: the path's two tasks; object q: the one beside it.
+  Builder b = path_and_side();
+  b.object(0, "p");
+  b.object(1, "p");
+  b.object(2, "q");
+  const Explanation e = b.explain(4000);
+  const StepExplanation& s = e.steps[0];
+  const WhatIf* p = find(s, "p", "50% faster");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->scope, "object");
+  EXPECT_EQ(p->model, "simulator");
+  EXPECT_EQ(p->predicted_ns, 2000);
+  const WhatIf* q = find(s, "q", "50% faster");
+  ASSERT_NE(q, nullptr);
+  EXPECT_EQ(q->gain, 0);
+  EXPECT_LT(p, q);  // ranked: p's gain first
+  EXPECT_EQ(find(s, "a", "50% faster")->scope, "kind");
+  EXPECT_EQ(find(s, "handoff", "free")->scope, "cause");
+  // The run's list, the JSON and the table carry them too.
+  bool in_run = false;
+  for (const WhatIf& w : e.what_if) in_run |= w.scope == "object" && w.target == "p";
+  EXPECT_TRUE(in_run);
+  const nlohmann::json j = nlohmann::json::parse(explanation_json(e));
+  bool in_json = false;
+  for (const auto& w : j["steps"][0]["what_if"])
+    in_json |= w["scope"] == "object" && w["target"] == "q";
+  EXPECT_TRUE(in_json);
+  EXPECT_NE(explanation_text(e, "t.json").find("object p"), std::string::npos);
+  // The timeline's objects survive both file formats.
+  for (const std::string& text : {compact_timeline_json(b.t), timeline_json(b.t)})
+    EXPECT_EQ(parse_timeline(text, "back.json").graphs, b.t.graphs);
+}
+
+TEST(Explain, OnlyTheObjectsWithTheMostWorkGetWhatIfs) {
+  Builder b(2);
+  std::int64_t free[2] = {0, 0};
+  for (int o = 0; o < 10; ++o) {  // object o's task costs (o + 1) us
+    const TaskId t = b.task("f", 1000 * (o + 1));
+    b.object(t, "o" + std::to_string(o));
+    const auto th = static_cast<std::uint32_t>(o % 2);
+    b.run(t, th, free[th], free[th] + 1000 * (o + 1));
+    free[th] += 1000 * (o + 1);
+  }
+  const StepExplanation s = b.explain(std::max(free[0], free[1])).steps[0];
+  std::size_t rows = 0;
+  for (const WhatIf& w : s.what_if) rows += w.scope == "object";
+  EXPECT_EQ(rows, 2u * 8u);  // 10 % and 50 % of the eight heaviest
+  EXPECT_EQ(find(s, "o0", "50% faster"), nullptr);
+  EXPECT_EQ(find(s, "o1", "50% faster"), nullptr);
+  EXPECT_NE(find(s, "o9", "50% faster"), nullptr);
+}
+
+TEST(Explain, AStepTheSimulatorDoesNotReproduceIsReTimed) {
+  // The bodies end at 1 us, the step at 10 us (a long join the simulator does not model).
+  Builder b(2);
+  b.run(b.task("f", 1000), 0, 0, 1000);
+  b.run(b.task("f", 1000), 1, 0, 1000);
+  const Explanation e = b.explain(10'000);
+  EXPECT_EQ(e.steps[0].simulated_ns, 1000);
+  const WhatIf* w = find(e.steps[0], "f", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->model, "executed_schedule");
+  EXPECT_EQ(w->predicted_ns, 9500);  // the bodies 500 ns shorter, the join as measured
+  // Asked to, the simulator predicts it all the same: the step x 500 / 1000.
+  ExplainOptions o;
+  o.simulator_fit = 1e9;
+  w = find(explain_timeline(b.t, "t.json", o).steps[0], "f", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->model, "simulator");
+  EXPECT_EQ(w->predicted_ns, 5000);
+}
+
+TEST(Explain, ASampledStepIsReTimedOnItsExecutedSchedule) {
+  Builder b = chain(2000, 1000, 100);
+  b.task("z", 500);  // never observed: the simulator would have to guess where it ran
+  const Explanation e = b.explain(3100);
+  EXPECT_EQ(e.steps[0].unobserved, 1u);
+  const WhatIf* w = find(e.steps[0], "a", "50% faster");
+  ASSERT_NE(w, nullptr);
+  EXPECT_EQ(w->predicted_ns, 2100);
+  for (const WhatIf& x : e.steps[0].what_if) EXPECT_EQ(x.model, "executed_schedule") << x.target;
+  EXPECT_EQ(e.steps[0].simulated_ns, 0);
 }
 
 TEST(Explain, RefusesATimelineWithoutGraphs) {
@@ -298,11 +449,7 @@ TEST(Explain, RefusesATimelineWithoutGraphs) {
 }
 
 TEST(Explain, WritesTheJsonShapeChecksRead) {
-  Builder b(2);
-  const TaskId a = b.task("a", 1000), c = b.task("c", 1000);
-  b.edge(a, c);
-  b.run(a, 0, 0, 1000);
-  b.run(c, 1, 1200, 2200);
+  Builder b = chain(1000, 1000, 200);
   const nlohmann::json j = nlohmann::json::parse(explanation_json(b.explain(2200)));
   ASSERT_EQ(j["steps"].size(), 1u);
   const auto& s = j["steps"][0];
@@ -311,6 +458,7 @@ TEST(Explain, WritesTheJsonShapeChecksRead) {
   EXPECT_EQ(s["attribution"]["lost_ns"], 2 * 2200 - 2000);
   EXPECT_EQ(s["critical_path"][1]["link"], "handoff");
   EXPECT_TRUE(s["what_if"][0].contains("gain"));
+  EXPECT_EQ(s["what_if"][0]["model"], "simulator");
   EXPECT_GE(s["what_if"][0]["gain"].get<std::int64_t>(), s["what_if"].back()["gain"].get<std::int64_t>());
   // The timeline itself, through its file format and back, explains the same.
   const Timeline back = parse_timeline(compact_timeline_json(b.t), "back.json");

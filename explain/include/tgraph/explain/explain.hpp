@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Where the time of a step went: its executed critical path, its lost processor time split
-// into named causes that add up to it, and what-ifs (virtual speed-ups, after Coz) on the
-// executed schedule. Works on a tgraph::Timeline that carries its steps' graphs
+// into named causes that add up to it, and what-ifs (virtual speed-ups, after Coz) through
+// the built-in simulator or on the executed schedule. Works on a tgraph::Timeline that carries its steps' graphs
 // (replay::TimelineObserver records them; docs/explain.md defines every figure).
 #pragma once
 
@@ -79,10 +79,14 @@ struct LateWriter {
 
 /// One virtual speed-up: the step's (or run's) time if `target` changed as `change` says.
 struct WhatIf {
-  std::string target;  ///< a kind name, or a cause ("handoff", "parks", "serial", ...)
+  std::string target;  ///< a kind's or an object's name, or a cause ("handoff", "parks", ...)
   std::string change;  ///< "10% faster", "50% faster", "free", ...
   std::int64_t predicted_ns = 0;
   std::int64_t gain = 0;  ///< makespan - predicted_ns
+  /// What predicted it: "simulator" (tgraph::model::simulate on the step's executed graph)
+  /// or "executed_schedule" (the schedule as it ran, re-timed); docs/explain.md.
+  std::string model;
+  std::string scope;  ///< what target names: "kind", "object" or "cause"
 };
 
 /// The explanation of one step.
@@ -102,6 +106,10 @@ struct StepExplanation {
   std::vector<PathLink> critical_path;  ///< chronological
   std::vector<LateWriter> late_writers;  ///< the largest first (at most 5)
   std::vector<WhatIf> what_if;          ///< the largest gain first
+  /// The built-in simulator's makespan of the step unchanged, what its what-ifs are scaled
+  /// against (0: not simulated: no what-ifs asked, or a step the simulator cannot run);
+  /// beyond ExplainOptions::simulator_fit of makespan_ns, the what-ifs are re-timed.
+  std::int64_t simulated_ns = 0;
 };
 
 /// A whole timeline's explanation.
@@ -115,6 +123,10 @@ struct Explanation {
 /// What to compute.
 struct ExplainOptions {
   bool what_ifs = true;
+  /// A step's what-ifs come from the built-in simulator when its simulated makespan
+  /// unchanged is within this fraction of the observed one (|simulated / observed - 1|),
+  /// else from the executed schedule (docs/explain.md).
+  double simulator_fit = 0.25;
   /// Only this step (by number); nullopt: every step with a graph.
   std::optional<std::uint32_t> step;
 };
@@ -138,7 +150,7 @@ std::string attribution_json(const Attribution& a);
 /// `tgraph explain --json`: {"threads", "attribution", "what_if", "steps": [{step,
 /// makespan_ns, work_ns, span_ns, attribution, makespan_split, critical_path: [{task, kind,
 /// thread, start_ns, end_ns, link}], late_writers, what_if: [{target, change,
-/// predicted_ns, gain}]}]}.
+/// predicted_ns, gain, model, scope}], simulated_ns}]}.
 std::string explanation_json(const Explanation& e);
 /// `tgraph explain`'s table: one line per step (causes in % of the lost time), then the
 /// run's causes and its what-ifs; with one step, its critical path and late writers too.

@@ -53,6 +53,10 @@ struct TimelineGraph {
   std::vector<std::pair<TaskId, TaskId>> loops;  ///< body [first, last); the last is the break
   std::vector<Edge> edges;           ///< intra-step (within one iteration in a loop body)
   std::vector<Edge> carried_edges;   ///< from iteration i to i + 1 of the same loop
+  std::vector<std::string> objects;  ///< object names (empty: not recorded)
+  /// Per executed task: index into objects, or kNoObject (a reducer, shared work); empty:
+  /// not recorded (timelines written before it).
+  std::vector<ObjectId> task_object;
   friend bool operator==(const TimelineGraph&, const TimelineGraph&) = default;
 };
 
