@@ -81,12 +81,10 @@ meas::EngineFactory factory(const ScalingScene& s) {
 // count, 4) threads: the uninstrumented engine pinned on each of that many cores, the fastest
 // core's median. The run itself (work stealing: no partitioner) is not reported.
 ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
-  meas::LiveOptions o;
+  meas::LiveOptions o = detail::live_options(
+      std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4), s.steps, p.repeat,
+      false);
   o.policy = tr::Policy::kWorksteal;
-  o.exec.threads = std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4);
-  o.steps = s.steps;
-  o.repeat = p.repeat;
-  o.observe = false;
   const meas::LiveResult r = meas::run_live(factory(s), nullptr, o);
   ScalingReference ref;
   ref.scene = s.label();
@@ -101,12 +99,8 @@ ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
 meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
                           const ScalingPlan& p) {
   const meas::MethodChoice m = meas::choose_method(method);
-  meas::LiveOptions o;
-  o.exec.threads = k;
-  o.steps = s.steps;
-  o.repeat = p.repeat;
+  meas::LiveOptions o = detail::live_options(k, s.steps, p.repeat, true);
   o.baseline = false;
-  o.observe = true;
   o.keep_assignments = m.policy == tr::Policy::kPartition;
   const std::optional<tp::StepPartitioner> part =
       meas::live_partitioner(m, meas::live_strategy_options(o), o);  // as `tgraph run` partitions
@@ -174,12 +168,7 @@ double predicted_speedup(const Trace& capture, const std::string& method, std::u
 // beside a pass of ODE self-threaded on a fresh copy of the scene), with its check.
 ode::RunResult ode_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
                        const ScalingPlan& p, bool check) {
-  ode::RunOptions o;
-  o.scene = s.scene;
-  o.steps = s.steps;
-  o.method = ode::choose_method(method);
-  o.threads = k;
-  o.repeat = p.repeat;
+  ode::RunOptions o = ode::run_options(s.scene, s.steps, ode::choose_method(method), k, p.repeat);
   o.check = check;
   return ode::run_scene(o);
 }
@@ -336,6 +325,7 @@ std::vector<ScalingScene> chosen_scenes(const std::vector<std::string>& names,
     }
     for (const std::string& n : ode::scene_names()) known.push_back(n);
 #else
+    (void)quick;
     if (name.rfind("ode-", 0) == 0)
       throw OptionError("scenes", "'" + name + "': the ODE scenes are not in this build "
                                                "(libode-dev was not found)");

@@ -60,6 +60,16 @@ double runtime_ns_per_call() {
 }
 
 }  // namespace
+ValidateOptions validate_options(const RunOptions& run, std::string calibration) {
+  return {.scene = run.scene,
+          .steps = run.steps.value_or(ValidateOptions{}.steps),
+          .threads = run.threads,
+          .method = run.method,
+          .repeat = run.repeat,
+          .stepper = run.stepper,
+          .calibration = std::move(calibration)};
+}
+
 ValidateReport validate_scene(const ValidateOptions& options) {
   if (!is_scene(options.scene))
     throw InputError(options.scene, std::nullopt,
@@ -87,13 +97,8 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   } close;
   std::vector<double> live, predicted, over;
   for (std::uint32_t round = 0; round < options.repeat; ++round) {
-    RunOptions run;
-    run.scene = options.scene;
-    run.steps = options.steps;
-    run.method = options.method;
-    run.threads = options.threads;
-    run.stepper = options.stepper;
-    const RunResult r = run_scene(run);
+    const RunResult r = run_scene(
+        run_options(options.scene, options.steps, options.method, options.threads, 1, options.stepper));
     ValidateRound v;
     v.live_ns = r.wall_ns;
     v.sequential_ns = r.sequential_wall_ns;

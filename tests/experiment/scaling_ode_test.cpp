@@ -41,14 +41,16 @@ TEST(ScalingOde, TheOdeScenesRunOdesMethodsAndTheCommandSaysTheScenes) {
 }
 
 TEST(ScalingOde, RefusesAnUnknownSceneAndAMethodOdeDoesNotTake) {
-  ScalingOptions o;
-  const auto error = [&o] { return test::option_error([&o] { plan_scaling(o, 2); }); };
-  o.scenes = {"ode-piles", "nosuch"};
-  EXPECT_EQ(error().rfind("scenes: unknown scene 'nosuch'", 0), 0u) << error();
-  o.scenes = {"ode-piles"};
-  o.methods = {"worksteal", "barrier"};
-  EXPECT_EQ(error().rfind("methods: unknown method 'barrier' for the ODE scenes", 0), 0u)
-      << error();
+  const auto error = [](std::vector<std::string> scenes, std::vector<std::string> methods) {
+    ScalingOptions o;
+    o.scenes = std::move(scenes);
+    o.methods = std::move(methods);
+    return test::option_error([&o] { plan_scaling(o, 2); });
+  };
+  const std::string scene = error({"ode-piles", "nosuch"}, {});
+  EXPECT_EQ(scene.rfind("scenes: unknown scene 'nosuch'", 0), 0u) << scene;
+  const std::string method = error({"ode-piles"}, {"worksteal", "barrier"});
+  EXPECT_EQ(method.rfind("methods: unknown method 'barrier' for the ODE scenes", 0), 0u) << method;
 }
 
 // A tiny sweep: 3 steps at 1 and 2 threads of ode-piles under ODE's four methods.
@@ -86,7 +88,9 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
     const std::set<std::string> checks = {"identical", "within-rounding", "within-tolerance",
                                           "differs"};
     EXPECT_TRUE(checks.count(r.check)) << r.check;
-    if (r.method == "sequential") EXPECT_EQ(r.check, "identical");
+    if (r.method == "sequential") {
+      EXPECT_EQ(r.check, "identical");
+    }
     // The partition-guided method partitions the first step's graph (every 10th step).
     EXPECT_EQ(r.partitioned_steps, r.method == "list" ? 1u : 0u);
     EXPECT_FALSE(r.attribution);
