@@ -97,6 +97,10 @@ TEST(OdeValidate, PredictsTheLiveRunFromACapture) {
   EXPECT_EQ(r.strategy, "list");
   const auto j = nlohmann::json::parse(to_json(r));
   EXPECT_TRUE(j.contains("predicted_over_live"));
+  // The recording's own time per part, measured in the run and taken off the parts: never
+  // negative, and reported.
+  EXPECT_GE(r.recording_ns_per_part, 0.0);
+  EXPECT_TRUE(j.contains("recording_ns_per_part"));
   EXPECT_TRUE(j.contains("live_speedup"));
 }
 

@@ -138,6 +138,10 @@ struct ValidateReport {
   /// The runtime's own time per call (a chain of trivial calls on one thread), charged by the
   /// simulator as `task_overhead_ns` scaled to the captured steps' calls per part.
   double runtime_ns_per_call = 0;
+  /// The recording's own time per part (the same chain recorded against not, over its
+  /// parts), taken off each captured part's cost before the simulation: the live run records
+  /// nothing.
+  double recording_ns_per_part = 0;
 };
 
 /// The validation of the run `run` describes (its scene, steps or 20, method, threads, repeat
