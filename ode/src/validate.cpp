@@ -176,20 +176,20 @@ ValidateReport validate_scene(const ValidateOptions& options) {
 }
 
 std::string to_json(const ValidateReport& r) {
-  nlohmann::ordered_json j;
-  j["scene"] = r.options.scene;
-  j["stepper"] = std::string(to_string(r.options.stepper));
-  j["method"] = method_name(r.options.method);
-  j["predicted_with"] = r.strategy;
-  j["threads"] = r.options.threads;
-  j["steps"] = r.options.steps;
-  j["repeat"] = r.options.repeat;
-  j["live_speedup"] = r.live_speedup;
-  j["predicted_speedup"] = r.predicted_speedup;
-  j["predicted_over_live"] = r.predicted_over_live;
-  j["runtime_ns_per_call"] = r.runtime_ns_per_call;
-  j["recording_ns_per_part"] = r.recording_ns_per_part;
-  j["within_15_percent"] = std::abs(r.predicted_over_live - 1.0) <= 0.15;
+  const ValidateOptions& o = r.options;
+  nlohmann::ordered_json j = {{"scene", o.scene},
+                              {"stepper", std::string(to_string(o.stepper))},
+                              {"method", method_name(o.method)},
+                              {"predicted_with", r.strategy},
+                              {"threads", o.threads},
+                              {"steps", o.steps},
+                              {"repeat", o.repeat},
+                              {"live_speedup", r.live_speedup},
+                              {"predicted_speedup", r.predicted_speedup},
+                              {"predicted_over_live", r.predicted_over_live},
+                              {"runtime_ns_per_call", r.runtime_ns_per_call},
+                              {"recording_ns_per_part", r.recording_ns_per_part},
+                              {"within_15_percent", std::abs(r.predicted_over_live - 1.0) <= 0.15}};
   nlohmann::ordered_json rounds = nlohmann::ordered_json::array();
   for (const ValidateRound& v : r.rounds)
     rounds.push_back({{"live_ns", v.live_ns},
