@@ -96,10 +96,10 @@ void capture_ode(const std::string& scene, std::optional<int> steps, const std::
 void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,
                   std::uint32_t threads, std::uint32_t repeat, const std::string& calibration,
                   bool json, const OdeFlags& flags) {
-  const ode::ValidateReport r = ode::validate_scene(ode::validate_options(
-      ode::run_options(scene, steps, ode::choose_method(ode_method(method)), threads, repeat,
-                       ode::parse_stepper(flags.stepper)),
-      calibration));
+  const ode::ValidateReport r = ode::validate_scene(
+      ode::validate_options(ode::run_options(scene, steps, ode::choose_method(ode_method(method)),
+                                             threads, repeat, ode::parse_stepper(flags.stepper)),
+                            calibration));
   std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
 }
 

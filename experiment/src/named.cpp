@@ -30,8 +30,7 @@ NamedRun run_named(std::string_view name, const ExperimentOptions& o, Progress& 
   if (name == "scaling") {
     if (o.replay) throw OptionError("replay", "the scaling experiment makes live runs only");
     const ScalingResult r = run_scaling(
-        {o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words, o.calibration,
-         o.scenes},
+        {o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words, o.calibration, o.scenes},
         progress);
     return {scaling_text(r), scaling_json(r), r.failed.size()};
   }

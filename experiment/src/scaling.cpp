@@ -55,7 +55,7 @@ const std::vector<std::string> kDefaultMethods = {"owner",   "metis",     "stick
 const std::vector<std::string> kOdeMethods = {"sequential", "ode", "worksteal", "list"};
 
 // A record's policy and method names: ode::choose_method's for an ODE scene, else measure's.
-std::pair<std::string, std::string> policy_and_method(const ScalingScene& s,
+std::pair<std::string, std::string> policy_and_method([[maybe_unused]] const ScalingScene& s,
                                                       const std::string& method) {
 #ifdef TGRAPH_HAVE_ODE
   if (s.ode) {
@@ -81,9 +81,9 @@ meas::EngineFactory factory(const ScalingScene& s) {
 // count, 4) threads: the uninstrumented engine pinned on each of that many cores, the fastest
 // core's median. The run itself (work stealing: no partitioner) is not reported.
 ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
-  meas::LiveOptions o = detail::live_options(
-      std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4), s.steps, p.repeat,
-      false);
+  meas::LiveOptions o =
+      detail::live_options(std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4),
+                           s.steps, p.repeat, false);
   o.policy = tr::Policy::kWorksteal;
   const meas::LiveResult r = meas::run_live(factory(s), nullptr, o);
   ScalingReference ref;
@@ -252,8 +252,7 @@ viz::SeriesChart speedup_chart(const ScalingResult& res, const ScalingScene& sc)
   for (const std::string& method : p.methods_of(sc)) {
     viz::Series s{method, viz::SeriesKind::kMeasured, colour++, {}};
     for (const ScalingRecord& r : res.records)
-      if (r.scene == scene && r.method == policy_and_method(sc, method).second &&
-          r.speedup > 0)
+      if (r.scene == scene && r.method == policy_and_method(sc, method).second && r.speedup > 0)
         s.points.push_back({static_cast<double>(r.threads), r.speedup});
     if (!s.points.empty()) c.series.push_back(std::move(s));
   }
@@ -273,8 +272,8 @@ std::string results_csv(const ScalingResult& res) {
     csv << r.scene << ',' << r.policy << ',' << r.method << ',' << r.threads << ',' << r.speedup
         << ',' << r.serial_share << ',' << r.inflation << ',' << r.wait_share << ','
         << r.parks_per_step << ',' << r.partitioned_steps << ',' << r.predicted_speedup << ','
-        << r.predicted_over_live << ',' << r.steps << ',' << r.wall_ns
-        << ',' << r.sequential_wall_ns << ',';
+        << r.predicted_over_live << ',' << r.steps << ',' << r.wall_ns << ','
+        << r.sequential_wall_ns << ',';
     if (r.world_speedup) csv << *r.world_speedup;
     csv << ',' << r.check << '\n';
   }
@@ -327,10 +326,12 @@ std::vector<ScalingScene> chosen_scenes(const std::vector<std::string>& names,
 #else
     (void)quick;
     if (name.rfind("ode-", 0) == 0)
-      throw OptionError("scenes", "'" + name + "': the ODE scenes are not in this build "
-                                               "(libode-dev was not found)");
+      throw OptionError("scenes", "'" + name +
+                                      "': the ODE scenes are not in this build "
+                                      "(libode-dev was not found)");
 #endif
-    throw OptionError("scenes", "unknown scene '" + name + "' (expected " + join(known, ", ") + ")");
+    throw OptionError("scenes",
+                      "unknown scene '" + name + "' (expected " + join(known, ", ") + ")");
   }
   return out;
 }
@@ -342,8 +343,9 @@ std::vector<std::string> ode_methods(const std::vector<std::string>& methods) {
     try {
       (void)ode::choose_method(m);
     } catch (const OptionError&) {
-      throw OptionError("methods", "unknown method '" + m + "' for the ODE scenes (expected "
-                                   "sequential, ode, worksteal or a partition strategy)");
+      throw OptionError("methods", "unknown method '" + m +
+                                       "' for the ODE scenes (expected "
+                                       "sequential, ode, worksteal or a partition strategy)");
     }
   }
 #endif
@@ -378,7 +380,8 @@ Invocation ScalingPlan::invocation() const {
   Invocation inv{"scaling", {}};
   if (quick) inv.settings.push_back({"quick", std::nullopt});
   inv.settings.push_back({"threads", join(threads)});
-  const bool any_ode = std::any_of(scenes.begin(), scenes.end(), [](const ScalingScene& x) { return x.ode; });
+  const bool any_ode =
+      std::any_of(scenes.begin(), scenes.end(), [](const ScalingScene& x) { return x.ode; });
   const bool all_ode = any_ode && std::all_of(scenes.begin(), scenes.end(),
                                               [](const ScalingScene& x) { return x.ode; });
   // A mix of scenes under the default methods: each kind's own defaults, not one list.
@@ -434,7 +437,8 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
     for (ScalingScene& s : p.scenes) s.steps = *o.steps;
   if (std::any_of(p.scenes.begin(), p.scenes.end(), [](const ScalingScene& s) { return s.ode; }))
     p.ode_methods = o.methods.empty() ? kOdeMethods : ode_methods(o.methods);
-  if (std::none_of(p.scenes.begin(), p.scenes.end(), [](const ScalingScene& s) { return !s.ode; })) {
+  if (std::none_of(p.scenes.begin(), p.scenes.end(),
+                   [](const ScalingScene& s) { return !s.ode; })) {
     // Only ODE scenes: the built-in scenes' methods are not run.
   } else if (o.methods.empty() && o.quick) {
     // A smoke run: a strategy that keeps its assignment, one that rebalances, and the two
@@ -501,15 +505,14 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
         try {
           const ScalingRecord rec = run_record(s, method, k, p, ref, model, capture);
           progress.end(run + ": speed-up " + fixed(rec.speedup, 2) +
-                       (rec.world_speedup ? ", world " + fixed(*rec.world_speedup, 2) +
-                                                ", check " + rec.check
-                                          : std::string()) +
+                       (rec.world_speedup
+                            ? ", world " + fixed(*rec.world_speedup, 2) + ", check " + rec.check
+                            : std::string()) +
                        ", serial " + fixed(rec.serial_share, 3) +
                        (rec.ode ? std::string()
                                 : ", inflation " + fixed(rec.inflation, 2) + ", wait " +
                                       fixed(rec.wait_share, 2)) +
-                       ", parks/step " +
-                       fixed(rec.parks_per_step, 1) + ", partitioned " +
+                       ", parks/step " + fixed(rec.parks_per_step, 1) + ", partitioned " +
                        std::to_string(rec.partitioned_steps) + "/" + std::to_string(s.steps) +
                        (rec.predicted_speedup > 0
                             ? ", predicted " + fixed(rec.predicted_speedup, 2) + " (x" +
@@ -586,26 +589,24 @@ std::string scaling_json(const ScalingResult& res, int indent) {
                                {"sequential_wall_ns", r.sequential_wall_ns}});
   j["scaling"] = nlohmann::json::array();
   for (const ScalingRecord& r : res.records) {
-    j["scaling"].push_back({{"scene", r.scene},
-                            {"policy", r.policy},
-                            {"method", r.method},
-                            {"threads", r.threads},
-                            {"speedup", r.speedup},
-                            {"serial_share", r.serial_share},
-                            {"inflation", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.inflation)},
-                            {"wait_share", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.wait_share)},
-                            {"parks_per_step", r.parks_per_step},
-                            {"partitioned_steps", r.partitioned_steps},
-                            {"predicted_speedup", r.predicted_speedup > 0
-                                                      ? nlohmann::json(r.predicted_speedup)
-                                                      : nlohmann::json(nullptr)},
-                            {"predicted_over_live", r.predicted_over_live > 0
-                                                        ? nlohmann::json(r.predicted_over_live)
-                                                        : nlohmann::json(nullptr)},
-                            {"attribution",
-                             r.attribution ? nlohmann::json::parse(
-                                                 explain::attribution_json(*r.attribution))
-                                           : nlohmann::json(nullptr)}});
+    j["scaling"].push_back(
+        {{"scene", r.scene},
+         {"policy", r.policy},
+         {"method", r.method},
+         {"threads", r.threads},
+         {"speedup", r.speedup},
+         {"serial_share", r.serial_share},
+         {"inflation", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.inflation)},
+         {"wait_share", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.wait_share)},
+         {"parks_per_step", r.parks_per_step},
+         {"partitioned_steps", r.partitioned_steps},
+         {"predicted_speedup",
+          r.predicted_speedup > 0 ? nlohmann::json(r.predicted_speedup) : nlohmann::json(nullptr)},
+         {"predicted_over_live", r.predicted_over_live > 0 ? nlohmann::json(r.predicted_over_live)
+                                                           : nlohmann::json(nullptr)},
+         {"attribution", r.attribution
+                             ? nlohmann::json::parse(explain::attribution_json(*r.attribution))
+                             : nlohmann::json(nullptr)}});
     if (r.ode) {
       nlohmann::json& rec = j["scaling"].back();
       rec["world_speedup"] = r.world_speedup.value_or(0.0);
@@ -642,7 +643,8 @@ std::string scaling_text(const ScalingResult& res) {
       << std::setw(4) << r.threads << std::setw(9) << fixed(r.speedup, 2) << std::setw(8)
       << fixed(r.serial_share, 3) << std::setw(10)
       << (r.ode ? std::string("-") : fixed(r.inflation, 2)) << std::setw(7)
-      << (r.ode ? std::string("-") : fixed(r.wait_share, 2)) << std::setw(12) << fixed(r.parks_per_step, 1) << std::setw(13)
+      << (r.ode ? std::string("-") : fixed(r.wait_share, 2)) << std::setw(12)
+      << fixed(r.parks_per_step, 1) << std::setw(13)
       << (std::to_string(r.partitioned_steps) + "/" + std::to_string(r.steps)) << std::setw(11)
       << (r.predicted_speedup > 0 ? fixed(r.predicted_speedup, 2) : std::string("-"))
       << std::setw(11)

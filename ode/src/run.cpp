@@ -216,12 +216,13 @@ void check_json(const RunResult& r, nlohmann::ordered_json& j) {
   j["check"] = r.check;
   j["check_reference"] = "plain";
   if (r.check == "identical") return;
-  j.update(nlohmann::ordered_json{
-      {"max_abs_diff", r.max_abs_diff},
-      {"max_rel_diff", r.max_rel_diff},
-      {"tolerance", r.tolerance},
-      {"tolerance_basis", "ODE self-threaded's final positions with another seed of its random "
-                          "constraint reordering"}});
+  j.update(
+      nlohmann::ordered_json{{"max_abs_diff", r.max_abs_diff},
+                             {"max_rel_diff", r.max_rel_diff},
+                             {"tolerance", r.tolerance},
+                             {"tolerance_basis",
+                              "ODE self-threaded's final positions with another seed of its random "
+                              "constraint reordering"}});
 }
 
 }  // namespace

@@ -135,8 +135,8 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   } close;
   std::vector<double> live, predicted, over;
   for (std::uint32_t round = 0; round < options.repeat; ++round) {
-    const RunResult r = run_scene(
-        run_options(options.scene, options.steps, options.method, options.threads, 1, options.stepper));
+    const RunResult r = run_scene(run_options(options.scene, options.steps, options.method,
+                                              options.threads, 1, options.stepper));
     ValidateRound v;
     v.live_ns = r.wall_ns;
     v.sequential_ns = r.sequential_wall_ns;

@@ -218,7 +218,8 @@ TEST(Plan, RejectsBadOptionsNamingTheField) {
     EXPECT_EQ(error(), "subobjects: " + std::to_string(bad) +
                             " is not a perfect square from 1 to 4096 (expected e.g. 4,16,64)");
   }
-  test::expect_zero_counts_refused<ExperimentOptions>([](const ExperimentOptions& x) { plan_experiment(x, 2); });
+  test::expect_zero_counts_refused<ExperimentOptions>(
+      [](const ExperimentOptions& x) { plan_experiment(x, 2); });
   o = {};
   o.threads = {2, 0};
   EXPECT_EQ(error().rfind("threads: 0 threads is out of range", 0), 0u) << error();

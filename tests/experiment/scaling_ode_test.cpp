@@ -29,8 +29,9 @@ TEST(ScalingOde, TheOdeScenesRunOdesMethodsAndTheCommandSaysTheScenes) {
   EXPECT_EQ(p.ode_methods, (std::vector<std::string>{"sequential", "ode", "worksteal", "list"}));
   EXPECT_EQ(p.methods_of(p.scenes[1]), p.ode_methods);
   EXPECT_EQ(p.runs(), 2 * (1 + 4 * 2u));
-  EXPECT_EQ(p.command(), "scaling threads=1,2 methods=sequential,ode,worksteal,list "
-                         "scenes=ode-piles,ode-chains steps=200 repeat=1 out=d");
+  EXPECT_EQ(p.command(),
+            "scaling threads=1,2 methods=sequential,ode,worksteal,list "
+            "scenes=ode-piles,ode-chains steps=200 repeat=1 out=d");
   // A mix: each kind its own methods; a built-in scene by its label.
   o.scenes = {"bars64", "ode-heap"};
   o.quick = true;
@@ -68,9 +69,10 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
   EXPECT_EQ(res.references[0].steps, 3u);
   EXPECT_GT(res.references[0].sequential_wall_ns, 0);
   ASSERT_EQ(res.records.size(), 8u);
-  const std::vector<std::pair<std::string, std::string>> order = {
-      {"sequential", "sequential"}, {"ode", "ode"}, {"worksteal", "worksteal"},
-      {"partition", "list"}};
+  const std::vector<std::pair<std::string, std::string>> order = {{"sequential", "sequential"},
+                                                                  {"ode", "ode"},
+                                                                  {"worksteal", "worksteal"},
+                                                                  {"partition", "list"}};
   for (std::size_t i = 0; i < res.records.size(); ++i) {
     const ScalingRecord& r = res.records[i];
     SCOPED_TRACE(r.method + " K=" + std::to_string(r.threads));
@@ -97,10 +99,20 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
   }
   // results.json: the keys of every record, then ODE's own; what is not measured is null.
   const nlohmann::json j = nlohmann::json::parse(scaling_json(res));
-  const std::set<std::string> keys = {"scene", "policy", "method", "threads", "speedup",
-                                      "serial_share", "inflation", "wait_share",
-                                      "parks_per_step", "partitioned_steps", "predicted_speedup",
-                                      "predicted_over_live", "attribution", "world_speedup",
+  const std::set<std::string> keys = {"scene",
+                                      "policy",
+                                      "method",
+                                      "threads",
+                                      "speedup",
+                                      "serial_share",
+                                      "inflation",
+                                      "wait_share",
+                                      "parks_per_step",
+                                      "partitioned_steps",
+                                      "predicted_speedup",
+                                      "predicted_over_live",
+                                      "attribution",
+                                      "world_speedup",
                                       "check"};
   ASSERT_EQ(j["scaling"].size(), 8u);
   for (const nlohmann::json& r : j["scaling"]) {
@@ -120,9 +132,10 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
 TEST(ScalingOde, WithoutOdeTheOdeScenesAreRefusedSayingWhy) {
   ScalingOptions o;
   o.scenes = {"ode-piles"};
-  EXPECT_EQ(test::option_error([&o] { plan_scaling(o, 2); }).rfind("scenes: 'ode-piles': the ODE "
-                                                                    "scenes are not in this build",
-                                                                    0),
+  EXPECT_EQ(test::option_error([&o] { plan_scaling(o, 2); })
+                .rfind("scenes: 'ode-piles': the ODE "
+                       "scenes are not in this build",
+                       0),
             0u);
 }
 

@@ -83,7 +83,8 @@ TEST(ScalingPlan, RejectsBadOptionsNamingTheField) {
   o = {};
   o.threads = {0};
   EXPECT_EQ(error(), "threads: 0 threads is out of range (expected 1 to 1024)");
-  test::expect_zero_counts_refused<ScalingOptions>([](const ScalingOptions& x) { plan_scaling(x, 2); });
+  test::expect_zero_counts_refused<ScalingOptions>(
+      [](const ScalingOptions& x) { plan_scaling(x, 2); });
 }
 
 // --calibration: read when the sweep is planned (a bad file stops it before its first run,

@@ -81,10 +81,10 @@ struct ScalingPlan {
 
 /// Resolves `options` on a machine with `cores` cores. `scenes` picks the scenes (an ODE scene
 /// takes 200 steps, 40 with quick, unless `steps`); a name that is neither a default scene's
-/// label nor an ODE scene of this build is an OptionError of "scenes". Defaults: bars64 (20 steps), falling64
-/// (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier, omp-tasks and
-/// starpu (when built); scaling_thread_list(cores); one pass. quick: 2, 3, 3 and 1 steps,
-/// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
+/// label nor an ODE scene of this build is an OptionError of "scenes". Defaults: bars64 (20 steps),
+/// falling64 (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier,
+/// omp-tasks and starpu (when built); scaling_thread_list(cores); one pass. quick: 2, 3, 3 and 1
+/// steps, threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
 /// field (an unknown method, sequential or partition as a method, starpu in a build without
 /// it, a thread count, steps or repeat of 0).
 ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
@@ -108,9 +108,9 @@ ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
 ///   makespan of a capture of the same steps with the assignments the live run used (its
 ///   first timed pass; the strategy's partition of the capture when the capture's steps
 ///   differ) and the live run's serial work per step, under ScalingOptions::calibration (else
-///   the default calibration, else the defaults), against its one-processor makespan with the capture's own host time
-///   (the uninstrumented engine, the live speed-up's reference); and that over the live
-///   speed-up.
+///   the default calibration, else the defaults), against its one-processor makespan with the
+///   capture's own host time (the uninstrumented engine, the live speed-up's reference); and that
+///   over the live speed-up.
 /// An ODE scene's record (ode::run_scene at K threads with its check): speedup and
 /// world_speedup against ODE self-threaded timed in the same run (its own passes, interleaved),
 /// check and max_abs_diff as `tgraph run --check` says them; serial_share = collision +
