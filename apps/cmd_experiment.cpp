@@ -30,6 +30,11 @@ void add_experiment(CLI::App& app) {
   cmd->add_option("--methods", o->methods,
                   "Strategies and baselines, e.g. owner,worksteal (metg: policies)")
       ->delimiter(',');
+  cmd->add_option(
+         "--scenes,--scene", o->scenes,
+         "scaling: comma list of scenes (bars64, falling64, torso, cloth256-s64, and "
+         "ode-piles, ode-heap, ode-chains when built with ODE; default: the four built-in)")
+      ->delimiter(',');
   cmd->add_option("--subobjects", o->subobjects,
                   "domain: comma list of sub-object counts (perfect squares; default 16,64)")
       ->delimiter(',');

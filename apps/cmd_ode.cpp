@@ -52,14 +52,9 @@ void add_ode_capture_flags(CLI::App* cmd, OdeFlags& flags) {
 void run_ode(const std::string& scene, std::optional<std::uint32_t> steps,
              const std::string& method, std::uint32_t threads, std::uint32_t repeat, bool check,
              bool json, double timeout_s, const OdeFlags& flags) {
-  ode::RunOptions o;
-  o.scene = scene;
-  o.steps = steps;
-  o.method = ode::choose_method(ode_method(method));
-  o.threads = threads;
-  o.repeat = repeat;
+  ode::RunOptions o = ode::run_options(scene, steps, ode::choose_method(ode_method(method)),
+                                       threads, repeat, ode::parse_stepper(flags.stepper));
   o.check = check;
-  o.stepper = ode::parse_stepper(flags.stepper);
   o.watchdog_s = timeout_s;
   o.repartition_interval = flags.repartition_interval;
   o.json = json;
@@ -101,15 +96,10 @@ void capture_ode(const std::string& scene, std::optional<int> steps, const std::
 void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,
                   std::uint32_t threads, std::uint32_t repeat, const std::string& calibration,
                   bool json, const OdeFlags& flags) {
-  ode::ValidateOptions o;
-  o.scene = scene;
-  o.steps = steps;
-  o.method = ode::choose_method(ode_method(method));
-  o.threads = threads;
-  o.repeat = repeat;
-  o.calibration = calibration;
-  o.stepper = ode::parse_stepper(flags.stepper);
-  const ode::ValidateReport r = ode::validate_scene(o);
+  const ode::ValidateReport r = ode::validate_scene(
+      ode::validate_options(ode::run_options(scene, steps, ode::choose_method(ode_method(method)),
+                                             threads, repeat, ode::parse_stepper(flags.stepper)),
+                            calibration));
   std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
 }
 

@@ -36,6 +36,16 @@ std::vector<std::string> check_methods(const std::vector<std::string>& methods) 
   return out;
 }
 
+measure::LiveOptions live_options(std::uint32_t threads, std::uint32_t steps, std::uint32_t repeat,
+                                  bool observe) {
+  measure::LiveOptions o;
+  o.exec.threads = threads;
+  o.steps = steps;
+  o.repeat = repeat;
+  o.observe = observe;
+  return o;
+}
+
 std::string join(const std::vector<std::string>& v, const char* sep) {
   std::string s;
   for (const std::string& x : v) {

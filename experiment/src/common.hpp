@@ -9,6 +9,7 @@
 
 #include "tgraph/experiment/machine.hpp"
 #include "tgraph/experiment/progress.hpp"
+#include "tgraph/measure/live.hpp"
 
 namespace tgraph::experiment::detail {
 
@@ -16,6 +17,10 @@ namespace tgraph::experiment::detail {
 /// name, sequential (every run's reference), partition (a strategy is named instead) or
 /// starpu in a build without it.
 std::vector<std::string> check_methods(const std::vector<std::string>& methods);
+/// A live run's options: `threads`, `steps`, `repeat` timed passes, the observed pass or not;
+/// the rest measure's defaults.
+measure::LiveOptions live_options(std::uint32_t threads, std::uint32_t steps, std::uint32_t repeat,
+                                  bool observe);
 /// The items joined by `sep`.
 std::string join(const std::vector<std::string>& v, const char* sep = ",");
 /// The counts joined by commas ("1,2,4").

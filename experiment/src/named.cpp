@@ -11,6 +11,8 @@
 namespace tgraph::experiment {
 
 NamedRun run_named(std::string_view name, const ExperimentOptions& o, Progress& progress) {
+  if (!o.scenes.empty() && name != "scaling")
+    throw OptionError("scenes", "applies to the scaling experiment only");
   if (const std::optional<ExperimentName> paper = parse_experiment_name(name)) {
     ExperimentOptions po = o;
     po.name = *paper;
@@ -28,7 +30,7 @@ NamedRun run_named(std::string_view name, const ExperimentOptions& o, Progress& 
   if (name == "scaling") {
     if (o.replay) throw OptionError("replay", "the scaling experiment makes live runs only");
     const ScalingResult r = run_scaling(
-        {o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words, o.calibration},
+        {o.quick, o.out, o.threads, o.methods, o.steps, o.repeat, o.words, o.calibration, o.scenes},
         progress);
     return {scaling_text(r), scaling_json(r), r.failed.size()};
   }

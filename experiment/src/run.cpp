@@ -56,11 +56,7 @@ struct LiveRun {
 
 LiveRun run_live(const SceneVariant& v, const std::string& method, std::uint32_t k,
                  const ExperimentPlan& p, bool every_step) {
-  meas::LiveOptions o;
-  o.exec.threads = k;
-  o.steps = p.steps;
-  o.repeat = p.repeat;
-  o.observe = false;
+  meas::LiveOptions o = detail::live_options(k, p.steps, p.repeat, false);
   o.repartition_every_step = every_step;
   auto calls = std::make_shared<std::vector<tp::Stats>>();  // in order, first pass first
   const std::optional<tp::StepPartitioner> part = meas::live_partitioner(

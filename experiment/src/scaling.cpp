@@ -32,6 +32,10 @@
 #include "tgraph/replay/policy.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/series_chart.hpp"
+#ifdef TGRAPH_HAVE_ODE
+#include "tgraph/ode/run.hpp"
+#include "tgraph/ode/scenes.hpp"
+#endif
 
 namespace tgraph::experiment {
 namespace {
@@ -45,6 +49,23 @@ namespace meas = tgraph::measure;
 // The partition strategies the issue measures, then every baseline policy.
 const std::vector<std::string> kDefaultMethods = {"owner",   "metis",     "sticky", "worksteal",
                                                   "barrier", "omp-tasks", "starpu"};
+
+// The ODE scenes' methods: ODE self-threaded, ODE's own pool (the peer), work stealing and
+// the partition-guided method (docs/ode.md).
+const std::vector<std::string> kOdeMethods = {"sequential", "ode", "worksteal", "list"};
+
+// A record's policy and method names: ode::choose_method's for an ODE scene, else measure's.
+std::pair<std::string, std::string> policy_and_method([[maybe_unused]] const ScalingScene& s,
+                                                      const std::string& method) {
+#ifdef TGRAPH_HAVE_ODE
+  if (s.ode) {
+    const ode::Method m = ode::choose_method(method);
+    return {std::string(ode::to_string(m.policy)), ode::method_name(m)};
+  }
+#endif
+  const meas::MethodChoice m = meas::choose_method(method);
+  return {std::string(tr::to_string(m.policy)), meas::method_name(m)};
+}
 
 samples::SceneOptions scene_options(const ScalingScene& s) {
   samples::SceneOptions so;
@@ -60,12 +81,10 @@ meas::EngineFactory factory(const ScalingScene& s) {
 // count, 4) threads: the uninstrumented engine pinned on each of that many cores, the fastest
 // core's median. The run itself (work stealing: no partitioner) is not reported.
 ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
-  meas::LiveOptions o;
+  meas::LiveOptions o =
+      detail::live_options(std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4),
+                           s.steps, p.repeat, false);
   o.policy = tr::Policy::kWorksteal;
-  o.exec.threads = std::min<std::uint32_t>(p.threads.empty() ? 1 : p.threads.back(), 4);
-  o.steps = s.steps;
-  o.repeat = p.repeat;
-  o.observe = false;
   const meas::LiveResult r = meas::run_live(factory(s), nullptr, o);
   ScalingReference ref;
   ref.scene = s.label();
@@ -80,27 +99,27 @@ ScalingReference reference_of(const ScalingScene& s, const ScalingPlan& p) {
 meas::LiveResult live_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
                           const ScalingPlan& p) {
   const meas::MethodChoice m = meas::choose_method(method);
-  meas::LiveOptions o;
-  o.exec.threads = k;
-  o.steps = s.steps;
-  o.repeat = p.repeat;
+  meas::LiveOptions o = detail::live_options(k, s.steps, p.repeat, true);
   o.baseline = false;
-  o.observe = true;
   o.keep_assignments = m.policy == tr::Policy::kPartition;
   const std::optional<tp::StepPartitioner> part =
       meas::live_partitioner(m, meas::live_strategy_options(o), o);  // as `tgraph run` partitions
   return meas::run_live(factory(s), part ? &*part : nullptr, o);
 }
 
-ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
-                        const meas::LiveResult& r, const ScalingReference& ref) {
-  const meas::MethodChoice m = meas::choose_method(method);
+// The fields every record has: the scene, the method's names, threads and steps.
+ScalingRecord record_head(const ScalingScene& s, const std::string& method, std::uint32_t k) {
   ScalingRecord rec;
   rec.scene = s.label();
-  rec.policy = std::string(tr::to_string(m.policy));
-  rec.method = meas::method_name(m);
+  std::tie(rec.policy, rec.method) = policy_and_method(s, method);
   rec.threads = k;
   rec.steps = s.steps;
+  return rec;
+}
+
+ScalingRecord record_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
+                        const meas::LiveResult& r, const ScalingReference& ref) {
+  ScalingRecord rec = record_head(s, method, k);
   rec.wall_ns = r.wall_ns;
   rec.sequential_wall_ns = ref.sequential_wall_ns;
   const double sequential = static_cast<double>(ref.sequential_wall_ns);
@@ -144,15 +163,77 @@ double predicted_speedup(const Trace& capture, const std::string& method, std::u
   return parallel > 0 ? sequential / parallel : 0.0;
 }
 
-ScalingMiss miss_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
-                    std::string reason) {
-  const meas::MethodChoice m = meas::choose_method(method);
-  return {s.label(), std::string(tr::to_string(m.policy)), meas::method_name(m), k,
-          std::move(reason)};
+#ifdef TGRAPH_HAVE_ODE
+// An ODE scene's run of METHOD on K threads (ode::run_scene: `repeat` timed passes, each
+// beside a pass of ODE self-threaded on a fresh copy of the scene), with its check.
+ode::RunResult ode_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
+                       const ScalingPlan& p, bool check) {
+  ode::RunOptions o = ode::run_options(s.scene, s.steps, ode::choose_method(method), k, p.repeat);
+  o.check = check;
+  return ode::run_scene(o);
 }
 
-viz::SeriesChart speedup_chart(const ScalingResult& res, const std::string& scene) {
+// An ODE scene's reference: ODE self-threaded (the calling thread, unpinned), median pass.
+ScalingReference ode_reference_of(const ScalingScene& s, const ScalingPlan& p) {
+  const ode::RunResult r = ode_run(s, "sequential", 1, p, false);
+  return {s.label(), r.steps, 1, r.sequential_wall_ns};
+}
+
+ScalingRecord ode_record_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
+                            const ode::RunResult& r) {
+  ScalingRecord rec = record_head(s, method, k);
+  rec.ode = true;
+  rec.wall_ns = r.wall_ns;
+  rec.sequential_wall_ns = r.sequential_wall_ns;  // the same run's ODE self-threaded
+  rec.speedup = r.speedup;
+  rec.world_speedup = r.world_speedup;
+  if (r.sequential_wall_ns > 0)
+    rec.serial_share = static_cast<double>(r.collide_ns + r.partition_ns) /
+                       static_cast<double>(r.sequential_wall_ns);
+  rec.parks_per_step = static_cast<double>(r.stats.parks) / std::max<double>(r.steps, 1);
+  rec.partitioned_steps = static_cast<std::uint32_t>(r.stats.partitions);
+  rec.check = r.check;
+  rec.max_abs_diff = r.max_abs_diff;
+  return rec;
+}
+#endif
+
+ScalingReference scene_reference(const ScalingScene& s, const ScalingPlan& p) {
+#ifdef TGRAPH_HAVE_ODE
+  if (s.ode) return ode_reference_of(s, p);
+#endif
+  return reference_of(s, p);
+}
+
+// One run of the sweep as its record: an ODE scene's through ode::run_scene, else the live
+// run, with the simulator's prediction under the partition policy (`capture` taken once per
+// scene, at the first partition run).
+ScalingRecord run_record(const ScalingScene& s, const std::string& method, std::uint32_t k,
+                         const ScalingPlan& p, const ScalingReference& ref,
+                         const model::CostModel& model, std::optional<Trace>& capture) {
+#ifdef TGRAPH_HAVE_ODE
+  if (s.ode) return ode_record_of(s, method, k, ode_run(s, method, k, p, true));
+#endif
+  const meas::LiveResult r = live_run(s, method, k, p);
+  ScalingRecord rec = record_of(s, method, k, r, ref);
+  const meas::MethodChoice m = meas::choose_method(method);
+  if (m.policy == tr::Policy::kPartition) {
+    if (!capture) capture = meas::capture_trace(s.scene, s.steps, scene_options(s));
+    rec.predicted_speedup = predicted_speedup(*capture, m.method, k, r, model);
+    if (rec.speedup > 0) rec.predicted_over_live = rec.predicted_speedup / rec.speedup;
+  }
+  return rec;
+}
+
+ScalingMiss miss_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
+                    std::string reason) {
+  const auto [policy, name] = policy_and_method(s, method);
+  return {s.label(), policy, name, k, std::move(reason)};
+}
+
+viz::SeriesChart speedup_chart(const ScalingResult& res, const ScalingScene& sc) {
   const ScalingPlan& p = res.plan;
+  const std::string scene = sc.label();
   viz::SeriesChart c;
   c.title = "Speed-up against threads: " + scene;
   std::uint32_t steps = 0;
@@ -168,11 +249,10 @@ viz::SeriesChart speedup_chart(const ScalingResult& res, const std::string& scen
   for (std::uint32_t k : p.threads) ideal.points.push_back({static_cast<double>(k), static_cast<double>(k)});
   c.series.push_back(std::move(ideal));
   std::uint32_t colour = 0;
-  for (const std::string& method : p.methods) {
+  for (const std::string& method : p.methods_of(sc)) {
     viz::Series s{method, viz::SeriesKind::kMeasured, colour++, {}};
     for (const ScalingRecord& r : res.records)
-      if (r.scene == scene && r.method == meas::method_name(meas::choose_method(method)) &&
-          r.speedup > 0)
+      if (r.scene == scene && r.method == policy_and_method(sc, method).second && r.speedup > 0)
         s.points.push_back({static_cast<double>(r.threads), r.speedup});
     if (!s.points.empty()) c.series.push_back(std::move(s));
   }
@@ -186,14 +266,17 @@ std::string results_csv(const ScalingResult& res) {
   std::ostringstream csv;
   csv << "scene,policy,method,threads,speedup,serial_share,inflation,wait_share,parks_per_step,"
          "partitioned_steps,predicted_speedup,predicted_over_live,steps,wall_ns,"
-         "sequential_wall_ns\n";
+         "sequential_wall_ns,world_speedup,check\n";
   csv << std::setprecision(6);
-  for (const ScalingRecord& r : res.records)
+  for (const ScalingRecord& r : res.records) {
     csv << r.scene << ',' << r.policy << ',' << r.method << ',' << r.threads << ',' << r.speedup
         << ',' << r.serial_share << ',' << r.inflation << ',' << r.wait_share << ','
         << r.parks_per_step << ',' << r.partitioned_steps << ',' << r.predicted_speedup << ','
-        << r.predicted_over_live << ',' << r.steps << ',' << r.wall_ns
-        << ',' << r.sequential_wall_ns << '\n';
+        << r.predicted_over_live << ',' << r.steps << ',' << r.wall_ns << ','
+        << r.sequential_wall_ns << ',';
+    if (r.world_speedup) csv << *r.world_speedup;
+    csv << ',' << r.check << '\n';
+  }
   return csv.str();
 }
 
@@ -203,7 +286,7 @@ void write_outputs(ScalingResult& res) {
   std::vector<std::pair<std::string, std::string>> files;
   files.emplace_back("results.csv", results_csv(res));
   for (const ScalingScene& s : res.plan.scenes) {
-    const viz::SeriesChart c = speedup_chart(res, s.label());
+    const viz::SeriesChart c = speedup_chart(res, s);
     if (c.series.size() < 2) continue;  // no measured line
     files.emplace_back("speedup-" + s.label() + ".svg",
                        viz::render_series_chart(c, viz::TimelineFormat::kSvg));
@@ -214,6 +297,59 @@ void write_outputs(ScalingResult& res) {
   for (const auto& f : files) res.files.push_back(f.first);
   for (const auto& [name, content] : files) write_file_atomic((fs::path(dir) / name).string(), content);
   write_file_atomic((fs::path(dir) / "results.json").string(), scaling_json(res, 1) + "\n");
+}
+
+}  // namespace
+
+namespace {
+
+// ScalingOptions::scenes resolved: a default scene by its label, an ODE scene (its own step
+// count, 40 when quick) in a build with tgraph::ode.
+std::vector<ScalingScene> chosen_scenes(const std::vector<std::string>& names,
+                                        const std::vector<ScalingScene>& defaults, bool quick) {
+  std::vector<ScalingScene> out;
+  std::vector<std::string> known;
+  for (const ScalingScene& d : defaults) known.push_back(d.label());
+  for (const std::string& name : names) {
+    const auto d = std::find_if(defaults.begin(), defaults.end(),
+                                [&](const ScalingScene& x) { return x.label() == name; });
+    if (d != defaults.end()) {
+      out.push_back(*d);
+      continue;
+    }
+#ifdef TGRAPH_HAVE_ODE
+    if (ode::is_scene(name)) {
+      out.push_back({name, std::nullopt, quick ? 40u : ode::default_steps(name), true});
+      continue;
+    }
+    for (const std::string& n : ode::scene_names()) known.push_back(n);
+#else
+    (void)quick;
+    if (name.rfind("ode-", 0) == 0)
+      throw OptionError("scenes", "'" + name +
+                                      "': the ODE scenes are not in this build "
+                                      "(libode-dev was not found)");
+#endif
+    throw OptionError("scenes",
+                      "unknown scene '" + name + "' (expected " + join(known, ", ") + ")");
+  }
+  return out;
+}
+
+// --methods for the ODE scenes: each one ode::choose_method takes.
+std::vector<std::string> ode_methods(const std::vector<std::string>& methods) {
+#ifdef TGRAPH_HAVE_ODE
+  for (const std::string& m : methods) {
+    try {
+      (void)ode::choose_method(m);
+    } catch (const OptionError&) {
+      throw OptionError("methods", "unknown method '" + m +
+                                       "' for the ODE scenes (expected "
+                                       "sequential, ode, worksteal or a partition strategy)");
+    }
+  }
+#endif
+  return methods;
 }
 
 }  // namespace
@@ -231,14 +367,33 @@ std::vector<std::uint32_t> scaling_thread_list(std::uint32_t cores) {
 }
 
 std::size_t ScalingPlan::runs() const {
-  return scenes.size() * (1 + methods.size() * threads.size());
+  std::size_t n = 0;
+  for (const ScalingScene& s : scenes) n += 1 + methods_of(s).size() * threads.size();
+  return n;
+}
+
+const std::vector<std::string>& ScalingPlan::methods_of(const ScalingScene& scene) const {
+  return scene.ode ? ode_methods : methods;
 }
 
 Invocation ScalingPlan::invocation() const {
   Invocation inv{"scaling", {}};
   if (quick) inv.settings.push_back({"quick", std::nullopt});
   inv.settings.push_back({"threads", join(threads)});
-  inv.settings.push_back({"methods", join(methods)});
+  const bool any_ode =
+      std::any_of(scenes.begin(), scenes.end(), [](const ScalingScene& x) { return x.ode; });
+  const bool all_ode = any_ode && std::all_of(scenes.begin(), scenes.end(),
+                                              [](const ScalingScene& x) { return x.ode; });
+  // A mix of scenes under the default methods: each kind's own defaults, not one list.
+  if (all_ode)
+    inv.settings.push_back({"methods", join(ode_methods)});
+  else if (!any_ode || methods_given)
+    inv.settings.push_back({"methods", join(methods)});
+  if (scenes_given) {
+    std::vector<std::string> labels;
+    for (const ScalingScene& x : scenes) labels.push_back(x.label());
+    inv.settings.push_back({"scenes", join(labels)});
+  }
   if (!scenes.empty() &&
       std::all_of(scenes.begin(), scenes.end(),
                   [&](const ScalingScene& x) { return x.steps == scenes.front().steps; }) &&
@@ -275,9 +430,17 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
               {"falling64", std::nullopt, o.quick ? 3u : 60u},
               {"torso", std::nullopt, o.quick ? 3u : 60u},
               {"cloth256", 64, o.quick ? 1u : 5u}};
+  if (!o.scenes.empty()) p.scenes = chosen_scenes(o.scenes, p.scenes, o.quick);
+  p.scenes_given = !o.scenes.empty();
+  p.methods_given = !o.methods.empty();
   if (o.steps)
     for (ScalingScene& s : p.scenes) s.steps = *o.steps;
-  if (o.methods.empty() && o.quick) {
+  if (std::any_of(p.scenes.begin(), p.scenes.end(), [](const ScalingScene& s) { return s.ode; }))
+    p.ode_methods = o.methods.empty() ? kOdeMethods : ode_methods(o.methods);
+  if (std::none_of(p.scenes.begin(), p.scenes.end(),
+                   [](const ScalingScene& s) { return !s.ode; })) {
+    // Only ODE scenes: the built-in scenes' methods are not run.
+  } else if (o.methods.empty() && o.quick) {
     // A smoke run: a strategy that keeps its assignment, one that rebalances, and the two
     // baselines of the paper (the others cost the most per run here: StarPU's start-up,
     // METIS on every partitioned step).
@@ -317,15 +480,16 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
     progress.begin(label + " reference");
     ScalingReference ref;
     try {
-      ref = reference_of(s, p);
+      ref = scene_reference(s, p);
       progress.end(label + " (" + std::to_string(s.steps) + " steps): sequential " +
                    fixed(static_cast<double>(ref.sequential_wall_ns) / 1e6, 1) +
-                   " ms (uninstrumented engine, fastest of " + std::to_string(ref.cores_timed) +
-                   " cores)");
+                   (s.ode ? std::string(" ms (ODE self-threaded)")
+                          : " ms (uninstrumented engine, fastest of " +
+                                std::to_string(ref.cores_timed) + " cores)"));
     } catch (const std::exception& e) {
       progress.end(label + ": reference run failed: " + e.what());
       for (std::uint32_t k : p.threads)
-        for (const std::string& method : p.methods)
+        for (const std::string& method : p.methods_of(s))
           res.failed.push_back(miss_of(s, method, k, std::string("reference run: ") + e.what()));
       continue;
     }
@@ -335,22 +499,20 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
     // Every method at one thread count before the next count: drift of the machine over the
     // sweep falls on thread counts alike, not on one method.
     for (std::uint32_t k : p.threads)
-      for (const std::string& method : p.methods) {
+      for (const std::string& method : p.methods_of(s)) {
         const std::string run = label + " " + method + " K=" + std::to_string(k);
         progress.begin(run);
         try {
-          const meas::LiveResult r = live_run(s, method, k, p);
-          ScalingRecord rec = record_of(s, method, k, r, ref);
-          const meas::MethodChoice m = meas::choose_method(method);
-          if (m.policy == tr::Policy::kPartition) {
-            if (!capture) capture = meas::capture_trace(s.scene, s.steps, scene_options(s));
-            rec.predicted_speedup = predicted_speedup(*capture, m.method, k, r, model);
-            if (rec.speedup > 0) rec.predicted_over_live = rec.predicted_speedup / rec.speedup;
-          }
-          progress.end(run + ": speed-up " + fixed(rec.speedup, 2) + ", serial " +
-                       fixed(rec.serial_share, 3) + ", inflation " + fixed(rec.inflation, 2) +
-                       ", wait " + fixed(rec.wait_share, 2) + ", parks/step " +
-                       fixed(rec.parks_per_step, 1) + ", partitioned " +
+          const ScalingRecord rec = run_record(s, method, k, p, ref, model, capture);
+          progress.end(run + ": speed-up " + fixed(rec.speedup, 2) +
+                       (rec.world_speedup
+                            ? ", world " + fixed(*rec.world_speedup, 2) + ", check " + rec.check
+                            : std::string()) +
+                       ", serial " + fixed(rec.serial_share, 3) +
+                       (rec.ode ? std::string()
+                                : ", inflation " + fixed(rec.inflation, 2) + ", wait " +
+                                      fixed(rec.wait_share, 2)) +
+                       ", parks/step " + fixed(rec.parks_per_step, 1) + ", partitioned " +
                        std::to_string(rec.partitioned_steps) + "/" + std::to_string(s.steps) +
                        (rec.predicted_speedup > 0
                             ? ", predicted " + fixed(rec.predicted_speedup, 2) + " (x" +
@@ -402,13 +564,21 @@ std::string scaling_json(const ScalingResult& res, int indent) {
       {"attribution",
        "the observed pass's lost processor time (threads x wall - sequential work) by cause, "
        "summed over the steps: {lost_ns, causes: {serial, imbalance, dependency_wait, handoff, "
-       "interruption, inflation, runtime, starvation, residual}} (docs/explain.md)"}};
+       "interruption, inflation, runtime, starvation, residual}} (docs/explain.md)"},
+      {"ode_scenes",
+       "an ODE scene's record is ode::run_scene's (tgraph run --scene ode-* --check): speedup "
+       "(whole step, collision included) and world_speedup (the world step alone) against ODE "
+       "self-threaded timed in the same run, check and max_abs_diff against its final state; "
+       "serial_share = collision + partitioning / that sequential wall time; parks_per_step "
+       "and partitioned_steps of the first timed pass; inflation, wait_share, the prediction "
+       "and attribution not measured (null); its reference is ODE self-threaded"}};
   j["machine"] = res.machine.summary();
   j["cores"] = res.plan.cores;
   j["date"] = res.date;
   j["seconds"] = res.seconds;
   j["threads"] = res.plan.threads;
   j["methods"] = res.plan.methods;
+  if (!res.plan.ode_methods.empty()) j["ode_methods"] = res.plan.ode_methods;
   j["repeat"] = res.plan.repeat;
   j["notes"] = res.plan.notes;
   j["references"] = nlohmann::json::array();
@@ -418,27 +588,32 @@ std::string scaling_json(const ScalingResult& res, int indent) {
                                {"cores_timed", r.cores_timed},
                                {"sequential_wall_ns", r.sequential_wall_ns}});
   j["scaling"] = nlohmann::json::array();
-  for (const ScalingRecord& r : res.records)
-    j["scaling"].push_back({{"scene", r.scene},
-                            {"policy", r.policy},
-                            {"method", r.method},
-                            {"threads", r.threads},
-                            {"speedup", r.speedup},
-                            {"serial_share", r.serial_share},
-                            {"inflation", r.inflation},
-                            {"wait_share", r.wait_share},
-                            {"parks_per_step", r.parks_per_step},
-                            {"partitioned_steps", r.partitioned_steps},
-                            {"predicted_speedup", r.predicted_speedup > 0
-                                                      ? nlohmann::json(r.predicted_speedup)
-                                                      : nlohmann::json(nullptr)},
-                            {"predicted_over_live", r.predicted_over_live > 0
-                                                        ? nlohmann::json(r.predicted_over_live)
-                                                        : nlohmann::json(nullptr)},
-                            {"attribution",
-                             r.attribution ? nlohmann::json::parse(
-                                                 explain::attribution_json(*r.attribution))
-                                           : nlohmann::json(nullptr)}});
+  for (const ScalingRecord& r : res.records) {
+    j["scaling"].push_back(
+        {{"scene", r.scene},
+         {"policy", r.policy},
+         {"method", r.method},
+         {"threads", r.threads},
+         {"speedup", r.speedup},
+         {"serial_share", r.serial_share},
+         {"inflation", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.inflation)},
+         {"wait_share", r.ode ? nlohmann::json(nullptr) : nlohmann::json(r.wait_share)},
+         {"parks_per_step", r.parks_per_step},
+         {"partitioned_steps", r.partitioned_steps},
+         {"predicted_speedup",
+          r.predicted_speedup > 0 ? nlohmann::json(r.predicted_speedup) : nlohmann::json(nullptr)},
+         {"predicted_over_live", r.predicted_over_live > 0 ? nlohmann::json(r.predicted_over_live)
+                                                           : nlohmann::json(nullptr)},
+         {"attribution", r.attribution
+                             ? nlohmann::json::parse(explain::attribution_json(*r.attribution))
+                             : nlohmann::json(nullptr)}});
+    if (r.ode) {
+      nlohmann::json& rec = j["scaling"].back();
+      rec["world_speedup"] = r.world_speedup.value_or(0.0);
+      rec["check"] = r.check;
+      if (r.check != "identical") rec["max_abs_diff"] = r.max_abs_diff;
+    }
+  }
   for (const auto& [key, list] : {std::pair{"skipped", &res.skipped}, std::pair{"failed", &res.failed}}) {
     j[key] = nlohmann::json::array();
     for (const ScalingMiss& m : *list)
@@ -466,12 +641,16 @@ std::string scaling_text(const ScalingResult& res) {
   for (const ScalingRecord& r : res.records)
     s << std::left << std::setw(14) << r.scene << std::setw(11) << r.method << std::right
       << std::setw(4) << r.threads << std::setw(9) << fixed(r.speedup, 2) << std::setw(8)
-      << fixed(r.serial_share, 3) << std::setw(10) << fixed(r.inflation, 2) << std::setw(7)
-      << fixed(r.wait_share, 2) << std::setw(12) << fixed(r.parks_per_step, 1) << std::setw(13)
+      << fixed(r.serial_share, 3) << std::setw(10)
+      << (r.ode ? std::string("-") : fixed(r.inflation, 2)) << std::setw(7)
+      << (r.ode ? std::string("-") : fixed(r.wait_share, 2)) << std::setw(12)
+      << fixed(r.parks_per_step, 1) << std::setw(13)
       << (std::to_string(r.partitioned_steps) + "/" + std::to_string(r.steps)) << std::setw(11)
       << (r.predicted_speedup > 0 ? fixed(r.predicted_speedup, 2) : std::string("-"))
       << std::setw(11)
       << (r.predicted_over_live > 0 ? fixed(r.predicted_over_live, 2) : std::string("-"))
+      << (r.ode ? "  world " + fixed(r.world_speedup.value_or(0.0), 2) + ", " + r.check
+                : std::string())
       << "\n";
   for (const ScalingMiss& m : res.skipped)
     s << "skipped " << m.scene << " " << m.method << " K=" << m.threads << ": " << m.reason << "\n";

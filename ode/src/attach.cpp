@@ -149,6 +149,7 @@ void Attachment::world_step(Stepper stepper, dReal dt) {
       placement.emplace(g.tasks[t].key, r.assignment.proc[t]);
     rt->set_placement(std::move(placement));
     m.stats.partition_ns += now_ns() - p0;
+    ++m.stats.partitions;
   }
   if (m.options.record) m.logs.push_back(std::move(log));
 }

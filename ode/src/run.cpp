@@ -47,13 +47,7 @@ Pass run_pass(const RunOptions& o, std::uint32_t steps, bool reference, unsigned
     for (std::uint32_t i = 0; i < steps; ++i) p.steps.push_back(scene->step(nullptr));
     p.partition_ns.assign(steps, 0);
   } else {
-    AttachOptions a;
-    a.method = o.method;
-    a.threads = o.threads;
-    a.watchdog_s = o.watchdog_s;
-    a.repartition_interval = o.repartition_interval;
-    a.strategy = o.strategy;
-    Attachment attach(scene->world(), a);
+    Attachment attach(scene->world(), attach_options(o));
     std::int64_t partitioned = 0;
     for (std::uint32_t i = 0; i < steps; ++i) {
       p.steps.push_back(scene->step(&attach));
@@ -76,6 +70,24 @@ double max_abs(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 }  // namespace
+
+RunOptions run_options(std::string scene, std::optional<std::uint32_t> steps, Method method,
+                       std::uint32_t threads, std::uint32_t repeat, Stepper stepper) {
+  return {.scene = std::move(scene),
+          .steps = steps,
+          .method = std::move(method),
+          .threads = threads,
+          .repeat = repeat,
+          .stepper = stepper};
+}
+
+AttachOptions attach_options(const RunOptions& o) {
+  return {.method = o.method,
+          .threads = o.threads,
+          .repartition_interval = o.repartition_interval,
+          .strategy = o.strategy,
+          .watchdog_s = o.watchdog_s};
+}
 
 RunResult run_scene(const RunOptions& options) {
   if (!is_scene(options.scene))
@@ -184,36 +196,53 @@ RunResult run_scene(const RunOptions& options) {
   return r;
 }
 
-std::string to_json(const RunResult& r) {
-  nlohmann::ordered_json j;
-  const RunOptions& o = r.options;
-  j["scene"] = o.scene;
-  j["stepper"] = std::string(to_string(o.stepper));
-  j["method"] = method_name(o.method);
-  j["policy"] = std::string(to_string(o.method.policy));
-  j["threads"] = o.threads;
-  j["steps"] = r.steps;
-  j["repeat"] = o.repeat;
-  j["wall_ns"] = r.wall_ns;
-  j["sequential_wall_ns"] = r.sequential_wall_ns;
-  j["world_ns"] = r.world_ns;
-  j["sequential_world_ns"] = r.sequential_world_ns;
-  j["speedup"] = r.speedup;
-  j["world_speedup"] = r.world_speedup;
+namespace {
+
+// The per-step record's fields beside its index, in the order `run --json` writes them.
+constexpr std::pair<const char*, std::int64_t RunStep::*> kStepFields[] = {
+    {"wall_ns", &RunStep::wall_ns},
+    {"world_ns", &RunStep::world_ns},
+    {"collide_ns", &RunStep::collide_ns},
+    {"partition_ns", &RunStep::partition_ns},
+    {"sequential_wall_ns", &RunStep::sequential_wall_ns},
+    {"sequential_world_ns", &RunStep::sequential_world_ns}};
+
+// `check` and, when the states differ, by how much and against which tolerance.
+void check_json(const RunResult& r, nlohmann::ordered_json& j) {
   if (r.check.empty()) {
     j["check"] = nullptr;
-  } else {
-    j["check"] = r.check;
-    j["check_reference"] = "plain";
-    if (r.check != "identical") {
-      j["max_abs_diff"] = r.max_abs_diff;
-      j["max_rel_diff"] = r.max_rel_diff;
-      j["tolerance"] = r.tolerance;
-      j["tolerance_basis"] =
-          "ODE self-threaded's final positions with another seed of its random constraint "
-          "reordering";
-    }
+    return;
   }
+  j["check"] = r.check;
+  j["check_reference"] = "plain";
+  if (r.check == "identical") return;
+  j.update(
+      nlohmann::ordered_json{{"max_abs_diff", r.max_abs_diff},
+                             {"max_rel_diff", r.max_rel_diff},
+                             {"tolerance", r.tolerance},
+                             {"tolerance_basis",
+                              "ODE self-threaded's final positions with another seed of its random "
+                              "constraint reordering"}});
+}
+
+}  // namespace
+
+std::string to_json(const RunResult& r) {
+  const RunOptions& o = r.options;
+  nlohmann::ordered_json j = {{"scene", o.scene},
+                              {"stepper", std::string(to_string(o.stepper))},
+                              {"method", method_name(o.method)},
+                              {"policy", std::string(to_string(o.method.policy))},
+                              {"threads", o.threads},
+                              {"steps", r.steps},
+                              {"repeat", o.repeat},
+                              {"wall_ns", r.wall_ns},
+                              {"sequential_wall_ns", r.sequential_wall_ns},
+                              {"world_ns", r.world_ns},
+                              {"sequential_world_ns", r.sequential_world_ns},
+                              {"speedup", r.speedup},
+                              {"world_speedup", r.world_speedup}};
+  check_json(r, j);
   j["breakdown"] = {{"collide_ns", r.collide_ns},
                     {"world_ns", r.world_ns},
                     {"partition_ns", r.partition_ns},
@@ -229,14 +258,9 @@ std::string to_json(const RunResult& r) {
   j["sequential_pass_wall_ns"] = r.sequential_pass_wall_ns;
   nlohmann::ordered_json steps_json = nlohmann::ordered_json::array();
   for (std::size_t s = 0; s < r.per_step.size(); ++s) {
-    const RunStep& st = r.per_step[s];
-    steps_json.push_back({{"step", s},
-                          {"wall_ns", st.wall_ns},
-                          {"world_ns", st.world_ns},
-                          {"collide_ns", st.collide_ns},
-                          {"partition_ns", st.partition_ns},
-                          {"sequential_wall_ns", st.sequential_wall_ns},
-                          {"sequential_world_ns", st.sequential_world_ns}});
+    nlohmann::ordered_json step = {{"step", s}};
+    for (const auto& [key, field] : kStepFields) step[key] = r.per_step[s].*field;
+    steps_json.push_back(std::move(step));
   }
   j["per_step"] = std::move(steps_json);
   return j.dump() + "\n";

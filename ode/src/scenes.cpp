@@ -24,7 +24,9 @@ bool is_scene(std::string_view name) {
 
 std::vector<std::string> scene_names() { return {"ode-piles", "ode-heap", "ode-chains"}; }
 
-std::uint32_t Scene::default_steps() const { return name_ == "ode-heap" ? 400 : 200; }
+std::uint32_t default_steps(std::string_view scene) { return scene == "ode-heap" ? 400 : 200; }
+
+std::uint32_t Scene::default_steps() const { return ode::default_steps(name_); }
 
 void Scene::near_callback(void* data, dGeomID a, dGeomID b) {
   auto* scene = static_cast<Scene*>(data);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "../option_error.hpp"
+#include "count_errors.hpp"
 #include "tgraph/graph/error.hpp"
 
 namespace tgraph::experiment {
@@ -217,12 +218,8 @@ TEST(Plan, RejectsBadOptionsNamingTheField) {
     EXPECT_EQ(error(), "subobjects: " + std::to_string(bad) +
                             " is not a perfect square from 1 to 4096 (expected e.g. 4,16,64)");
   }
-  o = {};
-  o.steps = 0;
-  EXPECT_EQ(error(), "steps: must be at least 1");
-  o = {};
-  o.repeat = 0;
-  EXPECT_EQ(error(), "repeat: must be at least 1");
+  test::expect_zero_counts_refused<ExperimentOptions>(
+      [](const ExperimentOptions& x) { plan_experiment(x, 2); });
   o = {};
   o.threads = {2, 0};
   EXPECT_EQ(error().rfind("threads: 0 threads is out of range", 0), 0u) << error();

@@ -38,15 +38,21 @@ std::string label(const StepGraph& g, TaskId t) {
   return g.kind_name(t) + "#" + std::to_string(i);
 }
 
-class Recording : public ::testing::TestWithParam<std::uint32_t> {};
+// A recording runtime on GetParam() threads (no watchdog) and the interface ODE calls it by.
+class Recording : public ::testing::TestWithParam<std::uint32_t> {
+ protected:
+  static RuntimeOptions options() {
+    RuntimeOptions o;
+    o.threads = GetParam();
+    o.watchdog_s = 0;
+    return o;
+  }
+  Recording() : rt(options()), w{rt.functions(), rt.id()} { rt.set_recording(true); }
+  Runtime rt;
+  World w;
+};
 
 TEST_P(Recording, EdgesAreTheDeclaredPostsReleasesAndWaitsAndNoMore) {
-  RuntimeOptions o;
-  o.threads = GetParam();
-  o.watchdog_s = 0;
-  Runtime rt(o);
-  World w{rt.functions(), rt.id()};
-  rt.set_recording(true);
   rt.begin_step("dWorldQuickStep");
   dCallWaitID wait = w.f->alloc_call_wait(w.impl);
   w.f->post_call(w.impl, nullptr, &w.r, 2, nullptr, wait, &leaf, nullptr, 0, "R");
@@ -91,12 +97,6 @@ TEST_P(Recording, EdgesAreTheDeclaredPostsReleasesAndWaitsAndNoMore) {
 }
 
 TEST_P(Recording, KeysRepeatFromOneStepToTheNext) {
-  RuntimeOptions o;
-  o.threads = GetParam();
-  o.watchdog_s = 0;
-  Runtime rt(o);
-  World w{rt.functions(), rt.id()};
-  rt.set_recording(true);
   std::vector<StepGraph> steps;
   dCallWaitID wait = w.f->alloc_call_wait(w.impl);  // as ODE keeps its wait from step to step
   for (int s = 0; s < 2; ++s) {

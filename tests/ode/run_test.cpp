@@ -16,11 +16,7 @@ namespace tgraph::ode {
 namespace {
 
 TEST(OdeRun, ReportsTheSpeedUpsTheCheckAndEachStep) {
-  RunOptions o;
-  o.scene = "ode-chains";
-  o.steps = 5;
-  o.method = choose_method("worksteal");
-  o.threads = 2;
+  RunOptions o = run_options("ode-chains", 5, choose_method("worksteal"), 2);
   o.check = true;
   const RunResult r = run_scene(o);
   EXPECT_TRUE(r.check == "identical" || r.check == "within-rounding" ||
@@ -38,21 +34,14 @@ TEST(OdeRun, ReportsTheSpeedUpsTheCheckAndEachStep) {
 }
 
 TEST(OdeRun, SequentialIsIdenticalToItself) {
-  RunOptions o;
-  o.scene = "ode-piles";
-  o.steps = 3;
-  o.method = choose_method("sequential");
+  RunOptions o = run_options("ode-piles", 3, choose_method("sequential"), 2);
   o.check = true;
   EXPECT_EQ(run_scene(o).check, "identical");
 }
 
 TEST(OdeRun, OneThreadOfTgraphsRuntimeIsIdenticalToOdeSelfThreaded) {
   // One thread runs the calls in an order ODE's own self-threaded stepping also takes.
-  RunOptions o;
-  o.scene = "ode-piles";
-  o.steps = 10;
-  o.method = choose_method("worksteal");
-  o.threads = 1;
+  RunOptions o = run_options("ode-piles", 10, choose_method("worksteal"), 1);
   o.check = true;
   EXPECT_EQ(run_scene(o).check, "identical");
 }
@@ -108,6 +97,10 @@ TEST(OdeValidate, PredictsTheLiveRunFromACapture) {
   EXPECT_EQ(r.strategy, "list");
   const auto j = nlohmann::json::parse(to_json(r));
   EXPECT_TRUE(j.contains("predicted_over_live"));
+  // The recording's own time per part, measured in the run and taken off the parts: never
+  // negative, and reported.
+  EXPECT_GE(r.recording_ns_per_part, 0.0);
+  EXPECT_TRUE(j.contains("recording_ns_per_part"));
   EXPECT_TRUE(j.contains("live_speedup"));
 }
 

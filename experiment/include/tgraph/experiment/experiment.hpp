@@ -53,6 +53,8 @@ struct ExperimentOptions {
   /// Calibration file of the predictions (`tgraph calibrate --out`); empty: the default
   /// calibration file when there is one, else the defaults. Not for metg (no prediction).
   std::string calibration;
+  /// scaling: the scenes (ScalingOptions::scenes); empty: the experiment's.
+  std::vector<std::string> scenes;
 };
 
 /// A scene with its build options.

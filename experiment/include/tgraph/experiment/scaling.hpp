@@ -30,13 +30,19 @@ struct ScalingOptions {
   /// Calibration file of the partition runs' predictions; empty: the default calibration
   /// file when there is one, else the defaults.
   std::string calibration;
+  /// The scenes (labels: bars64, falling64, torso, cloth256-s64, or an ODE scene ode-piles,
+  /// ode-heap, ode-chains in a build with tgraph::ode); empty: the four built-in ones.
+  std::vector<std::string> scenes;
 };
 
 /// A scene of the sweep with its step count.
 struct ScalingScene {
-  std::string scene;              ///< built-in scene
+  std::string scene;              ///< built-in scene or ODE scene
   std::optional<int> subobjects;  ///< cloth scenes: sub-objects (a square)
   std::uint32_t steps = 1;
+  /// An ODE scene: its runs are ode::run_scene's (ODE self-threaded timed beside each run),
+  /// under ScalingPlan::ode_methods.
+  bool ode = false;
   /// "bars64", "cloth256-s64".
   std::string label() const;
 };
@@ -49,6 +55,9 @@ std::vector<std::uint32_t> scaling_thread_list(std::uint32_t cores);
 struct ScalingPlan {
   std::vector<ScalingScene> scenes;
   std::vector<std::string> methods;  ///< strategies (partition policy), then baselines
+  /// The ODE scenes' methods (ode::choose_method's names): default sequential (ODE
+  /// self-threaded), ode (ODE's own pool), worksteal and list; else the --methods given.
+  std::vector<std::string> ode_methods;
   std::vector<std::uint32_t> threads;
   std::uint32_t repeat = 1;
   std::uint32_t cores = 1;
@@ -57,8 +66,12 @@ struct ScalingPlan {
   std::vector<std::string> notes;  ///< what the plan left out or warns about, and why
   InvocationWords words;           ///< ScalingOptions::words
   std::string calibration;         ///< ScalingOptions::calibration (checked readable)
+  bool scenes_given = false;       ///< ScalingOptions::scenes was not empty
+  bool methods_given = false;      ///< ScalingOptions::methods was not empty
   /// Live runs: one per scene, method and thread count, plus one reference run per scene.
   std::size_t runs() const;
+  /// The methods a scene runs: ode_methods for an ODE scene, else methods.
+  const std::vector<std::string>& methods_of(const ScalingScene& scene) const;
   /// The settings that reproduce this plan (quick, threads, methods, steps when every scene
   /// has the same count, repeat, out).
   Invocation invocation() const;
@@ -66,10 +79,12 @@ struct ScalingPlan {
   std::string command() const;
 };
 
-/// Resolves `options` on a machine with `cores` cores. Defaults: bars64 (20 steps), falling64
-/// (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier, omp-tasks and
-/// starpu (when built); scaling_thread_list(cores); one pass. quick: 2, 3, 3 and 1 steps,
-/// threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
+/// Resolves `options` on a machine with `cores` cores. `scenes` picks the scenes (an ODE scene
+/// takes 200 steps, 40 with quick, unless `steps`); a name that is neither a default scene's
+/// label nor an ODE scene of this build is an OptionError of "scenes". Defaults: bars64 (20 steps),
+/// falling64 (60), torso (60), cloth256-s64 (5); owner, metis, sticky, worksteal, barrier,
+/// omp-tasks and starpu (when built); scaling_thread_list(cores); one pass. quick: 2, 3, 3 and 1
+/// steps, threads 1,2, methods owner, sticky, worksteal, barrier. tgraph::OptionError names the bad
 /// field (an unknown method, sequential or partition as a method, starpu in a build without
 /// it, a thread count, steps or repeat of 0).
 ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
@@ -93,9 +108,15 @@ ScalingPlan plan_scaling(const ScalingOptions& options, std::uint32_t cores);
 ///   makespan of a capture of the same steps with the assignments the live run used (its
 ///   first timed pass; the strategy's partition of the capture when the capture's steps
 ///   differ) and the live run's serial work per step, under ScalingOptions::calibration (else
-///   the default calibration, else the defaults), against its one-processor makespan with the capture's own host time
-///   (the uninstrumented engine, the live speed-up's reference); and that over the live
-///   speed-up.
+///   the default calibration, else the defaults), against its one-processor makespan with the
+///   capture's own host time (the uninstrumented engine, the live speed-up's reference); and that
+///   over the live speed-up.
+/// An ODE scene's record (ode::run_scene at K threads with its check): speedup and
+/// world_speedup against ODE self-threaded timed in the same run (its own passes, interleaved),
+/// check and max_abs_diff as `tgraph run --check` says them; serial_share = collision +
+/// partitioning over that run's sequential wall time; parks_per_step and partitioned_steps of
+/// its first timed pass; inflation, wait_share, the prediction and attribution are not
+/// measured (null).
 struct ScalingRecord {
   std::string scene;   ///< ScalingScene::label()
   std::string policy;  ///< replay::Policy name
@@ -115,6 +136,12 @@ struct ScalingRecord {
   double predicted_over_live = 0;
   /// The observed pass's lost time by cause, summed over the steps (meas::LiveResult's).
   std::optional<explain::Attribution> attribution;
+  /// ODE scenes: the world step's speed-up, the check ("identical", "within-rounding",
+  /// "within-tolerance", "differs") and the largest position difference (m).
+  bool ode = false;
+  std::optional<double> world_speedup;
+  std::string check;
+  double max_abs_diff = 0;
   // Beside the record (results.csv, the text table), not in results.json's `scaling`:
   std::uint32_t steps = 0;
   std::int64_t wall_ns = 0;             ///< median pass

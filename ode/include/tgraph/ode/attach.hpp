@@ -43,6 +43,7 @@ struct AttachStats {
   std::int64_t world_ns = 0;      ///< in the world step (dWorldQuickStep / dWorldStep)
   std::int64_t collide_ns = 0;    ///< in collide(): the host's serial part
   std::int64_t partition_ns = 0;  ///< partition policy: graphs built and partitioned
+  std::uint64_t partitions = 0;   ///< partition policy: steps whose graph was partitioned
   std::uint64_t calls = 0;        ///< calls ODE posted (the runtime's policies)
   std::uint64_t steals = 0;       ///< calls run by a thread other than the one they were placed on
   std::uint64_t parks = 0;        ///< times a thread parked

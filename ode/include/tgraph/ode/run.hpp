@@ -25,9 +25,19 @@ struct RunOptions {
   Stepper stepper = Stepper::kQuickStep;
   double watchdog_s = 60.0;
   std::uint32_t repartition_interval = 10;
-  partition::Options strategy;
+  partition::Options strategy = {};
   bool json = false;
 };
+
+/// A run of `method` on `scene` at `threads` threads, `repeat` timed passes, under `stepper`
+/// (`steps` unset: the scene's own); the other fields their defaults. What `tgraph run`,
+/// `tgraph validate`, the scaling experiment and the tests start from.
+RunOptions run_options(std::string scene, std::optional<std::uint32_t> steps, Method method,
+                       std::uint32_t threads, std::uint32_t repeat = 1,
+                       Stepper stepper = Stepper::kQuickStep);
+/// The attachment each of a run's passes steps through: its method, threads, repartition
+/// interval, strategy options and watchdog.
+AttachOptions attach_options(const RunOptions& options);
 
 /// One step's medians over the timed passes.
 struct RunStep {
@@ -128,7 +138,15 @@ struct ValidateReport {
   /// The runtime's own time per call (a chain of trivial calls on one thread), charged by the
   /// simulator as `task_overhead_ns` scaled to the captured steps' calls per part.
   double runtime_ns_per_call = 0;
+  /// The recording's own time per part (the same chain recorded against not, over its
+  /// parts), taken off each captured part's cost before the simulation: the live run records
+  /// nothing.
+  double recording_ns_per_part = 0;
 };
+
+/// The validation of the run `run` describes (its scene, steps or 20, method, threads, repeat
+/// as rounds, stepper) with the simulator's calibration file.
+ValidateOptions validate_options(const RunOptions& run, std::string calibration = {});
 
 /// Each round: the live run (ode::run_scene, one pass), a capture of the same steps at the
 /// same threads (worksteal, recording on), and the built-in simulator on each captured step

@@ -23,6 +23,9 @@ class Attachment;
 bool is_scene(std::string_view name);
 /// The scenes' names.
 std::vector<std::string> scene_names();
+/// The steps `tgraph run` and `tgraph capture` take by default on a scene (400 for ode-heap,
+/// 200 for the others).
+std::uint32_t default_steps(std::string_view scene);
 
 /// How long one step of a scene took.
 struct StepTime {
