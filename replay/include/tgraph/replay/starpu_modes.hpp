@@ -35,13 +35,9 @@ inline void cpu_only_conf(starpu_conf& conf, unsigned ncpus) {
   starpu_conf_init(&conf);
   conf.precedence_over_environment_variables = 1;
   conf.ncpus = static_cast<int>(ncpus);
-  conf.ncuda = 0;
-  conf.nopencl = 0;
-  conf.nmic = 0;
-  conf.nmpi_ms = 0;
+  conf.ncuda = conf.nopencl = conf.nmic = conf.nmpi_ms = 0;  // CPU workers only
+  conf.calibrate = conf.bus_calibrate = 0;
   conf.catch_signals = 0;
-  conf.calibrate = 0;
-  conf.bus_calibrate = 0;
 }
 
 }  // namespace tgraph::replay
