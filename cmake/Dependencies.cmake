@@ -20,23 +20,30 @@ endmacro()
 # privately. When pkg-config finds m, TARGET compiles SOURCES, links PkgConfig::NAME and
 # defines D=1 (PUBLIC: also for what links TARGET, so that tests and tools can tell); a
 # status line either way ("w <version> found: FOUND", "w (pkg-config m, Debian d) not
-# found: MISSING").
+# found: MISSING"). The option TGRAPH_WITH_NAME (ON) set OFF leaves the dependency out even
+# when it is installed (the demo's build folder, scripts/demo, builds without SimGrid).
 macro(tgraph_optional_pkg target name)
   cmake_parse_arguments(_tgraph_opt "PUBLIC" "MODULE;WHAT;DEBIAN;DEFINE;FOUND;MISSING" "SOURCES"
                         ${ARGN})
-  tgraph_pkg_config(${name} OPTIONAL MODULES ${_tgraph_opt_MODULE})
-  if(${name}_FOUND)
-    message(STATUS "tgraph: ${_tgraph_opt_WHAT} ${${name}_VERSION} found: ${_tgraph_opt_FOUND}")
-    target_sources(${target} PRIVATE ${_tgraph_opt_SOURCES})
-    target_link_libraries(${target} PRIVATE PkgConfig::${name})
-    if(_tgraph_opt_PUBLIC)
-      target_compile_definitions(${target} PUBLIC ${_tgraph_opt_DEFINE}=1)
-    else()
-      target_compile_definitions(${target} PRIVATE ${_tgraph_opt_DEFINE}=1)
-    endif()
+  option(TGRAPH_WITH_${name} "Use ${_tgraph_opt_WHAT} when pkg-config finds it" ON)
+  if(NOT TGRAPH_WITH_${name})
+    message(STATUS "tgraph: ${_tgraph_opt_WHAT} left out (TGRAPH_WITH_${name}=OFF): "
+                   "${_tgraph_opt_MISSING}")
   else()
-    message(STATUS "tgraph: ${_tgraph_opt_WHAT} (pkg-config ${_tgraph_opt_MODULE}, Debian "
-                   "${_tgraph_opt_DEBIAN}) not found: ${_tgraph_opt_MISSING}")
+    tgraph_pkg_config(${name} OPTIONAL MODULES ${_tgraph_opt_MODULE})
+    if(${name}_FOUND)
+      message(STATUS "tgraph: ${_tgraph_opt_WHAT} ${${name}_VERSION} found: ${_tgraph_opt_FOUND}")
+      target_sources(${target} PRIVATE ${_tgraph_opt_SOURCES})
+      target_link_libraries(${target} PRIVATE PkgConfig::${name})
+      if(_tgraph_opt_PUBLIC)
+        target_compile_definitions(${target} PUBLIC ${_tgraph_opt_DEFINE}=1)
+      else()
+        target_compile_definitions(${target} PRIVATE ${_tgraph_opt_DEFINE}=1)
+      endif()
+    else()
+      message(STATUS "tgraph: ${_tgraph_opt_WHAT} (pkg-config ${_tgraph_opt_MODULE}, Debian "
+                     "${_tgraph_opt_DEBIAN}) not found: ${_tgraph_opt_MISSING}")
+    endif()
   endif()
 endmacro()
 find_package(Threads REQUIRED)

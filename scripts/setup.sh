@@ -12,10 +12,22 @@ TGRAPH_PACKAGES=(cmake g++ ninja-build pkg-config python3
   python3-dev python3-pybind11 pybind11-dev python3-pytest libsimgrid-dev
   liblapacke-dev liblapack-dev libblas-dev libopenmpi-dev openmpi-bin libptscotch-dev
   libode-dev)
+# What `tgraph demo` needs (scripts/demo, the demo-release preset): the compiler and build
+# tools, the libraries of the modules the `tgraph` binary links (Eigen for the engine, METIS
+# and Scotch for the strategies, Graphviz and cairo for the report, TBB, hwloc), and StarPU,
+# whose policy is one of the rows the demo compares. Not: SimGrid, ODE, OpenMPI, PT-Scotch,
+# clang, GoogleTest, Google Benchmark, pybind11, LAPACK (tests, benchmarks, the Python module,
+# the examples and the verbs the demo does not run; the preset leaves them out).
+TGRAPH_DEMO_PACKAGES=(cmake g++ ninja-build pkg-config
+  libeigen3-dev libmetis-dev libscotch-dev libgraphviz-dev libcairo2-dev
+  libtbb-dev libhwloc-dev libcli11-dev nlohmann-json3-dev libstarpu-dev zlib1g-dev)
 
+# tgraph_install_packages [PACKAGE...]: installs those missing of PACKAGE... (default:
+# TGRAPH_PACKAGES, everything the tests use), and npm.
 tgraph_install_packages() {
-  local missing=()
-  for p in "${TGRAPH_PACKAGES[@]}"; do
+  local missing=() wanted=("$@")
+  [ ${#wanted[@]} -gt 0 ] || wanted=("${TGRAPH_PACKAGES[@]}")
+  for p in "${wanted[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   # npm (with node) fetches the report's charting libraries at build time (viz/web); any npm

@@ -2,6 +2,7 @@
 #include "tgraph/graph/summary.hpp"
 
 #include <algorithm>
+#include <cstdarg>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <set>
@@ -33,6 +34,20 @@ std::string duration_text(std::uint64_t ns) {
     std::snprintf(b, sizeof b, "%llu ns", static_cast<unsigned long long>(ns));
   return b;
 }
+
+// Appends printf's text of `fmt` (a line of the summary, at most 1023 characters) to `out`.
+void appendf(std::string& out, const char* fmt, ...) __attribute__((format(printf, 2, 3)));
+void appendf(std::string& out, const char* fmt, ...) {
+  char line[1024];
+  va_list args;
+  va_start(args, fmt);
+  const int n = std::vsnprintf(line, sizeof line, fmt, args);
+  va_end(args);
+  out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 1023)));
+}
+
+// A count as printf's %llu takes it.
+unsigned long long ull(std::uint64_t v) { return v; }
 
 }  // namespace
 
@@ -193,28 +208,16 @@ std::string trace_summary_json(const TraceSummary& s, const std::string& trace_n
 
 std::string trace_summary_text(const TraceSummary& s, const std::string& trace_name) {
   std::string out;
-  char line[1024];
-  auto add = [&](int n) { out.append(line, static_cast<std::size_t>(std::clamp(n, 0, 1023))); };
-  add(std::snprintf(line, sizeof line, "trace          %s (scene %s, engine %s)\n",
-                    trace_name.c_str(), s.header.scene.c_str(), s.header.engine.c_str()));
-  add(std::snprintf(line, sizeof line, "steps          %llu\n",
-                    static_cast<unsigned long long>(s.steps)));
-  add(std::snprintf(
-      line, sizeof line, "tasks          %llu (per step min %llu, mean %.1f, max %llu)\n",
-      static_cast<unsigned long long>(s.tasks), static_cast<unsigned long long>(s.tasks_min),
-      s.tasks_mean, static_cast<unsigned long long>(s.tasks_max)));
-  add(std::snprintf(line, sizeof line, "data           %llu (largest step)\n",
-                    static_cast<unsigned long long>(s.data_max)));
-  add(std::snprintf(line, sizeof line,
-                    "edges          %llu (%llu within a step or loop iteration, %llu "
-                    "loop-carried)\n",
-                    static_cast<unsigned long long>(s.edges),
-                    static_cast<unsigned long long>(s.edges - s.edges_carried),
-                    static_cast<unsigned long long>(s.edges_carried)));
-  add(std::snprintf(line, sizeof line,
-                    "loops          %llu, %llu iterations (max %u in one loop)\n",
-                    static_cast<unsigned long long>(s.loops),
-                    static_cast<unsigned long long>(s.loop_iterations), s.max_loop_iterations));
+  appendf(out, "trace          %s (scene %s, engine %s)\n", trace_name.c_str(),
+          s.header.scene.c_str(), s.header.engine.c_str());
+  appendf(out, "steps          %llu\n", ull(s.steps));
+  appendf(out, "tasks          %llu (per step min %llu, mean %.1f, max %llu)\n", ull(s.tasks),
+          ull(s.tasks_min), s.tasks_mean, ull(s.tasks_max));
+  appendf(out, "data           %llu (largest step)\n", ull(s.data_max));
+  appendf(out, "edges          %llu (%llu within a step or loop iteration, %llu loop-carried)\n",
+          ull(s.edges), ull(s.edges - s.edges_carried), ull(s.edges_carried));
+  appendf(out, "loops          %llu, %llu iterations (max %u in one loop)\n", ull(s.loops),
+          ull(s.loop_iterations), s.max_loop_iterations);
   const bool timed = s.work_ns != 0;  // a trace without costs has only unit-cost figures
   if (timed) {
     out += "work           " + duration_text(s.work_ns) + " (sum of all task costs, all steps)\n";
@@ -225,36 +228,29 @@ std::string trace_summary_text(const TraceSummary& s, const std::string& trace_n
     out += "work, span     no task costs recorded: see the unit-cost figures\n";
   }
   if (s.unit_cost) {
-    add(std::snprintf(line, sizeof line, "work (unit)    %llu tasks (task runs, all steps)\n",
-                      static_cast<unsigned long long>(s.work_tasks)));
-    add(std::snprintf(line, sizeof line,
-                      "span (unit)    %llu tasks (sum of the steps' critical paths in tasks; "
-                      "longest step %llu)\n",
-                      static_cast<unsigned long long>(s.span_tasks),
-                      static_cast<unsigned long long>(s.span_tasks_max)));
+    appendf(out, "work (unit)    %llu tasks (task runs, all steps)\n", ull(s.work_tasks));
+    appendf(out,
+            "span (unit)    %llu tasks (sum of the steps' critical paths in tasks; longest step "
+            "%llu)\n",
+            ull(s.span_tasks), ull(s.span_tasks_max));
   }
   out += "host           " + duration_text(s.host_ns) +
          " (sum of the engine's work outside the tasks)\n";
   if (timed) {
-    add(std::snprintf(line, sizeof line,
-                      "parallelism    %.2f (work / span, raw: the recorded costs)\n",
-                      s.parallelism));
-    add(std::snprintf(line, sizeof line,
-                      "robust         %.2f (work %s / span %s, each task's cost the median "
-                      "of its cost over the steps of its structure)\n",
-                      s.robust_parallelism, duration_text(s.robust_work_ns).c_str(),
-                      duration_text(s.robust_span_ns).c_str()));
+    appendf(out, "parallelism    %.2f (work / span, raw: the recorded costs)\n", s.parallelism);
+    appendf(out,
+            "robust         %.2f (work %s / span %s, each task's cost the median of its cost "
+            "over the steps of its structure)\n",
+            s.robust_parallelism, duration_text(s.robust_work_ns).c_str(),
+            duration_text(s.robust_span_ns).c_str());
   }
   if (s.unit_cost)
-    add(std::snprintf(line, sizeof line, "parallelism    %.2f (unit costs: work / span in tasks)\n",
-                      s.unit_parallelism));
-  add(std::snprintf(line, sizeof line, "structures     %llu distinct\n",
-                    static_cast<unsigned long long>(s.distinct_structures)));
-  add(std::snprintf(
-      line, sizeof line,
-      "contacts       %llu steps whose contact set changed; last step %llu collision group(s)\n",
-      static_cast<unsigned long long>(s.contact_changes),
-      static_cast<unsigned long long>(s.last_step_collision_groups)));
+    appendf(out, "parallelism    %.2f (unit costs: work / span in tasks)\n", s.unit_parallelism);
+  appendf(out, "structures     %llu distinct\n", ull(s.distinct_structures));
+  appendf(out,
+          "contacts       %llu steps whose contact set changed; last step %llu collision "
+          "group(s)\n",
+          ull(s.contact_changes), ull(s.last_step_collision_groups));
   std::size_t changed = 0;
   for (const StepSummary& st : s.per_step) changed += st.structure_changed ? 1 : 0;
   if (changed > 0)

@@ -105,6 +105,12 @@ void encode_step_values(ByteWriter& w, const StepGraph& g) {
   w.u64(g.host_ns);
 }
 
+}  // namespace
+
+// Named (not file-local): TraceWriter::Impl holds one, and a type of the anonymous namespace
+// in a member is a warning (-Wsubobject-linkage) where this file is part of a unity batch.
+namespace detail {
+
 // Encodes steps one frame each, remembering structures already written so that a repeat
 // becomes a reference frame. Candidates are found by structural_hash() and confirmed with
 // same_structure(), which compares exactly the fields of the structure section.
@@ -158,6 +164,10 @@ class StepEncoder {
   std::uint32_t steps_ = 0;
   bool reuse_structure_ = true;
 };
+
+}  // namespace detail
+
+namespace {
 
 void encode_end(std::vector<std::uint8_t>& out, std::uint32_t steps) {
   const std::size_t at = begin_frame(out);

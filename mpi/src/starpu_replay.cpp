@@ -78,16 +78,7 @@ class StarpuMpiRun {
     setenv("STARPU_COMM_STATS", "1", 1);
     setenv("STARPU_WORKERS_NOBIND", "1", 0);
     starpu_conf conf;
-    starpu_conf_init(&conf);
-    conf.precedence_over_environment_variables = 1;
-    conf.ncpus = static_cast<int>(layout.threads_per_rank);
-    conf.ncuda = 0;
-    conf.nopencl = 0;
-    conf.nmic = 0;
-    conf.nmpi_ms = 0;
-    conf.catch_signals = 0;
-    conf.calibrate = 0;
-    conf.bus_calibrate = 0;
+    replay::cpu_only_conf(conf, layout.threads_per_rank);
     if (const int rc = starpu_mpi_init_conf(nullptr, nullptr, 0, MPI_COMM_WORLD, &conf); rc != 0)
       throw Error("StarPU-MPI: starpu_mpi_init_conf failed (" + std::to_string(rc) + ")");
     g_run = this;

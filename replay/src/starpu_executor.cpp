@@ -159,17 +159,8 @@ class StarpuExecutor final : public detail::PlannedExecutor<StarpuPlan> {
           "process); destroy it first");
     setenv("STARPU_SILENT", "1", 0);  // StarPU's banners would spoil a JSON report on stdout
     starpu_conf conf;
-    starpu_conf_init(&conf);
-    conf.precedence_over_environment_variables = 1;  // our flags win over STARPU_NCPU etc.
-    conf.ncpus = static_cast<int>(o.threads);
-    conf.ncuda = 0;
-    conf.nopencl = 0;
-    conf.nmic = 0;
-    conf.nmpi_ms = 0;
+    cpu_only_conf(conf, o.threads);  // our flags win over STARPU_NCPU etc.
     conf.sched_policy_name = options().starpu.sched.c_str();
-    conf.catch_signals = 0;  // leave SIGINT/SIGSEGV to the application
-    conf.calibrate = 0;
-    conf.bus_calibrate = 0;
     // Pinning (ExecOptions::pin): the rule of every policy, worker i on slot i's PU (StarPU
     // names PUs by hwloc's logical index); the submitting thread shares slot 0's core (bound in
     // run()), so K workers and the submitter take K cores, as the calling thread of the other

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "builtin_scenes.hpp"
 #include "scene_builder.hpp"
 #include "scene_reader.hpp"
 #include "tgraph/graph/error.hpp"
@@ -15,13 +16,6 @@
 namespace tgraph::samples {
 
 namespace detail {
-/// Built-in scene files: {name, text}, generated from samples/scenes/*.scene.
-struct BuiltinScene {
-  const char* name;
-  const char* text;
-};
-extern const BuiltinScene kBuiltinScenes[];
-extern const std::size_t kBuiltinSceneCount;
 
 void Directive::fail(const std::string& what) const {
   throw InputError(file_ + ":" + std::to_string(line_), std::nullopt, what);
