@@ -34,11 +34,11 @@ void add_simulate(CLI::App& app) {
   cmd->add_option("trace", c->trace, "Trace file (.tgt)")->required();
   cmd->add_option("assignment", c->assignment, "Assignment file (.tga)")->required();
   add_enum(cmd, "--engine", c->engine, {builtin, simgrid}, "builtin (one machine) or simgrid");
-  auto* platform =
+  auto* platform_flag =
       cmd->add_option("--platform", c->platform, "SimGrid platform file (tgraph platform -o)");
   cmd->add_option("--cluster", c->cluster,
                   "N nodes x C cores (e.g. 64x16): processor p on core p % C of node p / C")
-      ->excludes(platform);
+      ->excludes(platform_flag);
   add_enum(cmd, "--intra-node", c->intra_node, {reader, link},
            "simgrid, bytes between two cores of a node: reader (default; the reading core spends "
            "size / loopback bandwidth) or link (the loopback link carries them)");

@@ -61,7 +61,7 @@ TEST_P(Replayed, CausesAddUpToTheLostTime) {
 INSTANTIATE_TEST_SUITE_P(Policies, Replayed,
                          ::testing::Values(replay::Policy::kPartition, replay::Policy::kWorksteal,
                                            replay::Policy::kBarrier),
-                         [](const auto& info) { return std::string(to_string(info.param)); });
+                         [](const auto& p) { return std::string(to_string(p.param)); });
 
 }  // namespace
 }  // namespace tgraph::explain
