@@ -3,6 +3,11 @@
 // tgraph's runtime: nothing below the floor, the heap at rest, the chains' joints holding.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <memory>
+#include <string>
+
 #include "tgraph/ode/attach.hpp"
 #include "tgraph/ode/scenes.hpp"
 
@@ -14,27 +19,39 @@ namespace {
 //   box sink a few millimetres; a box through the floor is 0.3-0.5 m below);
 // - at rest: the boxes' kinetic energy that of every box moving at 5 cm/s (their
 //   root-mean-square speed below 0.05 m/s; ODE's 20 Gauss-Seidel iterations leave a few boxes
-//   of a heap jittering, so no single box's speed is the criterion);
-// - joints: a hinge's two anchors at most 5 % of a link's length apart (ODE corrects joint
-//   error at ERP 0.2 a step; 20 Gauss-Seidel iterations leave a residual along a chain).
+//   of a heap jittering, so no single box's speed is the criterion), over the last 0.5 s
+//   (100 steps) of 6 s (1200 steps). When a heap settles depends on the order its contacts
+//   are solved in, which under ODE's parallel LCP is the run's timing: self-threaded it is at
+//   about 0.005 m/s from 2.5 s on; on two threads it came to rest between 1.5 and 3 s, and a
+//   brick that slid late moved it again at 4 s (2026-12-02, four runs; every run at 0.004 to
+//   0.005 m/s at 5.5 and 6 s), so the check is that it has come to rest, not when;
 constexpr double kFloorDepth = 0.01;
 constexpr double kRestSpeed = 0.05;
 constexpr double kJointError = 0.05;
+constexpr std::uint32_t kRestSteps = 100;
+constexpr std::uint32_t kHeapSteps = 1200;
 
 class OdePhysics : public ::testing::TestWithParam<const char*> {
  protected:
   void SetUp() override { dInitODE2(0); }
   void TearDown() override { dCloseODE(); }
-  void run(Scene& scene, std::uint32_t steps) {
-    if (std::string(GetParam()) == "sequential") {
-      for (std::uint32_t i = 0; i < steps; ++i) scene.step(nullptr);
-      return;
+  // Steps the scene `steps` times, calling `after(i)` after step i (1-based).
+  template <class After>
+  void run(Scene& scene, std::uint32_t steps, After after) {
+    std::unique_ptr<Attachment> attach;
+    if (std::string(GetParam()) != "sequential") {
+      AttachOptions o;
+      o.method = choose_method(GetParam());
+      o.threads = 2;
+      attach = std::make_unique<Attachment>(scene.world(), o);
     }
-    AttachOptions o;
-    o.method = choose_method(GetParam());
-    o.threads = 2;
-    Attachment attach(scene.world(), o);
-    for (std::uint32_t i = 0; i < steps; ++i) scene.step(&attach);
+    for (std::uint32_t i = 1; i <= steps; ++i) {
+      scene.step(attach.get());
+      after(i);
+    }
+  }
+  void run(Scene& scene, std::uint32_t steps) {
+    run(scene, steps, [](std::uint32_t) {});
   }
 };
 
@@ -46,9 +63,17 @@ TEST_P(OdePhysics, PilesStayAboveTheFloor) {
 
 TEST_P(OdePhysics, HeapComesToRestInItsBin) {
   auto scene = Scene::make("ode-heap");
-  run(*scene, 600);  // 3 s: the overhanging bricks fall, tumble and settle
+  // The overhanging bricks fall, tumble and settle; the fastest rms speed of the last 100
+  // steps, and the fastest of all (the fall itself, far above rest).
+  double last = 0.0, fastest = 0.0;
+  run(*scene, kHeapSteps, [&](std::uint32_t i) {
+    const double v = scene->rms_speed();
+    fastest = std::max(fastest, v);
+    if (i > kHeapSteps - kRestSteps) last = std::max(last, v);
+  });
+  EXPECT_LT(last, kRestSpeed) << "not at rest over the last " << kRestSteps << " steps";
+  EXPECT_GT(fastest, 2 * kRestSpeed) << "the bricks did not fall";
   EXPECT_LT(scene->depth_below_floor(), kFloorDepth);
-  EXPECT_LT(scene->rms_speed(), kRestSpeed);
 }
 
 TEST_P(OdePhysics, ChainLinksStayWithinJointErrorOfTheirLength) {
