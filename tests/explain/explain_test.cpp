@@ -412,7 +412,8 @@ TEST(Explain, AStepTheSimulatorDoesNotReproduceIsReTimed) {
   // Asked to, the simulator predicts it all the same: the step x 500 / 1000.
   ExplainOptions o;
   o.simulator_fit = 1e9;
-  w = find(explain_timeline(b.t, "t.json", o).steps[0], "f", "50% faster");
+  const Explanation fitted = explain_timeline(b.t, "t.json", o);  // kept: w points into it
+  w = find(fitted.steps[0], "f", "50% faster");
   ASSERT_NE(w, nullptr);
   EXPECT_EQ(w->model, "simulator");
   EXPECT_EQ(w->predicted_ns, 5000);
