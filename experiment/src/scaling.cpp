@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "common.hpp"
+#include "scaling_ode.hpp"
 #include "tgraph/experiment/threads.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/file_util.hpp"
@@ -32,10 +33,6 @@
 #include "tgraph/replay/policy.hpp"
 #include "tgraph/samples/scene.hpp"
 #include "tgraph/viz/series_chart.hpp"
-#ifdef TGRAPH_HAVE_ODE
-#include "tgraph/ode/run.hpp"
-#include "tgraph/ode/scenes.hpp"
-#endif
 
 namespace tgraph::experiment {
 namespace {
@@ -50,19 +47,10 @@ namespace meas = tgraph::measure;
 const std::vector<std::string> kDefaultMethods = {"owner",   "metis",     "sticky", "worksteal",
                                                   "barrier", "omp-tasks", "starpu"};
 
-// The ODE scenes' methods: ODE self-threaded, ODE's own pool (the peer), work stealing and
-// the partition-guided method (docs/ode.md).
-const std::vector<std::string> kOdeMethods = {"sequential", "ode", "worksteal", "list"};
-
 // A record's policy and method names: ode::choose_method's for an ODE scene, else measure's.
-std::pair<std::string, std::string> policy_and_method([[maybe_unused]] const ScalingScene& s,
+std::pair<std::string, std::string> policy_and_method(const ScalingScene& s,
                                                       const std::string& method) {
-#ifdef TGRAPH_HAVE_ODE
-  if (s.ode) {
-    const ode::Method m = ode::choose_method(method);
-    return {std::string(ode::to_string(m.policy)), ode::method_name(m)};
-  }
-#endif
+  if (s.ode) return detail::ode_policy_and_method(method);
   const meas::MethodChoice m = meas::choose_method(method);
   return {std::string(tr::to_string(m.policy)), meas::method_name(m)};
 }
@@ -163,45 +151,8 @@ double predicted_speedup(const Trace& capture, const std::string& method, std::u
   return parallel > 0 ? sequential / parallel : 0.0;
 }
 
-#ifdef TGRAPH_HAVE_ODE
-// An ODE scene's run of METHOD on K threads (ode::run_scene: `repeat` timed passes, each
-// beside a pass of ODE self-threaded on a fresh copy of the scene), with its check.
-ode::RunResult ode_run(const ScalingScene& s, const std::string& method, std::uint32_t k,
-                       const ScalingPlan& p, bool check) {
-  ode::RunOptions o = ode::run_options(s.scene, s.steps, ode::choose_method(method), k, p.repeat);
-  o.check = check;
-  return ode::run_scene(o);
-}
-
-// An ODE scene's reference: ODE self-threaded (the calling thread, unpinned), median pass.
-ScalingReference ode_reference_of(const ScalingScene& s, const ScalingPlan& p) {
-  const ode::RunResult r = ode_run(s, "sequential", 1, p, false);
-  return {s.label(), r.steps, 1, r.sequential_wall_ns};
-}
-
-ScalingRecord ode_record_of(const ScalingScene& s, const std::string& method, std::uint32_t k,
-                            const ode::RunResult& r) {
-  ScalingRecord rec = record_head(s, method, k);
-  rec.ode = true;
-  rec.wall_ns = r.wall_ns;
-  rec.sequential_wall_ns = r.sequential_wall_ns;  // the same run's ODE self-threaded
-  rec.speedup = r.speedup;
-  rec.world_speedup = r.world_speedup;
-  if (r.sequential_wall_ns > 0)
-    rec.serial_share = static_cast<double>(r.collide_ns + r.partition_ns) /
-                       static_cast<double>(r.sequential_wall_ns);
-  rec.parks_per_step = static_cast<double>(r.stats.parks) / std::max<double>(r.steps, 1);
-  rec.partitioned_steps = static_cast<std::uint32_t>(r.stats.partitions);
-  rec.check = r.check;
-  rec.max_abs_diff = r.max_abs_diff;
-  return rec;
-}
-#endif
-
 ScalingReference scene_reference(const ScalingScene& s, const ScalingPlan& p) {
-#ifdef TGRAPH_HAVE_ODE
-  if (s.ode) return ode_reference_of(s, p);
-#endif
+  if (s.ode) return detail::ode_reference(s, p);
   return reference_of(s, p);
 }
 
@@ -211,9 +162,7 @@ ScalingReference scene_reference(const ScalingScene& s, const ScalingPlan& p) {
 ScalingRecord run_record(const ScalingScene& s, const std::string& method, std::uint32_t k,
                          const ScalingPlan& p, const ScalingReference& ref,
                          const model::CostModel& model, std::optional<Trace>& capture) {
-#ifdef TGRAPH_HAVE_ODE
-  if (s.ode) return ode_record_of(s, method, k, ode_run(s, method, k, p, true));
-#endif
+  if (s.ode) return detail::ode_record(s, method, k, p, record_head(s, method, k));
   const meas::LiveResult r = live_run(s, method, k, p);
   ScalingRecord rec = record_of(s, method, k, r, ref);
   const meas::MethodChoice m = meas::choose_method(method);
@@ -246,7 +195,8 @@ viz::SeriesChart speedup_chart(const ScalingResult& res, const ScalingScene& sc)
   c.log2_x = true;
   c.log2_y = true;
   viz::Series ideal{"ideal (= threads)", viz::SeriesKind::kReference, 0, {}};
-  for (std::uint32_t k : p.threads) ideal.points.push_back({static_cast<double>(k), static_cast<double>(k)});
+  for (std::uint32_t k : p.threads)
+    ideal.points.push_back({static_cast<double>(k), static_cast<double>(k)});
   c.series.push_back(std::move(ideal));
   std::uint32_t colour = 0;
   for (const std::string& method : p.methods_of(sc)) {
@@ -257,8 +207,8 @@ viz::SeriesChart speedup_chart(const ScalingResult& res, const ScalingScene& sc)
     if (!s.points.empty()) c.series.push_back(std::move(s));
   }
   if (!p.threads.empty() && p.threads.back() > p.cores)
-    c.marks.push_back({static_cast<double>(p.cores),
-                       std::to_string(p.cores) + " cores: oversubscribed beyond"});
+    c.marks.push_back(
+        {static_cast<double>(p.cores), std::to_string(p.cores) + " cores: oversubscribed beyond"});
   return c;
 }
 
@@ -295,13 +245,10 @@ void write_outputs(ScalingResult& res) {
   }
   res.files = {"results.json"};
   for (const auto& f : files) res.files.push_back(f.first);
-  for (const auto& [name, content] : files) write_file_atomic((fs::path(dir) / name).string(), content);
+  for (const auto& [name, content] : files)
+    write_file_atomic((fs::path(dir) / name).string(), content);
   write_file_atomic((fs::path(dir) / "results.json").string(), scaling_json(res, 1) + "\n");
 }
-
-}  // namespace
-
-namespace {
 
 // ScalingOptions::scenes resolved: a default scene by its label, an ODE scene (its own step
 // count, 40 when quick) in a build with tgraph::ode.
@@ -317,39 +264,15 @@ std::vector<ScalingScene> chosen_scenes(const std::vector<std::string>& names,
       out.push_back(*d);
       continue;
     }
-#ifdef TGRAPH_HAVE_ODE
-    if (ode::is_scene(name)) {
-      out.push_back({name, std::nullopt, quick ? 40u : ode::default_steps(name), true});
+    if (const std::optional<ScalingScene> o = detail::ode_scene(name, quick)) {
+      out.push_back(*o);
       continue;
     }
-    for (const std::string& n : ode::scene_names()) known.push_back(n);
-#else
-    (void)quick;
-    if (name.rfind("ode-", 0) == 0)
-      throw OptionError("scenes", "'" + name +
-                                      "': the ODE scenes are not in this build "
-                                      "(libode-dev was not found)");
-#endif
+    for (const std::string& n : detail::ode_scene_names()) known.push_back(n);
     throw OptionError("scenes",
                       "unknown scene '" + name + "' (expected " + join(known, ", ") + ")");
   }
   return out;
-}
-
-// --methods for the ODE scenes: each one ode::choose_method takes.
-std::vector<std::string> ode_methods(const std::vector<std::string>& methods) {
-#ifdef TGRAPH_HAVE_ODE
-  for (const std::string& m : methods) {
-    try {
-      (void)ode::choose_method(m);
-    } catch (const OptionError&) {
-      throw OptionError("methods", "unknown method '" + m +
-                                       "' for the ODE scenes (expected "
-                                       "sequential, ode, worksteal or a partition strategy)");
-    }
-  }
-#endif
-  return methods;
 }
 
 }  // namespace
@@ -436,7 +359,8 @@ ScalingPlan plan_scaling(const ScalingOptions& o, std::uint32_t cores) {
   if (o.steps)
     for (ScalingScene& s : p.scenes) s.steps = *o.steps;
   if (std::any_of(p.scenes.begin(), p.scenes.end(), [](const ScalingScene& s) { return s.ode; }))
-    p.ode_methods = o.methods.empty() ? kOdeMethods : ode_methods(o.methods);
+    p.ode_methods =
+        o.methods.empty() ? detail::default_ode_methods() : detail::checked_ode_methods(o.methods);
   if (std::none_of(p.scenes.begin(), p.scenes.end(),
                    [](const ScalingScene& s) { return !s.ode; })) {
     // Only ODE scenes: the built-in scenes' methods are not run.
@@ -614,7 +538,8 @@ std::string scaling_json(const ScalingResult& res, int indent) {
       if (r.check != "identical") rec["max_abs_diff"] = r.max_abs_diff;
     }
   }
-  for (const auto& [key, list] : {std::pair{"skipped", &res.skipped}, std::pair{"failed", &res.failed}}) {
+  for (const auto& [key, list] :
+       {std::pair{"skipped", &res.skipped}, std::pair{"failed", &res.failed}}) {
     j[key] = nlohmann::json::array();
     for (const ScalingMiss& m : *list)
       j[key].push_back({{"scene", m.scene},
@@ -637,7 +562,8 @@ std::string scaling_text(const ScalingResult& res) {
     << std::setw(4) << "K" << std::setw(9) << "speed-up" << std::setw(8) << "serial"
     << std::setw(10) << "inflation" << std::setw(7) << "wait" << std::setw(12) << "parks/step"
     << std::setw(13) << "partitioned" << std::setw(11) << "predicted" << std::setw(11)
-    << "pred/live" << "\n";
+    << "pred/live"
+    << "\n";
   for (const ScalingRecord& r : res.records)
     s << std::left << std::setw(14) << r.scene << std::setw(11) << r.method << std::right
       << std::setw(4) << r.threads << std::setw(9) << fixed(r.speedup, 2) << std::setw(8)
