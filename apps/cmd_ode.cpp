@@ -79,18 +79,7 @@ void capture_ode(const std::string& scene, std::optional<int> steps, const std::
   o.threads = flags.threads;
   o.stepper = ode::parse_stepper(flags.stepper);
   const ode::CaptureReport r = ode::capture_scene(o);
-  if (json) {
-    std::cout << "{\"scene\":\"" << scene << "\",\"steps\":" << r.steps << ",\"tasks\":" << r.tasks
-              << ",\"edges\":" << r.edges << ",\"bytes\":" << r.bytes
-              << ",\"recorded_ns\":" << r.recorded_ns << ",\"unrecorded_ns\":" << r.unrecorded_ns
-              << ",\"capture_overhead\":" << r.overhead << ",\"output\":\"" << output << "\"}\n";
-  } else {
-    std::cout << "captured " << scene << ": " << r.steps << " steps, " << r.tasks << " tasks, "
-              << r.edges << " edges -> " << output << " (" << r.bytes << " bytes); recording cost "
-              << r.overhead * 100.0 << " % (" << static_cast<double>(r.recorded_ns) / 1e6
-              << " ms against " << static_cast<double>(r.unrecorded_ns) / 1e6
-              << " ms unrecorded, same run)\n";
-  }
+  std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
 }
 
 void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,

@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <chrono>
+#include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/median.hpp"
@@ -21,6 +23,7 @@ CaptureReport capture_scene(const CaptureOptions& options) {
     ~Close() { dCloseODE(); }
   } close;
   CaptureReport report;
+  report.options = options;
   AttachOptions a;
   a.threads = options.threads;
   // The same steps recorded and not, in one run, three times each alternating (medians): the
@@ -63,6 +66,29 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   writer.close();
   report.bytes = writer.bytes_written();
   return report;
+}
+
+std::string to_json(const CaptureReport& r) {
+  const nlohmann::ordered_json j = {{"scene", r.options.scene},
+                                    {"steps", r.steps},
+                                    {"tasks", r.tasks},
+                                    {"edges", r.edges},
+                                    {"bytes", r.bytes},
+                                    {"recorded_ns", r.recorded_ns},
+                                    {"unrecorded_ns", r.unrecorded_ns},
+                                    {"capture_overhead", r.overhead},
+                                    {"output", r.options.output}};
+  return j.dump() + "\n";
+}
+
+std::string to_text(const CaptureReport& r) {
+  std::ostringstream out;
+  out << "captured " << r.options.scene << ": " << r.steps << " steps, " << r.tasks << " tasks, "
+      << r.edges << " edges -> " << r.options.output << " (" << r.bytes
+      << " bytes); recording cost " << r.overhead * 100.0 << " % ("
+      << static_cast<double>(r.recorded_ns) / 1e6 << " ms against "
+      << static_cast<double>(r.unrecorded_ns) / 1e6 << " ms unrecorded, same run)\n";
+  return out.str();
 }
 
 }  // namespace tgraph::ode

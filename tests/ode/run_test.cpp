@@ -82,6 +82,17 @@ TEST(OdeCapture, WritesATraceOfOdesCallsThatReadsBack) {
   std::uint64_t tasks = 0;
   for (const StepGraph& g : t.steps) tasks += g.tasks.size();
   EXPECT_EQ(tasks, r.tasks);
+  const nlohmann::json j = nlohmann::json::parse(to_json(r));
+  EXPECT_EQ(j.at("scene"), "ode-chains");
+  EXPECT_EQ(j.at("output"), o.output);
+  EXPECT_EQ(j.at("steps"), 3);
+  EXPECT_EQ(j.at("tasks"), tasks);
+  EXPECT_EQ(j.at("edges"), r.edges);
+  EXPECT_EQ(j.at("recorded_ns"), r.recorded_ns);
+  EXPECT_EQ(j.at("unrecorded_ns"), r.unrecorded_ns);
+  EXPECT_DOUBLE_EQ(j.at("capture_overhead").get<double>(), r.overhead);
+  EXPECT_EQ(
+      to_text(r).rfind("captured ode-chains: 3 steps, " + std::to_string(tasks) + " tasks", 0), 0u);
 }
 
 TEST(OdeValidate, PredictsTheLiveRunFromACapture) {

@@ -93,6 +93,7 @@ struct CaptureOptions {
 
 /// What a capture did.
 struct CaptureReport {
+  CaptureOptions options;  ///< as asked
   std::uint32_t steps = 0;
   std::uint64_t tasks = 0, edges = 0, bytes = 0;
   std::int64_t recorded_ns = 0;    ///< the steps recorded (median of 3 passes)
@@ -104,6 +105,12 @@ struct CaptureReport {
 /// (worksteal at `threads`), and writes the last recorded steps to `output`: one task per
 /// part of ODE's calls (docs/ode.md).
 CaptureReport capture_scene(const CaptureOptions& options);
+
+/// `tgraph capture --scene ode-* --json`: one object (scene, steps, tasks, edges, bytes,
+/// recorded_ns, unrecorded_ns, capture_overhead, output) and a newline.
+std::string to_json(const CaptureReport& r);
+/// The same as one line of text.
+std::string to_text(const CaptureReport& r);
 
 }  // namespace tgraph::ode
 
