@@ -128,6 +128,7 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   report.runtime_ns_per_call = runtime.ns_per_call;
   report.recording_ns_per_part = runtime.recording_ns_per_part;
   costs.spin_budget_ns = static_cast<double>(AttachOptions{}.spin_ns);
+  const auto own = static_cast<std::uint64_t>(runtime.recording_ns_per_part);
   auto strategy = partition::make_strategy(report.strategy);
   dInitODE2(0);
   struct Close {
@@ -152,7 +153,6 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       for (StepGraph& g : attach.take_steps()) {
         // Each part's recorded cost without the recording's own time (the live run records
         // none: it is measured in this run and removed, docs/ode.md "validate").
-        const auto own = static_cast<std::uint64_t>(runtime.recording_ns_per_part);
         for (Task& t : g.tasks) t.cost_ns = t.cost_ns > own ? t.cost_ns - own : 0;
         // The runtime's own time per call, which no part's cost holds, spread over the parts.
         model::CostModel step_costs = costs;
