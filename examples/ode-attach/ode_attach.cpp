@@ -159,6 +159,7 @@ int main(int argc, char** argv) {
     const std::int64_t ns = run(mine, steps, method, threads, 0);
     const std::vector<double> p_ref = positions(ref), p_mine = positions(mine);
     const double diff = max_diff(p_mine, p_ref);
+    // Five times the seeds' spread, as tgraph's own check (docs/ode.md, "The check").
     const double tolerance =
         5.0 * std::max(max_diff(positions(other1), p_ref), max_diff(positions(other2), p_ref));
     const char* check = diff == 0           ? "identical"

@@ -66,9 +66,9 @@ struct RunResult {
   double max_abs_diff = 0;  ///< largest difference of a body position (m)
   double max_rel_diff = 0;  ///< largest relative difference of a state number
   /// The tolerance of "within-tolerance" (m): kToleranceFactor times the farthest a body of
-  /// ODE self-threaded moves with either of two other seeds of its random constraint reordering (the same
-  /// algorithm, other equally valid orders of its sweeps) or with the world moved by 1e-12 m
-  /// (rounding alone; docs/ode.md, "The check").
+  /// ODE self-threaded moves with either of two other seeds of its random constraint
+  /// reordering (the same algorithm, other equally valid orders of its sweeps) or with the
+  /// world moved by 1e-12 m (rounding alone; docs/ode.md, "The check").
   double tolerance = 0;
 };
 
