@@ -3,6 +3,7 @@
 
 #include <ode/threading_impl.h>
 
+#include <algorithm>
 #include <chrono>
 #include <stdexcept>
 
@@ -30,6 +31,7 @@ struct Attachment::Impl {
   dThreadingThreadPoolID ode_pool = nullptr;
   std::unique_ptr<partition::Strategy> strategy;
   std::vector<detail::StepLog> logs;  // options.record
+  RecordingRoom room;                 // the largest recorded step's
   std::int64_t pending_host_ns = 0;
   std::uint64_t messages_at_start = 0;
   AttachStats stats;
@@ -77,6 +79,17 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
       ro.spin_ns = options.spin_ns;
       ro.watchdog_s = options.watchdog_s;
       impl_->runtime = std::make_unique<detail::Runtime>(ro);
+      if (options.record && options.reserve_steps > 0) {
+        // Each thread: twice its largest share, at most the whole step, and 10 % more.
+        const RecordingRoom& r = options.reserve_room;
+        const auto room = [](std::size_t whole, std::size_t thread) {
+          const std::size_t n = std::min(whole, 2 * thread);
+          return n + n / 10 + 16;
+        };
+        impl_->runtime->reserve_logs(options.reserve_steps, room(r.parts, r.thread_parts),
+                                     room(r.relations, r.thread_relations),
+                                     room(r.calls, r.thread_calls));
+      }
       dWorldSetStepThreadingImplementation(world, impl_->runtime->functions(),
                                            impl_->runtime->id());
       break;
@@ -151,7 +164,25 @@ void Attachment::world_step(Stepper stepper, dReal dt) {
     m.stats.partition_ns += now_ns() - p0;
     ++m.stats.partitions;
   }
-  if (m.options.record) m.logs.push_back(std::move(log));
+  if (m.options.record) {
+    RecordingRoom step;
+    for (const detail::SlotLog& part : log.slots) {
+      step.parts += part.segments.size();
+      step.relations += part.accesses.size();
+      step.calls += part.calls.size();
+      step.thread_parts = std::max(step.thread_parts, part.segments.size());
+      step.thread_relations = std::max(step.thread_relations, part.accesses.size());
+      step.thread_calls = std::max(step.thread_calls, part.calls.size());
+    }
+    RecordingRoom& r = m.room;
+    r.parts = std::max(r.parts, step.parts);
+    r.relations = std::max(r.relations, step.relations);
+    r.calls = std::max(r.calls, step.calls);
+    r.thread_parts = std::max(r.thread_parts, step.thread_parts);
+    r.thread_relations = std::max(r.thread_relations, step.thread_relations);
+    r.thread_calls = std::max(r.thread_calls, step.thread_calls);
+    m.logs.push_back(std::move(log));
+  }
 }
 
 void Attachment::collide(dSpaceID space, void* data, dNearCallback* callback) {
@@ -169,6 +200,8 @@ std::vector<StepGraph> Attachment::take_steps() {
   impl_->logs.clear();
   return steps;
 }
+
+RecordingRoom Attachment::recording_room() const { return impl_->room; }
 
 AttachStats Attachment::stats() const {
   AttachStats s = impl_->stats;

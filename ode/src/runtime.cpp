@@ -150,6 +150,7 @@ struct alignas(64) Slot {
   std::vector<AccessRecord> accesses;
   std::vector<CallRecord> records;
   std::uint32_t next_record = 0;
+  std::vector<SlotLog> spare;  // reserve_logs: the next steps' room, pages already written
   // The slot's own free calls (its thread only): no shared line per post and completion.
   Call* free = nullptr;
   int free_count = 0;
@@ -430,13 +431,46 @@ StepLog Runtime::end_step() {
     part.segments.swap(s->segments);
     part.accesses.swap(s->accesses);
     part.calls.swap(s->records);
-    // The next step starts with room for as much (one allocation, no regrowth).
-    s->segments.reserve(part.segments.size());
-    s->accesses.reserve(part.accesses.size());
-    s->records.reserve(part.calls.size());
+    if (!s->spare.empty()) {
+      install(*s, std::move(s->spare.back()));
+      s->spare.pop_back();
+    } else {
+      // The next step starts with room for as much (one allocation, no regrowth).
+      s->segments.reserve(part.segments.size());
+      s->accesses.reserve(part.accesses.size());
+      s->records.reserve(part.calls.size());
+    }
     log.slots.push_back(std::move(part));
   }
   return log;
+}
+
+void Runtime::install(Slot& slot, SlotLog&& room) {
+  slot.segments = std::move(room.segments);
+  slot.accesses = std::move(room.accesses);
+  slot.records = std::move(room.calls);
+}
+
+void Runtime::reserve_logs(std::uint32_t steps, std::size_t segments, std::size_t accesses,
+                           std::size_t calls) {
+  for (auto& s : slots_) {
+    s->spare.clear();
+    s->spare.reserve(steps);
+    for (std::uint32_t i = 0; i <= steps; ++i) {
+      SlotLog room;
+      // Written once (resize), then emptied: the capacity stays, its pages faulted in.
+      room.segments.resize(segments);
+      room.accesses.resize(accesses);
+      room.calls.resize(calls);
+      room.segments.clear();
+      room.accesses.clear();
+      room.calls.clear();
+      if (i == steps)
+        install(*s, std::move(room));  // the first step's
+      else
+        s->spare.push_back(std::move(room));
+    }
+  }
 }
 
 void Runtime::set_placement(std::unordered_map<std::uint64_t, std::uint32_t> placement) {

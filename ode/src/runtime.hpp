@@ -108,6 +108,11 @@ class Runtime {
   void begin_step(const char* entry);
   /// After it: closes that segment; when recording, the step's log (else an empty one).
   StepLog end_step();
+  /// Recording: `steps` logs of each thread with room for `segments`, `accesses` and `calls`
+  /// records, written once here (their pages faulted in now, not in the steps); end_step
+  /// hands the next one to each thread while they last.
+  void reserve_logs(std::uint32_t steps, std::size_t segments, std::size_t accesses,
+                    std::size_t calls);
   /// Partition policy: the slot of each call, by its first segment's key (segment_key).
   void set_placement(std::unordered_map<std::uint64_t, std::uint32_t> placement);
   RuntimeCounters counters() const;
@@ -147,6 +152,7 @@ class Runtime {
   std::uint64_t call_key(Slot& slot, const char* name, dcallindex_t instance);
   // Recording: the segment open on `slot` ends here (split at a post, alter or wait).
   void split(Slot& slot);
+  void install(Slot& slot, SlotLog&& room);  // the slot's logs become `room`'s
   void open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg, std::uint64_t after,
                     std::int64_t start_ns);
   void close_segment(Slot& slot, bool last, std::int64_t end_ns);

@@ -7,10 +7,10 @@
 #include "runtime.hpp"
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/median.hpp"
-#include "tgraph/ode/run.hpp"
-#include "tgraph/ode/scenes.hpp"
 #include "tgraph/model/cost_model.hpp"
 #include "tgraph/model/simulator.hpp"
+#include "tgraph/ode/run.hpp"
+#include "tgraph/ode/scenes.hpp"
 
 namespace tgraph::ode {
 namespace {
@@ -135,6 +135,9 @@ ValidateReport validate_scene(const ValidateOptions& options) {
     ~Close() { dCloseODE(); }
   } close;
   std::vector<double> live, predicted, over;
+  // The recordings' logs made before their steps: no fresh page faulted in inside a part.
+  const RecordingRoom room =
+      recording_room(options.scene, options.stepper, options.threads, options.steps);
   for (std::uint32_t round = 0; round < options.repeat; ++round) {
     const RunResult r = run_scene(run_options(options.scene, options.steps, options.method,
                                               options.threads, 1, options.stepper));
@@ -146,6 +149,8 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       AttachOptions a;
       a.threads = options.threads;
       a.record = true;
+      a.reserve_steps = options.steps;
+      a.reserve_room = room;
       Attachment attach(scene->world(), a);
       for (std::uint32_t i = 0; i < options.steps; ++i) scene->step(&attach);
       const double calls_per_step =

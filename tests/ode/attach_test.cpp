@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <set>
 #include <string>
 
@@ -79,6 +80,44 @@ TEST_F(OdeWorld, RecordsEachStepAsAGraphOfOdesCallsInTopologicalOrder) {
     EXPECT_TRUE(g.carried_edges.empty());
   }
   EXPECT_TRUE(attach.take_steps().empty());
+}
+
+TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
+  // One thread: the same world records the same call tree, so a recording into room made
+  // when attaching must give the very graphs of one that grows its logs.
+  AttachOptions o;
+  o.threads = 1;
+  o.record = true;
+  std::vector<StepGraph> grown, reserved;
+  RecordingRoom room;
+  {
+    auto scene = Scene::make("ode-chains");
+    Attachment attach(scene->world(), o);
+    for (int i = 0; i < 4; ++i) scene->step(&attach);
+    room = attach.recording_room();
+    grown = attach.take_steps();
+  }
+  std::size_t largest = 0;
+  for (const StepGraph& g : grown) largest = std::max(largest, g.tasks.size());
+  EXPECT_EQ(room.parts, largest);         // one task per recorded part
+  EXPECT_EQ(room.thread_parts, largest);  // one thread took them all
+  EXPECT_GT(room.calls, 24u);             // every chain's island at least one call
+  o.reserve_steps = 4;
+  o.reserve_room = room;
+  {
+    auto scene = Scene::make("ode-chains");
+    Attachment attach(scene->world(), o);
+    for (int i = 0; i < 4; ++i) scene->step(&attach);
+    reserved = attach.take_steps();
+  }
+  ASSERT_EQ(reserved.size(), grown.size());
+  for (std::size_t i = 0; i < grown.size(); ++i) {
+    EXPECT_EQ(reserved[i].validate(), "");
+    EXPECT_EQ(reserved[i].tasks.size(), grown[i].tasks.size()) << i;
+    EXPECT_EQ(reserved[i].edges.size(), grown[i].edges.size()) << i;
+    for (TaskId t = 0; t < grown[i].tasks.size(); ++t)
+      ASSERT_EQ(reserved[i].kind_name(t), grown[i].kind_name(t)) << i << " " << t;
+  }
 }
 
 TEST_F(OdeWorld, RefusesZeroThreadsAndRecordingUnderOdesOwnStepping) {

@@ -6,6 +6,7 @@
 
 #include <ode/ode.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -17,12 +18,24 @@
 
 namespace tgraph::ode {
 
+/// Room for a step's recording, in records (Attachment::recording_room()).
+struct RecordingRoom {
+  std::size_t parts = 0, relations = 0, calls = 0;  ///< the largest step's, all threads
+  std::size_t thread_parts = 0, thread_relations = 0, thread_calls = 0;  ///< one thread's largest
+};
+
 /// What an attachment does.
 struct AttachOptions {
   Method method;              ///< who runs ODE's calls
   std::uint32_t threads = 2;  ///< K: the stepping thread and K - 1 workers (at least 1)
   /// Record every step's calls (steps()): the runtime's policies only (worksteal, partition).
   bool record = false;
+  /// Recording: room for this many steps of `reserve_room` made and written once when
+  /// attaching, so that the recorded steps do not fault their logs' fresh pages in while they
+  /// run (a capture sizes it from an untimed first pass). Each thread gets twice its largest
+  /// share, at most the whole step, and 10 % more; a step that needs more grows its log.
+  std::uint32_t reserve_steps = 0;
+  RecordingRoom reserve_room{};
   /// Partition policy: steps between two partitionings of the last recorded step (the first
   /// step is recorded and partitioned for the second; then every `repartition_interval`).
   std::uint32_t repartition_interval = 10;
@@ -81,6 +94,8 @@ class Attachment {
 
   /// The recorded steps so far, as task graphs (edges derived); empties the record.
   std::vector<StepGraph> take_steps();
+  /// The largest step recorded so far (AttachOptions::reserve_room).
+  RecordingRoom recording_room() const;
   /// What was measured so far.
   AttachStats stats() const;
   const AttachOptions& options() const;

@@ -103,8 +103,15 @@ struct CaptureReport {
 
 /// Runs the scene three times without and three times with recording, alternating
 /// (worksteal at `threads`), and writes the last recorded steps to `output`: one task per
-/// part of ODE's calls (docs/ode.md).
+/// part of ODE's calls (docs/ode.md). The recorded passes' logs are made before their timed
+/// steps (recording_room).
 CaptureReport capture_scene(const CaptureOptions& options);
+
+/// The room `steps` recorded steps of the scene at `threads` (worksteal) took in an untimed
+/// recorded pass: AttachOptions::reserve_room for the recorded passes of capture and validate.
+/// Between dInitODE2 and dCloseODE.
+RecordingRoom recording_room(const std::string& scene, Stepper stepper, std::uint32_t threads,
+                             std::uint32_t steps);
 
 /// `tgraph capture --scene ode-* --json`: one object (scene, steps, tasks, edges, bytes,
 /// recorded_ns, unrecorded_ns, capture_overhead, output) and a newline.
