@@ -165,22 +165,19 @@ void Attachment::world_step(Stepper stepper, dReal dt) {
     ++m.stats.partitions;
   }
   if (m.options.record) {
-    RecordingRoom step;
+    RecordingRoom& r = m.room;  // the largest step's and thread's so far
+    std::size_t parts = 0, relations = 0, calls = 0;
     for (const detail::SlotLog& part : log.slots) {
-      step.parts += part.segments.size();
-      step.relations += part.accesses.size();
-      step.calls += part.calls.size();
-      step.thread_parts = std::max(step.thread_parts, part.segments.size());
-      step.thread_relations = std::max(step.thread_relations, part.accesses.size());
-      step.thread_calls = std::max(step.thread_calls, part.calls.size());
+      parts += part.segments.size();
+      relations += part.accesses.size();
+      calls += part.calls.size();
+      r.thread_parts = std::max(r.thread_parts, part.segments.size());
+      r.thread_relations = std::max(r.thread_relations, part.accesses.size());
+      r.thread_calls = std::max(r.thread_calls, part.calls.size());
     }
-    RecordingRoom& r = m.room;
-    r.parts = std::max(r.parts, step.parts);
-    r.relations = std::max(r.relations, step.relations);
-    r.calls = std::max(r.calls, step.calls);
-    r.thread_parts = std::max(r.thread_parts, step.thread_parts);
-    r.thread_relations = std::max(r.thread_relations, step.thread_relations);
-    r.thread_calls = std::max(r.thread_calls, step.thread_calls);
+    r.parts = std::max(r.parts, parts);
+    r.relations = std::max(r.relations, relations);
+    r.calls = std::max(r.calls, calls);
     m.logs.push_back(std::move(log));
   }
 }

@@ -30,14 +30,13 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   // recording's cost. The last recorded pass is the one written.
   std::vector<StepGraph> steps;
   std::vector<std::int64_t> off, on;
+  report.steps = options.steps.value_or(default_steps(options.scene));
   // The recorded passes' logs are made and written when attaching, before the timed steps.
-  a.reserve_steps =
-      options.steps.value_or(Scene::make(options.scene, options.stepper, 0)->default_steps());
-  a.reserve_room = recording_room(options.scene, options.stepper, a.threads, a.reserve_steps);
+  a.reserve_steps = report.steps;
+  a.reserve_room = recording_room(options.scene, options.stepper, a.threads, report.steps);
   for (int round = 0; round < 3; ++round) {
     for (const bool record : {false, true}) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
-      report.steps = options.steps.value_or(scene->default_steps());
       a.record = record;
       Attachment attach(scene->world(), a);
       const auto t0 = std::chrono::steady_clock::now();

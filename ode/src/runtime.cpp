@@ -431,10 +431,7 @@ StepLog Runtime::end_step() {
     part.segments.swap(s->segments);
     part.accesses.swap(s->accesses);
     part.calls.swap(s->records);
-    if (!s->spare.empty()) {
-      install(*s, std::move(s->spare.back()));
-      s->spare.pop_back();
-    } else {
+    if (!take_spare(*s)) {
       // The next step starts with room for as much (one allocation, no regrowth).
       s->segments.reserve(part.segments.size());
       s->accesses.reserve(part.accesses.size());
@@ -445,31 +442,31 @@ StepLog Runtime::end_step() {
   return log;
 }
 
-void Runtime::install(Slot& slot, SlotLog&& room) {
+bool Runtime::take_spare(Slot& slot) {
+  if (slot.spare.empty()) return false;
+  SlotLog& room = slot.spare.back();
   slot.segments = std::move(room.segments);
   slot.accesses = std::move(room.accesses);
   slot.records = std::move(room.calls);
+  slot.spare.pop_back();
+  return true;
 }
 
 void Runtime::reserve_logs(std::uint32_t steps, std::size_t segments, std::size_t accesses,
                            std::size_t calls) {
+  // Written once (resize), then emptied: the capacity stays, its pages faulted in.
+  const auto written = [](auto& records, std::size_t n) {
+    records.resize(n);
+    records.clear();
+  };
   for (auto& s : slots_) {
-    s->spare.clear();
-    s->spare.reserve(steps);
-    for (std::uint32_t i = 0; i <= steps; ++i) {
-      SlotLog room;
-      // Written once (resize), then emptied: the capacity stays, its pages faulted in.
-      room.segments.resize(segments);
-      room.accesses.resize(accesses);
-      room.calls.resize(calls);
-      room.segments.clear();
-      room.accesses.clear();
-      room.calls.clear();
-      if (i == steps)
-        install(*s, std::move(room));  // the first step's
-      else
-        s->spare.push_back(std::move(room));
+    s->spare.assign(steps, SlotLog{});
+    for (SlotLog& room : s->spare) {
+      written(room.segments, segments);
+      written(room.accesses, accesses);
+      written(room.calls, calls);
     }
+    take_spare(*s);  // the first step's
   }
 }
 

@@ -152,7 +152,7 @@ class Runtime {
   std::uint64_t call_key(Slot& slot, const char* name, dcallindex_t instance);
   // Recording: the segment open on `slot` ends here (split at a post, alter or wait).
   void split(Slot& slot);
-  void install(Slot& slot, SlotLog&& room);  // the slot's logs become `room`'s
+  bool take_spare(Slot& slot);  // the slot's logs become its next spare room's, if any
   void open_segment(Slot& slot, std::uint32_t call, std::uint32_t seg, std::uint64_t after,
                     std::int64_t start_ns);
   void close_segment(Slot& slot, bool last, std::int64_t end_ns);
