@@ -82,9 +82,9 @@ void capture_ode(const std::string& scene, std::optional<int> steps, const std::
   std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
 }
 
-void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,
-                  std::uint32_t threads, std::uint32_t repeat, const std::string& calibration,
-                  bool json, const OdeFlags& flags) {
+void validate_ode(const std::string& scene, std::optional<std::uint32_t> steps,
+                  const std::string& method, std::uint32_t threads, std::uint32_t repeat,
+                  const std::string& calibration, bool json, const OdeFlags& flags) {
   const ode::ValidateReport r = ode::validate_scene(
       ode::validate_options(ode::run_options(scene, steps, ode::choose_method(ode_method(method)),
                                              threads, repeat, ode::parse_stepper(flags.stepper)),
@@ -102,8 +102,8 @@ void capture_ode(const std::string& scene, std::optional<int>, const std::string
                  const OdeFlags&) {
   no_ode(scene);
 }
-void validate_ode(const std::string& scene, std::uint32_t, const std::string&, std::uint32_t,
-                  std::uint32_t, const std::string&, bool, const OdeFlags&) {
+void validate_ode(const std::string& scene, std::optional<std::uint32_t>, const std::string&,
+                  std::uint32_t, std::uint32_t, const std::string&, bool, const OdeFlags&) {
   no_ode(scene);
 }
 

@@ -21,7 +21,7 @@ void add_validate(CLI::App& app) {
   cmd->add_option("--threads,-k", o->threads, "Threads");
   cmd->add_option("--method", a->method,
                   "Partitioning strategy, or a baseline policy (worksteal, barrier, sequential)");
-  cmd->add_option("--steps", o->steps, "Steps (default 20)");
+  cmd->add_option("--steps", o->steps, "Steps (default 20; ODE scenes: the scene's, as run)");
   cmd->add_option("--split", o->scene_options.split, "Force-field tasks per deformable object")
       ->check(CLI::Range(1, 1024));
   cmd->add_option("--repeat", o->repeat,
@@ -33,10 +33,11 @@ void add_validate(CLI::App& app) {
   cmd->add_flag("--json", a->json, "Print one JSON object");
   auto ode = std::make_shared<OdeFlags>();
   add_ode_flags(cmd, *ode);
-  cmd->callback([o, a, ode] {
+  cmd->callback([cmd, o, a, ode] {
     if (is_ode_scene(o->scene))  // ODE's scenes: tgraph::ode (apps/cmd_ode.cpp)
-      return validate_ode(o->scene, o->steps, a->method, o->threads, o->repeat, o->calibration,
-                          a->json, *ode);
+      return validate_ode(
+          o->scene, cmd->count("--steps") ? std::optional<std::uint32_t>(o->steps) : std::nullopt,
+          a->method, o->threads, o->repeat, o->calibration, a->json, *ode);
     o->method = method_flags(a->method);
     const measure::Validation v = measure::validate(*o);
     std::cout << (a->json ? measure::to_json(v, *o) : measure::to_text(v, *o));

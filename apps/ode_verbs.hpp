@@ -33,8 +33,8 @@ void run_ode(const std::string& scene, std::optional<std::uint32_t> steps,
 void capture_ode(const std::string& scene, std::optional<int> steps, const std::string& output,
                  bool json, const OdeFlags& flags);
 /// `tgraph validate --scene ode-*`.
-void validate_ode(const std::string& scene, std::uint32_t steps, const std::string& method,
-                  std::uint32_t threads, std::uint32_t repeat, const std::string& calibration,
-                  bool json, const OdeFlags& flags);
+void validate_ode(const std::string& scene, std::optional<std::uint32_t> steps,
+                  const std::string& method, std::uint32_t threads, std::uint32_t repeat,
+                  const std::string& calibration, bool json, const OdeFlags& flags);
 
 }  // namespace tgraph::app

@@ -79,17 +79,7 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
       ro.spin_ns = options.spin_ns;
       ro.watchdog_s = options.watchdog_s;
       impl_->runtime = std::make_unique<detail::Runtime>(ro);
-      if (options.record && options.reserve_steps > 0) {
-        // Each thread: twice its largest share, at most the whole step, and 10 % more.
-        const RecordingRoom& r = options.reserve_room;
-        const auto room = [](std::size_t whole, std::size_t thread) {
-          const std::size_t n = std::min(whole, 2 * thread);
-          return n + n / 10 + 16;
-        };
-        impl_->runtime->reserve_logs(options.reserve_steps, room(r.parts, r.thread_parts),
-                                     room(r.relations, r.thread_relations),
-                                     room(r.calls, r.thread_calls));
-      }
+      reserve_recording(options.reserve_steps);
       dWorldSetStepThreadingImplementation(world, impl_->runtime->functions(),
                                            impl_->runtime->id());
       break;
@@ -198,7 +188,22 @@ std::vector<StepGraph> Attachment::take_steps() {
   return steps;
 }
 
+void Attachment::drop_steps() { impl_->logs.clear(); }
+
 RecordingRoom Attachment::recording_room() const { return impl_->room; }
+
+void Attachment::reserve_recording(std::uint32_t steps) {
+  if (!impl_->options.record || !impl_->runtime || steps == 0) return;
+  // Each thread: twice its largest share, at most the whole step, and 10 % more.
+  const RecordingRoom& r = impl_->options.reserve_room;
+  const auto room = [](std::size_t whole, std::size_t thread) {
+    const std::size_t n = std::min(whole, 2 * thread);
+    return n + n / 10 + 16;
+  };
+  impl_->runtime->reserve_logs(steps, room(r.parts, r.thread_parts),
+                               room(r.relations, r.thread_relations),
+                               room(r.calls, r.thread_calls));
+}
 
 AttachStats Attachment::stats() const {
   AttachStats s = impl_->stats;

@@ -78,7 +78,10 @@ RecordingRoom recording_room(const std::string& scene_name, Stepper stepper, std
   a.threads = threads;
   a.record = true;
   Attachment attach(scene->world(), a);
-  for (std::uint32_t i = 0; i < steps; ++i) scene->step(&attach);
+  for (std::uint32_t i = 0; i < steps; ++i) {
+    scene->step(&attach);
+    attach.drop_steps();  // only the maxima are wanted: one step's log held at a time
+  }
   return attach.recording_room();
 }
 

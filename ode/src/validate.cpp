@@ -15,56 +15,51 @@
 namespace tgraph::ode {
 namespace {
 
-int chained(void* context, dcallindex_t, dCallReleaseeID self);
-
-struct Chain {
-  const dThreadingFunctionsInfo* f;
-  dThreadingImplementationID impl;
-  int left;
-};
-
-// ODE's pattern: a running call adds a dependency to itself and posts the next call.
-int chained(void* context, dcallindex_t, dCallReleaseeID self) {
-  auto* c = static_cast<Chain*>(context);
-  if (--c->left > 0) {
-    c->f->alter_call_dependencies_count(c->impl, self, 1);
-    c->f->post_call(c->impl, nullptr, nullptr, 0, self, nullptr, &chained, c, 0, "chain");
-  }
-  return 1;
-}
-
 int leaf(void*, dcallindex_t, dCallReleaseeID) { return 1; }
 
 constexpr int kCalls = 20000;
+// validate records and simulates this many steps at a time.
+constexpr std::uint32_t kChunk = 25;
 
-// ODE's other pattern, flat: kCalls trivial calls posted from the stepping thread, each
-// releasing a last call that signals the wait. Through `rt` on its one thread, recorded or
-// not: its time, and the parts the recording made (0 unrecorded).
-std::pair<double, std::size_t> flat_ns(detail::Runtime& rt, dCallWaitID w, bool record) {
+// One flat round through `rt` on its one thread, recorded or not: kCalls trivial calls
+// posted from the stepping thread, each releasing a last call that signals the wait (ODE's
+// pattern of a stage's instances and their sync call).
+struct FlatRound {
+  double ns = 0;          ///< the whole round
+  double post_ns = 0;     ///< its posts alone (the poster's part holds them)
+  std::size_t parts = 0;  ///< the parts the recording made (0 unrecorded)
+};
+
+FlatRound flat_round(detail::Runtime& rt, dCallWaitID w, bool record) {
   const dThreadingFunctionsInfo* f = rt.functions();
   f->reset_call_wait(rt.id(), w);
   rt.set_recording(record);
   rt.begin_step("flat");
-  const auto t0 = std::chrono::steady_clock::now();
+  using Clock = std::chrono::steady_clock;
+  const auto t0 = Clock::now();
   dCallReleaseeID last = nullptr;
   f->post_call(rt.id(), nullptr, &last, kCalls, nullptr, w, &leaf, nullptr, 0, "last");
   for (int i = 0; i < kCalls; ++i)
     f->post_call(rt.id(), nullptr, nullptr, 0, last, nullptr, &leaf, nullptr,
                  static_cast<dcallindex_t>(i), "leaf");
+  const auto t1 = Clock::now();
   f->wait_call(rt.id(), nullptr, w, nullptr, "flat");
-  const double ns =
-      std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count();
-  std::size_t parts = 0;
-  for (const detail::SlotLog& s : rt.end_step().slots) parts += s.segments.size();
+  const auto t2 = Clock::now();
+  FlatRound r;
+  r.ns = std::chrono::duration<double, std::nano>(t2 - t0).count();
+  r.post_ns = std::chrono::duration<double, std::nano>(t1 - t0).count();
+  for (const detail::SlotLog& s : rt.end_step().slots) r.parts += s.segments.size();
   rt.set_recording(false);
-  return {ns, parts};
+  return r;
 }
 
-// On one thread, medians of 3 rounds: the runtime's own time per call (a chain of trivial
-// calls, ODE's pattern of a running call posting the next: post, dispatch, completion,
-// release; the simulator charges hand-offs between threads apart), and the recording's own
-// time per part (flat calls recorded against the same not recorded, alternating, over the
-// parts recorded: what each recorded part's cost holds beyond its body).
+// On one thread, medians of 3 rounds of flat calls, recorded and not, alternating:
+// - the runtime's own time per call that no part's recorded cost holds: not recorded, the
+//   round's time after its posts, per call (taking the call, running a trivial body,
+//   completing it, its release); a post runs inside its poster's part, so its cost is in
+//   that part's (the simulator charges hand-offs between threads apart);
+// - the recording's own time per part: the recorded round against the one not recorded,
+//   over the parts recorded (what each recorded part's cost holds beyond its body).
 struct RuntimeCosts {
   double ns_per_call = 0;
   double recording_ns_per_part = 0;
@@ -79,26 +74,20 @@ RuntimeCosts runtime_costs() {
   dCallWaitID w = f->alloc_call_wait(rt.id());
   std::vector<double> per_call, per_part;
   for (int round = 0; round < 3; ++round) {
-    Chain chain{f, rt.id(), kCalls};
-    f->reset_call_wait(rt.id(), w);
-    const auto t0 = std::chrono::steady_clock::now();
-    f->post_call(rt.id(), nullptr, nullptr, 0, nullptr, w, &chained, &chain, 0, "chain");
-    f->wait_call(rt.id(), nullptr, w, nullptr, "chain");
-    per_call.push_back(
-        std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() /
-        kCalls);
-    const double plain = flat_ns(rt, w, false).first;
-    const auto [recorded, parts] = flat_ns(rt, w, true);
-    per_part.push_back((recorded - plain) / static_cast<double>(std::max<std::size_t>(parts, 1)));
+    const FlatRound plain = flat_round(rt, w, false);
+    const FlatRound recorded = flat_round(rt, w, true);
+    per_call.push_back((plain.ns - plain.post_ns) / kCalls);
+    per_part.push_back((recorded.ns - plain.ns) /
+                       static_cast<double>(std::max<std::size_t>(recorded.parts, 1)));
   }
   f->free_call_wait(rt.id(), w);
-  return {median(per_call), std::max(0.0, median(per_part))};
+  return {std::max(0.0, median(per_call)), std::max(0.0, median(per_part))};
 }
 
 }  // namespace
 ValidateOptions validate_options(const RunOptions& run, std::string calibration) {
   return {.scene = run.scene,
-          .steps = run.steps.value_or(ValidateOptions{}.steps),
+          .steps = run.steps.value_or(default_steps(run.scene)),
           .threads = run.threads,
           .method = run.method,
           .repeat = run.repeat,
@@ -122,7 +111,7 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   report.options = options;
   report.strategy = options.method.policy == Policy::kPartition ? options.method.strategy : "list";
   model::CostModel costs = model::select_cost_model("calibrated", options.calibration);
-  // The runtime's own time per call, which no part's recorded cost holds (charged per part
+  // The runtime's own time per call that no part's recorded cost holds (charged per part
   // below, scaled by the step's calls per part), and its spin before a thread parks.
   const RuntimeCosts runtime = runtime_costs();
   report.runtime_ns_per_call = runtime.ns_per_call;
@@ -149,23 +138,31 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       AttachOptions a;
       a.threads = options.threads;
       a.record = true;
-      a.reserve_steps = options.steps;
       a.reserve_room = room;
       Attachment attach(scene->world(), a);
-      for (std::uint32_t i = 0; i < options.steps; ++i) scene->step(&attach);
-      const double calls_per_step =
-          static_cast<double>(attach.stats().calls) / static_cast<double>(options.steps);
-      for (StepGraph& g : attach.take_steps()) {
-        // Each part's recorded cost without the recording's own time (the live run records
-        // none: it is measured in this run and removed, docs/ode.md "validate").
-        for (Task& t : g.tasks) t.cost_ns = t.cost_ns > own ? t.cost_ns - own : 0;
-        // The runtime's own time per call, which no part's cost holds, spread over the parts.
-        model::CostModel step_costs = costs;
-        step_costs.task_overhead_ns = runtime.ns_per_call * calls_per_step /
-                                      static_cast<double>(std::max<std::size_t>(g.tasks.size(), 1));
-        const partition::Result p = strategy->partition(g, options.threads, {}, {});
-        v.predicted_ns +=
-            static_cast<std::int64_t>(model::simulate(g, p.assignment, step_costs).makespan_ns);
+      // Recorded and simulated kChunk steps at a time: the logs of one part of the steps
+      // held at once, their room made between the parts.
+      for (std::uint32_t done = 0; done < options.steps;) {
+        const std::uint32_t n = std::min(kChunk, options.steps - done);
+        attach.reserve_recording(n);
+        const std::uint64_t calls_before = attach.stats().calls;
+        for (std::uint32_t i = 0; i < n; ++i) scene->step(&attach);
+        done += n;
+        const double calls_per_step =
+            static_cast<double>(attach.stats().calls - calls_before) / static_cast<double>(n);
+        for (StepGraph& g : attach.take_steps()) {
+          // Each part's recorded cost without the recording's own time (the live run records
+          // none: it is measured in this run and removed, docs/ode.md "validate").
+          for (Task& t : g.tasks) t.cost_ns = t.cost_ns > own ? t.cost_ns - own : 0;
+          // The runtime's own time per call outside the parts, spread over the parts.
+          model::CostModel step_costs = costs;
+          step_costs.task_overhead_ns =
+              runtime.ns_per_call * calls_per_step /
+              static_cast<double>(std::max<std::size_t>(g.tasks.size(), 1));
+          const partition::Result p = strategy->partition(g, options.threads, {}, {});
+          v.predicted_ns +=
+              static_cast<std::int64_t>(model::simulate(g, p.assignment, step_costs).makespan_ns);
+        }
       }
     }
     report.rounds.push_back(v);

@@ -120,6 +120,44 @@ TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
   }
 }
 
+TEST_F(OdeWorld, ARecordingTakenInPartsGivesTheGraphsOfOneTakenWhole) {
+  // One thread, the same world: steps recorded two at a time, room made between the parts
+  // (validate's way), against the four taken at once; dropped steps leave no graph and keep
+  // the room's maxima.
+  AttachOptions o;
+  o.threads = 1;
+  o.record = true;
+  std::vector<StepGraph> whole, parts;
+  RecordingRoom room;
+  {
+    auto scene = Scene::make("ode-chains");
+    Attachment attach(scene->world(), o);
+    for (int i = 0; i < 4; ++i) scene->step(&attach);
+    room = attach.recording_room();
+    whole = attach.take_steps();
+  }
+  o.reserve_room = room;
+  {
+    auto scene = Scene::make("ode-chains");
+    Attachment attach(scene->world(), o);
+    for (int part = 0; part < 2; ++part) {
+      attach.reserve_recording(2);
+      for (int i = 0; i < 2; ++i) scene->step(&attach);
+      for (StepGraph& g : attach.take_steps()) parts.push_back(std::move(g));
+    }
+    scene->step(&attach);
+    attach.drop_steps();
+    EXPECT_TRUE(attach.take_steps().empty());
+    EXPECT_GE(attach.recording_room().parts, room.parts);
+  }
+  ASSERT_EQ(parts.size(), whole.size());
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    EXPECT_EQ(parts[i].validate(), "");
+    EXPECT_EQ(parts[i].tasks.size(), whole[i].tasks.size()) << i;
+    EXPECT_EQ(parts[i].edges.size(), whole[i].edges.size()) << i;
+  }
+}
+
 TEST_F(OdeWorld, RefusesZeroThreadsAndRecordingUnderOdesOwnStepping) {
   auto scene = Scene::make("ode-chains");
   AttachOptions o;

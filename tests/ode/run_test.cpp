@@ -11,6 +11,7 @@
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/graph/trace_io.hpp"
+#include "tgraph/ode/scenes.hpp"
 
 namespace tgraph::ode {
 namespace {
@@ -95,6 +96,20 @@ TEST(OdeCapture, WritesATraceOfOdesCallsThatReadsBack) {
   EXPECT_DOUBLE_EQ(j.at("capture_overhead").get<double>(), r.overhead);
   EXPECT_EQ(
       to_text(r).rfind("captured ode-chains: 3 steps, " + std::to_string(tasks) + " tasks", 0), 0u);
+}
+
+TEST(OdeValidate, ValidatesTheStepsARunWouldMakeUnlessTold) {
+  // `tgraph validate --scene ode-*` without --steps: the scene's own steps, as run and capture.
+  for (const char* scene : {"ode-piles", "ode-heap", "ode-chains"}) {
+    const ValidateOptions o = validate_options(
+        run_options(scene, std::nullopt, choose_method("worksteal"), 2, 3, Stepper::kQuickStep));
+    EXPECT_EQ(o.steps, default_steps(scene)) << scene;
+    EXPECT_EQ(o.repeat, 3u);
+  }
+  EXPECT_EQ(validate_options(
+                run_options("ode-piles", 7u, choose_method("worksteal"), 2, 1, Stepper::kQuickStep))
+                .steps,
+            7u);
 }
 
 TEST(OdeValidate, PredictsTheLiveRunFromACapture) {

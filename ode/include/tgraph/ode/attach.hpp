@@ -94,8 +94,14 @@ class Attachment {
 
   /// The recorded steps so far, as task graphs (edges derived); empties the record.
   std::vector<StepGraph> take_steps();
+  /// Empties the record without building its graphs (recording_room() keeps its maxima).
+  void drop_steps();
   /// The largest step recorded so far (AttachOptions::reserve_room).
   RecordingRoom recording_room() const;
+  /// Recording: room for the next `steps` steps of `options().reserve_room`, made and written
+  /// now, between steps, as AttachOptions::reserve_steps does when attaching (a long recording
+  /// taken in parts: take_steps, then room for the next part).
+  void reserve_recording(std::uint32_t steps);
   /// What was measured so far.
   AttachStats stats() const;
   const AttachOptions& options() const;

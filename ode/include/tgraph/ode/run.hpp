@@ -149,17 +149,18 @@ struct ValidateReport {
   double live_speedup = 0;         ///< median of sequential / live
   double predicted_speedup = 0;    ///< median of sequential / predicted
   double predicted_over_live = 0;  ///< median of predicted / live (time)
-  /// The runtime's own time per call (a chain of trivial calls on one thread), charged by the
-  /// simulator as `task_overhead_ns` scaled to the captured steps' calls per part.
+  /// The runtime's own time per call outside its poster's part (taking it, completing it,
+  /// its release; trivial calls posted flat on one thread, the time after the posts), charged
+  /// by the simulator as `task_overhead_ns` scaled to the captured steps' calls per part.
   double runtime_ns_per_call = 0;
-  /// The recording's own time per part (the same chain recorded against not, over its
+  /// The recording's own time per part (the same calls recorded against not, over their
   /// parts), taken off each captured part's cost before the simulation: the live run records
   /// nothing.
   double recording_ns_per_part = 0;
 };
 
-/// The validation of the run `run` describes (its scene, steps or 20, method, threads, repeat
-/// as rounds, stepper) with the simulator's calibration file.
+/// The validation of the run `run` describes (its scene, steps or the scene's, method, threads,
+/// repeat as rounds, stepper) with the simulator's calibration file.
 ValidateOptions validate_options(const RunOptions& run, std::string calibration = {});
 
 /// Each round: the live run (ode::run_scene, one pass), a capture of the same steps at the
