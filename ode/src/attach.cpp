@@ -18,7 +18,9 @@ namespace {
 
 using replay::now_ns;  // the steady clock of every timeline
 
-bool runtime_policy(Policy p) { return p == Policy::kWorksteal || p == Policy::kPartition; }
+bool runtime_policy(Policy p) {
+  return p == Policy::kWorksteal || p == Policy::kPartition || p == Policy::kIslands;
+}
 
 }  // namespace
 
@@ -72,10 +74,12 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
           world, dThreadingImplementationGetFunctions(impl_->ode_impl), impl_->ode_impl);
       break;
     case Policy::kWorksteal:
+    case Policy::kIslands:
     case Policy::kPartition: {
       detail::RuntimeOptions ro;
       ro.threads = options.threads;
       ro.placed = policy == Policy::kPartition;
+      ro.steal_root_only = policy == Policy::kIslands;
       ro.spin_ns = options.spin_ns;
       ro.watchdog_s = options.watchdog_s;
       impl_->runtime = std::make_unique<detail::Runtime>(ro);

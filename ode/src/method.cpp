@@ -18,17 +18,19 @@ std::string_view to_string(Policy policy) {
       return "worksteal";
     case Policy::kPartition:
       return "partition";
+    case Policy::kIslands:
+      return "islands";
   }
   return "?";
 }
 
 Method choose_method(std::string_view name) {
-  for (Policy p : {Policy::kSequential, Policy::kOde, Policy::kWorksteal})
+  for (Policy p : {Policy::kSequential, Policy::kOde, Policy::kWorksteal, Policy::kIslands})
     if (name == to_string(p)) return {p, ""};
   const std::vector<std::string> strategies = partition::strategy_names();
   if (std::find(strategies.begin(), strategies.end(), name) != strategies.end())
     return {Policy::kPartition, std::string(name)};
-  std::string known = "sequential, ode, worksteal";
+  std::string known = "sequential, ode, worksteal, islands";
   for (const std::string& s : strategies) known += ", " + s;
   throw OptionError("method",
                     "unknown method '" + std::string(name) + "' for an ODE scene (" + known + ")");

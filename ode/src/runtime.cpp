@@ -91,6 +91,7 @@ struct Call {
   // Stable key (recording, placement): from the poster's key and its post count.
   std::uint64_t key = 0;
   std::uint32_t posts = 0;  // posts this call made so far (its own thread only)
+  bool root = false;        // posted by the stepping thread's own code, not by a call
   // Recording: the order number its first segment must exceed (its poster's segment's, its
   // releasers' last segments'); raised by fetch_max before the release that may start it.
   std::atomic<std::uint64_t> ready_seq{0};
@@ -128,8 +129,9 @@ struct alignas(64) Slot {
   SpinLock lock;
   Call* head = nullptr;  // newest
   Call* tail = nullptr;  // oldest
-  // Written under the lock; read without it (relaxed) only to skip an empty deque.
-  std::atomic<std::uint32_t> size{0};
+  // Written under the lock; read without it (relaxed) only to skip an empty deque. roots:
+  // how many of its calls the stepping thread's own code posted (Call::root).
+  std::atomic<std::uint32_t> size{0}, roots{0};
   // Watchdog: the call running here and how many calls started here (relaxed: a sample).
   std::atomic<const char*> running{nullptr};
   std::atomic<dcallindex_t> running_instance{0};
@@ -165,6 +167,7 @@ struct alignas(64) Slot {
       tail = c;
     head = c;
     size.store(size.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+    if (c->root) roots.store(roots.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     lock.unlock();
   }
   Call* pop_front() {
@@ -177,7 +180,25 @@ struct alignas(64) Slot {
         head->prev = nullptr;
       else
         tail = nullptr;
-      size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+      taken(c);
+    }
+    lock.unlock();
+    return c;
+  }
+  void taken(const Call* c) {  // under the lock
+    size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    if (c->root) roots.store(roots.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+  }
+  // The oldest call the stepping thread's own code posted (RuntimeOptions::steal_root_only).
+  Call* pop_back_root() {
+    if (roots.load(std::memory_order_relaxed) == 0) return nullptr;
+    lock.lock();
+    Call* c = tail;
+    while (c && !c->root) c = c->prev;
+    if (c) {
+      (c->prev ? c->prev->next : head) = c->next;
+      (c->next ? c->next->prev : tail) = c->prev;
+      taken(c);
     }
     lock.unlock();
     return c;
@@ -192,7 +213,7 @@ struct alignas(64) Slot {
         tail->next = nullptr;
       else
         head = nullptr;
-      size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+      taken(c);
     }
     lock.unlock();
     return c;
@@ -233,6 +254,7 @@ Runtime::Runtime(const RuntimeOptions& options)
     : threads_(options.threads),
       advertised_(options.advertised_threads ? options.advertised_threads : options.threads),
       placed_(options.placed),
+      steal_root_only_(options.steal_root_only),
       spin_ns_(options.spin_ns),
       watchdog_s_(options.watchdog_s),
       pool_(std::make_unique<Pool>()) {
@@ -541,6 +563,7 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
   c->record = kNoRecord;
   slot.calls.store(slot.calls.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   c->posts = 0;
+  c->root = slot.current == nullptr;
   c->ready_seq.store(0, std::memory_order_relaxed);
   const bool rec = recording();
   if (rec || placed_) {
@@ -591,7 +614,8 @@ void Runtime::alter(dCallReleaseeID releasee, ddependencychange_t change) {
 void Runtime::make_ready(Call* c, Slot& slot) {
   Slot& target = placed_ ? *slots_[c->home] : slot;
   target.push_front(c);
-  wake();
+  // Under steal_root_only no other thread may take a call a call posted: none to wake.
+  if (!steal_root_only_ || c->root) wake();
 }
 
 void Runtime::wake() {
@@ -604,9 +628,12 @@ void Runtime::wake() {
   }
 }
 
-bool Runtime::any_work() const {
-  for (const auto& s : slots_)
-    if (s->size.load(std::memory_order_relaxed) != 0) return true;
+bool Runtime::any_work(const Slot& self) const {
+  for (const auto& s : slots_) {
+    const bool own = s.get() == &self;
+    if ((own || !steal_root_only_ ? s->size : s->roots).load(std::memory_order_relaxed) != 0)
+      return true;
+  }
   return false;
 }
 
@@ -614,7 +641,7 @@ Call* Runtime::find_work(Slot& slot) {
   if (Call* c = slot.pop_front()) return c;
   for (std::uint32_t i = 1; i < threads_; ++i) {
     Slot& other = *slots_[(slot.index + i) % threads_];
-    if (Call* c = other.pop_back()) {
+    if (Call* c = steal_root_only_ ? other.pop_back_root() : other.pop_back()) {
       slot.steals.store(slot.steals.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
       return c;
     }
@@ -695,7 +722,7 @@ void Runtime::signal(Wait* w) {
 void Runtime::park(Slot& slot, const std::atomic<std::uint32_t>* done) {
   const std::uint32_t e = epoch_.load(std::memory_order_acquire);
   sleepers_.fetch_add(1, std::memory_order_seq_cst);  // see wake()
-  if (!any_work() && !stop_.load(std::memory_order_acquire) &&
+  if (!any_work(slot) && !stop_.load(std::memory_order_acquire) &&
       !(done && done->load(std::memory_order_acquire))) {
     slot.parks.store(slot.parks.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
     epoch_.wait(e, std::memory_order_acquire);
@@ -729,7 +756,7 @@ void Runtime::wait(int* out_wait_status, dCallWaitID call_wait, const dThreadedW
     bool found = false;
     for (std::uint32_t spins = 0; !found; ++spins) {
       TGRAPH_ODE_PAUSE();
-      found = w->signalled.load(std::memory_order_acquire) != 0 || any_work();
+      found = w->signalled.load(std::memory_order_acquire) != 0 || any_work(slot);
       if ((spins & 63) == 63 && now_ns() - t0 > spin_ns_) break;
     }
     if (found) continue;
@@ -765,7 +792,7 @@ void Runtime::worker(std::uint32_t index) {
     bool found = false;
     for (std::uint32_t spins = 0; !found; ++spins) {
       TGRAPH_ODE_PAUSE();
-      found = any_work() || stop_.load(std::memory_order_relaxed);
+      found = any_work(slot) || stop_.load(std::memory_order_relaxed);
       if ((spins & 63) == 63 && now_ns() - t0 > spin_ns_) break;
     }
     if (!found) park(slot, nullptr);

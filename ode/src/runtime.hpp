@@ -78,6 +78,10 @@ struct RuntimeOptions {
   /// ODE's K-thread algorithm costs without K threads.
   std::uint32_t advertised_threads = 0;
   bool placed = false;  ///< partition policy: calls go to their key's slot
+  /// Islands policy: an idle thread steals only the calls the stepping thread's own code
+  /// posted (ODE's island jobs); a call posted by a running call stays on its poster's
+  /// thread (a stage's instances run one after another there).
+  bool steal_root_only = false;
   std::int64_t spin_ns = 50'000;
   double watchdog_s = 60.0;
 };
@@ -141,7 +145,8 @@ class Runtime {
   void free_call(Call* call, Slot& slot);
   void make_ready(Call* call, Slot& slot);
   Call* find_work(Slot& slot);
-  bool any_work() const;
+  /// Work `self`'s thread may take: its own calls, or the calls it may steal.
+  bool any_work(const Slot& self) const;
   void run(Call* call, Slot& slot);
   void complete(Call* call, Slot& slot);
   void signal(Wait* wait);
@@ -160,6 +165,7 @@ class Runtime {
   std::uint32_t threads_;
   std::uint32_t advertised_;
   bool placed_;
+  bool steal_root_only_;
   std::int64_t spin_ns_;
   double watchdog_s_;
   dThreadingFunctionsInfo functions_{};

@@ -99,7 +99,9 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   if (!is_scene(options.scene))
     throw InputError(options.scene, std::nullopt,
                      "unknown ODE scene (ode-piles, ode-heap, ode-chains)");
-  if (options.method.policy == Policy::kSequential || options.method.policy == Policy::kOde)
+  // islands: its placement (a posted call on its poster's thread) is no assignment of a
+  // captured step the simulator could be given before the step runs.
+  if (options.method.policy != Policy::kWorksteal && options.method.policy != Policy::kPartition)
     throw OptionError("method",
                       "validate predicts tgraph's runtime from a capture: worksteal or a "
                       "partition strategy, not '" +

@@ -23,7 +23,7 @@ class OdeWorld : public ::testing::Test {
 };
 
 TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
-  for (const char* method : {"worksteal", "list", "ode", "sequential"}) {
+  for (const char* method : {"worksteal", "islands", "list", "ode", "sequential"}) {
     auto scene = Scene::make("ode-piles");
     AttachOptions o;
     o.method = choose_method(method);
@@ -36,7 +36,8 @@ TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
       EXPECT_EQ(s.steps, 10u) << method;
       EXPECT_GT(s.world_ns, 0) << method;
       EXPECT_GT(s.collide_ns, 0) << method;
-      if (o.method.policy == Policy::kWorksteal || o.method.policy == Policy::kPartition) {
+      if (o.method.policy == Policy::kWorksteal || o.method.policy == Policy::kPartition ||
+          o.method.policy == Policy::kIslands) {
         EXPECT_GT(s.calls, 10u * 32) << method;  // every island at least one call a step
       }
     }

@@ -83,7 +83,8 @@ TEST_P(OdePhysics, ChainLinksStayWithinJointErrorOfTheirLength) {
   EXPECT_LT(scene->depth_below_floor(), kFloorDepth);
 }
 
-INSTANTIATE_TEST_SUITE_P(Methods, OdePhysics, ::testing::Values("sequential", "worksteal"));
+INSTANTIATE_TEST_SUITE_P(Methods, OdePhysics,
+                         ::testing::Values("sequential", "worksteal", "islands"));
 
 }  // namespace
 }  // namespace tgraph::ode

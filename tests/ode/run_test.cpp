@@ -63,6 +63,8 @@ TEST(OdeRun, RefusesBadOptionsByName) {
   v.scene = "ode-piles";
   v.method = choose_method("ode");
   EXPECT_THROW(validate_scene(v), OptionError);
+  v.method = choose_method("islands");  // no assignment of a captured step to simulate
+  EXPECT_THROW(validate_scene(v), OptionError);
   CaptureOptions c;
   c.scene = "ode-piles";
   EXPECT_THROW(capture_scene(c), OptionError);  // no output

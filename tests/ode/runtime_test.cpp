@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
@@ -176,6 +177,73 @@ TEST_P(RuntimeThreads, ManyCallsAllRunOnceAndTheThreadCountIsK) {
   f->unlock_group_mutex(impl, g, 2);
   f->free_mutex_group(impl, g);
   f->free_call_wait(impl, w);
+}
+
+// A job the stepping thread posts (ODE's island job): it adds kSubCalls sub-calls to itself,
+// each sleeping 1 ms and noting whether it ran on its poster's thread.
+struct Job {
+  const dThreadingFunctionsInfo* f;
+  dThreadingImplementationID impl;
+  std::thread::id poster;
+  std::atomic<int> away{0}, runs{0};
+};
+constexpr int kSubCalls = 20;
+
+int sub_call(void* c, dcallindex_t, dCallReleaseeID) {
+  auto* job = static_cast<Job*>(c);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  if (std::this_thread::get_id() != job->poster) job->away.fetch_add(1);
+  job->runs.fetch_add(1);
+  return 1;
+}
+
+int job_call(void* c, dcallindex_t, dCallReleaseeID self) {
+  auto* job = static_cast<Job*>(c);
+  job->poster = std::this_thread::get_id();
+  job->f->alter_call_dependencies_count(job->impl, self, kSubCalls);
+  for (int i = 0; i < kSubCalls; ++i)
+    job->f->post_call(job->impl, nullptr, nullptr, 0, self, nullptr, &sub_call, job, i, "sub");
+  return 1;
+}
+
+// Two jobs posted by the stepping thread; how many of their sub-calls ran away from their
+// poster's thread.
+int sub_calls_away(const RuntimeOptions& o) {
+  Runtime rt(o);
+  const dThreadingFunctionsInfo* f = rt.functions();
+  std::vector<std::unique_ptr<Job>> jobs;
+  dCallWaitID w = f->alloc_call_wait(rt.id());
+  dCallReleaseeID join = nullptr;
+  f->post_call(
+      rt.id(), nullptr, &join, 2, nullptr, w,
+      +[](void*, dcallindex_t, dCallReleaseeID) { return 1; }, nullptr, 0, "join");
+  for (int i = 0; i < 2; ++i) {
+    jobs.push_back(std::make_unique<Job>());
+    jobs.back()->f = f;
+    jobs.back()->impl = rt.id();
+    f->post_call(rt.id(), nullptr, nullptr, 0, join, nullptr, &job_call, jobs.back().get(), i,
+                 "job");
+  }
+  f->wait_call(rt.id(), nullptr, w, nullptr, "test");
+  f->free_call_wait(rt.id(), w);
+  int away = 0;
+  for (const auto& j : jobs) {
+    EXPECT_EQ(j->runs.load(), kSubCalls);
+    away += j->away.load();
+  }
+  return away;
+}
+
+TEST_P(RuntimeThreads, UnderIslandStealingACallsSubCallsRunOnItsThread) {
+  RuntimeOptions o = options();
+  o.steal_root_only = true;
+  EXPECT_EQ(sub_calls_away(o), 0);
+  if (GetParam() > 2) {
+    // The same calls under full stealing: the threads without a job take sub-calls (20 ms of
+    // them per job), so the count above would see stealing if it happened.
+    o.steal_root_only = false;
+    EXPECT_GT(sub_calls_away(o), 0);
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(Threads, RuntimeThreads, ::testing::Values(1u, 2u, 3u, 4u, 8u));

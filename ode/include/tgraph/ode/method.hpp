@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // How ODE's calls run: ODE self-threaded (the reference), ODE's own pool (the peer), or
-// tgraph's runtime under work stealing or a partition strategy's placement.
+// tgraph's runtime under work stealing, island-level stealing or a partition strategy's
+// placement.
 #pragma once
 
 #include <cstdint>
@@ -15,8 +16,12 @@ enum class Policy : std::uint8_t {
   kOde = 1,         ///< ODE's own multithreaded implementation and thread pool (the peer)
   kWorksteal = 2,   ///< tgraph's threads: per-thread deques, idle threads steal
   kPartition = 3,   ///< tgraph's threads: calls placed by stable key, idle threads steal
+  /// tgraph's threads: idle threads steal only what the stepping thread's own code posts
+  /// (ODE's island jobs); a call posted by a running call runs on its poster's thread, so an
+  /// island's stages run on the thread that took the island, one instance after another.
+  kIslands = 4,
 };
-/// "sequential", "ode", "worksteal" or "partition".
+/// "sequential", "ode", "worksteal", "partition" or "islands".
 std::string_view to_string(Policy policy);
 
 /// A run's policy and, under the partition policy, the strategy placing the calls.
@@ -24,8 +29,8 @@ struct Method {
   Policy policy = Policy::kWorksteal;
   std::string strategy;  ///< kPartition: a partition strategy (list, metis, ...)
 };
-/// `sequential`, `ode` or `worksteal`, else a partition strategy's name (`list`, `metis`...)
-/// under the partition policy; OptionError of the field "method" for any other name.
+/// `sequential`, `ode`, `worksteal` or `islands`, else a partition strategy's name (`list`,
+/// `metis`...) under the partition policy; OptionError of the field "method" for any other name.
 Method choose_method(std::string_view name);
 /// How reports name the method: the strategy under the partition policy, else the policy.
 std::string method_name(const Method& method);
