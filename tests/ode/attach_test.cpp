@@ -83,21 +83,35 @@ TEST_F(OdeWorld, RecordsEachStepAsAGraphOfOdesCallsInTopologicalOrder) {
   EXPECT_TRUE(attach.take_steps().empty());
 }
 
+// Four steps of ode-chains recorded on one thread, taken at once; `room`: their largest.
+std::vector<StepGraph> four_steps_whole(const AttachOptions& o, RecordingRoom* room) {
+  auto scene = Scene::make("ode-chains");
+  Attachment attach(scene->world(), o);
+  for (int i = 0; i < 4; ++i) scene->step(&attach);
+  if (room) *room = attach.recording_room();
+  return attach.take_steps();
+}
+
+// One thread records the same call tree from the same world: the same graphs, step by step.
+void expect_same_graphs(const std::vector<StepGraph>& a, const std::vector<StepGraph>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) {
+    EXPECT_EQ(a[i].validate(), "");
+    EXPECT_EQ(a[i].tasks.size(), b[i].tasks.size()) << i;
+    EXPECT_EQ(a[i].edges.size(), b[i].edges.size()) << i;
+    for (TaskId t = 0; t < b[i].tasks.size() && t < a[i].tasks.size(); ++t)
+      ASSERT_EQ(a[i].kind_name(t), b[i].kind_name(t)) << i << " " << t;
+  }
+}
+
 TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
-  // One thread: the same world records the same call tree, so a recording into room made
-  // when attaching must give the very graphs of one that grows its logs.
+  // A recording into room made when attaching must give the very graphs of one that grows
+  // its logs.
   AttachOptions o;
   o.threads = 1;
   o.record = true;
-  std::vector<StepGraph> grown, reserved;
   RecordingRoom room;
-  {
-    auto scene = Scene::make("ode-chains");
-    Attachment attach(scene->world(), o);
-    for (int i = 0; i < 4; ++i) scene->step(&attach);
-    room = attach.recording_room();
-    grown = attach.take_steps();
-  }
+  const std::vector<StepGraph> grown = four_steps_whole(o, &room);
   std::size_t largest = 0;
   for (const StepGraph& g : grown) largest = std::max(largest, g.tasks.size());
   EXPECT_EQ(room.parts, largest);         // one task per recorded part
@@ -105,39 +119,19 @@ TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
   EXPECT_GT(room.calls, 24u);             // every chain's island at least one call
   o.reserve_steps = 4;
   o.reserve_room = room;
-  {
-    auto scene = Scene::make("ode-chains");
-    Attachment attach(scene->world(), o);
-    for (int i = 0; i < 4; ++i) scene->step(&attach);
-    reserved = attach.take_steps();
-  }
-  ASSERT_EQ(reserved.size(), grown.size());
-  for (std::size_t i = 0; i < grown.size(); ++i) {
-    EXPECT_EQ(reserved[i].validate(), "");
-    EXPECT_EQ(reserved[i].tasks.size(), grown[i].tasks.size()) << i;
-    EXPECT_EQ(reserved[i].edges.size(), grown[i].edges.size()) << i;
-    for (TaskId t = 0; t < grown[i].tasks.size(); ++t)
-      ASSERT_EQ(reserved[i].kind_name(t), grown[i].kind_name(t)) << i << " " << t;
-  }
+  expect_same_graphs(four_steps_whole(o, nullptr), grown);
 }
 
 TEST_F(OdeWorld, ARecordingTakenInPartsGivesTheGraphsOfOneTakenWhole) {
-  // One thread, the same world: steps recorded two at a time, room made between the parts
-  // (validate's way), against the four taken at once; dropped steps leave no graph and keep
-  // the room's maxima.
+  // Steps recorded two at a time, room made between the parts (validate's way), against the
+  // four taken at once; dropped steps leave no graph and keep the room's maxima.
   AttachOptions o;
   o.threads = 1;
   o.record = true;
-  std::vector<StepGraph> whole, parts;
   RecordingRoom room;
-  {
-    auto scene = Scene::make("ode-chains");
-    Attachment attach(scene->world(), o);
-    for (int i = 0; i < 4; ++i) scene->step(&attach);
-    room = attach.recording_room();
-    whole = attach.take_steps();
-  }
+  const std::vector<StepGraph> whole = four_steps_whole(o, &room);
   o.reserve_room = room;
+  std::vector<StepGraph> parts;
   {
     auto scene = Scene::make("ode-chains");
     Attachment attach(scene->world(), o);
@@ -151,12 +145,7 @@ TEST_F(OdeWorld, ARecordingTakenInPartsGivesTheGraphsOfOneTakenWhole) {
     EXPECT_TRUE(attach.take_steps().empty());
     EXPECT_GE(attach.recording_room().parts, room.parts);
   }
-  ASSERT_EQ(parts.size(), whole.size());
-  for (std::size_t i = 0; i < whole.size(); ++i) {
-    EXPECT_EQ(parts[i].validate(), "");
-    EXPECT_EQ(parts[i].tasks.size(), whole[i].tasks.size()) << i;
-    EXPECT_EQ(parts[i].edges.size(), whole[i].edges.size()) << i;
-  }
+  expect_same_graphs(parts, whole);
 }
 
 TEST_F(OdeWorld, RefusesZeroThreadsAndRecordingUnderOdesOwnStepping) {

@@ -56,7 +56,8 @@ struct ScalingPlan {
   std::vector<ScalingScene> scenes;
   std::vector<std::string> methods;  ///< strategies (partition policy), then baselines
   /// The ODE scenes' methods (ode::choose_method's names): default sequential (ODE
-  /// self-threaded), ode (ODE's own pool), worksteal and list; else the --methods given.
+  /// self-threaded), ode (ODE's own pool), worksteal, islands and list; else the --methods
+  /// given.
   std::vector<std::string> ode_methods;
   std::vector<std::uint32_t> threads;
   std::uint32_t repeat = 1;
