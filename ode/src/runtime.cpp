@@ -613,9 +613,11 @@ void Runtime::alter(dCallReleaseeID releasee, ddependencychange_t change) {
 
 void Runtime::make_ready(Call* c, Slot& slot) {
   Slot& target = placed_ ? *slots_[c->home] : slot;
+  // Read before the push: once pushed, the call may run, complete and be reused elsewhere.
+  const bool root = c->root;
   target.push_front(c);
   // Under steal_root_only no other thread may take a call a call posted: none to wake.
-  if (!steal_root_only_ || c->root) wake();
+  if (!steal_root_only_ || root) wake();
 }
 
 void Runtime::wake() {

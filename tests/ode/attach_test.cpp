@@ -83,6 +83,13 @@ TEST_F(OdeWorld, RecordsEachStepAsAGraphOfOdesCallsInTopologicalOrder) {
   EXPECT_TRUE(attach.take_steps().empty());
 }
 
+AttachOptions one_thread_recording() {
+  AttachOptions o;
+  o.threads = 1;
+  o.record = true;
+  return o;
+}
+
 // Four steps of ode-chains recorded on one thread, taken at once; `room`: their largest.
 std::vector<StepGraph> four_steps_whole(const AttachOptions& o, RecordingRoom* room) {
   auto scene = Scene::make("ode-chains");
@@ -107,9 +114,7 @@ void expect_same_graphs(const std::vector<StepGraph>& a, const std::vector<StepG
 TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
   // A recording into room made when attaching must give the very graphs of one that grows
   // its logs.
-  AttachOptions o;
-  o.threads = 1;
-  o.record = true;
+  AttachOptions o = one_thread_recording();
   RecordingRoom room;
   const std::vector<StepGraph> grown = four_steps_whole(o, &room);
   std::size_t largest = 0;
@@ -125,9 +130,7 @@ TEST_F(OdeWorld, ReservedRoomRecordsTheSameGraphsAndTheRoomIsTheLargestStep) {
 TEST_F(OdeWorld, ARecordingTakenInPartsGivesTheGraphsOfOneTakenWhole) {
   // Steps recorded two at a time, room made between the parts (validate's way), against the
   // four taken at once; dropped steps leave no graph and keep the room's maxima.
-  AttachOptions o;
-  o.threads = 1;
-  o.record = true;
+  AttachOptions o = one_thread_recording();
   RecordingRoom room;
   const std::vector<StepGraph> whole = four_steps_whole(o, &room);
   o.reserve_room = room;
