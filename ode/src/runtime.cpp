@@ -174,32 +174,7 @@ struct alignas(64) Slot {
     if (size.load(std::memory_order_relaxed) == 0) return nullptr;
     lock.lock();
     Call* c = head;
-    if (c) {
-      head = c->next;
-      if (head)
-        head->prev = nullptr;
-      else
-        tail = nullptr;
-      taken(c);
-    }
-    lock.unlock();
-    return c;
-  }
-  void taken(const Call* c) {  // under the lock
-    size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
-    if (c->root) roots.store(roots.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
-  }
-  // The oldest call the stepping thread's own code posted (RuntimeOptions::steal_root_only).
-  Call* pop_back_root() {
-    if (roots.load(std::memory_order_relaxed) == 0) return nullptr;
-    lock.lock();
-    Call* c = tail;
-    while (c && !c->root) c = c->prev;
-    if (c) {
-      (c->prev ? c->prev->next : head) = c->next;
-      (c->next ? c->next->prev : tail) = c->prev;
-      taken(c);
-    }
+    if (c) unlink(c);
     lock.unlock();
     return c;
   }
@@ -207,16 +182,26 @@ struct alignas(64) Slot {
     if (size.load(std::memory_order_relaxed) == 0) return nullptr;
     lock.lock();
     Call* c = tail;
-    if (c) {
-      tail = c->prev;
-      if (tail)
-        tail->next = nullptr;
-      else
-        head = nullptr;
-      taken(c);
-    }
+    if (c) unlink(c);
     lock.unlock();
     return c;
+  }
+  // The oldest call the stepping thread's own code posted (RuntimeOptions::steal_root_only).
+  Call* pop_back_root() {
+    if (roots.load(std::memory_order_relaxed) == 0) return nullptr;
+    lock.lock();
+    Call* c = tail;
+    while (c && !c->root) c = c->prev;
+    if (c) unlink(c);
+    lock.unlock();
+    return c;
+  }
+  // Takes `c` out of the deque, wherever it is (under the lock).
+  void unlink(const Call* c) {
+    (c->prev ? c->prev->next : head) = c->next;
+    (c->next ? c->next->prev : tail) = c->prev;
+    size.store(size.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
+    if (c->root) roots.store(roots.load(std::memory_order_relaxed) - 1, std::memory_order_relaxed);
   }
 };
 
