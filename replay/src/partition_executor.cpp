@@ -186,7 +186,9 @@ std::string PartitionExecutor::stall_report() const {
     // relaxed: diagnostics, a racy snapshot is fine.
     threads[p] = {s.wait_kind.load(std::memory_order_relaxed),
                   s.wait_id.load(std::memory_order_relaxed),
-                  s.at_task.load(std::memory_order_relaxed)};
+                  s.at_task.load(std::memory_order_relaxed),
+                  s.inside.load(std::memory_order_relaxed),
+                  s.inside_of.load(std::memory_order_relaxed)};
   }
   return detail::stall_report(*exec_, *plan_, threads);
 }

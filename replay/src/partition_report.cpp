@@ -13,9 +13,17 @@ std::string stall_report(const ExecGraph& x, const PartitionPlan& plan,
   };
   std::string out;
   for (std::uint32_t p = 0; p < threads.size(); ++p) {
-    const auto [kind, id, task] = threads[p];
+    const auto [kind, id, task, inside, inside_of] = threads[p];
     if (!out.empty()) out += "; ";
     out += "thread " + std::to_string(p);
+    if (inside < x.graph.tasks.size()) {
+      out += " runs " + label(inside) + ", " +
+             (inside_of == p ? std::string("ahead in its own program")
+                             : "taken from thread " + std::to_string(inside_of) + "'s program") +
+             ", inside its wait:";
+      if (kind == 0) continue;
+      out += " it";
+    }
     if (kind == 1 && id < x.graph.tasks.size()) {
       out += " waits for " + label(id) + " on thread " + std::to_string(x.assignment.proc[id]);
       for (const Edge& e : x.graph.edges)

@@ -87,6 +87,9 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
     std::atomic<std::uint32_t> at_task{kNoTask};  // the task run or waited for last
     std::atomic<std::uint32_t> wait_kind{0};      // 0: none, 1: task, 2: loop, 3: first touch
     std::atomic<std::uint32_t> wait_id{0};        // the producer task or the loop
+    // The task it runs inside a wait (stealing), kNoTask otherwise, and whose program it is.
+    std::atomic<std::uint32_t> inside{kNoTask};
+    std::atomic<std::uint32_t> inside_of{0};
     // Stealing: (step << 32) | the op the owner is at (relaxed: a hint where thieves look).
     std::atomic<std::uint64_t> cursor{0};
     // 1 while the thread sleeps in a wait (relaxed: a hint for the waiters of its counters,

@@ -82,8 +82,13 @@ bool PartitionExecutor::steal_one(const Op& op, std::uint32_t q, std::uint32_t s
   if (observe) detail::notify_begin(observers(), self, t, n);
   Slot& slot = counters_[self];
   const bool watch = watchdog_ != nullptr;
-  if (watch) slot.at_task.store(t, std::memory_order_relaxed);  // relaxed: a report
+  if (watch) {  // relaxed: a report (a body that never returns is named as run here)
+    slot.at_task.store(t, std::memory_order_relaxed);
+    slot.inside_of.store(q, std::memory_order_relaxed);
+    slot.inside.store(t, std::memory_order_relaxed);
+  }
   workload_->run(TaskRun{exec_, t, op.origin, n, self});
+  if (watch) slot.inside.store(kNoTask, std::memory_order_relaxed);  // relaxed: as above
   if (observe) detail::notify_end(observers(), self, t, n);
   if (watch)  // relaxed: compared between two samples of the watchdog only
     slot.progress.store(slot.progress.load(std::memory_order_relaxed) + 1,

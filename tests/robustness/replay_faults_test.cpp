@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "partition_plan.hpp"     // replay/src: the combines of a plan
+#include "partition_report.hpp"   // replay/src: the watchdog's report
 #include "partition_testing.hpp"  // replay/src: the lost-signal fault
 #include "tgraph/capture/recorder.hpp"
 #include "tgraph/graph/error.hpp"
@@ -335,6 +336,44 @@ TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
   }
 }
 
+// A thread that runs a task inside a wait (taken from another program, or ahead in its own)
+// is named as running it, before the wait it is in: a body that never returns there is the
+// one to look at, not the wait.
+TEST(Watchdog, NamesATaskRunInsideAWaitBeforeTheWait) {
+  const StepGraph& g = falling_step();
+  const Assignment a = by_object(g, 2);
+  const ExecGraph x = lower(g, &a, CwMode::kReduce);
+  detail::PartitionPlan plan = detail::build_plan(x, 2, true, true);
+  detail::add_combines(x, plan);
+  ASSERT_FALSE(plan.combines.empty());
+  const detail::Combine& c = plan.combines[0];
+  const TaskId reducer = plan.procs[c.home].ops[c.head].task;
+  TaskId body = kNoTask;
+  for (const detail::Op& op : plan.procs[1].ops)
+    if (body == kNoTask && op.kind == detail::OpKind::kTask) body = op.task;
+  ASSERT_NE(body, kNoTask);
+  const std::string kind = x.graph.kind_name(body);
+  const std::string combine = "waits for task " + std::to_string(reducer) + " (" +
+                              x.graph.kind_name(reducer) +
+                              ") and the tasks after it, run by the last of their 2 threads "
+                              "to arrive";
+  const std::string taken = "thread 0 runs task " + std::to_string(body) + " (" + kind +
+                            "), taken from thread 1's program, inside its wait: it " + combine;
+  const std::string ahead = "thread 1 runs task " + std::to_string(body) + " (" + kind +
+                            "), ahead in its own program, inside its wait: it " + combine;
+  std::vector<detail::ThreadStand> stand(2);
+  stand[0] = {4, 0, reducer, body, 1};
+  EXPECT_EQ(detail::stall_report(x, plan, stand), taken + "; thread 1 has run no task yet");
+  stand[0] = {};
+  stand[1] = {4, 0, reducer, body, 1};
+  EXPECT_EQ(detail::stall_report(x, plan, stand), "thread 0 has run no task yet; " + ahead);
+  // Not inside a wait: the plain clause.
+  stand[1] = {0, 0, body, kNoTask, 0};
+  EXPECT_EQ(detail::stall_report(x, plan, stand),
+            "thread 0 has run no task yet; thread 1 runs or last ran task " +
+                std::to_string(body) + " (" + kind + ")");
+}
+
 // A workload whose body of one task never returns (it sleeps until the process ends).
 class HangingWorkload : public Workload {
  public:
@@ -362,6 +401,8 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         o.pin = false;
         // 1 s, not 200 ms: under ASan beside another test the second thread once ran no
         // task within 200 ms, and the watchdog then named a stall, not the hanging body.
+        // When the second thread starts late, the first may take the hanging body from its
+        // program inside a wait: the report names it there ("runs task ..., taken from").
         o.partition.timeout_ms = 1000;
         o.partition.timeout_exits = true;
         auto ex = make_executor(Policy::kPartition, o);
@@ -369,7 +410,7 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         ex->run_step(g, &a, w);
       },
       ::testing::ExitedWithCode(1),
-      "replay stopped making progress \\(watchdog timeout\\): thread .* runs or last ran task "
+      "replay stopped making progress \\(watchdog timeout\\): thread .* runs (or last ran )?task "
       ".*; a task body does not return, ending the process");
 }
 
