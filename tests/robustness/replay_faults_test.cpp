@@ -303,13 +303,26 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
 
 // A producer of a combined reduction that never arrives: its reducer's processor waits for
 // the combine, and the report says so.
-TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
+// The falling step by object on two threads, lowered and planned as the executor does it
+// (the same lowering, plan and combines).
+struct PlannedFalling {
   const StepGraph& g = falling_step();
   const Assignment a = by_object(g, 2);
-  // The first combine's offer in the plan the executor builds (the same lowering and plan).
   const ExecGraph x = lower(g, &a, CwMode::kReduce);
-  detail::PartitionPlan plan = detail::build_plan(x, 2, true, true);
-  detail::add_combines(x, plan);
+  detail::PartitionPlan plan = [this] {
+    detail::PartitionPlan p = detail::build_plan(x, 2, true, true);
+    detail::add_combines(x, p);
+    return p;
+  }();
+};
+
+TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
+  const PlannedFalling f;
+  const StepGraph& g = f.g;
+  const Assignment& a = f.a;
+  const ExecGraph& x = f.x;
+  const detail::PartitionPlan& plan = f.plan;
+  // The first combine's offer in the plan the executor builds.
   ASSERT_FALSE(plan.combines.empty());
   TaskId lost = kNoTask, reducer = kNoTask;
   for (const detail::ProcPlan& pp : plan.procs)
@@ -340,11 +353,9 @@ TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
 // is named as running it, before the wait it is in: a body that never returns there is the
 // one to look at, not the wait.
 TEST(Watchdog, NamesATaskRunInsideAWaitBeforeTheWait) {
-  const StepGraph& g = falling_step();
-  const Assignment a = by_object(g, 2);
-  const ExecGraph x = lower(g, &a, CwMode::kReduce);
-  detail::PartitionPlan plan = detail::build_plan(x, 2, true, true);
-  detail::add_combines(x, plan);
+  const PlannedFalling f;
+  const ExecGraph& x = f.x;
+  const detail::PartitionPlan& plan = f.plan;
   ASSERT_FALSE(plan.combines.empty());
   const detail::Combine& c = plan.combines[0];
   const TaskId reducer = plan.procs[c.home].ops[c.head].task;
