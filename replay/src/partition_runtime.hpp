@@ -192,12 +192,7 @@ class PartitionExecutor final : public detail::PlannedExecutor<PartitionPlan> {
         steal_ && kind != 3
             ? parking_.wait(
                   c, ok, abort_, parked, waited,
-                  [&] {
-                    if (!try_steal(thread, tc)) return false;
-                    // relaxed: as above.
-                    slot.at_task.store(task, std::memory_order_relaxed);
-                    return true;
-                  },
+                  [&] { return try_steal(thread, tc); },
                   awake, &slot.sleeping)
             : parking_.wait(
                   c, ok, abort_, parked, waited, [] { return false; }, awake, &slot.sleeping);

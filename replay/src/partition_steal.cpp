@@ -82,8 +82,9 @@ bool PartitionExecutor::steal_one(const Op& op, std::uint32_t q, std::uint32_t s
   if (observe) detail::notify_begin(observers(), self, t, n);
   Slot& slot = counters_[self];
   const bool watch = watchdog_ != nullptr;
-  if (watch) {  // relaxed: a report (a body that never returns is named as run here)
-    slot.at_task.store(t, std::memory_order_relaxed);
+  // relaxed: a report (a body that never returns is named as run here, inside the wait
+  // whose task at_task keeps).
+  if (watch) {
     slot.inside_of.store(q, std::memory_order_relaxed);
     slot.inside.store(t, std::memory_order_relaxed);
   }

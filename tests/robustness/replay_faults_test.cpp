@@ -301,8 +301,6 @@ TEST(Watchdog, EndsAStepWhoseWaitIsNeverSignalledNamingTheWait) {
   }
 }
 
-// A producer of a combined reduction that never arrives: its reducer's processor waits for
-// the combine, and the report says so.
 // The falling step by object on two threads, lowered and planned as the executor does it
 // (the same lowering, plan and combines).
 struct PlannedFalling {
@@ -316,6 +314,8 @@ struct PlannedFalling {
   }();
 };
 
+// A producer of a combined reduction that never arrives: its reducer's processor waits for
+// the combine, and the report says so.
 TEST(Watchdog, NamesACombineWhoseProducerNeverArrives) {
   const PlannedFalling f;
   const StepGraph& g = f.g;
@@ -421,8 +421,9 @@ TEST(WatchdogDeathTest, EndsTheProcessWhenATaskBodyNeverReturns) {
         ex->run_step(g, &a, w);
       },
       ::testing::ExitedWithCode(1),
-      "replay stopped making progress \\(watchdog timeout\\): thread .* runs (or last ran )?task "
-      ".*; a task body does not return, ending the process");
+      "replay stopped making progress \\(watchdog timeout\\): thread .* (runs or last ran task "
+      "|runs task .*, (taken from thread [0-9]+'s program|ahead in its own program), inside "
+      "its wait).*; a task body does not return, ending the process");
 }
 
 // A workload whose body of one task sleeps, once, long enough for every thread to stall
