@@ -6,9 +6,6 @@
 
 #include "commands.hpp"
 #include "tgraph/graph/stg.hpp"
-#include "tgraph/graph/trace_io.hpp"
-#include "tgraph/partition/assignment_io.hpp"
-#include "tgraph/partition/partition_graph.hpp"
 #include "tgraph/measure/calibrate.hpp"
 #include "tgraph/partition/compare.hpp"
 #include "tgraph/model/cost_model.hpp"
@@ -83,15 +80,8 @@ void add_partition_verbs(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Assignment file to write (.tga)");
   add_strategy_flags(cmd, *n);
   cmd->callback([a, n] {
-    const Trace trace = read_trace(a->input);
-    if (a->k == 0) throw OptionError("k", "expected at least 1");
-    tp::TracePartition r = tp::partition_trace(trace, a->method, a->k, n->options());
-    if (!a->output.empty()) tp::write_assignment(a->output, r.assignment, trace);
-    // One measure for every method and step: the strategies report their library's own
-    // objective, and some only for the steps they called it on (sticky: step 0).
-    for (std::size_t s = 0; s < r.stats.size() && s < trace.steps.size(); ++s)
-      r.stats[s].edgecut =
-          tp::edgecut(tp::library_graph(trace.steps[s]), r.assignment.steps[s].proc);
+    const tp::TracePartition r =
+        tp::partition_file(a->input, a->method, a->k, n->options(), a->output);
     for (const std::string& w : r.warnings) warn(w);
     std::cout << (a->json ? tp::partition_json(r, a->output) + "\n"
                           : tp::partition_text(r, a->output));

@@ -7,6 +7,7 @@
 #include "tgraph/graph/file_util.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/partition/assignment_io.hpp"
+#include "tgraph/partition/partition_graph.hpp"
 
 namespace tgraph::partition {
 
@@ -72,6 +73,10 @@ TracePartition partition_file(const std::string& trace_path, const std::string& 
   if (k == 0) throw OptionError("k", "expected at least 1");
   TracePartition r = partition_trace(trace, method, k, options);
   if (!output.empty()) write_assignment(output, r.assignment, trace);
+  // One measure for every method and step: the strategies report their library's own
+  // objective, and some only for the steps they called it on (sticky: step 0).
+  for (std::size_t s = 0; s < r.stats.size() && s < trace.steps.size(); ++s)
+    r.stats[s].edgecut = edgecut(library_graph(trace.steps[s]), r.assignment.steps[s].proc);
   return r;
 }
 

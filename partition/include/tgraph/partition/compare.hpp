@@ -29,7 +29,8 @@ PartitionSummary summarize(const std::vector<Stats>& stats);
 
 /// `tgraph partition`: every step of the trace file `trace_path` partitioned with `method` on
 /// `k` processors (an OptionError of the field "k" when 0), the assignment written to
-/// `output` unless it is empty.
+/// `output` unless it is empty; each step's `edgecut` is the cut of library_graph(step) by
+/// its assignment, whatever objective the method's library reported.
 TracePartition partition_file(const std::string& trace_path, const std::string& method,
                               std::uint32_t k, const Options& options, const std::string& output);
 
