@@ -19,7 +19,10 @@
 #include <string>
 
 #include "tgraph/graph/error.hpp"
+#include "tgraph/graph/trace_io.hpp"
 #include "tgraph/graph/undirected.hpp"
+#include "tgraph/mpi/session.hpp"
+#include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/partition_graph.hpp"
 
 static_assert(sizeof(SCOTCH_Num) == 4, "tgraph expects PT-Scotch built with 32-bit SCOTCH_Num");
@@ -432,6 +435,43 @@ std::string ptscotch_text(const PtScotchTraceResult& r, const PtScotchRun& run) 
     << "), imbalance " << r.imbalance << ", " << r.partition_ms << " ms partitioning\n";
   if (!run.output.empty()) o << "wrote " << run.output << "\n";
   return o.str();
+}
+
+PtScotchFileReport ptscotch_partition_file(const PtScotchFileOptions& o, MPI_Comm comm) {
+  int rank = 0, ranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &ranks);
+  const double t0 = MPI_Wtime();
+  Trace trace;
+  agree_on_input(
+      [&] {
+        if (o.nodes == 0) throw UsageError("--nodes: expected at least 1");
+        if (o.cores == 0) throw UsageError("--cores: expected at least 1");
+        trace = read_trace(o.trace);
+        if (o.step && *o.step >= trace.steps.size())
+          throw UsageError("--step: " + std::to_string(*o.step) + " is past the trace's " +
+                           std::to_string(trace.steps.size()) + " steps");
+      },
+      comm);
+  double read_ms = (MPI_Wtime() - t0) * 1e3;
+  MPI_Allreduce(MPI_IN_PLACE, &read_ms, 1, MPI_DOUBLE, MPI_MAX, comm);
+  partition::Options options = o.options;
+  options.scotch = partition::parse_scotch_flavour(o.scotch);
+  const std::size_t first = o.step.value_or(0);
+  const std::size_t last = o.step ? *o.step + 1 : trace.steps.size();
+  PtScotchFileReport r;
+  r.result = ptscotch_partition_trace(trace, first, last, o.nodes, o.cores, options, comm);
+  r.run.trace = o.trace;
+  r.run.output = o.output;
+  r.run.ranks = ranks;
+  r.run.nodes = o.nodes;
+  r.run.cores = o.cores;
+  r.run.first = first;
+  r.run.read_ms = read_ms;
+  r.run.max_rss_mib = max_rss_mib(comm);
+  if (rank == 0 && !o.output.empty())
+    partition::write_assignment(o.output, r.result.assignment, r.result.hashes);
+  return r;
 }
 
 }  // namespace tgraph::mpi

@@ -9,6 +9,7 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -82,5 +83,26 @@ struct PtScotchRun {
 std::string ptscotch_json(const PtScotchTraceResult& r, const PtScotchRun& run);
 /// The same as text (a line, and the output file when one was written).
 std::string ptscotch_text(const PtScotchTraceResult& r, const PtScotchRun& run);
+
+/// What `tgraph-mpi partition` is asked for: the trace file, the .tga to write (none when
+/// empty), the parts, one step or every step, the options and the Scotch flavour's name.
+struct PtScotchFileOptions {
+  std::string trace, output;
+  std::uint32_t nodes = 0, cores = 1;
+  std::optional<std::size_t> step;
+  partition::Options options;
+  std::string scotch = "quality";
+};
+
+/// The partition of a trace file and what its report says beside it.
+struct PtScotchFileReport {
+  PtScotchTraceResult result;
+  PtScotchRun run;
+};
+
+/// `tgraph-mpi partition`, a collective call: every rank reads the trace (a UsageError on
+/// every rank for 0 nodes or cores or a step past the trace's), ptscotch_partition_trace of
+/// the step or steps, and rank 0 writes `output` unless it is empty.
+PtScotchFileReport ptscotch_partition_file(const PtScotchFileOptions& o, MPI_Comm comm);
 
 }  // namespace tgraph::mpi
