@@ -45,6 +45,10 @@ void add_ode_capture_flags(CLI::App* cmd, OdeFlags& flags) {
   cmd->add_option("--threads,-k", flags.threads,
                   "ODE scenes: threads ODE posts its calls for (default 2)")
       ->check(CLI::Range(1u, 1024u));
+  cmd->add_option("--method,-m", flags.method,
+                  "ODE scenes: the policy whose steps are recorded: islands-serial (default: "
+                  "whole islands side by side, each stepped single-threaded), worksteal or "
+                  "islands (ODE's K-thread stages), or a partition strategy");
 }
 
 #if TGRAPH_HAVE_ODE
@@ -78,6 +82,7 @@ void capture_ode(const std::string& scene, std::optional<int> steps, const std::
   o.output = output;
   o.threads = flags.threads;
   o.stepper = ode::parse_stepper(flags.stepper);
+  o.method = ode::choose_method(flags.method);
   const ode::CaptureReport r = ode::capture_scene(o);
   std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
 }

@@ -16,13 +16,14 @@ struct OdeFlags {
   std::string stepper = "quickstep";        ///< quickstep (dWorldQuickStep) or step (dWorldStep)
   std::uint32_t repartition_interval = 10;  ///< partition-guided method: steps between partitions
   std::uint32_t threads = 2;                ///< capture: the threads ODE posts for
+  std::string method = "islands-serial";    ///< capture: the policy whose steps are recorded
 };
 
 /// True for ode-piles, ode-heap, ode-chains (whether or not tgraph::ode is built).
 bool is_ode_scene(const std::string& scene);
 /// `--stepper` and `--repartition-interval` (run, validate).
 void add_ode_flags(CLI::App* cmd, OdeFlags& flags);
-/// `--stepper` and `--threads` (capture).
+/// `--stepper`, `--threads` and `--method` (capture).
 void add_ode_capture_flags(CLI::App* cmd, OdeFlags& flags);
 
 /// `tgraph run --scene ode-*`: prints the report; throws Failure when --check finds "differs".

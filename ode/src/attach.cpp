@@ -19,7 +19,8 @@ namespace {
 using replay::now_ns;  // the steady clock of every timeline
 
 bool runtime_policy(Policy p) {
-  return p == Policy::kWorksteal || p == Policy::kPartition || p == Policy::kIslands;
+  return p == Policy::kWorksteal || p == Policy::kPartition || p == Policy::kIslands ||
+         p == Policy::kIslandsSerial;
 }
 
 }  // namespace
@@ -46,7 +47,7 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
   const Policy policy = options.method.policy;
   if (options.record && !runtime_policy(policy))
     throw OptionError("method",
-                      "recording needs tgraph's runtime (worksteal or a partition "
+                      "recording needs tgraph's runtime (worksteal, islands, islands-serial or a partition "
                       "strategy): under '" +
                           std::string(to_string(policy)) +
                           "' ODE runs its calls where tgraph cannot see them");
@@ -75,11 +76,13 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
       break;
     case Policy::kWorksteal:
     case Policy::kIslands:
+    case Policy::kIslandsSerial:
     case Policy::kPartition: {
       detail::RuntimeOptions ro;
       ro.threads = options.threads;
       ro.placed = policy == Policy::kPartition;
       ro.steal_root_only = policy == Policy::kIslands;
+      ro.serial_islands = policy == Policy::kIslandsSerial;
       ro.spin_ns = options.spin_ns;
       ro.watchdog_s = options.watchdog_s;
       impl_->runtime = std::make_unique<detail::Runtime>(ro);
@@ -117,9 +120,10 @@ void Attachment::world_step(Stepper stepper, dReal dt) {
   const bool partition_point =
       m.strategy && m.stats.steps % std::max<std::uint32_t>(m.options.repartition_interval, 1) == 0;
   const bool record = rt && (m.options.record || partition_point);
-  std::uint64_t calls_before = 0;
+  std::uint64_t calls_before = 0, refused_before = 0;
   if (rt) {
     calls_before = rt->counters().calls;
+    refused_before = rt->serial_islands_refused();
     rt->set_recording(record);
     rt->begin_step(entry);
   }
@@ -140,6 +144,11 @@ void Attachment::world_step(Stepper stepper, dReal dt) {
         " posted no call to tgraph's threading: the world is "
         "not stepped through this attachment (was dWorldSetStepThreadingImplementation "
         "called after attaching?)");
+  if (rt && rt->serial_islands_refused() != refused_before)
+    throw UsageError(std::string(entry) +
+                     " did not plan its step as ODE 0.16.2 does (two thread-count queries, "
+                     "then its island jobs): islands-serial needs ODE 0.16.2's step; this "
+                     "step ran as ODE planned it");
   if (record) {
     log.entry = entry;
     log.host_ns = m.pending_host_ns;

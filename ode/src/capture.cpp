@@ -26,6 +26,7 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   report.options = options;
   AttachOptions a;
   a.threads = options.threads;
+  a.method = options.method;
   // The same steps recorded and not, in one run, three times each alternating (medians): the
   // recording's cost. The last recorded pass is the one written.
   std::vector<StepGraph> steps;
@@ -33,7 +34,8 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   report.steps = options.steps.value_or(default_steps(options.scene));
   // The recorded passes' logs are made and written when attaching, before the timed steps.
   a.reserve_steps = report.steps;
-  a.reserve_room = recording_room(options.scene, options.stepper, a.threads, report.steps);
+  a.reserve_room =
+      recording_room(options.scene, options.stepper, a.threads, report.steps, a.method);
   for (int round = 0; round < 3; ++round) {
     for (const bool record : {false, true}) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
@@ -57,7 +59,8 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   TraceHeader header;
   header.scene = options.scene;
   header.engine = "ODE " + std::string(to_string(options.stepper)) + " through tgraph::ode (" +
-                  std::to_string(options.threads) + " threads, worksteal)";
+                  std::to_string(options.threads) + " threads, " + method_name(options.method) +
+                  ")";
   header.machine = machine_description();
   header.tgraph_version = TGRAPH_VERSION;
   TraceWriter writer(options.output, header);
@@ -72,10 +75,11 @@ CaptureReport capture_scene(const CaptureOptions& options) {
 }
 
 RecordingRoom recording_room(const std::string& scene_name, Stepper stepper, std::uint32_t threads,
-                             std::uint32_t steps) {
+                             std::uint32_t steps, const Method& method) {
   auto scene = Scene::make(scene_name, stepper, 0);
   AttachOptions a;
   a.threads = threads;
+  a.method = method;
   a.record = true;
   Attachment attach(scene->world(), a);
   for (std::uint32_t i = 0; i < steps; ++i) {

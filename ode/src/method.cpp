@@ -20,17 +20,20 @@ std::string_view to_string(Policy policy) {
       return "partition";
     case Policy::kIslands:
       return "islands";
+    case Policy::kIslandsSerial:
+      return "islands-serial";
   }
   return "?";
 }
 
 Method choose_method(std::string_view name) {
-  for (Policy p : {Policy::kSequential, Policy::kOde, Policy::kWorksteal, Policy::kIslands})
+  for (Policy p : {Policy::kSequential, Policy::kOde, Policy::kWorksteal, Policy::kIslands,
+                   Policy::kIslandsSerial})
     if (name == to_string(p)) return {p, ""};
   const std::vector<std::string> strategies = partition::strategy_names();
   if (std::find(strategies.begin(), strategies.end(), name) != strategies.end())
     return {Policy::kPartition, std::string(name)};
-  std::string known = "sequential, ode, worksteal, islands";
+  std::string known = "sequential, ode, worksteal, islands, islands-serial";
   for (const std::string& s : strategies) known += ", " + s;
   throw OptionError("method",
                     "unknown method '" + std::string(name) + "' for an ODE scene (" + known + ")");

@@ -64,6 +64,8 @@ std::uint64_t mix(std::uint64_t h, std::uint64_t v) {
 }
 
 constexpr std::uint32_t kNoRecord = CallRecord::kNone;
+/// The name 0.16.2 posts its island jobs under (util.cpp, dxProcessIslands).
+constexpr const char* kIslandJobs = "World Islands Stepping Start";
 constexpr int kBatch = 64;  // calls moved between a slot's free list and the shared pool
 
 }  // namespace
@@ -240,6 +242,7 @@ Runtime::Runtime(const RuntimeOptions& options)
       advertised_(options.advertised_threads ? options.advertised_threads : options.threads),
       placed_(options.placed),
       steal_root_only_(options.steal_root_only),
+      serial_islands_(options.serial_islands),
       spin_ns_(options.spin_ns),
       watchdog_s_(options.watchdog_s),
       pool_(std::make_unique<Pool>()) {
@@ -395,8 +398,19 @@ std::uint64_t Runtime::call_key(Slot& slot, const char* name, dcallindex_t insta
   return mix(mix(parent, slot.hash_value[i]), instance);
 }
 
+unsigned Runtime::thread_count() {
+  if (!serial_islands_ || !in_step_) return advertised_;
+  // 0.16.2's world step asks twice before posting its island jobs: first to size the island
+  // arenas (K: one per island job), then to plan the step (1: one job, islands stepped by the
+  // single-threaded stepper); the LDLT solver's later queries are capped at 1 by the plan.
+  return step_queries_.fetch_add(1, std::memory_order_relaxed) == 0 ? advertised_ : 1u;
+}
+
 void Runtime::begin_step(const char* entry) {
   root_key_ = fnv1a(entry);
+  step_queries_.store(0, std::memory_order_relaxed);
+  jobs_multiplied_ = false;
+  in_step_ = true;
   if (first_tick_ == 0) {
     first_ns_ = now_ns();
     first_tick_ = stamp();
@@ -421,6 +435,7 @@ void Runtime::begin_step(const char* entry) {
 }
 
 StepLog Runtime::end_step() {
+  in_step_ = false;
   StepLog log;
   if (!recording()) return log;
   const std::int64_t ns = now_ns(), tick = stamp();
@@ -533,6 +548,21 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
                    dCallWaitID call_wait, dThreadedCallFunction* function, void* context,
                    dcallindex_t instance, const char* name) {
   Slot& slot = my_slot();
+  if (serial_islands_ && in_step_ && !jobs_multiplied_ && slot.current == nullptr && name &&
+      dependent_releasee && std::strcmp(name, kIslandJobs) == 0) {
+    // ODE's one island job, posted by the world step's own code. The group it releases
+    // counts K jobs before any of them can complete; the K - 1 added ones step islands with
+    // their own arenas (sized for K) and take islands from ODE's counter as its own jobs do.
+    jobs_multiplied_ = true;
+    if (step_queries_.load(std::memory_order_relaxed) == 2 && instance == 0 && dependencies == 0 &&
+        threads_ > 1) {
+      alter(dependent_releasee, static_cast<ddependencychange_t>(threads_ - 1));
+      for (std::uint32_t i = 1; i < threads_; ++i)
+        post(nullptr, nullptr, 0, dependent_releasee, nullptr, function, context, i, name);
+    } else if (threads_ > 1) {
+      ++serial_refused_;
+    }
+  }
   Call* c = allocate_call(slot);
   c->function = function;
   c->context = context;

@@ -82,6 +82,15 @@ struct RuntimeOptions {
   /// posted (ODE's island jobs); a call posted by a running call stays on its poster's
   /// thread (a stage's instances run one after another there).
   bool steal_root_only = false;
+  /// Serial island stepping: ODE is told K threads when it sizes a step's memory (K island
+  /// arenas) and 1 when it plans the step (one island job, each island stepped by its
+  /// single-threaded stepper, ODE self-threaded's algorithm); the runtime then posts K - 1
+  /// more island jobs beside ODE's, so K threads step whole islands side by side. What later
+  /// ODE offers as `island_stepping_max_threads` (dWorldSetSteppingThreadingParameters, not
+  /// in 0.16.2), made from 0.16.2's own step: it queries the thread count exactly twice
+  /// (sizing, then planning) before it posts its island jobs; a step that queried otherwise
+  /// runs as ODE planned it, its jobs not multiplied, and serial_islands_refused() says so.
+  bool serial_islands = false;
   std::int64_t spin_ns = 50'000;
   double watchdog_s = 60.0;
 };
@@ -136,7 +145,10 @@ class Runtime {
   void alter(dCallReleaseeID releasee, ddependencychange_t change);
   void wait(int* out_wait_status, dCallWaitID wait, const dThreadedWaitTime* timeout,
             const char* name);
-  unsigned thread_count() const { return advertised_; }
+  unsigned thread_count();
+  /// Serial island stepping: the number of world steps whose thread-count queries did not
+  /// follow 0.16.2's pattern (their island jobs were not multiplied).
+  std::uint64_t serial_islands_refused() const { return serial_refused_; }
   int preallocate(ddependencycount_t calls);
 
  private:
@@ -166,6 +178,14 @@ class Runtime {
   std::uint32_t advertised_;
   bool placed_;
   bool steal_root_only_;
+  bool serial_islands_;
+  // Serial island stepping, per world step (the stepping thread's, but thread_count may be
+  // queried from a running call): the queries made since begin_step, whether ODE's island
+  // jobs were multiplied, and whether a world step is under way.
+  std::atomic<std::uint32_t> step_queries_{0};
+  bool jobs_multiplied_ = false;
+  bool in_step_ = false;
+  std::uint64_t serial_refused_ = 0;
   std::int64_t spin_ns_;
   double watchdog_s_;
   dThreadingFunctionsInfo functions_{};

@@ -101,10 +101,11 @@ ValidateReport validate_scene(const ValidateOptions& options) {
                      "unknown ODE scene (ode-piles, ode-heap, ode-chains)");
   // islands: its placement (a posted call on its poster's thread) is no assignment of a
   // captured step the simulator could be given before the step runs.
-  if (options.method.policy != Policy::kWorksteal && options.method.policy != Policy::kPartition)
+  if (options.method.policy != Policy::kWorksteal && options.method.policy != Policy::kPartition &&
+      options.method.policy != Policy::kIslandsSerial)
     throw OptionError("method",
-                      "validate predicts tgraph's runtime from a capture: worksteal or a "
-                      "partition strategy, not '" +
+                      "validate predicts tgraph's runtime from a capture: worksteal, "
+                      "islands-serial or a partition strategy, not '" +
                           method_name(options.method) + "'");
   if (options.threads == 0) throw OptionError("threads", "must be at least 1");
   if (options.repeat == 0) throw OptionError("repeat", "must be at least 1");
@@ -126,9 +127,12 @@ ValidateReport validate_scene(const ValidateOptions& options) {
     ~Close() { dCloseODE(); }
   } close;
   std::vector<double> live, predicted, over;
+  // The steps are recorded under the live run's policy (islands-serial: ODE's plan of
+  // whole islands; worksteal and a strategy: its K-thread stages).
+  const Method& recorded = options.method;
   // The recordings' logs made before their steps: no fresh page faulted in inside a part.
   const RecordingRoom room =
-      recording_room(options.scene, options.stepper, options.threads, options.steps);
+      recording_room(options.scene, options.stepper, options.threads, options.steps, recorded);
   for (std::uint32_t round = 0; round < options.repeat; ++round) {
     const RunResult r = run_scene(run_options(options.scene, options.steps, options.method,
                                               options.threads, 1, options.stepper));
@@ -139,6 +143,7 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
       AttachOptions a;
       a.threads = options.threads;
+      a.method = recorded;
       a.record = true;
       a.reserve_room = room;
       Attachment attach(scene->world(), a);

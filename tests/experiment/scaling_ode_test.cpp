@@ -27,11 +27,12 @@ TEST(ScalingOde, TheOdeScenesRunOdesMethodsAndTheCommandSaysTheScenes) {
   EXPECT_TRUE(p.scenes[0].ode);
   EXPECT_EQ(p.scenes[0].steps, 200u);  // the scene's own, as `tgraph run` takes
   EXPECT_EQ(p.ode_methods,
-            (std::vector<std::string>{"sequential", "ode", "worksteal", "islands", "list"}));
+            (std::vector<std::string>{"sequential", "ode", "worksteal", "islands",
+                                      "islands-serial", "list"}));
   EXPECT_EQ(p.methods_of(p.scenes[1]), p.ode_methods);
-  EXPECT_EQ(p.runs(), 2 * (1 + 5 * 2u));
+  EXPECT_EQ(p.runs(), 2 * (1 + 6 * 2u));
   EXPECT_EQ(p.command(),
-            "scaling threads=1,2 methods=sequential,ode,worksteal,islands,list "
+            "scaling threads=1,2 methods=sequential,ode,worksteal,islands,islands-serial,list "
             "scenes=ode-piles,ode-chains steps=200 repeat=1 out=d");
   // A mix: each kind its own methods; a built-in scene by its label.
   o.scenes = {"bars64", "ode-heap"};
@@ -55,7 +56,7 @@ TEST(ScalingOde, RefusesAnUnknownSceneAndAMethodOdeDoesNotTake) {
   EXPECT_EQ(method.rfind("methods: unknown method 'barrier' for the ODE scenes", 0), 0u) << method;
 }
 
-// A tiny sweep: 3 steps at 1 and 2 threads of ode-piles under ODE's five methods.
+// A tiny sweep: 3 steps at 1 and 2 threads of ode-piles under ODE's six methods.
 TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
   ScalingOptions o;
   o.scenes = {"ode-piles"};
@@ -69,18 +70,20 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
   EXPECT_EQ(res.references[0].scene, "ode-piles");
   EXPECT_EQ(res.references[0].steps, 3u);
   EXPECT_GT(res.references[0].sequential_wall_ns, 0);
-  ASSERT_EQ(res.records.size(), 10u);
+  ASSERT_EQ(res.records.size(), 12u);
   const std::vector<std::pair<std::string, std::string>> order = {{"sequential", "sequential"},
                                                                   {"ode", "ode"},
                                                                   {"worksteal", "worksteal"},
                                                                   {"islands", "islands"},
+                                                                  {"islands-serial",
+                                                                   "islands-serial"},
                                                                   {"partition", "list"}};
   for (std::size_t i = 0; i < res.records.size(); ++i) {
     const ScalingRecord& r = res.records[i];
     SCOPED_TRACE(r.method + " K=" + std::to_string(r.threads));
-    EXPECT_EQ(r.threads, i < 5 ? 1u : 2u);  // every method at one count before the next
-    EXPECT_EQ(r.policy, order[i % 5].first);
-    EXPECT_EQ(r.method, order[i % 5].second);
+    EXPECT_EQ(r.threads, i < 6 ? 1u : 2u);  // every method at one count before the next
+    EXPECT_EQ(r.policy, order[i % 6].first);
+    EXPECT_EQ(r.method, order[i % 6].second);
     EXPECT_TRUE(r.ode);
     EXPECT_EQ(r.steps, 3u);
     EXPECT_GT(r.speedup, 0);
@@ -115,7 +118,7 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
                                       "attribution",
                                       "world_speedup",
                                       "check"};
-  ASSERT_EQ(j["scaling"].size(), 10u);
+  ASSERT_EQ(j["scaling"].size(), 12u);
   for (const nlohmann::json& r : j["scaling"]) {
     std::set<std::string> got;
     for (const auto& [k, v] : r.items()) got.insert(k);

@@ -23,7 +23,7 @@ class OdeWorld : public ::testing::Test {
 };
 
 TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
-  for (const char* method : {"worksteal", "islands", "list", "ode", "sequential"}) {
+  for (const char* method : {"worksteal", "islands", "islands-serial", "list", "ode", "sequential"}) {
     auto scene = Scene::make("ode-piles");
     AttachOptions o;
     o.method = choose_method(method);
@@ -36,8 +36,7 @@ TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
       EXPECT_EQ(s.steps, 10u) << method;
       EXPECT_GT(s.world_ns, 0) << method;
       EXPECT_GT(s.collide_ns, 0) << method;
-      if (o.method.policy == Policy::kWorksteal || o.method.policy == Policy::kPartition ||
-          o.method.policy == Policy::kIslands) {
+      if (o.method.policy != Policy::kOde && o.method.policy != Policy::kSequential) {
         EXPECT_GT(s.calls, 10u * 32) << method;  // every island at least one call a step
       }
     }
@@ -81,6 +80,58 @@ TEST_F(OdeWorld, RecordsEachStepAsAGraphOfOdesCallsInTopologicalOrder) {
     EXPECT_TRUE(g.carried_edges.empty());
   }
   EXPECT_TRUE(attach.take_steps().empty());
+}
+
+// The calls of `steps` recorded steps of ode-piles under islands-serial at `threads`.
+std::vector<StepGraph> serial_islands_steps(std::uint32_t threads, int steps) {
+  auto scene = Scene::make("ode-piles");
+  AttachOptions o;
+  o.method = choose_method("islands-serial");
+  o.threads = threads;
+  o.record = true;
+  Attachment attach(scene->world(), o);
+  for (int i = 0; i < steps; ++i) scene->step(&attach);
+  return attach.take_steps();
+}
+
+TEST_F(OdeWorld, SerialIslandsStepsEachIslandSingleThreadedInOneJobPerThread) {
+  // ODE plans one island job of single-threaded island steps; the runtime adds the others:
+  // K "World Islands Stepping Start" calls (each split at its post of the first selection),
+  // one "Island Stepping Job Start" per island, and no stage of ODE's threaded quickstep.
+  for (const std::uint32_t threads : {1u, 2u, 3u}) {
+    const std::vector<StepGraph> steps = serial_islands_steps(threads, 3);
+    ASSERT_EQ(steps.size(), 3u);
+    for (const StepGraph& g : steps) {
+      EXPECT_EQ(g.validate(), "");
+      int job_parts = 0, island_steps = 0, stages = 0;
+      for (TaskId t = 0; t < g.tasks.size(); ++t) {
+        const std::string kind(g.kind_name(t));
+        job_parts += kind == "World Islands Stepping Start";
+        island_steps += kind == "Island Stepping Job Start";
+        stages += kind.rfind("QuickStepIsland", 0) == 0;
+      }
+      EXPECT_EQ(job_parts, 2 * static_cast<int>(threads)) << threads;
+      // The first steps' boxes fall apart, not touching: each of the 640 its own island.
+      EXPECT_EQ(island_steps, 640) << threads;
+      EXPECT_EQ(stages, 0) << threads;
+    }
+  }
+}
+
+TEST_F(OdeWorld, SerialIslandsOnOneThreadIsOdeSelfThreadedBitForBit) {
+  // One thread, one job: the very algorithm and order of ODE self-threaded (each scene made
+  // just before its steps: making one seeds ODE's random reordering of constraints).
+  const auto forty_steps = [](const char* method) {
+    auto scene = Scene::make("ode-piles");
+    AttachOptions o;
+    o.threads = 1;
+    o.method = choose_method(method);
+    Attachment attach(scene->world(), o);
+    for (int i = 0; i < 40; ++i) scene->step(&attach);
+    return scene->state();
+  };
+  const std::vector<double> reference = forty_steps("sequential");
+  EXPECT_EQ(forty_steps("islands-serial"), reference);
 }
 
 AttachOptions one_thread_recording() {

@@ -84,7 +84,8 @@ TEST_P(OdePhysics, ChainLinksStayWithinJointErrorOfTheirLength) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, OdePhysics,
-                         ::testing::Values("sequential", "worksteal", "islands"));
+                         ::testing::Values("sequential", "worksteal", "islands",
+                                           "islands-serial"));
 
 }  // namespace
 }  // namespace tgraph::ode

@@ -252,6 +252,66 @@ int never_returns(void*, dcallindex_t, dCallReleaseeID) {
   for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
 }
 
+// ODE 0.16.2's world step as islands-serial sees it, planted: `queries` thread-count queries,
+// then one island job posted by the step's own code, releasing a group that counts one job.
+struct PlantedIslandStep {
+  std::atomic<int> jobs{0};
+  std::atomic<std::uint32_t> instances{0};  // bit i: instance i ran
+  static int job(void* c, dcallindex_t i, dCallReleaseeID) {
+    auto* self = static_cast<PlantedIslandStep*>(c);
+    self->jobs.fetch_add(1);
+    self->instances.fetch_or(1u << i);
+    return 1;
+  }
+  // The counts ODE was told, and how many jobs ran before the group's wait returned.
+  std::vector<unsigned> run(Runtime& rt, int queries) {
+    const dThreadingFunctionsInfo* f = rt.functions();
+    dThreadingImplementationID impl = rt.id();
+    rt.begin_step("dWorldQuickStep");
+    std::vector<unsigned> told;
+    for (int q = 0; q < queries; ++q) told.push_back(f->retrieve_thread_count(impl));
+    dCallWaitID w = f->alloc_call_wait(impl);
+    dCallReleaseeID group = nullptr;
+    f->post_call(impl, nullptr, &group, 1, nullptr, w, &PlantedIslandStep::job, this, 99,
+                 "World Islands Stepping Group");
+    f->post_call(impl, nullptr, nullptr, 0, group, nullptr, &PlantedIslandStep::job, this, 0,
+                 "World Islands Stepping Start");
+    f->wait_call(impl, nullptr, w, nullptr, "World Islands Stepping Wait");
+    rt.end_step();
+    f->free_call_wait(impl, w);
+    told.push_back(static_cast<unsigned>(jobs.load()) - 1);  // the group's own call aside
+    return told;
+  }
+};
+
+TEST(RuntimeSerialIslands, TellsKToSizeAnd1ToPlanThenRunsKIslandJobsBeforeTheGroup) {
+  RuntimeOptions o;
+  o.threads = 3;
+  o.watchdog_s = 0;
+  o.serial_islands = true;
+  Runtime rt(o);
+  PlantedIslandStep step;
+  // Sizing told 3, planning 1; the one job became three (instances 0, 1, 2), all done when
+  // the group's wait returned.
+  EXPECT_EQ(step.run(rt, 2), (std::vector<unsigned>{3, 1, 3}));
+  EXPECT_EQ(step.instances.load() & 7u, 7u);
+  EXPECT_EQ(rt.serial_islands_refused(), 0u);
+  EXPECT_EQ(rt.functions()->retrieve_thread_count(rt.id()), 3u);  // between steps: K
+}
+
+TEST(RuntimeSerialIslands, AStepThatQueriedOtherwiseRunsAsPlannedAndIsCounted) {
+  RuntimeOptions o;
+  o.threads = 2;
+  o.watchdog_s = 0;
+  o.serial_islands = true;
+  Runtime rt(o);
+  PlantedIslandStep once, thrice;
+  EXPECT_EQ(once.run(rt, 1), (std::vector<unsigned>{2, 1}));  // one job, as posted
+  EXPECT_EQ(rt.serial_islands_refused(), 1u);
+  EXPECT_EQ(thrice.run(rt, 3), (std::vector<unsigned>{2, 1, 1, 1}));
+  EXPECT_EQ(rt.serial_islands_refused(), 2u);
+}
+
 TEST(RuntimeWatchdog, NamesTheCallThatNeverReturnsAndExits1) {
   EXPECT_EXIT(
       {

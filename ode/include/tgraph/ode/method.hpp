@@ -20,8 +20,12 @@ enum class Policy : std::uint8_t {
   /// (ODE's island jobs); a call posted by a running call runs on its poster's thread, so an
   /// island's stages run on the thread that took the island, one instance after another.
   kIslands = 4,
+  /// tgraph's threads, work stealing, ODE made to step each island with its single-threaded
+  /// stepper (ODE self-threaded's algorithm) and K island jobs: K threads step whole islands
+  /// side by side (docs/ode.md: what later ODE calls island_stepping_max_threads = 1).
+  kIslandsSerial = 5,
 };
-/// "sequential", "ode", "worksteal", "partition" or "islands".
+/// "sequential", "ode", "worksteal", "partition", "islands" or "islands-serial".
 std::string_view to_string(Policy policy);
 
 /// A run's policy and, under the partition policy, the strategy placing the calls.
@@ -29,7 +33,7 @@ struct Method {
   Policy policy = Policy::kWorksteal;
   std::string strategy;  ///< kPartition: a partition strategy (list, metis, ...)
 };
-/// `sequential`, `ode`, `worksteal` or `islands`, else a partition strategy's name (`list`,
+/// `sequential`, `ode`, `worksteal`, `islands` or `islands-serial`, else a partition strategy's name (`list`,
 /// `metis`...) under the partition policy; OptionError of the field "method" for any other name.
 Method choose_method(std::string_view name);
 /// How reports name the method: the strategy under the partition policy, else the policy.

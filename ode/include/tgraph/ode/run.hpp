@@ -88,6 +88,9 @@ struct CaptureOptions {
   std::optional<std::uint32_t> steps;
   std::uint32_t threads = 2;  ///< ODE posts as many instances of a stage as it has threads
   Stepper stepper = Stepper::kQuickStep;
+  /// Whose steps are recorded: tgraph's runtime under this policy (not `ode`, `sequential`).
+  /// islands-serial records whole islands' steps; worksteal and islands ODE's K-thread stages.
+  Method method{Policy::kIslandsSerial, ""};
   std::string output;  ///< .tgt
 };
 
@@ -107,11 +110,11 @@ struct CaptureReport {
 /// steps (recording_room).
 CaptureReport capture_scene(const CaptureOptions& options);
 
-/// The room `steps` recorded steps of the scene at `threads` (worksteal) took in an untimed
-/// recorded pass: AttachOptions::reserve_room for the recorded passes of capture and validate.
-/// Between dInitODE2 and dCloseODE.
+/// The room `steps` recorded steps of the scene at `threads` under `method` (a policy of
+/// tgraph's runtime) took in an untimed recorded pass: AttachOptions::reserve_room for the
+/// recorded passes of capture and validate. Between dInitODE2 and dCloseODE.
 RecordingRoom recording_room(const std::string& scene, Stepper stepper, std::uint32_t threads,
-                             std::uint32_t steps);
+                             std::uint32_t steps, const Method& method = {});
 
 /// `tgraph capture --scene ode-* --json`: one object (scene, steps, tasks, edges, bytes,
 /// recorded_ns, unrecorded_ns, capture_overhead, output) and a newline.
