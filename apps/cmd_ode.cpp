@@ -13,9 +13,10 @@ namespace tgraph::app {
 namespace {
 
 // `owner`, the verbs' default strategy, follows objects; ODE's calls have none (its own
-// fallback would be list): an ODE scene's default is work stealing.
+// fallback would be list): an ODE scene's default is tgraph's best policy there,
+// islands-serial (docs/ode.md).
 [[maybe_unused]] std::string ode_method(const std::string& method) {
-  return method == "owner" ? "worksteal" : method;
+  return method == "owner" ? "islands-serial" : method;
 }
 
 [[maybe_unused]] void no_ode(const std::string& scene) {

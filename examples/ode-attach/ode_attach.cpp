@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
   if (argc < 2) return usage();
   const int steps = std::atoi(argv[1]);
   unsigned threads = 2;
-  std::string method = "worksteal";
+  std::string method = "islands-serial";
   bool json = false;
   for (int i = 2; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--threads") && i + 1 < argc) {
