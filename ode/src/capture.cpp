@@ -27,7 +27,7 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   AttachOptions a;
   a.threads = options.threads;
   a.method = options.method;
-  // The same steps recorded and not, in one run, three times each alternating (medians): the
+  // The same steps recorded and not, in one run, five times each alternating (medians): the
   // recording's cost. The last recorded pass is the one written.
   std::vector<StepGraph> steps;
   std::vector<std::int64_t> off, on;
@@ -36,7 +36,8 @@ CaptureReport capture_scene(const CaptureOptions& options) {
   a.reserve_steps = report.steps;
   a.reserve_room =
       recording_room(options.scene, options.stepper, a.threads, report.steps, a.method);
-  for (int round = 0; round < 3; ++round) {
+  constexpr int kRounds = 5;  // a 50-step pass of ode-piles is some 50 ms: five for a median
+  for (int round = 0; round < kRounds; ++round) {
     for (const bool record : {false, true}) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
       a.record = record;
@@ -47,7 +48,7 @@ CaptureReport capture_scene(const CaptureOptions& options) {
                                   std::chrono::steady_clock::now() - t0)
                                   .count();
       (record ? on : off).push_back(ns);
-      if (record && round == 2) steps = attach.take_steps();  // built after the timed steps
+      if (record && round == kRounds - 1) steps = attach.take_steps();  // built after the timed steps
     }
   }
   report.unrecorded_ns = median(off);

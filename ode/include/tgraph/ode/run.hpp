@@ -99,13 +99,13 @@ struct CaptureReport {
   CaptureOptions options;  ///< as asked
   std::uint32_t steps = 0;
   std::uint64_t tasks = 0, edges = 0, bytes = 0;
-  std::int64_t recorded_ns = 0;    ///< the steps recorded (median of 3 passes)
+  std::int64_t recorded_ns = 0;    ///< the steps recorded (median of 5 passes)
   std::int64_t unrecorded_ns = 0;  ///< the same steps not recorded, alternating, same run
   double overhead = 0;             ///< recorded / unrecorded - 1
 };
 
-/// Runs the scene three times without and three times with recording, alternating
-/// (worksteal at `threads`), and writes the last recorded steps to `output`: one task per
+/// Runs the scene five times without and five times with recording, alternating
+/// (`method` at `threads`), and writes the last recorded steps to `output`: one task per
 /// part of ODE's calls (docs/ode.md). The recorded passes' logs are made before their timed
 /// steps (recording_room).
 CaptureReport capture_scene(const CaptureOptions& options);
