@@ -548,7 +548,8 @@ void Runtime::post(int* out_summary_fault, dCallReleaseeID* out_post_releasee,
                    dCallWaitID call_wait, dThreadedCallFunction* function, void* context,
                    dcallindex_t instance, const char* name) {
   Slot& slot = my_slot();
-  if (serial_islands_ && in_step_ && !jobs_multiplied_ && slot.current == nullptr && name &&
+  // slot.current first: a running call's post (any thread) reads nothing of the step's own.
+  if (serial_islands_ && slot.current == nullptr && in_step_ && !jobs_multiplied_ && name &&
       dependent_releasee && std::strcmp(name, kIslandJobs) == 0) {
     // ODE's one island job, posted by the world step's own code. The group it releases
     // counts K jobs before any of them can complete; the K - 1 added ones step islands with

@@ -284,12 +284,16 @@ struct PlantedIslandStep {
   }
 };
 
-TEST(RuntimeSerialIslands, TellsKToSizeAnd1ToPlanThenRunsKIslandJobsBeforeTheGroup) {
+RuntimeOptions serial_islands(std::uint32_t threads) {
   RuntimeOptions o;
-  o.threads = 3;
+  o.threads = threads;
   o.watchdog_s = 0;
   o.serial_islands = true;
-  Runtime rt(o);
+  return o;
+}
+
+TEST(RuntimeSerialIslands, TellsKToSizeAnd1ToPlanThenRunsKIslandJobsBeforeTheGroup) {
+  Runtime rt(serial_islands(3));
   PlantedIslandStep step;
   // Sizing told 3, planning 1; the one job became three (instances 0, 1, 2), all done when
   // the group's wait returned.
@@ -300,11 +304,7 @@ TEST(RuntimeSerialIslands, TellsKToSizeAnd1ToPlanThenRunsKIslandJobsBeforeTheGro
 }
 
 TEST(RuntimeSerialIslands, AStepThatQueriedOtherwiseRunsAsPlannedAndIsCounted) {
-  RuntimeOptions o;
-  o.threads = 2;
-  o.watchdog_s = 0;
-  o.serial_islands = true;
-  Runtime rt(o);
+  Runtime rt(serial_islands(2));
   PlantedIslandStep once, thrice;
   EXPECT_EQ(once.run(rt, 1), (std::vector<unsigned>{2, 1}));  // one job, as posted
   EXPECT_EQ(rt.serial_islands_refused(), 1u);
