@@ -15,8 +15,8 @@
 namespace tgraph::experiment::detail {
 
 const std::vector<std::string>& default_ode_methods() {
-  static const std::vector<std::string> methods = {"sequential", "ode",     "worksteal",
-                                                   "islands",    "islands-serial", "list"};
+  static const std::vector<std::string> methods = {"sequential",     "ode", "worksteal", "islands",
+                                                   "islands-serial", "list"};
   return methods;
 }
 

@@ -46,11 +46,11 @@ Attachment::Attachment(dWorldID world, const AttachOptions& options)
   if (world == nullptr) throw OptionError("world", "no ODE world to attach to (null dWorldID)");
   const Policy policy = options.method.policy;
   if (options.record && !runtime_policy(policy))
-    throw OptionError("method",
-                      "recording needs tgraph's runtime (worksteal, islands, islands-serial or a partition "
-                      "strategy): under '" +
-                          std::string(to_string(policy)) +
-                          "' ODE runs its calls where tgraph cannot see them");
+    throw OptionError(
+        "method",
+        "recording needs tgraph's runtime (worksteal, islands, islands-serial or a partition "
+        "strategy): under '" +
+            std::string(to_string(policy)) + "' ODE runs its calls where tgraph cannot see them");
   if (policy == Policy::kPartition)
     impl_->strategy = partition::make_strategy(options.method.strategy);
   impl_->world = world;

@@ -48,7 +48,8 @@ CaptureReport capture_scene(const CaptureOptions& options) {
                                   std::chrono::steady_clock::now() - t0)
                                   .count();
       (record ? on : off).push_back(ns);
-      if (record && round == kRounds - 1) steps = attach.take_steps();  // built after the timed steps
+      if (record && round == kRounds - 1)
+        steps = attach.take_steps();  // built after the timed steps
     }
   }
   report.unrecorded_ns = median(off);

@@ -26,9 +26,8 @@ TEST(ScalingOde, TheOdeScenesRunOdesMethodsAndTheCommandSaysTheScenes) {
   ASSERT_EQ(p.scenes.size(), 2u);
   EXPECT_TRUE(p.scenes[0].ode);
   EXPECT_EQ(p.scenes[0].steps, 200u);  // the scene's own, as `tgraph run` takes
-  EXPECT_EQ(p.ode_methods,
-            (std::vector<std::string>{"sequential", "ode", "worksteal", "islands",
-                                      "islands-serial", "list"}));
+  EXPECT_EQ(p.ode_methods, (std::vector<std::string>{"sequential", "ode", "worksteal", "islands",
+                                                     "islands-serial", "list"}));
   EXPECT_EQ(p.methods_of(p.scenes[1]), p.ode_methods);
   EXPECT_EQ(p.runs(), 2 * (1 + 6 * 2u));
   EXPECT_EQ(p.command(),
@@ -71,13 +70,10 @@ TEST(ScalingOde, ATinySweepGivesARecordPerMethodAndThreadCountWithOdesFigures) {
   EXPECT_EQ(res.references[0].steps, 3u);
   EXPECT_GT(res.references[0].sequential_wall_ns, 0);
   ASSERT_EQ(res.records.size(), 12u);
-  const std::vector<std::pair<std::string, std::string>> order = {{"sequential", "sequential"},
-                                                                  {"ode", "ode"},
-                                                                  {"worksteal", "worksteal"},
-                                                                  {"islands", "islands"},
-                                                                  {"islands-serial",
-                                                                   "islands-serial"},
-                                                                  {"partition", "list"}};
+  const std::vector<std::pair<std::string, std::string>> order = {
+      {"sequential", "sequential"},         {"ode", "ode"},
+      {"worksteal", "worksteal"},           {"islands", "islands"},
+      {"islands-serial", "islands-serial"}, {"partition", "list"}};
   for (std::size_t i = 0; i < res.records.size(); ++i) {
     const ScalingRecord& r = res.records[i];
     SCOPED_TRACE(r.method + " K=" + std::to_string(r.threads));

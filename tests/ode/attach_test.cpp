@@ -23,7 +23,8 @@ class OdeWorld : public ::testing::Test {
 };
 
 TEST_F(OdeWorld, StepsOnTwoThreadsUnderEachPolicy) {
-  for (const char* method : {"worksteal", "islands", "islands-serial", "list", "ode", "sequential"}) {
+  for (const char* method :
+       {"worksteal", "islands", "islands-serial", "list", "ode", "sequential"}) {
     auto scene = Scene::make("ode-piles");
     AttachOptions o;
     o.method = choose_method(method);

@@ -84,8 +84,7 @@ TEST_P(OdePhysics, ChainLinksStayWithinJointErrorOfTheirLength) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Methods, OdePhysics,
-                         ::testing::Values("sequential", "worksteal", "islands",
-                                           "islands-serial"));
+                         ::testing::Values("sequential", "worksteal", "islands", "islands-serial"));
 
 }  // namespace
 }  // namespace tgraph::ode

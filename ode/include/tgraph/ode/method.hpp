@@ -33,8 +33,9 @@ struct Method {
   Policy policy = Policy::kWorksteal;
   std::string strategy;  ///< kPartition: a partition strategy (list, metis, ...)
 };
-/// `sequential`, `ode`, `worksteal`, `islands` or `islands-serial`, else a partition strategy's name (`list`,
-/// `metis`...) under the partition policy; OptionError of the field "method" for any other name.
+/// `sequential`, `ode`, `worksteal`, `islands` or `islands-serial`, else a partition strategy's
+/// name (`list`, `metis`...) under the partition policy; OptionError of the field "method" for any
+/// other name.
 Method choose_method(std::string_view name);
 /// How reports name the method: the strategy under the partition policy, else the policy.
 std::string method_name(const Method& method);
