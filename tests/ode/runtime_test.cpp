@@ -260,9 +260,10 @@ struct PlantedIslandStep {
   static int job(void* c, dcallindex_t i, dCallReleaseeID) {
     auto* self = static_cast<PlantedIslandStep*>(c);
     self->jobs.fetch_add(1);
-    self->instances.fetch_or(1u << i);
+    if (i < 32) self->instances.fetch_or(1u << i);
     return 1;
   }
+  static int group(void*, dcallindex_t, dCallReleaseeID) { return 1; }  // a wrapper, as ODE's
   // The counts ODE was told, and how many jobs ran before the group's wait returned.
   std::vector<unsigned> run(Runtime& rt, int queries) {
     const dThreadingFunctionsInfo* f = rt.functions();
@@ -271,15 +272,15 @@ struct PlantedIslandStep {
     std::vector<unsigned> told;
     for (int q = 0; q < queries; ++q) told.push_back(f->retrieve_thread_count(impl));
     dCallWaitID w = f->alloc_call_wait(impl);
-    dCallReleaseeID group = nullptr;
-    f->post_call(impl, nullptr, &group, 1, nullptr, w, &PlantedIslandStep::job, this, 99,
+    dCallReleaseeID releasee = nullptr;
+    f->post_call(impl, nullptr, &releasee, 1, nullptr, w, &PlantedIslandStep::group, this, 0,
                  "World Islands Stepping Group");
-    f->post_call(impl, nullptr, nullptr, 0, group, nullptr, &PlantedIslandStep::job, this, 0,
+    f->post_call(impl, nullptr, nullptr, 0, releasee, nullptr, &PlantedIslandStep::job, this, 0,
                  "World Islands Stepping Start");
     f->wait_call(impl, nullptr, w, nullptr, "World Islands Stepping Wait");
     rt.end_step();
     f->free_call_wait(impl, w);
-    told.push_back(static_cast<unsigned>(jobs.load()) - 1);  // the group's own call aside
+    told.push_back(static_cast<unsigned>(jobs.load()));
     return told;
   }
 };
