@@ -372,8 +372,8 @@ PtScotchResult ptscotch_partition(const StepGraph& g, std::uint32_t nodes, std::
 
 PtScotchTraceResult ptscotch_partition_trace(const Trace& trace, std::size_t first,
                                              std::size_t last, std::uint32_t nodes,
-                                             std::uint32_t cores,
-                                             const partition::Options& options, MPI_Comm comm) {
+                                             std::uint32_t cores, const partition::Options& options,
+                                             MPI_Comm comm) {
   PtScotchTraceResult out;
   out.assignment.method = "ptscotch";
   out.assignment.k = nodes * cores;
@@ -429,10 +429,10 @@ std::string ptscotch_json(const PtScotchTraceResult& r, const PtScotchRun& run) 
 
 std::string ptscotch_text(const PtScotchTraceResult& r, const PtScotchRun& run) {
   std::ostringstream o;
-  o << "ptscotch on " << run.ranks << " rank(s): " << r.assignment.steps.size()
-    << " step(s) over " << run.nodes << " nodes x " << run.cores << " cores (k = "
-    << r.assignment.k << "): cut " << r.cut << " (between nodes " << r.node_cut
-    << "), imbalance " << r.imbalance << ", " << r.partition_ms << " ms partitioning\n";
+  o << "ptscotch on " << run.ranks << " rank(s): " << r.assignment.steps.size() << " step(s) over "
+    << run.nodes << " nodes x " << run.cores << " cores (k = " << r.assignment.k << "): cut "
+    << r.cut << " (between nodes " << r.node_cut << "), imbalance " << r.imbalance << ", "
+    << r.partition_ms << " ms partitioning\n";
   if (!run.output.empty()) o << "wrote " << run.output << "\n";
   return o.str();
 }
@@ -445,12 +445,12 @@ PtScotchFileReport ptscotch_partition_file(const PtScotchFileOptions& o, MPI_Com
   Trace trace;
   agree_on_input(
       [&] {
-        if (o.nodes == 0) throw UsageError("--nodes: expected at least 1");
-        if (o.cores == 0) throw UsageError("--cores: expected at least 1");
+        if (o.nodes == 0) throw OptionError("nodes", "expected at least 1");
+        if (o.cores == 0) throw OptionError("cores", "expected at least 1");
         trace = read_trace(o.trace);
         if (o.step && *o.step >= trace.steps.size())
-          throw UsageError("--step: " + std::to_string(*o.step) + " is past the trace's " +
-                           std::to_string(trace.steps.size()) + " steps");
+          throw OptionError("step", std::to_string(*o.step) + " is past the trace's " +
+                                        std::to_string(trace.steps.size()) + " steps");
       },
       comm);
   double read_ms = (MPI_Wtime() - t0) * 1e3;
