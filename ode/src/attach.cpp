@@ -18,10 +18,8 @@ namespace {
 
 using replay::now_ns;  // the steady clock of every timeline
 
-bool runtime_policy(Policy p) {
-  return p == Policy::kWorksteal || p == Policy::kPartition || p == Policy::kIslands ||
-         p == Policy::kIslandsSerial;
-}
+// Every policy but ODE's own stepping runs the calls on tgraph's runtime.
+bool runtime_policy(Policy p) { return p != Policy::kOde && p != Policy::kSequential; }
 
 }  // namespace
 

@@ -128,11 +128,10 @@ ValidateReport validate_scene(const ValidateOptions& options) {
   } close;
   std::vector<double> live, predicted, over;
   // The steps are recorded under the live run's policy (islands-serial: ODE's plan of
-  // whole islands; worksteal and a strategy: its K-thread stages).
-  const Method& recorded = options.method;
-  // The recordings' logs made before their steps: no fresh page faulted in inside a part.
-  const RecordingRoom room =
-      recording_room(options.scene, options.stepper, options.threads, options.steps, recorded);
+  // whole islands; worksteal and a strategy: its K-thread stages), their logs made before
+  // their steps: no fresh page faulted in inside a part.
+  const RecordingRoom room = recording_room(options.scene, options.stepper, options.threads,
+                                            options.steps, options.method);
   for (std::uint32_t round = 0; round < options.repeat; ++round) {
     const RunResult r = run_scene(run_options(options.scene, options.steps, options.method,
                                               options.threads, 1, options.stepper));
@@ -143,7 +142,7 @@ ValidateReport validate_scene(const ValidateOptions& options) {
       auto scene = Scene::make(options.scene, options.stepper, 0);
       AttachOptions a;
       a.threads = options.threads;
-      a.method = recorded;
+      a.method = options.method;
       a.record = true;
       a.reserve_room = room;
       Attachment attach(scene->world(), a);

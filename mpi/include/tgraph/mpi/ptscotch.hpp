@@ -100,9 +100,10 @@ struct PtScotchFileReport {
   PtScotchRun run;
 };
 
-/// `tgraph-mpi partition`, a collective call: every rank reads the trace (a UsageError on
-/// every rank for 0 nodes or cores or a step past the trace's), ptscotch_partition_trace of
-/// the step or steps, and rank 0 writes `output` unless it is empty.
+/// `tgraph-mpi partition`, a collective call: every rank reads the trace (an OptionError of
+/// `nodes`, `cores` or `step` on every rank for 0 nodes or cores or a step past the
+/// trace's), ptscotch_partition_trace of the step or steps, and rank 0 writes `output`
+/// unless it is empty.
 PtScotchFileReport ptscotch_partition_file(const PtScotchFileOptions& o, MPI_Comm comm);
 
 }  // namespace tgraph::mpi

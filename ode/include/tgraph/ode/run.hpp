@@ -114,7 +114,7 @@ CaptureReport capture_scene(const CaptureOptions& options);
 /// tgraph's runtime) took in an untimed recorded pass: AttachOptions::reserve_room for the
 /// recorded passes of capture and validate. Between dInitODE2 and dCloseODE.
 RecordingRoom recording_room(const std::string& scene, Stepper stepper, std::uint32_t threads,
-                             std::uint32_t steps, const Method& method = {});
+                             std::uint32_t steps, const Method& method);
 
 /// `tgraph capture --scene ode-* --json`: one object (scene, steps, tasks, edges, bytes,
 /// recorded_ns, unrecorded_ns, capture_overhead, output) and a newline.
