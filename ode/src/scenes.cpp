@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <random>
 
 #include "tgraph/graph/error.hpp"
 #include "tgraph/ode/attach.hpp"
@@ -29,21 +30,41 @@ std::uint32_t default_steps(std::string_view scene) { return scene == "ode-heap"
 std::uint32_t Scene::default_steps() const { return ode::default_steps(name_); }
 
 void Scene::near_callback(void* data, dGeomID a, dGeomID b) {
-  auto* scene = static_cast<Scene*>(data);
+  static_cast<Scene*>(data)->contacts(a, b);
+}
+
+void Scene::pair_callback(void* data, dGeomID a, dGeomID b) {
+  static_cast<Scene*>(data)->pairs_.emplace_back(a, b);
+}
+
+void Scene::contacts(dGeomID a, dGeomID b) {
   dBodyID ba = dGeomGetBody(a), bb = dGeomGetBody(b);
   if (ba == nullptr && bb == nullptr) return;  // two static geoms
-  if (scene->skip_connected_ && ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact))
-    return;
+  if (skip_connected_ && ba && bb && dAreConnectedExcluding(ba, bb, dJointTypeContact)) return;
   dContact contact[kMaxContacts] = {};
   const int n = dCollide(a, b, kMaxContacts, &contact[0].geom, sizeof(dContact));
   for (int i = 0; i < n; ++i) {
     contact[i].surface.mode = dContactApprox1 | dContactSoftERP;
     contact[i].surface.mu = 0.5;
     contact[i].surface.soft_erp = 0.5;
-    dJointID j = dJointCreateContact(scene->world_, scene->contacts_, &contact[i]);
+    dJointID j = dJointCreateContact(world_, contacts_, &contact[i]);
     dJointAttach(j, ba, bb);
   }
 }
+
+void Scene::collide() {
+  if (shuffle_seed_ == 0) {
+    dSpaceCollide(space_, this, &near_callback);
+    return;
+  }
+  pairs_.clear();
+  dSpaceCollide(space_, this, &pair_callback);
+  std::mt19937_64 draw(shuffle_seed_ * 0x9e3779b97f4a7c15ull + shuffled_steps_++);
+  std::shuffle(pairs_.begin(), pairs_.end(), draw);
+  for (const auto& [a, b] : pairs_) (draw() & 1) ? contacts(b, a) : contacts(a, b);
+}
+
+void Scene::shuffle_contacts(unsigned long seed) { shuffle_seed_ = seed; }
 
 std::unique_ptr<Scene> Scene::make(std::string_view name, Stepper stepper, unsigned long seed) {
   if (!is_scene(name))
@@ -152,7 +173,7 @@ StepTime Scene::step(Attachment* attach) {
     t.world_ns = now_ns() - w0;
   } else {
     const std::int64_t c0 = now_ns();
-    dSpaceCollide(space_, this, &near_callback);
+    collide();
     const std::int64_t c1 = now_ns();
     if (stepper_ == Stepper::kQuickStep)
       dWorldQuickStep(world_, kDt);

@@ -49,6 +49,20 @@ TEST(OdeRun, OneThreadOfTgraphsRuntimeIsIdenticalToOdeSelfThreaded) {
   EXPECT_EQ(run_scene(o).check, "identical");
 }
 
+TEST(OdeRun, DWorldStepOnTwoThreadsIsWithinTheSpreadOfAnotherContactOrder) {
+  // dWorldStep has no random reordering; two island jobs make the next step's contacts in
+  // another order (docs/ode.md, "The check"), which its LCP on these piles turns into
+  // centimetres: the tolerance is what another contact order does to ODE self-threaded.
+  RunOptions o =
+      run_options("ode-piles", 40, choose_method("islands-serial"), 2, 1, Stepper::kStep);
+  o.check = true;
+  const RunResult r = run_scene(o);
+  EXPECT_NE(r.check, "differs") << r.max_abs_diff << " m, tolerance " << r.tolerance << " m";
+  if (r.check == "within-tolerance") {
+    EXPECT_LE(r.max_abs_diff, r.tolerance);
+  }
+}
+
 TEST(OdeRun, RefusesBadOptionsByName) {
   RunOptions o;
   o.scene = "ode-nothing";

@@ -63,6 +63,13 @@ class Scene {
   /// Moves every body by `dx` along x (the scenes are invariant under it): a perturbation of
   /// the size of rounding, whose growth is what rounding alone can do to a run.
   void nudge(double dx);
+  /// From now on each self-threaded step's (step(nullptr)) contact joints are made in an
+  /// order shuffled with `seed` (0: the collision's own order, the default): the same
+  /// contacts, which ODE's constraint solvers then take in another order. A K-thread run reorders
+  /// them so (K island jobs mark their bodies' geoms moved in the order they step them, and the
+  /// collision space keeps moved geoms in that order); `run --check` measures what this does to ODE
+  /// self-threaded.
+  void shuffle_contacts(unsigned long seed);
   /// Every body's position, quaternion, linear and angular velocity (13 numbers a body).
   std::vector<double> state() const;
   /// The scene's length scale (m): its box edge or link length.
@@ -81,6 +88,9 @@ class Scene {
  private:
   Scene() = default;
   static void near_callback(void* data, dGeomID a, dGeomID b);
+  static void pair_callback(void* data, dGeomID a, dGeomID b);
+  void contacts(dGeomID a, dGeomID b);
+  void collide();
   std::string name_;
   Stepper stepper_ = Stepper::kQuickStep;
   double length_ = 0.5;
@@ -91,6 +101,9 @@ class Scene {
   std::vector<dGeomID> geoms_;  ///< every geom (bodies', the plane, the bin's walls)
   std::vector<dJointID> hinges_;
   bool skip_connected_ = false;
+  unsigned long shuffle_seed_ = 0;
+  std::uint64_t shuffled_steps_ = 0;
+  std::vector<std::pair<dGeomID, dGeomID>> pairs_;  ///< shuffle_contacts: a step's pairs
 };
 
 }  // namespace tgraph::ode
