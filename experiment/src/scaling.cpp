@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
 #include "common.hpp"
@@ -389,8 +390,11 @@ ScalingResult run_scaling(const ScalingOptions& options, Progress& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   ScalingResult res = detail::start_experiment<ScalingResult>(options, plan_scaling, progress);
   const ScalingPlan& p = res.plan;
+  std::set<std::string> methods;  // the built-in scenes' and the ODE scenes' that run
+  for (const ScalingScene& s : p.scenes)
+    methods.insert(p.methods_of(s).begin(), p.methods_of(s).end());
   progress.note("experiment scaling on " + res.machine.summary() + ": " +
-                std::to_string(p.scenes.size()) + " scenes, " + std::to_string(p.methods.size()) +
+                std::to_string(p.scenes.size()) + " scenes, " + std::to_string(methods.size()) +
                 " methods, " + std::to_string(p.threads.size()) + " thread counts; " +
                 std::to_string(p.runs()) + " runs");
   for (const std::string& n : p.notes) progress.note(n);
