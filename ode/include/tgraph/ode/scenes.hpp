@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // ODE scenes made with ODE's public API: ode-piles (many islands), ode-heap (one big island),
-// ode-chains (joint-heavy). Each step: dSpaceCollide (hash space, ground plane, contacts
-// dContactApprox1 | dContactSoftERP, mu 0.5, soft_erp 0.5, up to 4 per pair), the world step
-// (dt 0.005), the contact group emptied.
+// ode-chains (joint-heavy). Each step: dSpaceCollide (sweep-and-prune space, ground plane,
+// contacts dContactApprox1 | dContactSoftERP, mu 0.5, soft_erp 0.5, up to 4 per pair), the
+// world step (dt 0.005), the contact group emptied.
 #pragma once
 
 #include <ode/ode.h>
@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "tgraph/ode/method.hpp"
