@@ -41,12 +41,12 @@ void add_viz_verbs(CLI::App& app) {
     try {
       note = viz::draw_step(trace, a->input, a->step, assignment, *o, a->output);
     } catch (const OptionError& e) {
-      // Too many tasks to draw one by one, and neither an aggregation nor a limit asked for
-      // (a captured ODE step's falling phase has thousands of parts): the step's kinds, said
-      // on stderr. Asked for, the refusal stands.
+      // More tasks than nodes drawn one by one, and neither an aggregation nor a limit asked
+      // for (a captured ODE step's falling phase has thousands of parts): the step's kinds,
+      // said on stderr. Asked for, or too many edges, the refusal stands.
       const bool asked =
           cmd->count("--collapse") + cmd->count("--max-nodes") + cmd->count("--max-edges") > 0;
-      if (asked || (e.option() != "max_nodes" && e.option() != "max_edges")) throw;
+      if (asked || e.option() != "max_nodes") throw;
       viz::ViewOptions by_kind = *o;
       by_kind.collapse = viz::Collapse::kKind;
       note = viz::draw_step(trace, a->input, a->step, assignment, by_kind, a->output);
