@@ -21,12 +21,17 @@ namespace {
 //   box sink a few millimetres; a box through the floor is 0.3-0.5 m below);
 // - at rest: the boxes' kinetic energy that of every box moving at 5 cm/s (their
 //   root-mean-square speed below 0.05 m/s; ODE's 20 Gauss-Seidel iterations leave a few boxes
-//   of a heap jittering, so no single box's speed is the criterion), over the last 0.5 s
-//   (100 steps) of 6 s (1200 steps). When a heap settles depends on the order its contacts
-//   are solved in, which under ODE's parallel LCP is the run's timing: self-threaded it is at
-//   about 0.005 m/s from 2.5 s on; on two threads it came to rest between 1.5 and 3 s, and a
-//   brick that slid late moved it again at 4 s (2026-12-02, four runs; every run at 0.004 to
-//   0.005 m/s at 5.5 and 6 s), so the check is that it has come to rest, not when;
+//   of a heap jittering, so no single box's speed is the criterion). When a heap settles,
+//   and when a brick slides off it later, depends on the order its contacts are solved in,
+//   which a multi-threaded run's timing sets: on two threads it came to rest between 1.5 and
+//   3 s (2026-12-02, four runs) and a brick that slid late moved it again at 4 s; ODE
+//   self-threaded with another order of its contacts last passed 5 cm/s at step 812, and
+//   islands-serial at steps 1031 and 1051 (2026-12-04, 22 runs of 2400 steps: every one at
+//   0.003 to 0.006 m/s at 1200, 1600, 2000 and 2400), and CI once saw a slide in the last 100
+//   of 1200 steps (0.055 m/s there at most). So the check is that the heap comes to rest (100
+//   consecutive steps, 0.5 s, below the speed) and is at rest at the end (the median of the
+//   last 100 of 6 s (1200 steps) below it: a late slide of a few steps does not move the
+//   median), not when it settles nor that nothing ever slides;
 constexpr double kFloorDepth = 0.01;
 constexpr double kRestSpeed = 0.05;
 constexpr double kJointError = 0.05;
@@ -65,16 +70,24 @@ TEST_P(OdePhysics, PilesStayAboveTheFloor) {
 
 TEST_P(OdePhysics, HeapComesToRestInItsBin) {
   auto scene = Scene::make("ode-heap");
-  // The overhanging bricks fall, tumble and settle; the fastest rms speed of the last 100
-  // steps, and the fastest of all (the fall itself, far above rest).
-  double last = 0.0, fastest = 0.0;
-  run(*scene, kHeapSteps, [&](std::uint32_t i) {
-    const double v = scene->rms_speed();
-    fastest = std::max(fastest, v);
-    if (i > kHeapSteps - kRestSteps) last = std::max(last, v);
-  });
-  EXPECT_LT(last, kRestSpeed) << "not at rest over the last " << kRestSteps << " steps";
-  EXPECT_GT(fastest, 2 * kRestSpeed) << "the bricks did not fall";
+  // The overhanging bricks fall, tumble and settle: each step's rms speed.
+  std::vector<double> v;
+  run(*scene, kHeapSteps, [&](std::uint32_t) { v.push_back(scene->rms_speed()); });
+  ASSERT_EQ(v.size(), kHeapSteps);
+  const auto fall = std::max_element(v.begin(), v.end());
+  EXPECT_GT(*fall, 2 * kRestSpeed) << "the bricks did not fall";
+  // Comes to rest: kRestSteps consecutive steps below the speed, after the fall.
+  std::uint32_t run_below = 0, longest = 0;
+  for (auto it = fall; it != v.end(); ++it) {
+    run_below = *it < kRestSpeed ? run_below + 1 : 0;
+    longest = std::max(longest, run_below);
+  }
+  EXPECT_GE(longest, kRestSteps) << "never " << kRestSteps << " steps at rest after the fall";
+  // At rest at the end: the median of the last kRestSteps.
+  std::vector<double> last(v.end() - kRestSteps, v.end());
+  std::nth_element(last.begin(), last.begin() + kRestSteps / 2, last.end());
+  EXPECT_LT(last[kRestSteps / 2], kRestSpeed)
+      << "not at rest over the last " << kRestSteps << " steps (median)";
   EXPECT_LT(scene->depth_below_floor(), kFloorDepth);
 }
 
