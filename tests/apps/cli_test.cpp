@@ -12,11 +12,11 @@
 #include <string>
 #include <utility>
 
-#include "../scratch_dir.hpp"
-#include "cli_run.hpp"
 #include "tgraph/graph/timeline.hpp"
 #include "tgraph/graph/trace_io.hpp"
 #include "tgraph/version.hpp"
+#include "../scratch_dir.hpp"
+#include "cli_run.hpp"
 
 namespace {
 
@@ -27,7 +27,9 @@ using tgraph::test::slurp;
 
 class Cli : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = tgraph::test::scratch_dir("tgraph_cli_"); }
+  void SetUp() override {
+    dir_ = tgraph::test::scratch_dir("tgraph_cli_");
+  }
   void TearDown() override { fs::remove_all(dir_); }
 
   Result run(const std::string& args) { return tgraph::test::run_tgraph(dir_, args); }
@@ -108,8 +110,7 @@ TEST_F(Cli, ExperimentVizTimelineValidateAndDemoErrorsNameTheFlag) {
       {"experiment independent --threads 1,,2", "tgraph: --threads 1,,2: expected counts"},
       {"experiment independent --threads 4-2", "tgraph: --threads 4-2: expected counts"},
       {"experiment metg --threads 2000", "tgraph: --threads 2000: expected counts"},
-      {"experiment independent --methods owner,nosuch",
-       "tgraph: --methods: unknown method 'nosuch'"},
+      {"experiment independent --methods owner,nosuch", "tgraph: --methods: unknown method 'nosuch'"},
       {"experiment scaling --methods sequential", "tgraph: --methods: sequential is every run's"},
       {"experiment metg --methods owner", "tgraph: --methods: unknown policy 'owner'"},
       {"experiment domain --subobjects 5", "tgraph: --subobjects: 5 is not a perfect square"},
@@ -135,8 +136,7 @@ TEST_F(Cli, ExperimentVizTimelineValidateAndDemoErrorsNameTheFlag) {
   const nlohmann::json j =
       run_json("experiment metg --quick --threads 2,1-2 --methods sequential --out m --json");
   EXPECT_EQ(j["threads"], (nlohmann::json{1, 2}));
-  EXPECT_EQ(j["command"],
-            "tgraph experiment metg --quick --threads 1,2 --methods sequential --out m");
+  EXPECT_EQ(j["command"], "tgraph experiment metg --quick --threads 1,2 --methods sequential --out m");
 }
 
 #ifdef TGRAPH_HAVE_ODE
@@ -269,10 +269,7 @@ TEST_F(Cli, ExportedGraphsAreAcceptedByGpmetisAndScotchGpart) {
       << slurp(dir_ / "gpmetis.out");
   EXPECT_NE(slurp(dir_ / "gpmetis.out").find("Edgecut:"), std::string::npos);
   EXPECT_TRUE(fs::exists(dir_ / "g.metis.part.2"));
-  ASSERT_EQ(
-      std::system(("scotch_gpart 2 '" + d + "/g.grf' '" + d + "/g.map' >'" + d + "/gpart.out' 2>&1")
-                      .c_str()),
-      0)
+  ASSERT_EQ(std::system(("scotch_gpart 2 '" + d + "/g.grf' '" + d + "/g.map' >'" + d + "/gpart.out' 2>&1").c_str()), 0)
       << slurp(dir_ / "gpart.out");
   // The mapping file: vertex count, then one "vertex part" line per vertex.
   std::ifstream map(dir_ / "g.map");
@@ -300,8 +297,7 @@ TEST_F(Cli, DemoComparesEveryStrategyWithTheBaselinesAndWritesAReport) {
       EXPECT_GE(row["imbalance"].get<double>(), 1.0) << row.dump();
     }
   }
-  for (const char* m : {"owner", "metis", "scotch", "sticky", "list", "roundrobin", "random",
-                        "worksteal", "barrier"})
+  for (const char* m : {"owner", "metis", "scotch", "sticky", "list", "roundrobin", "random", "worksteal", "barrier"})
     EXPECT_NE(std::find(names.begin(), names.end(), m), names.end()) << m;
 #ifdef TGRAPH_HAVE_STARPU
   EXPECT_NE(std::find(names.begin(), names.end(), "starpu"), names.end());
@@ -333,8 +329,7 @@ void write_objectless_trace(const fs::path& path, int layers, int width, std::ui
       if (l > 0) {
         const auto prev = static_cast<tgraph::DatumId>(1 + (l - 1) * width);
         acc.push_back({static_cast<tgraph::DatumId>(prev + i), tgraph::AccessMode::R});
-        acc.push_back(
-            {static_cast<tgraph::DatumId>(prev + (i + 1) % width), tgraph::AccessMode::R});
+        acc.push_back({static_cast<tgraph::DatumId>(prev + (i + 1) % width), tgraph::AccessMode::R});
       }
       g.add_task(k, tgraph::kNoObject, acc, cost_ns, static_cast<tgraph::StableKey>(d + 1));
     }
@@ -345,8 +340,7 @@ TEST_F(Cli, OwnerOnAGraphWithoutObjectsFallsBackToListSchedulingAndSaysSo) {
   write_objectless_trace(dir_ / "t.tgt", 4, 8, 1000);
   Result r = run("partition t.tgt --method owner -k 2 --json");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("tgraph: warning: owner: the tasks have no objects"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("tgraph: warning: owner: the tasks have no objects"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("list"), std::string::npos) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["placed_by"], "list");
@@ -354,8 +348,7 @@ TEST_F(Cli, OwnerOnAGraphWithoutObjectsFallsBackToListSchedulingAndSaysSo) {
   // A strategy that leaves a processor empty is reported too.
   r = run("partition t.tgt --method single -k 2");
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("single leaves 1 of 2 processors without tasks"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("single leaves 1 of 2 processors without tasks"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, ReplayWithoutAnAssignmentUsesEveryThreadOnAGraphWithoutObjectsAndNamesTheStrategy) {
@@ -402,13 +395,11 @@ TEST_F(Cli, InfoUnitCostGivesTheSpanInTasks) {
   r = run("info f.tgt --json");
   j = nlohmann::json::parse(r.out);
   std::uint64_t longest = 0;
-  for (const auto& st : j["per_step"])
-    longest = std::max(longest, st["span_ns"].get<std::uint64_t>());
+  for (const auto& st : j["per_step"]) longest = std::max(longest, st["span_ns"].get<std::uint64_t>());
   EXPECT_EQ(j["span_max_ns"], longest);
   EXPECT_FALSE(j.contains("span_tasks"));  // only with --unit-cost
   r = run("info f.tgt");
-  EXPECT_NE(r.out.find("sum of the steps' critical paths; longest step"), std::string::npos)
-      << r.out;
+  EXPECT_NE(r.out.find("sum of the steps' critical paths; longest step"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, SequentialReplayIsItsOwnBaselineWithSpeedupOne) {
@@ -433,8 +424,7 @@ TEST_F(Cli, ReplayChromeTraceHasOneSlicePerTimelineEvent) {
   ASSERT_FALSE(t.at("tasks").empty());
   std::size_t slices = 0, waits = 0, names = 0;
   for (const auto& e : c.at("traceEvents")) {
-    if (e["ph"] == "X" && e["cat"] == "wait")
-      ++waits;
+    if (e["ph"] == "X" && e["cat"] == "wait") ++waits;
     else if (e["ph"] == "X") {
       ASSERT_LT(slices, t["tasks"].size());
       const nlohmann::json& task = t["tasks"][slices++];
@@ -443,8 +433,7 @@ TEST_F(Cli, ReplayChromeTraceHasOneSlicePerTimelineEvent) {
       EXPECT_EQ(e["cat"], task["origin"].is_null() ? "reducer" : "task");
       EXPECT_DOUBLE_EQ(e["dur"].get<double>(),
                        static_cast<double>(task["end_ns"].get<std::int64_t>() -
-                                           task["start_ns"].get<std::int64_t>()) /
-                           1000);
+                                           task["start_ns"].get<std::int64_t>()) / 1000);
     }
     if (e["ph"] == "M") ++names;
   }
@@ -456,10 +445,7 @@ TEST_F(Cli, ReplayChromeTraceHasOneSlicePerTimelineEvent) {
 TEST_F(Cli, BarrierRuleFlagChoosesThePhasesAndRejectsUnknownRules) {
   ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
   for (const char* rule : {"level", "operation"}) {
-    const Result r =
-        run(std::string(
-                "replay f.tgt --policy barrier --threads 2 --repeat 1 --no-pin --barrier-rule ") +
-            rule);
+    const Result r = run(std::string("replay f.tgt --policy barrier --threads 2 --repeat 1 --no-pin --barrier-rule ") + rule);
     EXPECT_EQ(r.code, 0) << rule << ": " << r.err;
   }
   const Result bad = run("replay f.tgt --policy barrier --barrier-rule task");
@@ -475,8 +461,7 @@ TEST_F(Cli, ReduceScopeFlagReachesTheDynamicPoliciesOnly) {
   ASSERT_EQ(run("capture --scene fig2 --steps 2 -o f.tgt").code, 0);
   for (const char* scope : {"per-writer", "per-thread"}) {
     const Result r = run(std::string("replay f.tgt --policy worksteal --threads 2 --repeat 1 "
-                                     "--no-pin --json --reduce-scope ") +
-                         scope);
+                                     "--no-pin --json --reduce-scope ") + scope);
     ASSERT_EQ(r.code, 0) << scope << ": " << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["reduce_scope"], scope);
   }
@@ -514,8 +499,7 @@ TEST_F(Cli, PartitionEdgecutIsTheSameMeasureForEveryMethodAndStep) {
 }
 
 TEST_F(Cli, RunTakesThePartitioningFlags) {
-  const std::string live =
-      "run --scene fig2 --threads 2 --method sticky --steps 2 --no-pin --json ";
+  const std::string live = "run --scene fig2 --threads 2 --method sticky --steps 2 --no-pin --json ";
   const Result missing = run(live + "--calibration nope.json");
   EXPECT_EQ(missing.code, 2);
   EXPECT_TRUE(one_line(missing.err)) << missing.err;
