@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "commands.hpp"
+#include "option_words.hpp"
 #include "tgraph/partition/assignment_io.hpp"
 #include "tgraph/partition/evaluate.hpp"
 #include "tgraph/viz/graphviz.hpp"
@@ -33,29 +34,14 @@ void add_viz_verbs(CLI::App& app) {
   cmd->add_option("-o,--output", a->output, "Output file: .dot, .svg, .png or .pdf")->required();
   cmd->callback([a, o, cmd] {
     const Trace trace = read_trace(a->input);
-    // before the assignment is checked against the trace
-    const std::size_t tasks = step_at(trace, a->step, a->input).tasks.size();
+    step_at(trace, a->step, a->input);  // before the assignment is checked against the trace
     const auto as = partition::load_assignment_if(a->assignment, trace, a->input);
-    const TraceAssignment* assignment = as ? &*as : nullptr;
-    std::string note;
-    try {
-      note = viz::draw_step(trace, a->input, a->step, assignment, *o, a->output);
-    } catch (const OptionError& e) {
-      // More tasks than nodes drawn one by one, and neither an aggregation nor a limit asked
-      // for (a captured ODE step's falling phase has thousands of parts): the step's kinds,
-      // said on stderr. Asked for, or too many edges, the refusal stands.
-      const bool asked =
-          cmd->count("--collapse") + cmd->count("--max-nodes") + cmd->count("--max-edges") > 0;
-      if (asked || e.option() != "max_nodes") throw;
-      viz::ViewOptions by_kind = *o;
-      by_kind.collapse = viz::Collapse::kKind;
-      note = viz::draw_step(trace, a->input, a->step, assignment, by_kind, a->output);
-      note = a->input + " step " + std::to_string(a->step) + ": " + std::to_string(tasks) +
-             " tasks, too many to draw one by one: drawn collapsed by kind (--collapse none "
-             "--max-nodes 0 --max-edges 0 draws every task)" +
-             (note.empty() ? "" : "; " + note);
-    }
-    if (!note.empty()) std::fprintf(stderr, "tgraph viz: %s\n", note.c_str());
+    // Neither an aggregation nor a limit asked for: a step too large is drawn by kind.
+    o->kinds_when_too_many =
+        cmd->count("--collapse") + cmd->count("--max-nodes") + cmd->count("--max-edges") == 0;
+    const std::string note =
+        viz::draw_step(trace, a->input, a->step, as ? &*as : nullptr, *o, a->output);
+    if (!note.empty()) std::fprintf(stderr, "tgraph viz: %s\n", name_fields(note, flag_of).c_str());
   });
   add_timeline(app);
   add_report(app);

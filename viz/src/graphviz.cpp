@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "tgraph/graph/error.hpp"
@@ -333,7 +334,9 @@ GraphFormat graph_format_of(const std::string& path) {
                    kNamesFields);
 }
 
-std::string draw_step(const Trace& trace, const std::string& trace_name, std::size_t step,
+namespace {
+
+std::string draw_view(const Trace& trace, const std::string& trace_name, std::size_t step,
                       const TraceAssignment* assignment, const ViewOptions& options,
                       const std::string& output) {
   const GraphFormat format = graph_format_of(output);
@@ -367,6 +370,28 @@ std::string draw_step(const Trace& trace, const std::string& trace_name, std::si
   }
   write_file_atomic(output, render_graph(v, format));
   return v.collapse != Collapse::kNone && v.hidden_deps > 0 ? hidden_deps_note(v) : "";
+}
+
+}  // namespace
+
+std::string draw_step(const Trace& trace, const std::string& trace_name, std::size_t step,
+                      const TraceAssignment* assignment, const ViewOptions& options,
+                      const std::string& output) {
+  if (!options.kinds_when_too_many || options.collapse != Collapse::kNone)
+    return draw_view(trace, trace_name, step, assignment, options, output);
+  try {
+    return draw_view(trace, trace_name, step, assignment, options, output);
+  } catch (const OptionError& e) {
+    if (e.option() != "max_nodes") throw;  // too many edges stays a refusal
+    ViewOptions by_kind = options;
+    by_kind.collapse = Collapse::kKind;
+    const std::string note = draw_view(trace, trace_name, step, assignment, by_kind, output);
+    return trace_name + " step " + std::to_string(step) + ": " +
+           std::to_string(step_at(trace, step, trace_name).tasks.size()) +
+           " tasks, too many to draw one by one: drawn collapsed by kind ({collapse} none "
+           "{max_nodes} 0 {max_edges} 0 draws every task)" +
+           (note.empty() ? "" : "; " + note);
+  }
 }
 
 std::string to_dot(const GraphView& view) {

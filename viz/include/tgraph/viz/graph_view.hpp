@@ -104,6 +104,10 @@ struct ViewOptions {
   /// Likewise for edges (0: no limit): dot's layout time grows with the edges (bars64's
   /// 11,206 task-level edges take minutes), so large pictures are refused before layout.
   std::size_t max_edges = 4000;
+  /// draw_step: a step with more nodes than max_nodes under kNone is drawn collapsed by kind
+  /// instead of refused, and its note says so (`tgraph viz` given none of its collapse and
+  /// limit options: a captured ODE step's falling phase has thousands of parts).
+  bool kinds_when_too_many = false;
   std::string title;  ///< first line of the graph label
   /// false: edge labels become tooltips (shown on hover in SVG) and dot's layout stays
   /// compact, for large collapsed graphs where labels would overlap.

@@ -37,7 +37,8 @@ std::string render_graph(const GraphView& view, GraphFormat format);
 
 /// Step `step` of `trace` (named `trace_name`; trace_step_view) drawn into `output` in the
 /// format of its extension (graph_format_of), atomically. Returns hidden_deps_note when a
-/// collapsed view leaves dependencies out, else "".
+/// collapsed view leaves dependencies out, else "", and under kinds_when_too_many a note
+/// naming the fields `{collapse}`, `{max_nodes}`, `{max_edges}` when it drew kinds.
 std::string draw_step(const Trace& trace, const std::string& trace_name, std::size_t step,
                       const TraceAssignment* assignment, const ViewOptions& options,
                       const std::string& output);
