@@ -232,14 +232,10 @@ void check_json(const RunResult& r, nlohmann::ordered_json& j) {
   j["check"] = r.check;
   j["check_reference"] = "plain";
   if (r.check == "identical") return;
-  j.update(nlohmann::ordered_json{
-      {"max_abs_diff", r.max_abs_diff},
-      {"max_rel_diff", r.max_rel_diff},
-      {"tolerance", r.tolerance},
-      {"tolerance_basis",
-       "five times the farthest ODE self-threaded's final positions move with "
-       "another seed of its random constraint reordering, its contacts made in "
-       "another order or the world moved by 1e-12 m"}});
+  j.update(nlohmann::ordered_json{{"max_abs_diff", r.max_abs_diff},
+                                  {"max_rel_diff", r.max_rel_diff},
+                                  {"tolerance", r.tolerance},
+                                  {"tolerance_basis", kToleranceBasis}});
 }
 
 }  // namespace
