@@ -65,10 +65,7 @@ void run_ode(const std::string& scene, std::optional<std::uint32_t> steps,
   o.json = json;
   const ode::RunResult r = ode::run_scene(o);
   std::cout << (json ? ode::to_json(r) : ode::to_text(r)) << std::flush;
-  if (r.check == "differs")
-    throw Failure("final state differs from ODE self-threaded's by " +
-                  std::to_string(r.max_abs_diff) + " m, more than the tolerance (" +
-                  std::to_string(r.tolerance) + " m: " + std::string(ode::kToleranceBasis) + ")");
+  if (r.check == "differs") throw Failure(ode::differs_line(r));
 }
 
 void capture_ode(const std::string& scene, std::optional<int> steps, const std::string& output,

@@ -22,6 +22,12 @@ constexpr double kRounding = 1e-9;
 // The tolerance over the seeds' spread (docs/ode.md, "The check": twice gave 2.9 % false
 // alarms on correct 2-thread runs, five times 0.003 %).
 constexpr double kToleranceFactor = 5.0;
+// What RunResult::tolerance is: the perturbations a K-thread run makes, applied to ODE
+// self-threaded (run --json's tolerance_basis, differs_line).
+constexpr const char* kToleranceBasis =
+    "five times the farthest ODE self-threaded's final positions move with another seed of its "
+    "random constraint reordering, its contacts made in another order or the world moved by "
+    "1e-12 m";
 
 struct Pass {
   std::vector<StepTime> steps;
@@ -239,6 +245,12 @@ void check_json(const RunResult& r, nlohmann::ordered_json& j) {
 }
 
 }  // namespace
+
+std::string differs_line(const RunResult& r) {
+  return "final state differs from ODE self-threaded's by " + std::to_string(r.max_abs_diff) +
+         " m, more than the tolerance (" + std::to_string(r.tolerance) + " m: " + kToleranceBasis +
+         ")";
+}
 
 std::string to_json(const RunResult& r) {
   const RunOptions& o = r.options;

@@ -63,6 +63,25 @@ TEST(OdeRun, DWorldStepOnTwoThreadsIsWithinTheSpreadOfAnotherContactOrder) {
   }
 }
 
+TEST(OdeRun, ADifferingCheckFailsWithOneLineNamingTheDistanceAndTheTolerance) {
+  RunResult r;
+  r.check = "differs";
+  r.max_abs_diff = 0.5;
+  r.tolerance = 0.125;
+  const std::string line = differs_line(r);
+  EXPECT_EQ(line.rfind("final state differs from ODE self-threaded's by 0.500000 m, more than "
+                       "the tolerance (0.125000 m: five times",
+                       0),
+            0u)
+      << line;
+  EXPECT_EQ(line.find('\n'), std::string::npos) << line;
+  // The basis the JSON gives.
+  RunResult j = r;
+  j.options = run_options("ode-piles", 1, choose_method("worksteal"), 2);
+  const std::string basis = nlohmann::json::parse(to_json(j))["tolerance_basis"].get<std::string>();
+  EXPECT_NE(line.find(basis), std::string::npos) << line;
+}
+
 TEST(OdeRun, RefusesBadOptionsByName) {
   RunOptions o;
   o.scene = "ode-nothing";

@@ -7,7 +7,6 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "tgraph/ode/attach.hpp"
@@ -70,12 +69,9 @@ struct RunResult {
   double tolerance = 0;
 };
 
-/// What RunResult::tolerance is (`run --json`'s tolerance_basis, the failure line): the
-/// perturbations a K-thread run makes, applied to ODE self-threaded.
-inline constexpr std::string_view kToleranceBasis =
-    "five times the farthest ODE self-threaded's final positions move with another seed of its "
-    "random constraint reordering, its contacts made in another order or the world moved by "
-    "1e-12 m";
+/// The one line a run whose check says "differs" fails with: by how much, against which
+/// tolerance and its basis (the same basis as `run --json`'s tolerance_basis).
+std::string differs_line(const RunResult& r);
 
 /// Runs the scene: `repeat` timed passes under the method, each beside a pass of ODE
 /// self-threaded, one warm-up pass of each before; the check from the first passes.
